@@ -1,0 +1,353 @@
+//! Writes the demo scene `assets/demo/demo.gltf` (+ `demo.bin` and one PNG per wall):
+//! a closed 4 m × 3 m × 4 m box room with a textured diffuse material per wall, a mirror
+//! sphere, a solid glass sphere, a small diffuse box, a point light and a camera.
+//!
+//! Every wall texture carries a checkerboard, a diagonal band and a large "F", so that a
+//! mirrored or transposed reflection is obvious at a glance.
+//!
+//! Run: `cargo run --example make_demo_scene [-- OUTPUT_DIR]` (default `assets/demo`).
+//! The output is deterministic and committed; the example reloads it through
+//! `specula::scene::load` and checks the material classification.
+
+use std::path::PathBuf;
+
+use glam::{Mat4, Quat, Vec2, Vec3};
+use serde_json::{json, Value};
+use specula::scene::SurfaceKind;
+
+const TEXTURE_SIZE: u32 = 256;
+const WALL_QUADS: usize = 8;
+
+struct Geometry {
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
+    indices: Vec<u32>,
+}
+
+impl Geometry {
+    fn new() -> Geometry {
+        Geometry { positions: Vec::new(), normals: Vec::new(), uvs: Vec::new(), indices: Vec::new() }
+    }
+
+    /// Adds triangle (a, b, c), wound counter-clockwise as seen from the side its vertex
+    /// normals point to; degenerate triangles are dropped.
+    fn triangle(&mut self, a: u32, b: u32, c: u32) {
+        let p = |i: u32| self.positions[i as usize];
+        let face = (p(b) - p(a)).cross(p(c) - p(a));
+        if face.length_squared() < 1e-14 {
+            return;
+        }
+        let n = self.normals[a as usize] + self.normals[b as usize] + self.normals[c as usize];
+        if face.dot(n) >= 0.0 {
+            self.indices.extend([a, b, c]);
+        } else {
+            self.indices.extend([a, c, b]);
+        }
+    }
+
+    /// A grid of `cols × rows` quads; `vertex(i, j)` gives position, normal and uv.
+    fn grid(&mut self, cols: usize, rows: usize, vertex: impl Fn(usize, usize) -> (Vec3, Vec3, Vec2)) {
+        let first = self.positions.len() as u32;
+        for j in 0..=rows {
+            for i in 0..=cols {
+                let (p, n, t) = vertex(i, j);
+                self.positions.push(p);
+                self.normals.push(n);
+                self.uvs.push(t);
+            }
+        }
+        let at = |i: usize, j: usize| first + (j * (cols + 1) + i) as u32;
+        for j in 0..rows {
+            for i in 0..cols {
+                self.triangle(at(i, j), at(i + 1, j), at(i + 1, j + 1));
+                self.triangle(at(i, j), at(i + 1, j + 1), at(i, j + 1));
+            }
+        }
+    }
+}
+
+/// A rectangle centred at `center`, spanned by `right` × half_w and `up` × half_h, facing
+/// `right × up`; the texture appears upright and unmirrored when seen from that side.
+fn wall(center: Vec3, right: Vec3, up: Vec3, half_w: f32, half_h: f32) -> Geometry {
+    let normal = right.cross(up).normalize();
+    let mut g = Geometry::new();
+    g.grid(WALL_QUADS, WALL_QUADS, |i, j| {
+        let s = i as f32 / WALL_QUADS as f32; // 0..1 along right
+        let t = j as f32 / WALL_QUADS as f32; // 0..1 downwards
+        let p = center + right * (half_w * (2.0 * s - 1.0)) + up * (half_h * (1.0 - 2.0 * t));
+        (p, normal, Vec2::new(s, t))
+    });
+    g
+}
+
+/// UV sphere centred at the origin with analytic normals.
+fn sphere(radius: f32, segments: usize, rings: usize) -> Geometry {
+    let mut g = Geometry::new();
+    g.grid(segments, rings, |i, j| {
+        let phi = std::f32::consts::TAU * i as f32 / segments as f32;
+        let theta = std::f32::consts::PI * j as f32 / rings as f32;
+        let n = Vec3::new(theta.sin() * phi.sin(), theta.cos(), theta.sin() * phi.cos());
+        (n * radius, n, Vec2::new(i as f32 / segments as f32, j as f32 / rings as f32))
+    });
+    g
+}
+
+/// Axis-aligned cube of edge `size` centred at the origin, flat-shaded.
+fn cube(size: f32) -> Geometry {
+    let h = size * 0.5;
+    let mut g = Geometry::new();
+    for (n, right, up) in [
+        (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+    ] {
+        let base = g.positions.len() as u32;
+        for (s, t) in [(-1.0, 1.0), (1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
+            g.positions.push(n * h + right * (h * s) + up * (h * t));
+            g.normals.push(n);
+            g.uvs.push(Vec2::new((s + 1.0) * 0.5, (1.0 - t) * 0.5));
+        }
+        g.triangle(base, base + 1, base + 2);
+        g.triangle(base, base + 2, base + 3);
+    }
+    g
+}
+
+/// Checkerboard in two shades of `hue`, a light diagonal band and a dark "F".
+fn wall_texture(hue: [u8; 3]) -> image::RgbaImage {
+    let shade = |k: f32| -> image::Rgba<u8> {
+        let c = hue.map(|v| (v as f32 * k).round().clamp(0.0, 255.0) as u8);
+        image::Rgba([c[0], c[1], c[2], 255])
+    };
+    let tint = |w: f32| -> image::Rgba<u8> {
+        let c = hue.map(|v| (v as f32 + (255.0 - v as f32) * w).round() as u8);
+        image::Rgba([c[0], c[1], c[2], 255])
+    };
+    image::RgbaImage::from_fn(TEXTURE_SIZE, TEXTURE_SIZE, |x, y| {
+        let (xi, yi) = (x as i32, y as i32);
+        let in_rect = |x0: i32, y0: i32, x1: i32, y1: i32| xi >= x0 && xi < x1 && yi >= y0 && yi < y1;
+        // "F": stem, top bar, middle bar (asymmetric under every flip and transpose).
+        if in_rect(56, 40, 88, 216) || in_rect(56, 40, 184, 72) || in_rect(56, 112, 152, 144) {
+            return shade(0.22);
+        }
+        if (xi - yi).abs() < 12 {
+            return tint(0.6);
+        }
+        if ((x / 32) + (y / 32)) % 2 == 0 {
+            shade(1.0)
+        } else {
+            shade(0.72)
+        }
+    })
+}
+
+/// Binary buffer with one buffer view per accessor.
+struct Bin {
+    data: Vec<u8>,
+    views: Vec<Value>,
+    accessors: Vec<Value>,
+}
+
+impl Bin {
+    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+        while self.data.len() % 4 != 0 {
+            self.data.push(0);
+        }
+        self.views.push(json!({
+            "buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len(), "target": target
+        }));
+        self.data.extend_from_slice(bytes);
+        self.views.len() - 1
+    }
+
+    fn vec_accessor(&mut self, values: &[f32], dims: usize, bounds: bool) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, 34962);
+        let mut acc = json!({
+            "bufferView": view, "componentType": 5126, "count": values.len() / dims,
+            "type": if dims == 3 { "VEC3" } else { "VEC2" }
+        });
+        if bounds {
+            let (mut lo, mut hi) = (vec![f32::INFINITY; dims], vec![f32::NEG_INFINITY; dims]);
+            for c in values.chunks_exact(dims) {
+                for k in 0..dims {
+                    lo[k] = lo[k].min(c[k]);
+                    hi[k] = hi[k].max(c[k]);
+                }
+            }
+            acc["min"] = json!(lo);
+            acc["max"] = json!(hi);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
+    }
+
+    fn primitive(&mut self, g: &Geometry, material: usize) -> Value {
+        let flat3 = |v: &[Vec3]| v.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>();
+        let pos = self.vec_accessor(&flat3(&g.positions), 3, true);
+        let nrm = self.vec_accessor(&flat3(&g.normals), 3, false);
+        let uv = self.vec_accessor(&g.uvs.iter().flat_map(|t| t.to_array()).collect::<Vec<f32>>(), 2, false);
+        assert!(g.positions.len() <= u16::MAX as usize);
+        let bytes: Vec<u8> = g.indices.iter().flat_map(|&i| (i as u16).to_le_bytes()).collect();
+        let view = self.view(&bytes, 34963);
+        self.accessors.push(json!({
+            "bufferView": view, "componentType": 5123, "count": g.indices.len(), "type": "SCALAR"
+        }));
+        json!({
+            "attributes": { "POSITION": pos, "NORMAL": nrm, "TEXCOORD_0": uv },
+            "indices": self.accessors.len() - 1,
+            "material": material,
+        })
+    }
+}
+
+/// κ of a conductor with index `nu` whose normal-incidence reflectance is `f0`.
+fn kappa_for(f0: f32, nu: f32) -> f32 {
+    ((f0 * (nu + 1.0).powi(2) - (nu - 1.0).powi(2)) / (1.0 - f0)).max(0.0).sqrt()
+}
+
+fn main() {
+    let out =
+        std::env::args_os().nth(1).map(PathBuf::from).unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo")));
+    std::fs::create_dir_all(&out).expect("create output directory");
+
+    let mut bin = Bin { data: Vec::new(), views: Vec::new(), accessors: Vec::new() };
+    let mut materials = Vec::new();
+    let mut meshes = Vec::new();
+    let mut nodes = Vec::new();
+    let mut images = Vec::new();
+
+    // The room: x ∈ [−2, 2], y ∈ [0, 3], z ∈ [−2, 2], every wall facing inwards.
+    let walls = [
+        ("floor", [196, 148, 96], Vec3::new(0.0, 0.0, 0.0), Vec3::X, Vec3::NEG_Z, 2.0, 2.0),
+        ("ceiling", [226, 222, 196], Vec3::new(0.0, 3.0, 0.0), Vec3::X, Vec3::Z, 2.0, 2.0),
+        ("back", [72, 112, 204], Vec3::new(0.0, 1.5, -2.0), Vec3::X, Vec3::Y, 2.0, 1.5),
+        ("front", [92, 172, 92], Vec3::new(0.0, 1.5, 2.0), Vec3::NEG_X, Vec3::Y, 2.0, 1.5),
+        ("left", [204, 72, 60], Vec3::new(-2.0, 1.5, 0.0), Vec3::NEG_Z, Vec3::Y, 2.0, 1.5),
+        ("right", [152, 92, 196], Vec3::new(2.0, 1.5, 0.0), Vec3::Z, Vec3::Y, 2.0, 1.5),
+    ];
+    let mut wall_nodes = Vec::new();
+    for (name, hue, center, right, up, hw, hh) in walls {
+        let file = format!("wall_{name}.png");
+        wall_texture(hue).save(out.join(&file)).expect("write wall texture");
+        images.push(json!({ "uri": file, "name": format!("wall_{name}") }));
+        let texture = images.len() - 1;
+        materials.push(json!({
+            "name": format!("wall_{name}"),
+            "pbrMetallicRoughness": {
+                "baseColorTexture": { "index": texture },
+                "metallicFactor": 0.0, "roughnessFactor": 1.0
+            }
+        }));
+        let g = wall(center, right, up, hw, hh);
+        let prim = bin.primitive(&g, materials.len() - 1);
+        meshes.push(json!({ "name": format!("wall_{name}"), "primitives": [prim] }));
+        nodes.push(json!({ "name": format!("wall_{name}"), "mesh": meshes.len() - 1 }));
+        wall_nodes.push(nodes.len() - 1);
+    }
+    nodes.push(json!({ "name": "room", "children": wall_nodes }));
+    let room = nodes.len() - 1;
+
+    // Mirror sphere: silver-like ν with κ chosen so that F0 equals the base colour.
+    let f0 = [0.95f32, 0.93, 0.88];
+    let nu = [0.155f32, 0.117, 0.138];
+    let kappa: Vec<f32> = (0..3).map(|c| kappa_for(f0[c], nu[c])).collect();
+    materials.push(json!({
+        "name": "mirror",
+        "pbrMetallicRoughness": {
+            "baseColorFactor": [f0[0], f0[1], f0[2], 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.0
+        },
+        "extras": { "specula": { "nu": nu, "kappa": kappa } }
+    }));
+    let prim = bin.primitive(&sphere(0.5, 64, 32), materials.len() - 1);
+    meshes.push(json!({ "name": "mirror_sphere", "primitives": [prim] }));
+    nodes.push(json!({ "name": "mirror_sphere", "mesh": meshes.len() - 1, "translation": [-1.2, 0.5, -1.1] }));
+    let mirror = nodes.len() - 1;
+
+    // Solid glass sphere.
+    materials.push(json!({
+        "name": "glass",
+        "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+        "extensions": {
+            "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+            "KHR_materials_ior": { "ior": 1.5 },
+            "KHR_materials_volume": { "thicknessFactor": 0.6 }
+        }
+    }));
+    let prim = bin.primitive(&sphere(0.45, 64, 32), materials.len() - 1);
+    meshes.push(json!({ "name": "glass_sphere", "primitives": [prim] }));
+    nodes.push(json!({ "name": "glass_sphere", "mesh": meshes.len() - 1, "translation": [0.9, 0.45, -0.3] }));
+    let glass = nodes.len() - 1;
+
+    // Occluder: a light grey 0.5 m box standing on the floor, turned 20° about +Y.
+    materials.push(json!({
+        "name": "box",
+        "pbrMetallicRoughness": { "baseColorFactor": [0.7, 0.7, 0.7, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.8 }
+    }));
+    let prim = bin.primitive(&cube(0.5), materials.len() - 1);
+    meshes.push(json!({ "name": "box", "primitives": [prim] }));
+    let q = Quat::from_rotation_y(20f32.to_radians());
+    nodes.push(json!({ "name": "box", "mesh": meshes.len() - 1, "translation": [0.2, 0.25, 0.8], "rotation": q.to_array() }));
+    let occluder = nodes.len() - 1;
+
+    nodes.push(json!({
+        "name": "light", "translation": [0.0, 2.6, 0.3],
+        "extensions": { "KHR_lights_punctual": { "light": 0 } }
+    }));
+    let light = nodes.len() - 1;
+
+    let eye = Vec3::new(1.6, 1.6, 1.9);
+    let world_from_camera = Mat4::look_at_rh(eye, Vec3::new(-0.3, 0.8, -0.6), Vec3::Y).inverse();
+    let (_, rotation, _) = world_from_camera.to_scale_rotation_translation();
+    nodes.push(json!({ "name": "camera", "camera": 0, "translation": eye.to_array(), "rotation": rotation.normalize().to_array() }));
+    let camera = nodes.len() - 1;
+
+    let bin_name = "demo.bin";
+    let doc = json!({
+        "asset": { "version": "2.0", "generator": "specula examples/make_demo_scene.rs" },
+        "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
+        "extensions": {
+            "KHR_lights_punctual": { "lights": [{ "name": "light", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 25.0 }] }
+        },
+        "scene": 0,
+        "scenes": [{ "name": "demo", "nodes": [room, mirror, glass, occluder, light, camera] }],
+        "nodes": nodes,
+        "meshes": meshes,
+        "materials": materials,
+        "samplers": [{ "magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 10497 }],
+        "textures": (0..images.len()).map(|i| json!({ "sampler": 0, "source": i })).collect::<Vec<_>>(),
+        "images": images,
+        "cameras": [{
+            "name": "camera", "type": "perspective",
+            "perspective": { "yfov": 60f32.to_radians(), "znear": 0.05, "zfar": 100.0, "aspectRatio": 1.5 }
+        }],
+        "buffers": [{ "uri": bin_name, "byteLength": bin.data.len() }],
+        "bufferViews": bin.views,
+        "accessors": bin.accessors,
+    });
+    std::fs::write(out.join(bin_name), &bin.data).expect("write demo.bin");
+    let gltf_path = out.join("demo.gltf");
+    std::fs::write(&gltf_path, serde_json::to_string_pretty(&doc).unwrap() + "\n").expect("write demo.gltf");
+
+    // Read it back through the importer.
+    let scene = specula::scene::load(&gltf_path).unwrap_or_else(|e| panic!("reloading the demo scene: {e}"));
+    let count = |f: &dyn Fn(&SurfaceKind) -> bool| scene.materials.iter().filter(|m| f(&m.kind)).count();
+    let diffuse = count(&|k| *k == SurfaceKind::Diffuse);
+    let mirrors = count(&|k| matches!(k, SurfaceKind::Mirror { .. }));
+    let solids = count(&|k| matches!(k, SurfaceKind::Dielectric { thin: false, .. }));
+    assert_eq!((diffuse, mirrors, solids, scene.materials.len()), (7, 1, 1, 9), "demo classification");
+    assert!(scene.camera.is_some() && scene.lights.len() == 1 && scene.textures.len() == 6);
+    println!(
+        "wrote {} ({} meshes, {} triangles, {} materials: {diffuse} diffuse, {mirrors} mirror, {solids} solid dielectric; {} textures, {} light)",
+        gltf_path.display(),
+        scene.meshes.len(),
+        scene.triangle_count(),
+        scene.materials.len(),
+        scene.textures.len(),
+        scene.lights.len()
+    );
+}

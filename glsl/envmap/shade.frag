@@ -1,0 +1,22 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// envmap.shade: classic environment mapping (survey §3, §3.1). The reflected and the
+// refracted direction look the object's cube map up, ignoring the ray origin; the
+// radiances are weighted by the Fresnel function (survey eq. 1).
+#include "common/specular.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+    float layer = float(o.envmap_layer);
+    vec3 c = s.fr * textureLod(envmaps, vec4(s.r, layer), 0.0).rgb;
+    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * textureLod(envmaps, vec4(s.t, layer), 0.0).rgb;
+    out_color = vec4(c, 1.0);
+}

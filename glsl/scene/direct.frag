@@ -1,0 +1,27 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// scene.direct: non-specular surfaces (emission + Lambertian direct light with shadows).
+// The same shader fills environment maps, where specular objects other than the map's
+// owner have no map of their own yet: they reflect and refract the environment map.
+#include "common/specular.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Material m = materials[objects[push.object].material];
+    vec3 n = normalize(in_normal);
+    vec3 eye = views[in_view].eye.xyz;
+    vec3 c;
+    if (m.kind == KIND_DIFFUSE) {
+        c = shade_diffuse(m, in_position, n, eye, in_uv);
+    } else {
+        SpecularSplit s = specular_split(m, in_position, n, eye);
+        c = s.fr * sky_radiance(s.r);
+        if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * sky_radiance(s.t);
+    }
+    out_color = vec4(c, 1.0);
+}

@@ -1,0 +1,14 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// What rays that leave the scene see: the environment map.
+#include "common/sky.glsl"
+
+layout(location = 0) in vec2 in_ndc;
+layout(location = 1) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    View v = views[in_view];
+    vec4 w = v.inv_view_proj * vec4(in_ndc, 0.5, 1.0);
+    out_color = vec4(sky_radiance(w.xyz / w.w - v.eye.xyz), 1.0);
+}

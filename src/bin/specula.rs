@@ -1,0 +1,295 @@
+//! The specula command line: render, info, plan, knobs, demo.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use glam::Vec3;
+use specula::scene::{self, Camera};
+use specula::vk::{Context, DeviceOptions};
+use specula::{Method, Quality, Scene};
+
+#[derive(Parser)]
+#[command(name = "specula", version, about = "Specular effects on the GPU through raw Vulkan")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(clap::Args, Clone)]
+struct RenderArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
+    scene: PathBuf,
+    /// Rendering method (`specula knobs` lists methods and knobs).
+    #[arg(long, default_value = "envmap")]
+    method: String,
+    /// Output size WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512")]
+    size: String,
+    /// Accuracy knob key=value (repeatable).
+    #[arg(long = "quality", short = 'q')]
+    quality: Vec<String>,
+    /// Equirectangular environment map (.exr, .hdr, .png, .jpg).
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Camera position x,y,z (overrides the scene's camera; with --camera-target).
+    #[arg(long)]
+    camera_pos: Option<String>,
+    /// Camera target x,y,z.
+    #[arg(long)]
+    camera_target: Option<String>,
+    /// Vertical field of view in degrees (with --camera-pos).
+    #[arg(long, default_value_t = 60.0)]
+    fov: f32,
+    /// Enable the Khronos validation layer; any validation error fails the command.
+    #[arg(long)]
+    validate: bool,
+    /// Device name filter (substring, e.g. llvmpipe); default SPECULA_DEVICE or the first GPU.
+    #[arg(long)]
+    device: Option<String>,
+    /// Untimed frames before the timed ones.
+    #[arg(long, default_value_t = 1)]
+    warmup: u32,
+    /// Timed frames; the profile reports the median per pass.
+    #[arg(long, default_value_t = 1)]
+    frames: u32,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (.png: sRGB, clamped; .exr: linear radiance).
+    Render {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Output image.
+        #[arg(long)]
+        out: PathBuf,
+        /// Write the per-pass profile as Chrome trace-event JSON (opens in Perfetto).
+        #[arg(long)]
+        profile: Option<PathBuf>,
+    },
+    /// List meshes, materials with their classification, lights, camera and bounds.
+    Info { scene: PathBuf },
+    /// Print the plan (maps, passes, knobs) a scene gets, as JSON.
+    Plan {
+        #[command(flatten)]
+        args: RenderArgs,
+    },
+    /// List methods and accuracy knobs with their ranges and defaults.
+    Knobs,
+    /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
+    Demo {
+        #[arg(default_value = "out")]
+        outdir: PathBuf,
+        #[arg(long, default_value = "512x512")]
+        size: String,
+        #[arg(long)]
+        validate: bool,
+        #[arg(long)]
+        device: Option<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("specula: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn parse_vec3(what: &str, s: &str) -> specula::Result<Vec3> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| specula::Error::invalid(what, format!("'{s}' is not x,y,z")))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(specula::Error::invalid(what, format!("'{s}' is not three finite numbers x,y,z"))),
+    }
+}
+
+fn parse_size(s: &str) -> specula::Result<(u32, u32)> {
+    let bad = || specula::Error::invalid("--size", format!("'{s}' is not WIDTHxHEIGHT"));
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h) = (w.parse::<u32>().map_err(|_| bad())?, h.parse::<u32>().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(specula::Error::invalid("--size", format!("{w}x{h} is outside 1..=16384")));
+    }
+    Ok((w, h))
+}
+
+struct Job {
+    scene: Scene,
+    method: Method,
+    quality: Quality,
+    width: u32,
+    height: u32,
+}
+
+fn prepare(a: &RenderArgs) -> specula::Result<Job> {
+    let mut scene = scene::load(&a.scene)?;
+    if let Some(env) = &a.env {
+        scene.environment = Some(scene::load_environment(env)?);
+    }
+    if let Some(pos) = &a.camera_pos {
+        let eye = parse_vec3("--camera-pos", pos)?;
+        let target = a.camera_target.as_deref().map(|t| parse_vec3("--camera-target", t)).transpose()?.unwrap_or(eye + Vec3::NEG_Z);
+        if !(a.fov > 0.0 && a.fov < 180.0) {
+            return Err(specula::Error::invalid("--fov", "must be in (0, 180) degrees"));
+        }
+        scene.camera = Some(Camera::look_at(eye, target, a.fov.to_radians()));
+    }
+    let mut quality = Quality::default();
+    for q in &a.quality {
+        quality.set_pair(q)?;
+    }
+    let (width, height) = parse_size(&a.size)?;
+    Ok(Job { scene, method: Method::parse(&a.method)?, quality, width, height })
+}
+
+fn context(validate: bool, device: &Option<String>) -> specula::Result<Context> {
+    Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })
+}
+
+fn write_image(path: &Path, frame: &specula::Frame) -> specula::Result<()> {
+    let img = &frame.image;
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("exr") => scene::write_exr(path, img.width, img.height, &img.data),
+        Some("png") => scene::write_png_srgb(path, img.width, img.height, &img.data),
+        _ => Err(specula::Error::invalid("--out", format!("{}: use .png or .exr", path.display()))),
+    }
+}
+
+fn run(cmd: Command) -> specula::Result<()> {
+    match cmd {
+        Command::Render { args, out, profile } => {
+            let job = prepare(&args)?;
+            let ctx = context(args.validate, &args.device)?;
+            let frame = specula::render(&ctx, &job.scene, job.method, &job.quality, job.width, job.height, args.warmup, args.frames)?;
+            write_image(&out, &frame)?;
+            println!("{} on {} ({}), {}x{}", job.method.name(), ctx.device_name, ctx.driver_info, job.width, job.height);
+            print!("{}", specula::profile::table(&frame.passes, &frame.memory));
+            if let Some(p) = profile {
+                let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);
+                std::fs::write(&p, json).map_err(|e| specula::Error::io(&p, e))?;
+            }
+            if args.validate {
+                println!("validation: {} error(s), {} warning(s)", ctx.validation.error_count(), ctx.validation.warning_count());
+            }
+            Ok(())
+        }
+        Command::Info { scene: path } => {
+            let s = scene::load(&path)?;
+            print!("{}", info(&s));
+            Ok(())
+        }
+        Command::Plan { args } => {
+            let job = prepare(&args)?;
+            let p = specula::plan(&job.scene, job.method, &job.quality);
+            println!("{}", serde_json::to_string_pretty(&p).unwrap_or_default());
+            Ok(())
+        }
+        Command::Knobs => {
+            println!("methods: {}", Method::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "));
+            println!("\n{:<16} {:<22} {:<9} description", "knob", "values", "default");
+            for k in specula::quality::KNOBS {
+                println!("{:<16} {:<22} {:<9} {}", k.name, k.values, k.default, k.doc);
+            }
+            Ok(())
+        }
+        Command::Demo { outdir, size, validate, device } => demo(&outdir, &size, validate, &device),
+    }
+}
+
+fn info(s: &Scene) -> String {
+    use std::fmt::Write as _;
+    let mut o = String::new();
+    let b = s.bounds();
+    let _ = writeln!(o, "meshes: {} ({} triangles)", s.meshes.len(), s.triangle_count());
+    for m in &s.meshes {
+        let mb = m.bounds();
+        let _ = writeln!(
+            o,
+            "  {:<28} {:>7} tris  material {:<3} box [{:.3} {:.3} {:.3}]..[{:.3} {:.3} {:.3}]",
+            m.name,
+            m.triangle_count(),
+            m.material,
+            mb.min.x,
+            mb.min.y,
+            mb.min.z,
+            mb.max.x,
+            mb.max.y,
+            mb.max.z
+        );
+    }
+    let _ = writeln!(o, "materials: {}", s.materials.len());
+    for (i, m) in s.materials.iter().enumerate() {
+        let detail = match m.kind {
+            scene::SurfaceKind::Diffuse => format!("base {:?} emissive {:?}", m.base_color.to_array(), m.emissive.to_array()),
+            scene::SurfaceKind::Mirror { nu, kappa } => format!("nu {:?} kappa {:?}", nu.to_array(), kappa.to_array()),
+            scene::SurfaceKind::Dielectric { ior, .. } => format!("ior {ior}"),
+        };
+        let _ = writeln!(o, "  [{i}] {:<20} {:<24} {detail}", m.name, m.kind.label());
+    }
+    let _ = writeln!(o, "textures: {}", s.textures.len());
+    let _ = writeln!(o, "lights: {}", s.lights.len());
+    for l in &s.lights {
+        let _ = writeln!(
+            o,
+            "  {:<20} {:?} at {:?} dir {:?} intensity {:?}",
+            l.name,
+            l.kind,
+            l.position.to_array(),
+            l.direction.to_array(),
+            l.intensity.to_array()
+        );
+    }
+    match &s.camera {
+        Some(c) => {
+            let _ = writeln!(
+                o,
+                "camera: at {:?} looking {:?}, yfov {:.1}°",
+                c.position.to_array(),
+                c.forward().to_array(),
+                c.yfov.to_degrees()
+            );
+        }
+        None => {
+            let _ = writeln!(o, "camera: none (a default camera frames the bounds)");
+        }
+    }
+    let _ = writeln!(o, "bounds: [{:.3} {:.3} {:.3}]..[{:.3} {:.3} {:.3}]", b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z);
+    o
+}
+
+/// The README's main job: every method on the demo scene, images and a timing table.
+fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> specula::Result<()> {
+    let scene_path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/demo.gltf");
+    let scene = scene::load(&scene_path)?;
+    let (w, h) = parse_size(size)?;
+    std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
+    let ctx = context(validate, device)?;
+    let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
+    for &method in Method::ALL {
+        let frame = specula::render(&ctx, &scene, method, &Quality::default(), w, h, 2, 5)?;
+        let png = outdir.join(format!("{}.png", method.name()));
+        let exr = outdir.join(format!("{}.exr", method.name()));
+        write_image(&png, &frame)?;
+        write_image(&exr, &frame)?;
+        let trace = outdir.join(format!("{}.trace.json", method.name()));
+        std::fs::write(&trace, specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name))
+            .map_err(|e| specula::Error::io(&trace, e))?;
+        report += &format!("== method {} -> {} (median of 5 frames)\n", method.name(), png.display());
+        report += &specula::profile::table(&frame.passes, &frame.memory);
+        report.push('\n');
+    }
+    print!("{report}");
+    let table = outdir.join("timings.txt");
+    std::fs::write(&table, &report).map_err(|e| specula::Error::io(&table, e))?;
+    Ok(())
+}

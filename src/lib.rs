@@ -1,0 +1,52 @@
+//! specula: mirror reflections, refractions and caustics on the GPU through raw Vulkan,
+//! after Szirmay-Kalos et al., "Specular Effects on the GPU: State of the Art".
+
+pub mod error;
+pub mod scene;
+
+pub use error::{Error, Result};
+pub mod cube;
+pub mod gpu_scene;
+pub mod methods;
+pub mod optics;
+pub mod plan;
+pub mod profile;
+pub mod quality;
+pub mod renderer;
+pub mod shaders;
+pub mod vk;
+
+pub use plan::{plan, Method, Plan};
+pub use quality::Quality;
+pub use renderer::{Frame, Renderer};
+pub use scene::Scene;
+
+/// Renders `scene` with `method`: `warmup` frames (pipelines compile lazily on some
+/// drivers), then `frames` timed ones. Returns the last frame with the median per pass.
+pub fn render(
+    ctx: &vk::Context,
+    scene: &Scene,
+    method: Method,
+    quality: &Quality,
+    width: u32,
+    height: u32,
+    warmup: u32,
+    frames: u32,
+) -> Result<Frame> {
+    let mut r = Renderer::new(ctx, scene, plan(scene, method, quality), width, height)?;
+    let result = (|| {
+        for _ in 0..warmup {
+            r.render(ctx)?;
+        }
+        let mut all = Vec::new();
+        for _ in 0..frames.max(1) {
+            all.push(r.render(ctx)?);
+        }
+        let passes = profile::median_passes(&all);
+        let mut last = all.pop().unwrap();
+        last.passes = passes;
+        Ok(last)
+    })();
+    r.destroy(ctx);
+    result
+}

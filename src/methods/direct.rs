@@ -1,0 +1,121 @@
+//! `scene.direct`: the camera's view of everything that is not specular: the sky
+//! (environment map) and emission + Lambertian direct light with shadows. Specular
+//! objects are drawn by their method's shading pass afterwards, into the same target.
+
+use ash::vk;
+
+use super::{destroy_pipelines, FrameInputs};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
+use crate::Result;
+
+pub const TARGET_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+pub const DEPTH_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
+
+pub struct SceneDirect {
+    sky: vk::Pipeline,
+    direct: vk::Pipeline,
+}
+
+/// The sky and direct-light pipelines for a colour format and view mask (also used to
+/// fill environment maps).
+pub fn sky_and_direct(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    format: vk::Format,
+    view_mask: u32,
+    name: &str,
+) -> Result<(vk::Pipeline, vk::Pipeline)> {
+    let formats = [format];
+    let sky = graphics_pipeline(
+        ctx,
+        layout,
+        &GraphicsDesc {
+            name: &format!("{name}.sky"),
+            vertex: "scene/sky.vert",
+            fragment: "scene/sky.frag",
+            vertex_input: VertexInput::None,
+            color_formats: &formats,
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: false,
+            depth_write: false,
+            view_mask,
+        },
+    )?;
+    let direct = graphics_pipeline(
+        ctx,
+        layout,
+        &GraphicsDesc {
+            name: &format!("{name}.direct"),
+            vertex: "scene/mesh.vert",
+            fragment: "scene/direct.frag",
+            vertex_input: VertexInput::Mesh,
+            color_formats: &formats,
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            depth_write: true,
+            view_mask,
+        },
+    );
+    match direct {
+        Ok(d) => Ok((sky, d)),
+        Err(e) => {
+            unsafe { ctx.device.destroy_pipeline(sky, None) };
+            Err(e)
+        }
+    }
+}
+
+impl SceneDirect {
+    pub fn new(ctx: &Context, layout: vk::PipelineLayout) -> Result<SceneDirect> {
+        let (sky, direct) = sky_and_direct(ctx, layout, TARGET_FORMAT, 0, "scene")?;
+        Ok(SceneDirect { sky, direct })
+    }
+
+    /// Clears `target`, draws the sky, then every non-specular mesh from view `view`.
+    pub fn record<'a>(
+        &self,
+        rec: &mut Recorder,
+        f: &FrameInputs,
+        view: u32,
+        target: &mut Image,
+        depth: &mut Image,
+        sampled: impl Iterator<Item = &'a Image>,
+    ) {
+        let mut pass = rec.pass("scene.direct").writes(target, Access::ColorAttachment).writes(depth, Access::DepthAttachment);
+        for img in sampled {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let colors = [target.view];
+        begin_rendering(
+            ctx,
+            cmd,
+            &Target {
+                color: &colors,
+                depth: Some(depth.view),
+                width: target.width,
+                height: target.height,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [0.0; 4],
+                clear: true,
+            },
+        );
+        f.bind(ctx, cmd, self.sky);
+        f.draw_sky(ctx, cmd, view);
+        f.bind(ctx, cmd, self.direct);
+        for d in f.scene.draws.iter().filter(|d| !d.specular) {
+            f.draw(ctx, cmd, view, d);
+        }
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        rec.end(open);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        destroy_pipelines(ctx, &mut [self.sky, self.direct]);
+        self.sky = vk::Pipeline::null();
+        self.direct = vk::Pipeline::null();
+    }
+}

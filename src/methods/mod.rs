@@ -1,0 +1,169 @@
+//! One module per family of the survey, mirroring `glsl/`; one file per pass, each with
+//! its resources in one struct (`new` creates everything, `destroy` frees everything) and
+//! a `record` that reads like a sentence: declare reads and writes, render, close.
+
+pub mod direct;
+pub mod envmap;
+pub mod shadow;
+
+use ash::vk;
+
+use crate::gpu_scene::{Draw, GpuScene};
+use crate::quality::CubeMode;
+use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
+
+/// Push constants of every scene-drawing shader (`Push` in glsl/common/scene.glsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Push {
+    pub view: u32,
+    pub object: u32,
+    pub flags: u32,
+    pub light_count: u32,
+}
+
+pub const FLAG_FRESNEL_EXACT: u32 = 1;
+pub const FLAG_HAS_ENVIRONMENT: u32 = 2;
+
+/// What every pass needs to draw the scene: geometry, the frame's descriptor set and
+/// pipeline layout, and the frame-wide push-constant fields.
+pub struct FrameInputs<'a> {
+    pub scene: &'a GpuScene,
+    pub set: vk::DescriptorSet,
+    pub layout: vk::PipelineLayout,
+    pub flags: u32,
+    pub light_count: u32,
+}
+
+impl FrameInputs<'_> {
+    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: vk::Pipeline) {
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
+        }
+        self.scene.bind_geometry(ctx, cmd);
+    }
+
+    pub fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32) {
+        let p = Push { view, object, flags: self.flags, light_count: self.light_count };
+        unsafe {
+            ctx.device.cmd_push_constants(
+                cmd,
+                self.layout,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytemuck::bytes_of(&p),
+            )
+        };
+    }
+
+    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, d: &Draw) {
+        self.push(ctx, cmd, view, d.mesh);
+        unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+    }
+
+    /// The full-screen sky triangle (bound pipeline must be a sky pipeline).
+    pub fn draw_sky(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32) {
+        self.push(ctx, cmd, view, 0);
+        unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+    }
+}
+
+/// Renders the six faces of cube `cube` of `color` (a cube or cube-array attachment),
+/// either in six passes or in one multiview pass. `draw(cmd, view)` records the draws of
+/// one pass whose first view is `view` (the face's view, or the cube's first view with
+/// multiview, where the shader adds gl_ViewIndex).
+#[allow(clippy::too_many_arguments)]
+pub fn render_cube_faces(
+    rec: &Recorder,
+    color: &Image,
+    depth: &mut Image,
+    cube: u32,
+    view_base: u32,
+    mode: CubeMode,
+    clear_color: [f32; 4],
+    mut draw: impl FnMut(vk::CommandBuffer, u32),
+) {
+    let (ctx, cmd) = (rec.ctx, rec.cmd);
+    let size = color.width;
+    match mode {
+        CubeMode::Multiview => {
+            rec.barrier(depth, Access::DepthAttachment);
+            let colors = [color.group_view(cube)];
+            begin_rendering(
+                ctx,
+                cmd,
+                &Target {
+                    color: &colors,
+                    depth: Some(depth.group_view(0)),
+                    width: size,
+                    height: size,
+                    view_mask: 0x3F,
+                    layer_count: 1,
+                    clear_color,
+                    clear: true,
+                },
+            );
+            draw(cmd, view_base);
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        }
+        CubeMode::SixPasses => {
+            for face in 0..6 {
+                rec.barrier(depth, Access::DepthAttachment);
+                let colors = [color.layer_view(6 * cube + face)];
+                begin_rendering(
+                    ctx,
+                    cmd,
+                    &Target {
+                        color: &colors,
+                        depth: Some(depth.view),
+                        width: size,
+                        height: size,
+                        view_mask: 0,
+                        layer_count: 1,
+                        clear_color,
+                        clear: true,
+                    },
+                );
+                draw(cmd, view_base + face);
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
+        }
+    }
+}
+
+/// The depth buffer cube rendering needs: six layers for multiview, one otherwise.
+pub fn cube_depth(ctx: &Context, name: &str, size: u32, mode: CubeMode) -> crate::Result<Image> {
+    let kind = match mode {
+        CubeMode::Multiview => crate::vk::ImageKind::D2Array { layers: 6 },
+        CubeMode::SixPasses => crate::vk::ImageKind::D2,
+    };
+    Image::new(
+        ctx,
+        &crate::vk::ImageDesc {
+            name,
+            format: vk::Format::D32_SFLOAT,
+            width: size,
+            height: size,
+            kind,
+            usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        },
+    )
+}
+
+pub fn view_mask(mode: CubeMode) -> u32 {
+    match mode {
+        CubeMode::Multiview => 0x3F,
+        CubeMode::SixPasses => 0,
+    }
+}
+
+/// Destroys pipelines that were created (null handles are skipped).
+pub fn destroy_pipelines(ctx: &Context, pipelines: &mut [vk::Pipeline]) {
+    for p in pipelines.iter_mut() {
+        if *p != vk::Pipeline::null() {
+            unsafe { ctx.device.destroy_pipeline(*p, None) };
+            *p = vk::Pipeline::null();
+        }
+    }
+}

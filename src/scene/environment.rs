@@ -1,0 +1,141 @@
+//! Environment maps in and rendered images out.
+//!
+//! `load_environment` reads an equirectangular linear-radiance image: OpenEXR through the
+//! `exr` crate, Radiance `.hdr` (linear) and 8/16-bit PNG/JPEG (sRGB-encoded, decoded to
+//! linear) through the `image` crate. Negative radiance is clamped to 0; NaN or infinite
+//! pixels are an error.
+
+use std::path::Path;
+
+use super::EnvironmentMap;
+use crate::error::{Error, Result};
+
+/// sRGB-encoded 8-bit value → linear [0, 1].
+pub fn srgb_to_linear(v: u8) -> f32 {
+    srgb_decode(v as f32 / 255.0)
+}
+
+/// Linear value → sRGB-encoded 8-bit value, clamped to [0, 1] first (NaN → 0).
+pub fn linear_to_srgb(v: f32) -> u8 {
+    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+    let e = if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 };
+    (e * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+}
+
+fn srgb_decode(e: f32) -> f32 {
+    if e <= 0.040_45 {
+        e / 12.92
+    } else {
+        ((e + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn image_error(path: &Path, e: image::ImageError) -> Error {
+    match e {
+        image::ImageError::IoError(io) => Error::io(path, io),
+        other => Error::Image(format!("{}: {other}", path.display())),
+    }
+}
+
+fn exr_error(path: &Path, e: exr::error::Error) -> Error {
+    match e {
+        exr::error::Error::Io(io) => Error::io(path, io),
+        other => Error::Image(format!("{}: {other}", path.display())),
+    }
+}
+
+/// Loads an equirectangular environment map as linear RGBA32F radiance.
+pub fn load_environment(path: &Path) -> Result<EnvironmentMap> {
+    // Report a missing file as such, whatever the decoder would say.
+    std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let (width, height, mut rgba32f) = if ext == "exr" {
+        let image = exr::prelude::read_first_rgba_layer_from_file(
+            path,
+            |resolution, _| (resolution.width(), vec![0f32; resolution.width() * resolution.height() * 4]),
+            |(w, pixels): &mut (usize, Vec<f32>), pos, (r, g, b, a): (f32, f32, f32, f32)| {
+                let i = (pos.y() * *w + pos.x()) * 4;
+                pixels[i..i + 4].copy_from_slice(&[r, g, b, a]);
+            },
+        )
+        .map_err(|e| exr_error(path, e))?;
+        let size = image.layer_data.size;
+        let (_, pixels) = image.layer_data.channel_data.pixels;
+        (size.width() as u32, size.height() as u32, pixels)
+    } else {
+        let img = image::ImageReader::open(path)
+            .map_err(|e| Error::io(path, e))?
+            .with_guessed_format()
+            .map_err(|e| Error::io(path, e))?
+            .decode()
+            .map_err(|e| image_error(path, e))?;
+        let (w, h) = (img.width(), img.height());
+        let linear = matches!(img.color(), image::ColorType::Rgb32F | image::ColorType::Rgba32F);
+        let mut data = img.into_rgba32f().into_raw();
+        if !linear {
+            for px in data.chunks_exact_mut(4) {
+                for c in &mut px[..3] {
+                    *c = srgb_decode(*c);
+                }
+            }
+        }
+        (w, h, data)
+    };
+    if width == 0 || height == 0 {
+        return Err(Error::Image(format!("{}: empty image ({width}×{height})", path.display())));
+    }
+    if let Some(i) = rgba32f.iter().position(|v| !v.is_finite()) {
+        let px = i / 4;
+        return Err(Error::Image(format!(
+            "{}: pixel ({}, {}) is not finite ({})",
+            path.display(),
+            px as u32 % width,
+            px as u32 / width,
+            rgba32f[i]
+        )));
+    }
+    for v in &mut rgba32f {
+        *v = v.max(0.0);
+    }
+    Ok(EnvironmentMap { width, height, rgba32f })
+}
+
+fn check_size(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<()> {
+    let expected = width as usize * height as usize * 4;
+    if width == 0 || height == 0 || rgba32f.len() != expected {
+        return Err(Error::invalid(
+            format!("image {}", path.display()),
+            format!("{width}×{height} RGBA needs {expected} floats, got {}", rgba32f.len()),
+        ));
+    }
+    Ok(())
+}
+
+fn create_parent(path: &Path) -> Result<()> {
+    match path.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e)),
+        _ => Ok(()),
+    }
+}
+
+/// Writes linear RGBA32F pixels (row-major, top row first) as an OpenEXR file.
+pub fn write_exr(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<()> {
+    check_size(path, width, height, rgba32f)?;
+    create_parent(path)?;
+    let w = width as usize;
+    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+        let i = (y * w + x) * 4;
+        (rgba32f[i], rgba32f[i + 1], rgba32f[i + 2], rgba32f[i + 3])
+    })
+    .map_err(|e| exr_error(path, e))
+}
+
+/// Writes linear RGBA32F pixels as an 8-bit sRGB-encoded PNG (clamped; alpha 255).
+pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<()> {
+    check_size(path, width, height, rgba32f)?;
+    create_parent(path)?;
+    let bytes: Vec<u8> =
+        rgba32f.chunks_exact(4).flat_map(|p| [linear_to_srgb(p[0]), linear_to_srgb(p[1]), linear_to_srgb(p[2]), 255]).collect();
+    image::save_buffer_with_format(path, &bytes, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
+        .map_err(|e| image_error(path, e))
+}

@@ -1,0 +1,890 @@
+//! glTF 2.0 import (`.gltf` with external or embedded buffers, `.glb`) into a world-space
+//! [`Scene`].
+//!
+//! The `gltf` crate parses and validates the JSON; everything that touches binary data
+//! (buffers, buffer views, accessors, images) is read and bounds-checked here, so that a
+//! malformed file gives an [`Error::Scene`] naming the file and the offending field
+//! (`meshes[0].primitives[1].attributes.POSITION`, `images[2] (uri "wall.png")` …) and
+//! never a panic.
+//!
+//! Choices where glTF leaves room:
+//! - Primitive modes: triangles, triangle strips and triangle fans are imported (strips and
+//!   fans are converted to lists); points and lines are skipped without error, as are
+//!   primitives with no vertices or no triangles.
+//! - Materials are imported when a drawn primitive uses them (so `Scene::materials` is not
+//!   indexed like the glTF `materials` array), but every material's scalar parameters
+//!   (KHR_materials_ior, KHR_materials_emissive_strength) are validated up front.
+//!   Only images that an imported base-colour or emissive texture refers to are decoded.
+//! - Texture coordinates: the set the base-colour texture names (KHR_texture_transform's
+//!   `texCoord` override included; set 0 without a base-colour texture), with the base-colour
+//!   texture's KHR_texture_transform applied. The emissive texture shares these coordinates.
+//! - Only perspective cameras are considered; orthographic ones are ignored. The first one
+//!   in depth-first traversal order wins.
+//! - `extras.specula.reference_point` (on the node, else on the mesh) is given in the node's
+//!   local frame and transformed to world space.
+//! - Skins, morph targets and animations are ignored (the static node transforms are used).
+//! - A node hierarchy with a cycle is an error.
+
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::panic::AssertUnwindSafe;
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::json::validation::Checked;
+use gltf::mesh::{Mode, Semantic};
+use serde_json::Value;
+
+use super::{Camera, Light, LightKind, Material, Mesh, Scene, SurfaceKind, Texture};
+use crate::error::{Error, Result};
+
+/// Largest element count accepted for an accessor without a buffer view (all zeros).
+const MAX_ZERO_ELEMENTS: usize = 1 << 24;
+
+/// Loads a `.gltf` or `.glb` file into a world-space scene. See the module documentation.
+pub fn load(path: &Path) -> Result<Scene> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let file = path.display().to_string();
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    // Everything below checks its input; the unwind guard is a last line of defence against
+    // a panic inside a dependency on input nobody anticipated.
+    match std::panic::catch_unwind(AssertUnwindSafe(|| import(&file, base, &bytes))) {
+        Ok(result) => result,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(Error::scene(file, "(document)", format!("internal error while importing: {what}")))
+        }
+    }
+}
+
+fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(file, e))?;
+    let (doc, blob) = (gltf.document, gltf.blob);
+    // gltf-json's validation indexes the POSITION accessor before checking the index.
+    precheck(file, doc.as_json())?;
+    let doc = gltf::Document::from_json(doc.into_json()).map_err(|e| gltf_error(file, e))?;
+
+    let mut imp = Importer {
+        file,
+        base,
+        doc: &doc,
+        buffers: Vec::new(),
+        scene: Scene::new(),
+        materials: HashMap::new(),
+        default_material: None,
+        textures: HashMap::new(),
+    };
+    imp.buffers = imp.load_buffers(blob)?;
+    for material in doc.materials() {
+        imp.check_material_scalars(&material)?;
+    }
+    imp.walk()?;
+    Ok(imp.scene)
+}
+
+/// gltf-json spells extension names in its paths as Rust fields ("khrLightsPunctual").
+fn extension_names(path: String) -> String {
+    const NAMES: &[(&str, &str)] = &[
+        ("khrLightsPunctual", "KHR_lights_punctual"),
+        ("khrMaterialsIor", "KHR_materials_ior"),
+        ("khrMaterialsTransmission", "KHR_materials_transmission"),
+        ("khrMaterialsVolume", "KHR_materials_volume"),
+        ("khrMaterialsSpecular", "KHR_materials_specular"),
+        ("khrMaterialsEmissiveStrength", "KHR_materials_emissive_strength"),
+        ("khrTextureTransform", "KHR_texture_transform"),
+        ("textureTransform", "KHR_texture_transform"),
+    ];
+    NAMES.iter().fold(path, |p, (from, to)| p.replace(from, to))
+}
+
+/// Wraps a `gltf` crate error; validation errors name the first offending path.
+fn gltf_error(file: &str, e: gltf::Error) -> Error {
+    match e {
+        gltf::Error::Validation(list) => {
+            let field = list.first().map(|(p, _)| extension_names(p.to_string())).unwrap_or_else(|| "(document)".into());
+            let message = list.iter().map(|(p, e)| format!("{}: {e}", extension_names(p.to_string()))).collect::<Vec<_>>().join("; ");
+            Error::scene(file, field, format!("invalid glTF: {message}"))
+        }
+        gltf::Error::Deserialize(e) => Error::scene(file, "(JSON)", format!("malformed glTF JSON: {e}")),
+        gltf::Error::Binary(e) => Error::scene(file, "(GLB container)", format!("malformed GLB: {e}")),
+        other => Error::scene(file, "(document)", other.to_string()),
+    }
+}
+
+/// Checks what gltf-json's validation would otherwise index out of range.
+fn precheck(file: &str, root: &gltf::json::Root) -> Result<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "?".into(),
+                    };
+                    return Err(Error::scene(
+                        file,
+                        format!("meshes[{m}].primitives[{p}].attributes.{name}"),
+                        format!("accessor index {} out of range ({} accessors)", index.value(), root.accessors.len()),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A URI for messages: data URIs are cut short.
+fn short_uri(uri: &str) -> String {
+    if uri.starts_with("data:") {
+        let head: String = uri.chars().take(32).collect();
+        format!("{head}…")
+    } else {
+        uri.to_string()
+    }
+}
+
+fn decode_data_uri(uri: &str) -> std::result::Result<Vec<u8>, String> {
+    let rest = &uri["data:".len()..];
+    let Some((_, payload)) = rest.split_once(";base64,") else {
+        return Err("only base64 data URIs are supported".into());
+    };
+    let engine = base64::engine::GeneralPurpose::new(
+        &base64::alphabet::STANDARD,
+        base64::engine::GeneralPurposeConfig::new().with_decode_padding_mode(base64::engine::DecodePaddingMode::Indifferent),
+    );
+    engine.decode(payload.trim()).map_err(|e| format!("invalid base64 data: {e}"))
+}
+
+/// Percent-decodes a relative URI into a path string.
+fn percent_decode(uri: &str) -> std::result::Result<String, String> {
+    let b = uri.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            let hex = std::str::from_utf8(&b[i + 1..i + 3]).ok().and_then(|h| u8::from_str_radix(h, 16).ok());
+            if let Some(v) = hex {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8(out).map_err(|_| "URI does not decode to UTF-8".to_string())
+}
+
+fn parse_extras(extras: &gltf::json::Extras) -> Option<Value> {
+    extras.as_ref().and_then(|raw| serde_json::from_str::<Value>(raw.get()).ok())
+}
+
+/// `extras.specula` as an object, if present.
+fn specula_extras(extras: &gltf::json::Extras, file: &str, field: &str) -> Result<Option<serde_json::Map<String, Value>>> {
+    let Some(value) = parse_extras(extras) else {
+        return Ok(None);
+    };
+    match value.get("specula") {
+        None => Ok(None),
+        Some(Value::Object(map)) => Ok(Some(map.clone())),
+        Some(_) => Err(Error::scene(file, format!("{field}.extras.specula"), "must be an object")),
+    }
+}
+
+fn json_vec3(v: &Value, file: &str, field: &str) -> Result<Vec3> {
+    let nums: Option<Vec<f32>> = v.as_array().and_then(|a| a.iter().map(|x| x.as_f64().map(|f| f as f32)).collect());
+    match nums {
+        Some(n) if n.len() == 3 && n.iter().all(|x| x.is_finite()) => Ok(Vec3::new(n[0], n[1], n[2])),
+        _ => Err(Error::scene(file, field, format!("expected an array of 3 finite numbers, got {v}"))),
+    }
+}
+
+/// ν of a conductor with κ = 0 whose normal-incidence reflectance is `f0`.
+fn nu_from_f0(f0: f32) -> f32 {
+    let f0 = if f0.is_nan() { 0.0 } else { f0.clamp(0.0, 0.9999) };
+    let s = f0.sqrt();
+    (1.0 + s) / (1.0 - s)
+}
+
+fn apply_texture_transform(uv: Vec2, t: &gltf::texture::TextureTransform) -> Vec2 {
+    let [ox, oy] = t.offset();
+    let [sx, sy] = t.scale();
+    let (s, c) = t.rotation().sin_cos();
+    let (u, v) = (uv.x * sx, uv.y * sy);
+    Vec2::new(c * u + s * v + ox, -s * u + c * v + oy)
+}
+
+/// Maps a `Scene::add_*` validation error into a scene error; `field` picks the glTF field
+/// from the suffix of the error's `what` ("mesh 'x': positions" → "positions").
+fn map_invalid(file: &str, e: Error, field: impl Fn(Option<&str>) -> String) -> Error {
+    match e {
+        Error::InvalidInput { what, message } => {
+            let suffix = what.rsplit_once(": ").map(|(_, s)| s.to_string());
+            Error::scene(file, field(suffix.as_deref()), format!("{what}: {message}"))
+        }
+        other => other,
+    }
+}
+
+struct Importer<'a> {
+    file: &'a str,
+    base: PathBuf,
+    doc: &'a gltf::Document,
+    buffers: Vec<Vec<u8>>,
+    scene: Scene,
+    /// glTF material index → scene material.
+    materials: HashMap<usize, usize>,
+    default_material: Option<usize>,
+    /// glTF image index → scene texture.
+    textures: HashMap<usize, usize>,
+}
+
+impl<'a> Importer<'a> {
+    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::scene(self.file, field, message)
+    }
+
+    // ---------------------------------------------------------------- binary data
+
+    fn load_buffers(&self, mut blob: Option<Vec<u8>>) -> Result<Vec<Vec<u8>>> {
+        let mut out = Vec::new();
+        for buffer in self.doc.buffers() {
+            let i = buffer.index();
+            let (field, data) = match buffer.source() {
+                gltf::buffer::Source::Bin => {
+                    let field = format!("buffers[{i}] (GLB BIN chunk)");
+                    match blob.take() {
+                        Some(b) => (field, b),
+                        None => return Err(self.err(field, "refers to the GLB BIN chunk, but the file has none (or it is already used)")),
+                    }
+                }
+                gltf::buffer::Source::Uri(uri) => {
+                    let field = format!("buffers[{i}] (uri {:?})", short_uri(uri));
+                    let data = self.read_uri(uri).map_err(|m| self.err(&field, m))?;
+                    (field, data)
+                }
+            };
+            if data.len() < buffer.length() {
+                return Err(self.err(field, format!("declares byteLength {} but holds only {} bytes", buffer.length(), data.len())));
+            }
+            out.push(data);
+        }
+        Ok(out)
+    }
+
+    /// Reads a data URI or a file relative to the glTF file.
+    fn read_uri(&self, uri: &str) -> std::result::Result<Vec<u8>, String> {
+        if uri.starts_with("data:") {
+            return decode_data_uri(uri);
+        }
+        let relative = if let Some(rest) = uri.strip_prefix("file://") {
+            rest
+        } else if let Some(rest) = uri.strip_prefix("file:") {
+            rest
+        } else if let Some((scheme, _)) = uri.split_once(':') {
+            // A one-letter "scheme" is a Windows drive letter.
+            if scheme.len() > 1 && !scheme.contains(['/', '\\']) {
+                return Err(format!("unsupported URI scheme '{scheme}:'"));
+            }
+            uri
+        } else {
+            uri
+        };
+        let decoded = percent_decode(relative)?;
+        let path = self.base.join(&decoded);
+        std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+    }
+
+    /// The bytes of a buffer view, range-checked against its buffer.
+    fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8]> {
+        let b = view.buffer();
+        let data = &self.buffers[b.index()];
+        let limit = b.length().min(data.len());
+        match view.offset().checked_add(view.length()) {
+            Some(end) if end <= limit => Ok(&data[view.offset()..end]),
+            _ => Err(self.err(
+                format!("bufferViews[{}]", view.index()),
+                format!("byteOffset {} + byteLength {} exceeds buffers[{}] ({} bytes)", view.offset(), view.length(), b.index(), limit),
+            )),
+        }
+    }
+
+    /// Checks that the accessor's elements lie within its buffer view (or, without one, that
+    /// its count is sane) and returns the element count; call before allocating for them.
+    fn checked_count(&self, acc: &gltf::Accessor) -> Result<usize> {
+        let field = format!("accessors[{}]", acc.index());
+        let (elem, count) = (acc.size(), acc.count());
+        let Some(view) = acc.view() else {
+            if count > MAX_ZERO_ELEMENTS {
+                return Err(self.err(field, format!("{count} elements without a bufferView is too many")));
+            }
+            return Ok(count);
+        };
+        let bytes = self.view_bytes(&view)?;
+        let stride = view.stride().unwrap_or(elem);
+        if count > 0 {
+            let end = stride.checked_mul(count - 1).and_then(|x| x.checked_add(acc.offset())).and_then(|x| x.checked_add(elem));
+            if !end.is_some_and(|end| end <= bytes.len()) {
+                return Err(self.err(
+                    field,
+                    format!(
+                        "byteOffset {} + {count} elements of {elem} bytes (stride {stride}) exceed bufferViews[{}] ({} bytes)",
+                        acc.offset(),
+                        view.index(),
+                        bytes.len()
+                    ),
+                ));
+            }
+        }
+        Ok(count)
+    }
+
+    /// Calls `f(i, element bytes)` for every element of the accessor (sparse substitutions
+    /// are delivered after the base values, so the last call for an index wins).
+    fn for_each_element(&self, acc: &gltf::Accessor, mut f: impl FnMut(usize, &[u8])) -> Result<()> {
+        let field = format!("accessors[{}]", acc.index());
+        let elem = acc.size();
+        let count = self.checked_count(acc)?;
+        match acc.view() {
+            Some(view) => {
+                let bytes = self.view_bytes(&view)?;
+                let stride = view.stride().unwrap_or(elem);
+                for i in 0..count {
+                    let start = acc.offset() + stride * i;
+                    f(i, &bytes[start..start + elem]);
+                }
+            }
+            None => {
+                let zeros = vec![0u8; elem];
+                for i in 0..count {
+                    f(i, &zeros);
+                }
+            }
+        }
+        if let Some(sparse) = acc.sparse() {
+            let n = sparse.count();
+            let iv = sparse.indices().view();
+            let isize = sparse.indices().index_type().size();
+            let ibytes = self.view_bytes(&iv)?;
+            let vv = sparse.values().view();
+            let vbytes = self.view_bytes(&vv)?;
+            let fits =
+                |off: usize, size: usize, len: usize| n.checked_mul(size).and_then(|x| x.checked_add(off)).is_some_and(|end| end <= len);
+            if !fits(sparse.indices().offset(), isize, ibytes.len()) {
+                return Err(self.err(format!("{field}.sparse.indices"), format!("{n} indices exceed bufferViews[{}]", iv.index())));
+            }
+            if !fits(sparse.values().offset(), elem, vbytes.len()) {
+                return Err(self.err(format!("{field}.sparse.values"), format!("{n} values exceed bufferViews[{}]", vv.index())));
+            }
+            for k in 0..n {
+                let s = sparse.indices().offset() + k * isize;
+                let idx = match isize {
+                    1 => ibytes[s] as usize,
+                    2 => u16::from_le_bytes([ibytes[s], ibytes[s + 1]]) as usize,
+                    _ => u32::from_le_bytes([ibytes[s], ibytes[s + 1], ibytes[s + 2], ibytes[s + 3]]) as usize,
+                };
+                if idx >= count {
+                    return Err(self.err(format!("{field}.sparse.indices"), format!("index {idx} out of range ({count} elements)")));
+                }
+                let s = sparse.values().offset() + k * elem;
+                f(idx, &vbytes[s..s + elem]);
+            }
+        }
+        Ok(())
+    }
+
+    /// Reads a float-valued accessor with `dims` components per element; integer types are
+    /// accepted when normalized and listed in `allowed`.
+    fn read_floats(&self, acc: &gltf::Accessor, dims: Dimensions, allowed: &[DataType], field: &str) -> Result<Vec<f32>> {
+        let dt = acc.data_type();
+        if acc.dimensions() != dims || !allowed.contains(&dt) || (dt != DataType::F32 && !acc.normalized()) {
+            return Err(self.err(
+                field,
+                format!(
+                    "accessors[{}] is {:?} {:?}{}, expected {:?} of {:?}",
+                    acc.index(),
+                    acc.dimensions(),
+                    dt,
+                    if acc.normalized() { " (normalized)" } else { "" },
+                    dims,
+                    allowed
+                ),
+            ));
+        }
+        let n = dims.multiplicity();
+        let cs = dt.size();
+        let mut out = vec![0f32; self.checked_count(acc)? * n];
+        self.for_each_element(acc, |i, b| {
+            for c in 0..n {
+                let x = &b[c * cs..(c + 1) * cs];
+                out[i * n + c] = match dt {
+                    DataType::F32 => f32::from_le_bytes([x[0], x[1], x[2], x[3]]),
+                    DataType::U8 => x[0] as f32 / 255.0,
+                    DataType::I8 => (x[0] as i8 as f32 / 127.0).max(-1.0),
+                    DataType::U16 => u16::from_le_bytes([x[0], x[1]]) as f32 / 65535.0,
+                    DataType::I16 => (i16::from_le_bytes([x[0], x[1]]) as f32 / 32767.0).max(-1.0),
+                    DataType::U32 => u32::from_le_bytes([x[0], x[1], x[2], x[3]]) as f32,
+                };
+            }
+        })?;
+        Ok(out)
+    }
+
+    fn read_indices(&self, acc: &gltf::Accessor, field: &str) -> Result<Vec<u32>> {
+        let dt = acc.data_type();
+        if acc.dimensions() != Dimensions::Scalar || !matches!(dt, DataType::U8 | DataType::U16 | DataType::U32) {
+            return Err(
+                self.err(field, format!("accessors[{}] is {:?} {:?}, expected a scalar U8, U16 or U32", acc.index(), acc.dimensions(), dt))
+            );
+        }
+        let mut out = vec![0u32; self.checked_count(acc)?];
+        self.for_each_element(acc, |i, x| {
+            out[i] = match dt {
+                DataType::U8 => x[0] as u32,
+                DataType::U16 => u16::from_le_bytes([x[0], x[1]]) as u32,
+                _ => u32::from_le_bytes([x[0], x[1], x[2], x[3]]),
+            };
+        })?;
+        Ok(out)
+    }
+
+    // ---------------------------------------------------------------- traversal
+
+    fn walk(&mut self) -> Result<()> {
+        let doc = self.doc;
+        let roots: Vec<usize> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+            Some(s) => s.nodes().map(|n| n.index()).collect(),
+            None => {
+                let mut is_child = vec![false; doc.nodes().len()];
+                for n in doc.nodes() {
+                    for c in n.children() {
+                        is_child[c.index()] = true;
+                    }
+                }
+                (0..is_child.len()).filter(|&i| !is_child[i]).collect()
+            }
+        };
+        let nodes: Vec<gltf::Node> = doc.nodes().collect();
+        // Iterative depth-first pre-order; `path` holds the ancestors of the current node.
+        let mut stack: Vec<(usize, Mat4, usize)> = roots.iter().rev().map(|&r| (r, Mat4::IDENTITY, 0)).collect();
+        let mut path: Vec<usize> = Vec::new();
+        let mut on_path = vec![false; nodes.len()];
+        while let Some((index, parent, depth)) = stack.pop() {
+            for old in path.drain(depth..) {
+                on_path[old] = false;
+            }
+            if on_path[index] {
+                return Err(self.err(format!("nodes[{index}]"), "the node hierarchy has a cycle (a node is its own ancestor)"));
+            }
+            path.push(index);
+            on_path[index] = true;
+            let node = &nodes[index];
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let world = parent * local;
+            self.visit(node, world)?;
+            for child in node.children().collect::<Vec<_>>().into_iter().rev() {
+                stack.push((child.index(), world, depth + 1));
+            }
+        }
+        Ok(())
+    }
+
+    fn visit(&mut self, node: &gltf::Node, world: Mat4) -> Result<()> {
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                self.import_primitive(node, &mesh, &prim, world)?;
+            }
+        }
+        if let Some(light) = node.light() {
+            self.import_light(node, &light, world)?;
+        }
+        if self.scene.camera.is_none() {
+            if let Some(cam) = node.camera() {
+                self.import_camera(node, cam.index(), world)?;
+            }
+        }
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- meshes
+
+    fn import_primitive(&mut self, node: &gltf::Node, mesh: &gltf::Mesh, prim: &gltf::Primitive, world: Mat4) -> Result<()> {
+        let (m, p) = (mesh.index(), prim.index());
+        let pfield = format!("meshes[{m}].primitives[{p}]");
+        let mode = prim.mode();
+        if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            return Ok(());
+        }
+
+        // Positions.
+        let pos_field = format!("{pfield}.attributes.POSITION");
+        let Some(pos_acc) = prim.get(&Semantic::Positions) else {
+            return Err(self.err(pos_field, "missing"));
+        };
+        let raw = self.read_floats(&pos_acc, Dimensions::Vec3, &[DataType::F32], &pos_field)?;
+        let local_positions: Vec<Vec3> = raw.chunks_exact(3).map(Vec3::from_slice).collect();
+        if let Some(i) = local_positions.iter().position(|v| !v.is_finite()) {
+            return Err(self.err(pos_field, format!("vertex {i} is not finite ({})", local_positions[i])));
+        }
+        let n = local_positions.len();
+        if n == 0 {
+            return Ok(());
+        }
+        if n > u32::MAX as usize {
+            return Err(self.err(pos_field, format!("{n} vertices is too many")));
+        }
+
+        // Normals.
+        let mut normals = Vec::new();
+        if let Some(acc) = prim.get(&Semantic::Normals) {
+            let field = format!("{pfield}.attributes.NORMAL");
+            let raw = self.read_floats(&acc, Dimensions::Vec3, &[DataType::F32], &field)?;
+            if raw.len() / 3 != n {
+                return Err(self.err(field, format!("{} normals for {n} vertices", raw.len() / 3)));
+            }
+            normals = raw.chunks_exact(3).map(Vec3::from_slice).collect();
+        }
+
+        // Texture coordinates of the base-colour texture's set.
+        let material = prim.material();
+        let base_info = material.pbr_metallic_roughness().base_color_texture();
+        let transform = base_info.as_ref().and_then(|i| i.texture_transform());
+        let set = transform.as_ref().and_then(|t| t.tex_coord()).or_else(|| base_info.as_ref().map(|i| i.tex_coord())).unwrap_or(0);
+        let uv_field = format!("{pfield}.attributes.TEXCOORD_{set}");
+        let mut uvs = Vec::new();
+        if let Some(acc) = prim.get(&Semantic::TexCoords(set)) {
+            let raw = self.read_floats(&acc, Dimensions::Vec2, &[DataType::F32, DataType::U8, DataType::U16], &uv_field)?;
+            if raw.len() / 2 != n {
+                return Err(self.err(uv_field, format!("{} texture coordinates for {n} vertices", raw.len() / 2)));
+            }
+            uvs = raw.chunks_exact(2).map(Vec2::from_slice).collect();
+            if let Some(t) = &transform {
+                for uv in &mut uvs {
+                    *uv = apply_texture_transform(*uv, t);
+                }
+            }
+        }
+
+        // Indices.
+        let idx_field = format!("{pfield}.indices");
+        let (raw_indices, count_field) = match prim.indices() {
+            Some(acc) => (self.read_indices(&acc, &idx_field)?, idx_field.clone()),
+            None => ((0..n as u32).collect(), pos_field.clone()),
+        };
+        if let Some(k) = raw_indices.iter().position(|&i| i as usize >= n) {
+            return Err(self.err(idx_field, format!("index {} (element {k}) is out of range: only {n} vertices", raw_indices[k])));
+        }
+        let mut indices = match mode {
+            Mode::Triangles => {
+                if raw_indices.len() % 3 != 0 {
+                    return Err(self.err(count_field, format!("{} indices is not a whole number of triangles", raw_indices.len())));
+                }
+                raw_indices
+            }
+            Mode::TriangleStrip => {
+                let mut out = Vec::with_capacity(raw_indices.len().saturating_sub(2) * 3);
+                for i in 0..raw_indices.len().saturating_sub(2) {
+                    let (a, b, c) = (raw_indices[i], raw_indices[i + 1], raw_indices[i + 2]);
+                    if i % 2 == 0 {
+                        out.extend([a, b, c]);
+                    } else {
+                        out.extend([b, a, c]);
+                    }
+                }
+                out
+            }
+            _ => {
+                let mut out = Vec::with_capacity(raw_indices.len().saturating_sub(2) * 3);
+                for i in 1..raw_indices.len().saturating_sub(1) {
+                    out.extend([raw_indices[i], raw_indices[i + 1], raw_indices[0]]);
+                }
+                out
+            }
+        };
+        if indices.is_empty() {
+            return Ok(());
+        }
+
+        // To world space.
+        let positions: Vec<Vec3> = local_positions.iter().map(|&v| world.transform_point3(v)).collect();
+        if let Some(i) = positions.iter().position(|v| !v.is_finite()) {
+            return Err(self.err(
+                format!("nodes[{}]", node.index()),
+                format!("the node's world transform makes vertex {i} of {pos_field} non-finite"),
+            ));
+        }
+        let linear = Mat3::from_mat4(world);
+        let det = linear.determinant();
+        if !normals.is_empty() {
+            if det.is_finite() && det != 0.0 {
+                let normal_matrix = linear.inverse().transpose();
+                for nrm in &mut normals {
+                    *nrm = (normal_matrix * *nrm).normalize_or_zero();
+                }
+            } else {
+                normals.clear(); // degenerate transform: let add_mesh compute them
+            }
+        }
+        if det < 0.0 {
+            for t in indices.chunks_exact_mut(3) {
+                t.swap(1, 2);
+            }
+        }
+
+        // Reference point: node extras first, then the mesh's.
+        let mut reference_point = None;
+        for (extras, field) in [(node.extras(), format!("nodes[{}]", node.index())), (mesh.extras(), format!("meshes[{m}]"))] {
+            if let Some(map) = specula_extras(extras, self.file, &field)? {
+                if let Some(v) = map.get("reference_point") {
+                    let rp_field = format!("{field}.extras.specula.reference_point");
+                    let local = json_vec3(v, self.file, &rp_field)?;
+                    reference_point = Some(world.transform_point3(local));
+                    break;
+                }
+            }
+        }
+
+        let material_index = self.material_index(&material)?;
+        let name = format!("{}/{p}", mesh.name().map(str::to_string).unwrap_or_else(|| m.to_string()));
+        let mesh_value = Mesh { name, positions, normals, uvs, indices, material: material_index, reference_point };
+        let file = self.file;
+        self.scene.add_mesh(mesh_value).map_err(|e| {
+            map_invalid(file, e, |suffix| match suffix {
+                Some("positions") => pos_field.clone(),
+                Some("indices") => idx_field.clone(),
+                Some("normals") => format!("{pfield}.attributes.NORMAL"),
+                Some("uvs") => uv_field.clone(),
+                Some("material") => format!("{pfield}.material"),
+                Some("reference_point") => {
+                    format!("nodes[{}].extras.specula.reference_point", node.index())
+                }
+                _ => pfield.clone(),
+            })
+        })?;
+        Ok(())
+    }
+
+    // ---------------------------------------------------------------- materials
+
+    fn check_material_scalars(&self, material: &gltf::Material) -> Result<()> {
+        let i = material.index().unwrap_or(0);
+        if let Some(ior) = material.ior() {
+            if !(ior > 0.0 && ior.is_finite()) {
+                return Err(self.err(
+                    format!("materials[{i}].extensions.KHR_materials_ior.ior"),
+                    format!("index of refraction must be finite and > 0, got {ior}"),
+                ));
+            }
+        }
+        if let Some(s) = material.emissive_strength() {
+            if !(s >= 0.0 && s.is_finite()) {
+                return Err(self.err(
+                    format!("materials[{i}].extensions.KHR_materials_emissive_strength.emissiveStrength"),
+                    format!("must be finite and ≥ 0, got {s}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn material_index(&mut self, material: &gltf::Material) -> Result<usize> {
+        let Some(i) = material.index() else {
+            if let Some(d) = self.default_material {
+                return Ok(d);
+            }
+            let d = self
+                .scene
+                .add_material(Material { name: "default".into(), ..Material::default() })
+                .map_err(|e| map_invalid(self.file, e, |_| "(default material)".into()))?;
+            self.default_material = Some(d);
+            return Ok(d);
+        };
+        if let Some(&s) = self.materials.get(&i) {
+            return Ok(s);
+        }
+        let s = self.import_material(material, i)?;
+        self.materials.insert(i, s);
+        Ok(s)
+    }
+
+    fn import_material(&mut self, material: &gltf::Material, i: usize) -> Result<usize> {
+        let field = format!("materials[{i}]");
+        self.check_material_scalars(material)?;
+        let pbr = material.pbr_metallic_roughness();
+        let [r, g, b, _] = pbr.base_color_factor();
+        let base_color = Vec3::new(r, g, b);
+        let roughness = pbr.roughness_factor();
+        let transmission = material.transmission().map(|t| t.transmission_factor()).unwrap_or(0.0);
+
+        let kind = if pbr.metallic_factor() == 1.0 && roughness == 0.0 {
+            let extras = specula_extras(material.extras(), self.file, &field)?;
+            let nu = extras.as_ref().and_then(|m| m.get("nu"));
+            let kappa = extras.as_ref().and_then(|m| m.get("kappa"));
+            match (nu, kappa) {
+                (Some(nu), kappa) => SurfaceKind::Mirror {
+                    nu: json_vec3(nu, self.file, &format!("{field}.extras.specula.nu"))?,
+                    kappa: match kappa {
+                        Some(k) => json_vec3(k, self.file, &format!("{field}.extras.specula.kappa"))?,
+                        None => Vec3::ZERO,
+                    },
+                },
+                (None, Some(_)) => {
+                    return Err(self.err(format!("{field}.extras.specula.kappa"), "kappa given without nu"));
+                }
+                (None, None) => SurfaceKind::Mirror { nu: Vec3::new(nu_from_f0(r), nu_from_f0(g), nu_from_f0(b)), kappa: Vec3::ZERO },
+            }
+        } else if transmission == 1.0 && roughness == 0.0 {
+            let thin = material.volume().is_none_or(|v| v.thickness_factor() == 0.0);
+            SurfaceKind::Dielectric { ior: material.ior().unwrap_or(1.5), thin }
+        } else {
+            SurfaceKind::Diffuse
+        };
+
+        let base_color_texture = match pbr.base_color_texture() {
+            Some(info) => {
+                Some(self.texture_index(info.texture().source().index(), &format!("{field}.pbrMetallicRoughness.baseColorTexture"))?)
+            }
+            None => None,
+        };
+        let emissive_texture = match material.emissive_texture() {
+            Some(info) => Some(self.texture_index(info.texture().source().index(), &format!("{field}.emissiveTexture"))?),
+            None => None,
+        };
+        let emissive = Vec3::from(material.emissive_factor()) * material.emissive_strength().unwrap_or(1.0);
+        let (specular_factor, specular_color) = match material.specular() {
+            Some(s) => (s.specular_factor(), Vec3::from(s.specular_color_factor())),
+            None => (1.0, Vec3::ONE),
+        };
+        let m = Material {
+            name: material.name().map(str::to_string).unwrap_or_else(|| format!("material{i}")),
+            base_color,
+            base_color_texture,
+            emissive,
+            emissive_texture,
+            kind,
+            specular_color,
+            specular_factor,
+        };
+        let file = self.file;
+        self.scene.add_material(m).map_err(|e| {
+            map_invalid(file, e, |suffix| match suffix {
+                Some("ior") => format!("{field}.extensions.KHR_materials_ior.ior"),
+                Some("nu/kappa") => format!("{field}.extras.specula"),
+                _ => field.clone(),
+            })
+        })
+    }
+
+    // ---------------------------------------------------------------- images
+
+    fn texture_index(&mut self, image: usize, used_by: &str) -> Result<usize> {
+        if let Some(&t) = self.textures.get(&image) {
+            return Ok(t);
+        }
+        let json = &self.doc.as_json().images[image];
+        let (field, bytes): (String, Cow<[u8]>) = match (&json.uri, &json.buffer_view) {
+            (Some(uri), _) => {
+                let field = format!("images[{image}] (uri {:?})", short_uri(uri));
+                let bytes = self.read_uri(uri).map_err(|m| self.err(&field, format!("{m} (used by {used_by})")))?;
+                (field, Cow::Owned(bytes))
+            }
+            (None, Some(view)) => {
+                let field = format!("images[{image}] (bufferView {})", view.value());
+                let view = self.doc.views().nth(view.value()).ok_or_else(|| self.err(&field, "bufferView out of range"))?;
+                (field, Cow::Borrowed(self.view_bytes(&view)?))
+            }
+            (None, None) => return Err(self.err(format!("images[{image}]"), "has neither uri nor bufferView")),
+        };
+        let decoded = image::load_from_memory(&bytes)
+            .map_err(|e| self.err(&field, format!("cannot decode image (used by {used_by}): {e}")))?
+            .to_rgba8();
+        let name = json
+            .name
+            .clone()
+            .or_else(|| json.uri.as_ref().filter(|u| !u.starts_with("data:")).cloned())
+            .unwrap_or_else(|| format!("image{image}"));
+        let (width, height) = decoded.dimensions();
+        self.scene.textures.push(Texture { name, width, height, rgba8: decoded.into_raw() });
+        let t = self.scene.textures.len() - 1;
+        self.textures.insert(image, t);
+        Ok(t)
+    }
+
+    // ---------------------------------------------------------------- lights, camera
+
+    fn import_light(&mut self, node: &gltf::Node, light: &gltf::khr_lights_punctual::Light, world: Mat4) -> Result<()> {
+        use gltf::khr_lights_punctual::Kind;
+        let j = light.index();
+        let field = format!("extensions.KHR_lights_punctual.lights[{j}]");
+        let kind = match light.kind() {
+            Kind::Point => LightKind::Point,
+            Kind::Directional => LightKind::Directional,
+            Kind::Spot { inner_cone_angle, outer_cone_angle } => {
+                let ok = inner_cone_angle >= 0.0 && inner_cone_angle <= outer_cone_angle && outer_cone_angle <= std::f32::consts::FRAC_PI_2;
+                if !ok {
+                    return Err(self.err(
+                        format!("{field}.spot"),
+                        format!("cone angles must satisfy 0 ≤ inner ({inner_cone_angle}) ≤ outer ({outer_cone_angle}) ≤ π/2"),
+                    ));
+                }
+                LightKind::Spot { inner_cone: inner_cone_angle, outer_cone: outer_cone_angle }
+            }
+        };
+        let range = light.range();
+        if let Some(r) = range {
+            if r.is_nan() || r <= 0.0 {
+                return Err(self.err(format!("{field}.range"), format!("must be > 0, got {r}")));
+            }
+        }
+        let l = Light {
+            name: light.name().map(str::to_string).unwrap_or_else(|| format!("light{j}")),
+            kind,
+            position: world.w_axis.truncate(),
+            direction: world.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
+            intensity: Vec3::from(light.color()) * light.intensity(),
+            range,
+        };
+        let file = self.file;
+        let node_index = node.index();
+        self.scene.add_light(l).map_err(|e| map_invalid(file, e, |_| format!("{field} (on nodes[{node_index}])")))?;
+        Ok(())
+    }
+
+    fn import_camera(&mut self, node: &gltf::Node, camera: usize, world: Mat4) -> Result<()> {
+        let json = &self.doc.as_json().cameras[camera];
+        if json.type_ != Checked::Valid(gltf::json::camera::Type::Perspective) {
+            return Ok(()); // orthographic: ignored
+        }
+        let field = format!("cameras[{camera}].perspective");
+        let Some(p) = &json.perspective else {
+            return Err(self.err(field, "type is \"perspective\" but the perspective object is missing"));
+        };
+        if !(p.yfov > 0.0 && p.yfov < std::f32::consts::PI) {
+            return Err(self.err(format!("{field}.yfov"), format!("must be in (0, π), got {}", p.yfov)));
+        }
+        if !(p.znear > 0.0 && p.znear.is_finite()) {
+            return Err(self.err(format!("{field}.znear"), format!("must be finite and > 0, got {}", p.znear)));
+        }
+        if let Some(zfar) = p.zfar {
+            if zfar.is_nan() || zfar <= p.znear {
+                return Err(self.err(format!("{field}.zfar"), format!("must be > znear ({}), got {zfar}", p.znear)));
+            }
+        }
+        let (_, rotation, translation) = world.to_scale_rotation_translation();
+        let world_from_camera = Mat4::from_rotation_translation(rotation.normalize(), translation);
+        if !world_from_camera.is_finite() {
+            return Err(self.err(format!("nodes[{}]", node.index()), "the camera node's world transform is degenerate"));
+        }
+        self.scene.camera = Some(Camera { position: translation, world_from_camera, yfov: p.yfov, znear: p.znear, zfar: p.zfar });
+        Ok(())
+    }
+}

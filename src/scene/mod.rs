@@ -1,0 +1,354 @@
+//! The scene the renderer consumes: world-space meshes, classified materials, punctual
+//! lights, a camera and an optional environment map. Loaded from glTF (`load`) or built
+//! in code (`Scene::add_mesh` …), which is what the C ABI and the tests do.
+//!
+//! Conventions are glTF's: right-handed, +Y up, metres, the camera looks down −Z.
+//! Radiometry: a punctual light's intensity is used 1:1 as radiant intensity [W/sr]
+//! (point, spot) or irradiance [W/m²] (directional); emission and images are linear
+//! radiance.
+
+mod environment;
+mod gltf_import;
+
+pub use environment::*;
+pub use gltf_import::load;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::error::{Error, Result};
+
+/// How a surface scatters light, as the survey classifies it (§1.1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SurfaceKind {
+    /// Emission plus Lambertian reflection of punctual lights.
+    Diffuse,
+    /// Ideal mirror (glTF: metallic 1, roughness 0). Index of refraction ν and extinction
+    /// coefficient κ per RGB channel; F0 follows from survey eq. 2.
+    Mirror { nu: Vec3, kappa: Vec3 },
+    /// Ideal dielectric (glTF: transmission 1, roughness 0) of index of refraction `ior`
+    /// relative to the outside medium. `thin` surfaces (KHR_materials_volume thickness 0)
+    /// are thin-walled: light passes through without bending.
+    Dielectric { ior: f32, thin: bool },
+}
+
+impl SurfaceKind {
+    pub fn is_specular(&self) -> bool {
+        !matches!(self, SurfaceKind::Diffuse)
+    }
+    pub fn label(&self) -> &'static str {
+        match self {
+            SurfaceKind::Diffuse => "diffuse",
+            SurfaceKind::Mirror { .. } => "mirror",
+            SurfaceKind::Dielectric { thin: true, .. } => "dielectric (thin-walled)",
+            SurfaceKind::Dielectric { thin: false, .. } => "dielectric (solid)",
+        }
+    }
+}
+
+/// A material after classification. Textures index `Scene::textures`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    /// Linear base colour (albedo of diffuse surfaces).
+    pub base_color: Vec3,
+    pub base_color_texture: Option<usize>,
+    /// Emitted radiance (emissive factor × KHR_materials_emissive_strength).
+    pub emissive: Vec3,
+    pub emissive_texture: Option<usize>,
+    pub kind: SurfaceKind,
+    /// KHR_materials_specular: scales the Fresnel reflectance of dielectrics
+    /// (F0 colour and the strength at every angle); (1,1,1) and 1 without it.
+    pub specular_color: Vec3,
+    pub specular_factor: f32,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: String::new(),
+            base_color: Vec3::ONE,
+            base_color_texture: None,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
+            kind: SurfaceKind::Diffuse,
+            specular_color: Vec3::ONE,
+            specular_factor: 1.0,
+        }
+    }
+}
+
+/// An RGBA8 texture whose colour channels are sRGB-encoded (decoded on sampling).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+/// One drawable: a triangle list in world space with one material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    pub name: String,
+    pub positions: Vec<Vec3>,
+    pub normals: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
+    pub indices: Vec<u32>,
+    pub material: usize,
+    /// Reference point for the maps of a specular object (§3); `None` means the centre
+    /// of the mesh's bounding box.
+    pub reference_point: Option<Vec3>,
+}
+
+impl Mesh {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::from_points(self.positions.iter().copied())
+    }
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
+    pub fn from_points(points: impl IntoIterator<Item = Vec3>) -> Aabb {
+        points.into_iter().fold(Aabb::EMPTY, |b, p| Aabb { min: b.min.min(p), max: b.max.max(p) })
+    }
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
+    }
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+    pub fn diagonal(&self) -> f32 {
+        if self.is_empty() {
+            0.0
+        } else {
+            (self.max - self.min).length()
+        }
+    }
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    Point,
+    /// Cone angles in radians from the axis, glTF's KHR_lights_punctual semantics.
+    Spot {
+        inner_cone: f32,
+        outer_cone: f32,
+    },
+    Directional,
+}
+
+/// A punctual light (KHR_lights_punctual). `direction` is where the light travels
+/// (the node's −Z); unused for point lights.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Light {
+    pub name: String,
+    pub kind: LightKind,
+    pub position: Vec3,
+    pub direction: Vec3,
+    /// Colour × intensity: radiant intensity [W/sr] or irradiance [W/m²] per channel.
+    pub intensity: Vec3,
+    /// glTF `range`: beyond it the light contributes nothing; `None` is unbounded.
+    pub range: Option<f32>,
+}
+
+/// A perspective pinhole camera. The output size's aspect ratio wins over any stored one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub position: Vec3,
+    /// World-from-camera rotation+translation; the camera looks down its −Z.
+    pub world_from_camera: Mat4,
+    /// Vertical field of view in radians.
+    pub yfov: f32,
+    pub znear: f32,
+    /// `None`: infinite far plane.
+    pub zfar: Option<f32>,
+}
+
+impl Camera {
+    /// A camera at `eye` looking at `target` with +Y up.
+    pub fn look_at(eye: Vec3, target: Vec3, yfov: f32) -> Camera {
+        let world_from_camera = Mat4::look_at_rh(eye, target, Vec3::Y).inverse();
+        Camera { position: eye, world_from_camera, yfov, znear: 0.01, zfar: None }
+    }
+    pub fn forward(&self) -> Vec3 {
+        -self.world_from_camera.z_axis.truncate().normalize()
+    }
+    pub fn view(&self) -> Mat4 {
+        self.world_from_camera.inverse()
+    }
+}
+
+/// Equirectangular linear-radiance environment map: direction d maps to
+/// u = 0.5 + atan2(d.x, −d.z)/2π, v = acos(d.y)/π (v = 0 is straight up).
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvironmentMap {
+    pub width: u32,
+    pub height: u32,
+    pub rgba32f: Vec<f32>,
+}
+
+impl EnvironmentMap {
+    pub fn constant(c: Vec3) -> EnvironmentMap {
+        EnvironmentMap { width: 1, height: 1, rgba32f: vec![c.x, c.y, c.z, 1.0] }
+    }
+}
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Scene {
+    pub meshes: Vec<Mesh>,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub lights: Vec<Light>,
+    pub camera: Option<Camera>,
+    /// What rays that leave the scene see; `None` is black.
+    pub environment: Option<EnvironmentMap>,
+}
+
+impl Scene {
+    pub fn new() -> Scene {
+        Scene::default()
+    }
+
+    pub fn add_material(&mut self, m: Material) -> Result<usize> {
+        validate_material(&m, &format!("material '{}'", m.name))?;
+        self.materials.push(m);
+        Ok(self.materials.len() - 1)
+    }
+
+    /// Adds a world-space mesh; normals are computed (area-weighted) when `normals` is empty,
+    /// uvs default to zero. Validates everything: finite positions, in-range indices.
+    pub fn add_mesh(&mut self, mut mesh: Mesh) -> Result<usize> {
+        let what = format!("mesh '{}'", mesh.name);
+        validate_mesh(&mut mesh, self.materials.len(), &what)?;
+        self.meshes.push(mesh);
+        Ok(self.meshes.len() - 1)
+    }
+
+    pub fn add_light(&mut self, l: Light) -> Result<usize> {
+        let bad = !l.position.is_finite() || !l.intensity.is_finite() || l.intensity.min_element() < 0.0;
+        let bad_dir = l.kind != LightKind::Point && (!l.direction.is_finite() || l.direction.length_squared() == 0.0);
+        if bad || bad_dir {
+            return Err(Error::invalid(format!("light '{}'", l.name), "non-finite or negative position, direction or intensity"));
+        }
+        self.lights.push(Light { direction: l.direction.normalize_or_zero(), ..l });
+        Ok(self.lights.len() - 1)
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.meshes.iter().fold(Aabb::EMPTY, |b, m| b.union(&m.bounds()))
+    }
+
+    pub fn specular_meshes(&self) -> impl Iterator<Item = (usize, &Mesh)> {
+        self.meshes.iter().enumerate().filter(|(_, m)| self.materials[m.material].kind.is_specular())
+    }
+
+    /// The reference point of a mesh's maps (survey §3): its own, or its box centre.
+    pub fn reference_point(&self, mesh: usize) -> Vec3 {
+        let m = &self.meshes[mesh];
+        m.reference_point.unwrap_or_else(|| m.bounds().center())
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.meshes.iter().map(Mesh::triangle_count).sum()
+    }
+
+    /// A camera that frames the whole scene when none was given.
+    pub fn camera_or_default(&self) -> Camera {
+        self.camera.unwrap_or_else(|| {
+            let b = self.bounds();
+            let (c, r) = if b.is_empty() { (Vec3::ZERO, 1.0) } else { (b.center(), b.diagonal().max(1e-3) * 0.5) };
+            Camera::look_at(c + Vec3::new(0.0, 0.0, 2.5 * r), c, 45f32.to_radians())
+        })
+    }
+}
+
+pub(crate) fn validate_material(m: &Material, what: &str) -> Result<()> {
+    let finite = m.base_color.is_finite() && m.emissive.is_finite() && m.specular_color.is_finite() && m.specular_factor.is_finite();
+    if !finite {
+        return Err(Error::invalid(what, "non-finite colour or factor"));
+    }
+    match m.kind {
+        SurfaceKind::Dielectric { ior, .. } if !(ior > 0.0 && ior.is_finite()) => {
+            Err(Error::invalid(format!("{what}: ior"), format!("index of refraction must be finite and > 0, got {ior}")))
+        }
+        SurfaceKind::Mirror { nu, kappa }
+            if !(nu.min_element() > 0.0 && nu.is_finite() && kappa.min_element() >= 0.0 && kappa.is_finite()) =>
+        {
+            Err(Error::invalid(format!("{what}: nu/kappa"), "ν must be finite and > 0, κ finite and ≥ 0"))
+        }
+        _ => Ok(()),
+    }
+}
+
+pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) -> Result<()> {
+    if mesh.material >= material_count {
+        return Err(Error::invalid(
+            format!("{what}: material"),
+            format!("index {} out of range ({} materials)", mesh.material, material_count),
+        ));
+    }
+    if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(Error::invalid(format!("{what}: positions"), format!("vertex {i} is not finite ({:?})", mesh.positions[i])));
+    }
+    if mesh.indices.len() % 3 != 0 {
+        return Err(Error::invalid(
+            format!("{what}: indices"),
+            format!("{} indices is not a whole number of triangles", mesh.indices.len()),
+        ));
+    }
+    let n = mesh.positions.len();
+    if let Some(&i) = mesh.indices.iter().find(|&&i| i as usize >= n) {
+        return Err(Error::invalid(format!("{what}: indices"), format!("index {i} out of range ({n} vertices)")));
+    }
+    if let Some(p) = mesh.reference_point {
+        if !p.is_finite() {
+            return Err(Error::invalid(format!("{what}: reference_point"), "not finite"));
+        }
+    }
+    if mesh.normals.is_empty() {
+        mesh.normals = compute_normals(&mesh.positions, &mesh.indices);
+    } else if mesh.normals.len() != n {
+        return Err(Error::invalid(format!("{what}: normals"), format!("{} normals for {} vertices", mesh.normals.len(), n)));
+    } else {
+        // Non-finite or zero normals (degenerate input) fall back to the computed ones.
+        let computed = compute_normals(&mesh.positions, &mesh.indices);
+        for (nrm, c) in mesh.normals.iter_mut().zip(computed) {
+            *nrm = if nrm.is_finite() && nrm.length_squared() > 0.0 { nrm.normalize() } else { c };
+        }
+    }
+    if mesh.uvs.is_empty() {
+        mesh.uvs = vec![Vec2::ZERO; n];
+    } else if mesh.uvs.len() != n {
+        return Err(Error::invalid(format!("{what}: uvs"), format!("{} uvs for {} vertices", mesh.uvs.len(), n)));
+    } else if mesh.uvs.iter().any(|t| !t.is_finite()) {
+        return Err(Error::invalid(format!("{what}: uvs"), "non-finite texture coordinate"));
+    }
+    Ok(())
+}
+
+/// Area-weighted vertex normals; a vertex only on degenerate triangles gets +Y.
+pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; positions.len()];
+    for t in indices.chunks_exact(3) {
+        let (a, b, c) = (positions[t[0] as usize], positions[t[1] as usize], positions[t[2] as usize]);
+        let face = (b - a).cross(c - a); // length = 2 × area
+        if face.is_finite() {
+            for &i in t {
+                n[i as usize] += face;
+            }
+        }
+    }
+    n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Y)).collect()
+}

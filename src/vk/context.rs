@@ -1,0 +1,437 @@
+//! The Vulkan context: instance, physical device, device, queue family, allocator and the
+//! validation messenger. Either created by the library (standalone, headless) or borrowed
+//! from a host engine (the FSR2/XeSS model): passes never assume they own the queue or the
+//! command buffer, they record into whatever `vk::CommandBuffer` they are given.
+
+use std::collections::BTreeMap;
+use std::ffi::{c_void, CStr, CString};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+
+use crate::error::{Error, Result, VkCall};
+
+const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// How to create a standalone context.
+#[derive(Clone, Debug, Default)]
+pub struct DeviceOptions {
+    /// Enable the Khronos validation layer (tests always do).
+    pub validation: bool,
+    /// Case-insensitive substring of the device name ("llvmpipe", "NVIDIA" …). Falls back
+    /// to the `SPECULA_DEVICE` environment variable; without either, the first discrete or
+    /// integrated GPU is taken, then anything else (lavapipe).
+    pub device_filter: Option<String>,
+}
+
+/// Messages the validation layer reported; tests fail on any error.
+#[derive(Debug, Default)]
+pub struct ValidationLog {
+    pub errors: AtomicU32,
+    pub warnings: AtomicU32,
+    pub messages: Mutex<Vec<String>>,
+}
+
+impl ValidationLog {
+    pub fn error_count(&self) -> u32 {
+        self.errors.load(Ordering::Relaxed)
+    }
+    pub fn warning_count(&self) -> u32 {
+        self.warnings.load(Ordering::Relaxed)
+    }
+    pub fn error_messages(&self) -> Vec<String> {
+        self.messages.lock().map(|m| m.clone()).unwrap_or_default()
+    }
+}
+
+/// Every live device allocation, by resource name: what the frame's resources hold.
+#[derive(Debug, Default)]
+pub struct MemoryRegistry {
+    next: AtomicU64,
+    live: Mutex<BTreeMap<u64, (String, u64)>>,
+}
+
+impl MemoryRegistry {
+    pub(crate) fn add(&self, name: &str, bytes: u64) -> u64 {
+        let id = self.next.fetch_add(1, Ordering::Relaxed);
+        if let Ok(mut l) = self.live.lock() {
+            l.insert(id, (name.to_string(), bytes));
+        }
+        id
+    }
+    pub(crate) fn remove(&self, id: u64) {
+        if let Ok(mut l) = self.live.lock() {
+            l.remove(&id);
+        }
+    }
+    /// (resource name, bytes) of every live allocation, in creation order.
+    pub fn snapshot(&self) -> Vec<(String, u64)> {
+        self.live.lock().map(|l| l.values().cloned().collect()).unwrap_or_default()
+    }
+    pub fn total(&self) -> u64 {
+        self.snapshot().iter().map(|(_, b)| b).sum()
+    }
+}
+
+pub struct Context {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue_family: u32,
+    /// The library's own queue; `None` when a host owns submission.
+    pub queue: Option<vk::Queue>,
+    pub properties: vk::PhysicalDeviceProperties,
+    pub device_name: String,
+    pub driver_info: String,
+    pub debug_utils: Option<ash::ext::debug_utils::Device>,
+    debug_instance: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+    pub validation: Arc<ValidationLog>,
+    pub memory: MemoryRegistry,
+    allocator: Mutex<Option<Allocator>>,
+    owned: bool,
+}
+
+/// Device extensions the library needs beyond Vulkan 1.3: null descriptors stand in for
+/// maps a scene does not need, instead of dummy allocations.
+pub const REQUIRED_DEVICE_EXTENSIONS: &[&CStr] = &[ash::ext::robustness2::NAME];
+
+/// Device features every pass relies on; a host device must enable them (see
+/// `required_device_extensions` and `Context::from_host`).
+pub fn required_features_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> std::result::Result<(), String> {
+    let mut f11 = vk::PhysicalDeviceVulkan11Features::default();
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f11).push_next(&mut f13).push_next(&mut robust);
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    let f = f2.features;
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    for name in REQUIRED_DEVICE_EXTENSIONS {
+        if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == *name)) {
+            return Err(format!("device lacks the extension {}", name.to_string_lossy()));
+        }
+    }
+    let checks = [
+        (f.image_cube_array, "imageCubeArray"),
+        (f11.multiview, "multiview"),
+        (robust.null_descriptor, "nullDescriptor (VK_EXT_robustness2)"),
+        (f13.dynamic_rendering, "dynamicRendering"),
+        (f13.synchronization2, "synchronization2"),
+        (f13.maintenance4, "maintenance4"),
+    ];
+    match checks.iter().find(|(v, _)| *v == vk::FALSE) {
+        Some((_, name)) => Err(format!("device lacks the feature {name}")),
+        None => Ok(()),
+    }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // Never unwind through the driver: nothing here can panic on bad input.
+    if user.is_null() || data.is_null() {
+        return vk::FALSE;
+    }
+    let log = &*(user as *const ValidationLog);
+    let msg = if (*data).p_message.is_null() { "".into() } else { CStr::from_ptr((*data).p_message).to_string_lossy() };
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        log.errors.fetch_add(1, Ordering::Relaxed);
+        eprintln!("[vulkan validation error] {msg}");
+        if let Ok(mut m) = log.messages.lock() {
+            if m.len() < 64 {
+                m.push(msg.into_owned());
+            }
+        }
+    } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+        log.warnings.fetch_add(1, Ordering::Relaxed);
+        eprintln!("[vulkan validation warning] {msg}");
+    }
+    vk::FALSE
+}
+
+impl Context {
+    /// Creates a headless instance and device of the library's own.
+    pub fn new(opts: &DeviceOptions) -> Result<Context> {
+        let entry = unsafe { ash::Entry::load() }
+            .map_err(|e| Error::Unsupported(format!("cannot load the Vulkan loader (libvulkan.so.1): {e}")))?;
+        let layers_avail = unsafe { entry.enumerate_instance_layer_properties() }.call("vkEnumerateInstanceLayerProperties")?;
+        let has_layer = |n: &CStr| layers_avail.iter().any(|l| l.layer_name_as_c_str().is_ok_and(|x| x == n));
+        if opts.validation && !has_layer(VALIDATION_LAYER) {
+            return Err(Error::Unsupported(
+                "validation requested but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)".into(),
+            ));
+        }
+        let exts_avail = unsafe { entry.enumerate_instance_extension_properties(None) }.call("vkEnumerateInstanceExtensionProperties")?;
+        let has_debug_utils = exts_avail.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == ash::ext::debug_utils::NAME));
+
+        let app_name = c"specula";
+        let app = vk::ApplicationInfo::default().application_name(app_name).engine_name(app_name).api_version(vk::API_VERSION_1_3);
+        let layers: Vec<*const i8> = if opts.validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
+        let exts: Vec<*const i8> = if has_debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+        let validation = Arc::new(ValidationLog::default());
+        let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+            .message_type(
+                vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                    | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                    | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+            )
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(Arc::as_ptr(&validation) as *mut c_void);
+        let mut ci = vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&exts);
+        if has_debug_utils && opts.validation {
+            ci = ci.push_next(&mut messenger_info); // also catches create/destroy-instance messages
+        }
+        let instance = unsafe { entry.create_instance(&ci, None) }.call("vkCreateInstance")?;
+        let mut ctx_guard = InstanceGuard { instance: Some(instance), debug: None, messenger: vk::DebugUtilsMessengerEXT::null() };
+        let instance_ref = ctx_guard.instance.as_ref().unwrap();
+        if has_debug_utils {
+            let di = ash::ext::debug_utils::Instance::new(&entry, instance_ref);
+            if opts.validation {
+                ctx_guard.messenger =
+                    unsafe { di.create_debug_utils_messenger(&messenger_info, None) }.call("vkCreateDebugUtilsMessengerEXT")?;
+            }
+            ctx_guard.debug = Some(di);
+        }
+
+        let filter = opts.device_filter.clone().or_else(|| std::env::var("SPECULA_DEVICE").ok()).filter(|s| !s.is_empty());
+        let physical = pick_physical_device(instance_ref, filter.as_deref())?;
+        required_features_supported(instance_ref, physical).map_err(Error::Unsupported)?;
+        let families = unsafe { instance_ref.get_physical_device_queue_family_properties(physical) };
+        let queue_family = families
+            .iter()
+            .position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE) && f.timestamp_valid_bits > 0)
+            .ok_or_else(|| Error::Unsupported("no graphics+compute queue with timestamps".into()))? as u32;
+
+        let prio = [1.0f32];
+        let qci = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];
+        let features = vk::PhysicalDeviceFeatures::default().image_cube_array(true);
+        let mut f11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
+        let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
+        let ext_names: Vec<*const i8> = REQUIRED_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+        let dci = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&qci)
+            .enabled_extension_names(&ext_names)
+            .enabled_features(&features)
+            .push_next(&mut f11)
+            .push_next(&mut f13)
+            .push_next(&mut robust);
+        let device = unsafe { instance_ref.create_device(physical, &dci, None) }.call("vkCreateDevice")?;
+        let queue = unsafe { device.get_device_queue(queue_family, 0) };
+        let (instance, debug_instance, messenger) = ctx_guard.release();
+        let mut ctx =
+            Context::assemble(entry, instance, physical, device, queue_family, Some(queue), debug_instance, messenger, validation, true)?;
+        ctx.owned = true;
+        Ok(ctx)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn assemble(
+        entry: ash::Entry,
+        instance: ash::Instance,
+        physical: vk::PhysicalDevice,
+        device: ash::Device,
+        queue_family: u32,
+        queue: Option<vk::Queue>,
+        debug_instance: Option<ash::ext::debug_utils::Instance>,
+        messenger: vk::DebugUtilsMessengerEXT,
+        validation: Arc<ValidationLog>,
+        owned: bool,
+    ) -> Result<Context> {
+        let properties = unsafe { instance.get_physical_device_properties(physical) };
+        let device_name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
+        let driver_info = format!(
+            "{} {}",
+            driver.driver_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(),
+            driver.driver_info_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+        );
+        let debug_utils = debug_instance.as_ref().map(|_| ash::ext::debug_utils::Device::new(&instance, &device));
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: instance.clone(),
+            device: device.clone(),
+            physical_device: physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| Error::Unsupported(format!("gpu-allocator: {e}")))?;
+        Ok(Context {
+            entry,
+            instance,
+            physical,
+            device,
+            queue_family,
+            queue,
+            properties,
+            device_name,
+            driver_info: driver_info.trim().to_string(),
+            debug_utils,
+            debug_instance,
+            messenger,
+            validation,
+            memory: MemoryRegistry::default(),
+            allocator: Mutex::new(Some(allocator)),
+            owned,
+        })
+    }
+
+    pub(crate) fn allocator(&self) -> std::sync::MutexGuard<'_, Option<Allocator>> {
+        self.allocator.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Gives `object` a debug name (RenderDoc, validation messages).
+    pub fn name<H: vk::Handle>(&self, object: H, name: &str) {
+        if let Some(du) = &self.debug_utils {
+            if let Ok(n) = CString::new(name) {
+                let info = vk::DebugUtilsObjectNameInfoEXT::default().object_handle(object).object_name(&n);
+                let _ = unsafe { du.set_debug_utils_object_name(&info) };
+            }
+        }
+    }
+
+    pub fn begin_label(&self, cmd: vk::CommandBuffer, name: &str) {
+        if let Some(du) = &self.debug_utils {
+            if let Ok(n) = CString::new(name) {
+                let label = vk::DebugUtilsLabelEXT::default().label_name(&n).color([0.9, 0.7, 0.2, 1.0]);
+                unsafe { du.cmd_begin_debug_utils_label(cmd, &label) };
+            }
+        }
+    }
+
+    pub fn end_label(&self, cmd: vk::CommandBuffer) {
+        if let Some(du) = &self.debug_utils {
+            unsafe { du.cmd_end_debug_utils_label(cmd) };
+        }
+    }
+
+    /// Timestamp tick length in nanoseconds.
+    pub fn timestamp_period_ns(&self) -> f64 {
+        self.properties.limits.timestamp_period as f64
+    }
+
+    /// Records `f` into a fresh command buffer on the library's queue, submits it and waits.
+    /// Standalone mode only.
+    pub fn one_shot<R>(&self, f: impl FnOnce(vk::CommandBuffer) -> Result<R>) -> Result<R> {
+        let queue = self.queue.ok_or_else(|| Error::invalid("one_shot", "this context has no queue of its own (host-device mode)"))?;
+        let d = &self.device;
+        let pool = unsafe { d.create_command_pool(&vk::CommandPoolCreateInfo::default().queue_family_index(self.queue_family), None) }
+            .call("vkCreateCommandPool")?;
+        let result = (|| {
+            let cmd =
+                unsafe { d.allocate_command_buffers(&vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1)) }
+                    .call("vkAllocateCommandBuffers")?[0];
+            unsafe {
+                d.begin_command_buffer(cmd, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT))
+            }
+            .call("vkBeginCommandBuffer")?;
+            let r = f(cmd)?;
+            unsafe { d.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
+            let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.call("vkCreateFence")?;
+            let cmds = [cmd];
+            let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
+            let waited = unsafe { d.queue_submit(queue, &submit, fence) }
+                .call("vkQueueSubmit")
+                .and_then(|_| unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.call("vkWaitForFences"));
+            unsafe { d.destroy_fence(fence, None) };
+            waited.map(|_| r)
+        })();
+        unsafe { d.destroy_command_pool(pool, None) };
+        result
+    }
+
+    pub fn wait_idle(&self) -> Result<()> {
+        unsafe { self.device.device_wait_idle() }.call("vkDeviceWaitIdle")
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            // The allocator frees its memory blocks; it must go before the device.
+            if let Ok(mut a) = self.allocator.lock() {
+                a.take();
+            }
+            if self.owned {
+                self.device.destroy_device(None);
+                if let Some(di) = &self.debug_instance {
+                    if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                        di.destroy_debug_utils_messenger(self.messenger, None);
+                    }
+                }
+                self.instance.destroy_instance(None);
+            }
+        }
+    }
+}
+
+/// Destroys a half-built instance when device creation fails part-way.
+struct InstanceGuard {
+    instance: Option<ash::Instance>,
+    debug: Option<ash::ext::debug_utils::Instance>,
+    messenger: vk::DebugUtilsMessengerEXT,
+}
+
+impl InstanceGuard {
+    fn release(mut self) -> (ash::Instance, Option<ash::ext::debug_utils::Instance>, vk::DebugUtilsMessengerEXT) {
+        let i = self.instance.take().unwrap();
+        (i, self.debug.take(), self.messenger)
+    }
+}
+
+impl Drop for InstanceGuard {
+    fn drop(&mut self) {
+        if let Some(i) = self.instance.take() {
+            unsafe {
+                if let Some(d) = &self.debug {
+                    if self.messenger != vk::DebugUtilsMessengerEXT::null() {
+                        d.destroy_debug_utils_messenger(self.messenger, None);
+                    }
+                }
+                i.destroy_instance(None);
+            }
+        }
+    }
+}
+
+fn pick_physical_device(instance: &ash::Instance, filter: Option<&str>) -> Result<vk::PhysicalDevice> {
+    let devices = unsafe { instance.enumerate_physical_devices() }.call("vkEnumeratePhysicalDevices")?;
+    let named: Vec<(vk::PhysicalDevice, String, vk::PhysicalDeviceType)> = devices
+        .into_iter()
+        .map(|d| {
+            let p = unsafe { instance.get_physical_device_properties(d) };
+            let name = p.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            (d, name, p.device_type)
+        })
+        .collect();
+    if let Some(f) = filter {
+        let f = f.to_lowercase();
+        return named.iter().find(|(_, n, _)| n.to_lowercase().contains(&f)).map(|(d, _, _)| *d).ok_or_else(|| {
+            Error::Unsupported(format!(
+                "no Vulkan device matches '{f}' (available: {})",
+                named.iter().map(|(_, n, _)| n.as_str()).collect::<Vec<_>>().join(", ")
+            ))
+        });
+    }
+    let rank = |t: vk::PhysicalDeviceType| match t {
+        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+        _ => 3,
+    };
+    named
+        .iter()
+        .min_by_key(|(_, _, t)| rank(*t))
+        .map(|(d, _, _)| *d)
+        .ok_or_else(|| Error::Unsupported("no Vulkan device (is mesa-vulkan-drivers installed?)".into()))
+}

@@ -1,0 +1,226 @@
+//! Graphics and compute pipelines from the embedded SPIR-V, and descriptor set layouts.
+
+use ash::vk;
+
+use super::Context;
+use crate::error::{Error, Result, VkCall};
+
+pub fn shader_module(ctx: &Context, name: &str) -> Result<vk::ShaderModule> {
+    let bytes = crate::shaders::get(name).ok_or_else(|| Error::invalid("shader", format!("no embedded shader '{name}'")))?;
+    let words = ash::util::read_spv(&mut std::io::Cursor::new(bytes)).map_err(|e| Error::invalid(name, format!("bad SPIR-V: {e}")))?;
+    let m = unsafe { ctx.device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None) }
+        .call("vkCreateShaderModule")?;
+    ctx.name(m, name);
+    Ok(m)
+}
+
+/// A descriptor binding: (binding, type, count). What a scene does not need is written as
+/// a null descriptor (VK_EXT_robustness2) instead of a dummy allocation.
+pub type Binding = (u32, vk::DescriptorType, u32);
+
+pub fn descriptor_set_layout(
+    ctx: &Context,
+    name: &str,
+    bindings: &[Binding],
+    stages: vk::ShaderStageFlags,
+) -> Result<vk::DescriptorSetLayout> {
+    let b: Vec<_> = bindings
+        .iter()
+        .map(|&(binding, ty, count)| {
+            vk::DescriptorSetLayoutBinding::default().binding(binding).descriptor_type(ty).descriptor_count(count).stage_flags(stages)
+        })
+        .collect();
+    let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&b);
+    let l = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }.call("vkCreateDescriptorSetLayout")?;
+    ctx.name(l, name);
+    Ok(l)
+}
+
+/// A pool sized for exactly one set of `bindings`, and that set.
+pub fn allocate_set(
+    ctx: &Context,
+    name: &str,
+    layout: vk::DescriptorSetLayout,
+    bindings: &[Binding],
+) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
+    let sizes: Vec<_> = bindings.iter().map(|&(_, ty, count)| vk::DescriptorPoolSize { ty, descriptor_count: count }).collect();
+    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
+        .call("vkCreateDescriptorPool")?;
+    let layouts = [layout];
+    let set = match unsafe {
+        ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+    } {
+        Ok(s) => s[0],
+        Err(e) => {
+            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            return Err(e).call("vkAllocateDescriptorSets");
+        }
+    };
+    ctx.name(set, name);
+    Ok((pool, set))
+}
+
+/// Writes a buffer descriptor; a null `buffer` writes a null descriptor.
+pub fn write_buffer(ctx: &Context, set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
+    let info = [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];
+    let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).buffer_info(&info);
+    unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+}
+
+/// Writes an image descriptor; a null `view` writes a null descriptor.
+#[allow(clippy::too_many_arguments)]
+pub fn write_image(
+    ctx: &Context,
+    set: vk::DescriptorSet,
+    binding: u32,
+    element: u32,
+    ty: vk::DescriptorType,
+    view: vk::ImageView,
+    sampler: vk::Sampler,
+    layout: vk::ImageLayout,
+) {
+    let info = [vk::DescriptorImageInfo { sampler, image_view: view, image_layout: layout }];
+    let w = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(binding)
+        .dst_array_element(element)
+        .descriptor_type(ty)
+        .image_info(&info);
+    unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+}
+
+pub fn pipeline_layout(
+    ctx: &Context,
+    name: &str,
+    sets: &[vk::DescriptorSetLayout],
+    push_bytes: u32,
+    stages: vk::ShaderStageFlags,
+) -> Result<vk::PipelineLayout> {
+    let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_bytes }];
+    let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets);
+    if push_bytes > 0 {
+        info = info.push_constant_ranges(&ranges);
+    }
+    let l = unsafe { ctx.device.create_pipeline_layout(&info, None) }.call("vkCreatePipelineLayout")?;
+    ctx.name(l, name);
+    Ok(l)
+}
+
+/// Vertex layout of the scene's interleaved vertex buffer (see `gpu_scene::Vertex`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VertexInput {
+    None,
+    /// position vec3, normal vec3, uv vec2: 32 bytes.
+    Mesh,
+}
+
+/// Everything that distinguishes one graphics pipeline of this library from another.
+pub struct GraphicsDesc<'a> {
+    pub name: &'a str,
+    pub vertex: &'a str,
+    pub fragment: &'a str,
+    pub vertex_input: VertexInput,
+    pub color_formats: &'a [vk::Format],
+    pub depth_format: Option<vk::Format>,
+    /// Reversed-Z: GREATER passes nearer fragments.
+    pub depth_test: bool,
+    pub depth_write: bool,
+    /// Multiview mask (0x3F renders all six cube faces in one pass).
+    pub view_mask: u32,
+}
+
+pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &GraphicsDesc) -> Result<vk::Pipeline> {
+    let vs = shader_module(ctx, desc.vertex)?;
+    let fs = match shader_module(ctx, desc.fragment) {
+        Ok(f) => f,
+        Err(e) => {
+            unsafe { ctx.device.destroy_shader_module(vs, None) };
+            return Err(e);
+        }
+    };
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main"),
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"),
+    ];
+    let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: 32, input_rate: vk::VertexInputRate::VERTEX }];
+    let attrs = [
+        vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 0 },
+        vk::VertexInputAttributeDescription { location: 1, binding: 0, format: vk::Format::R32G32B32_SFLOAT, offset: 12 },
+        vk::VertexInputAttributeDescription { location: 2, binding: 0, format: vk::Format::R32G32_SFLOAT, offset: 24 },
+    ];
+    let vi = match desc.vertex_input {
+        VertexInput::None => vk::PipelineVertexInputStateCreateInfo::default(),
+        VertexInput::Mesh => {
+            vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&bindings).vertex_attribute_descriptions(&attrs)
+        }
+    };
+    let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let vp = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    // Two-sided: rooms are seen from inside, refractors from both sides.
+    let rs = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .line_width(1.0);
+    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let ds = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(desc.depth_test)
+        .depth_write_enable(desc.depth_write)
+        .depth_compare_op(vk::CompareOp::GREATER);
+    let blend: Vec<_> = desc
+        .color_formats
+        .iter()
+        .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
+        .collect();
+    let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
+    let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    let dy = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dyn_states);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(desc.color_formats)
+        .depth_attachment_format(desc.depth_format.unwrap_or(vk::Format::UNDEFINED))
+        .view_mask(desc.view_mask);
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vi)
+        .input_assembly_state(&ia)
+        .viewport_state(&vp)
+        .rasterization_state(&rs)
+        .multisample_state(&ms)
+        .depth_stencil_state(&ds)
+        .color_blend_state(&cb)
+        .dynamic_state(&dy)
+        .layout(layout)
+        .push_next(&mut rendering);
+    let r = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+    unsafe {
+        ctx.device.destroy_shader_module(vs, None);
+        ctx.device.destroy_shader_module(fs, None);
+    }
+    let p = r.map_err(|(_, e)| e).call("vkCreateGraphicsPipelines")?[0];
+    ctx.name(p, desc.name);
+    Ok(p)
+}
+
+pub fn compute_pipeline(ctx: &Context, layout: vk::PipelineLayout, shader: &str) -> Result<vk::Pipeline> {
+    let cs = shader_module(ctx, shader)?;
+    let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(cs).name(c"main");
+    let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
+    let r = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
+    unsafe { ctx.device.destroy_shader_module(cs, None) };
+    let p = r.map_err(|(_, e)| e).call("vkCreateComputePipelines")?[0];
+    ctx.name(p, shader);
+    Ok(p)
+}
+
+pub fn sampler(ctx: &Context, name: &str, filter: vk::Filter, address: vk::SamplerAddressMode) -> Result<vk::Sampler> {
+    let info = vk::SamplerCreateInfo::default()
+        .mag_filter(filter)
+        .min_filter(filter)
+        .mipmap_mode(vk::SamplerMipmapMode::NEAREST)
+        .address_mode_u(address)
+        .address_mode_v(address)
+        .address_mode_w(address)
+        .max_lod(0.0);
+    let s = unsafe { ctx.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
+    ctx.name(s, name);
+    Ok(s)
+}
