@@ -289,6 +289,16 @@ impl Renderer {
         Ok(())
     }
 
+    /// The environment-map cube array (one cube per `plan.envmaps` entry), if planned.
+    pub fn envmaps(&self) -> Option<&Image> {
+        self.envmap_generate.as_ref().map(|g| &g.maps)
+    }
+
+    /// The shadow cube array (one cube per `plan.shadow_cubes` entry), if planned.
+    pub fn shadow_cubes(&self) -> Option<&Image> {
+        self.shadows.cubes.as_ref()
+    }
+
     pub fn camera(&self) -> &Camera {
         &self.camera
     }

@@ -333,7 +333,7 @@ impl<'a> Importer<'a> {
         let stride = view.stride().unwrap_or(elem);
         if count > 0 {
             let end = stride.checked_mul(count - 1).and_then(|x| x.checked_add(acc.offset())).and_then(|x| x.checked_add(elem));
-            if !end.is_some_and(|end| end <= bytes.len()) {
+            if end.is_none_or(|end| end > bytes.len()) {
                 return Err(self.err(
                     field,
                     format!(

@@ -9,6 +9,7 @@
 
 mod environment;
 mod gltf_import;
+pub mod shapes;
 
 pub use environment::*;
 pub use gltf_import::load;
@@ -87,7 +88,7 @@ pub struct Texture {
 }
 
 /// One drawable: a triangle list in world space with one material.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     pub name: String,
     pub positions: Vec<Vec3>,

@@ -1,0 +1,106 @@
+//! Procedural meshes for scenes built in code (tests, the C ABI's examples, benchmarks).
+
+use glam::{Vec2, Vec3};
+
+use super::Mesh;
+
+/// A UV sphere with analytic normals: `segments` around, `rings` from pole to pole.
+pub fn uv_sphere(name: &str, center: Vec3, radius: f32, segments: u32, rings: u32, material: usize) -> Mesh {
+    let (segments, rings) = (segments.max(3), rings.max(2));
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    for r in 0..=rings {
+        let theta = std::f32::consts::PI * r as f32 / rings as f32;
+        for s in 0..=segments {
+            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            m.positions.push(center + n * radius);
+            m.normals.push(n);
+            m.uvs.push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+        }
+    }
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b, c, d) = (r * row + s, r * row + s + 1, (r + 1) * row + s, (r + 1) * row + s + 1);
+            if r != 0 {
+                m.indices.extend([a, c, b]);
+            }
+            if r != rings - 1 {
+                m.indices.extend([b, c, d]);
+            }
+        }
+    }
+    m
+}
+
+/// A planar quad `origin + u·[0,1] + v·[0,1]`, tessellated `n`×`n`, facing `u × v`.
+pub fn quad(name: &str, origin: Vec3, u: Vec3, v: Vec3, n: u32, material: usize) -> Mesh {
+    let n = n.max(1);
+    let normal = u.cross(v).normalize();
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    for j in 0..=n {
+        for i in 0..=n {
+            let (a, b) = (i as f32 / n as f32, j as f32 / n as f32);
+            m.positions.push(origin + u * a + v * b);
+            m.normals.push(normal);
+            m.uvs.push(Vec2::new(a, b));
+        }
+    }
+    for j in 0..n {
+        for i in 0..n {
+            let k = j * (n + 1) + i;
+            m.indices.extend([k, k + 1, k + n + 2, k, k + n + 2, k + n + 1]);
+        }
+    }
+    m
+}
+
+/// The six inward-facing walls of an axis-aligned box room, in the order
+/// +X, −X, +Y, −Y, +Z, −Z, each split into 2×2 quadrants (24 meshes). Quadrant q of a
+/// wall covers the signs (bit 1: second in-plane axis > 0, bit 0: first > 0) of the two
+/// other coordinates relative to `center`, the in-plane axes taken in x, y, z order.
+/// `material(wall, quadrant)` names each quadrant's material.
+pub fn quadrant_room(center: Vec3, half: f32, tessellation: u32, material: impl Fn(usize, usize) -> usize) -> Vec<Mesh> {
+    let mut meshes = Vec::new();
+    for wall in 0..6 {
+        let axis = wall / 2;
+        let sign = if wall % 2 == 0 { 1.0 } else { -1.0 };
+        let (a1, a2) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        for q in 0..4 {
+            let (p1, p2) = (if q & 1 != 0 { 1.0 } else { -1.0 }, if q & 2 != 0 { 1.0 } else { -1.0 });
+            let mut o = Vec3::ZERO;
+            o[axis] = sign * half;
+            let mut u = Vec3::ZERO;
+            u[a1] = p1 * half;
+            let mut v = Vec3::ZERO;
+            v[a2] = p2 * half;
+            // Orient each quad to face the room's centre.
+            let (u, v) = if u.cross(v).dot(-o) > 0.0 { (u, v) } else { (v, u) };
+            meshes.push(quad(&format!("wall{wall}.q{q}"), center + o, u, v, tessellation, material(wall, q)));
+        }
+    }
+    meshes
+}
+
+/// Which wall and quadrant of `quadrant_room` the ray from `center` along `d` hits.
+pub fn quadrant_room_hit(d: Vec3) -> (usize, usize) {
+    let a = d.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    let wall = 2 * axis + if d[axis] >= 0.0 { 0 } else { 1 };
+    let (a1, a2) = match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    };
+    (wall, (d[a1] > 0.0) as usize | (((d[a2] > 0.0) as usize) << 1))
+}
