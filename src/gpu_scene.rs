@@ -122,6 +122,7 @@ impl GpuScene {
         if scene.meshes.is_empty() || scene.triangle_count() == 0 {
             return Err(Error::invalid("scene", "has no triangles to render"));
         }
+        scene.validate()?;
         if scene.textures.len() > MAX_TEXTURES {
             return Err(Error::invalid("scene", format!("{} textures exceed the limit of {MAX_TEXTURES}", scene.textures.len())));
         }

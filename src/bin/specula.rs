@@ -134,7 +134,7 @@ struct Job {
 fn prepare(a: &RenderArgs) -> specula::Result<Job> {
     let mut scene = scene::load(&a.scene)?;
     if let Some(env) = &a.env {
-        scene.environment = Some(scene::load_environment(env)?);
+        scene.set_environment(scene::load_environment(env)?)?;
     }
     if let Some(pos) = &a.camera_pos {
         let eye = parse_vec3("--camera-pos", pos)?;

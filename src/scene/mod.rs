@@ -180,7 +180,10 @@ pub struct Camera {
 impl Camera {
     /// A camera at `eye` looking at `target` with +Y up.
     pub fn look_at(eye: Vec3, target: Vec3, yfov: f32) -> Camera {
-        let world_from_camera = Mat4::look_at_rh(eye, target, Vec3::Y).inverse();
+        // Looking straight up or down, +Y cannot be the up vector: take −Z instead.
+        let dir = (target - eye).normalize_or(Vec3::NEG_Z);
+        let up = if dir.cross(Vec3::Y).length_squared() < 1e-10 { Vec3::NEG_Z } else { Vec3::Y };
+        let world_from_camera = Mat4::look_to_rh(eye, dir, up).inverse();
         Camera { position: eye, world_from_camera, yfov, znear: 0.01, zfar: None }
     }
     pub fn forward(&self) -> Vec3 {
@@ -204,6 +207,20 @@ impl EnvironmentMap {
     pub fn constant(c: Vec3) -> EnvironmentMap {
         EnvironmentMap { width: 1, height: 1, rgba32f: vec![c.x, c.y, c.z, 1.0] }
     }
+
+    /// Size matches texels, every texel finite and non-negative.
+    pub fn validate(&self) -> Result<()> {
+        if self.width == 0 || self.height == 0 || self.rgba32f.len() as u64 != self.width as u64 * self.height as u64 * 4 {
+            return Err(Error::invalid(
+                "environment map",
+                format!("{} floats for {}x{} RGBA", self.rgba32f.len(), self.width, self.height),
+            ));
+        }
+        if self.rgba32f.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            return Err(Error::invalid("environment map", "non-finite or negative radiance"));
+        }
+        Ok(())
+    }
 }
 
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -223,7 +240,16 @@ impl Scene {
     }
 
     pub fn add_material(&mut self, m: Material) -> Result<usize> {
-        validate_material(&m, &format!("material '{}'", m.name))?;
+        let what = format!("material '{}'", m.name);
+        validate_material(&m, &what)?;
+        for (field, t) in [("base_color_texture", m.base_color_texture), ("emissive_texture", m.emissive_texture)] {
+            if let Some(t) = t.filter(|&t| t >= self.textures.len()) {
+                return Err(Error::invalid(
+                    format!("{what}: {field}"),
+                    format!("texture {t} out of range ({} textures)", self.textures.len()),
+                ));
+            }
+        }
         self.materials.push(m);
         Ok(self.materials.len() - 1)
     }
@@ -237,11 +263,38 @@ impl Scene {
         Ok(self.meshes.len() - 1)
     }
 
+    /// Adds an RGBA8 (sRGB) texture; its texel count must match its size.
+    pub fn add_texture(&mut self, t: Texture) -> Result<usize> {
+        if t.width == 0 || t.height == 0 || t.rgba8.len() as u64 != t.width as u64 * t.height as u64 * 4 {
+            return Err(Error::invalid(
+                format!("texture '{}'", t.name),
+                format!("{} bytes for {}x{} RGBA8", t.rgba8.len(), t.width, t.height),
+            ));
+        }
+        self.textures.push(t);
+        Ok(self.textures.len() - 1)
+    }
+
+    /// Sets the environment map after checking its size against its texels.
+    pub fn set_environment(&mut self, e: EnvironmentMap) -> Result<()> {
+        e.validate()?;
+        self.environment = Some(e);
+        Ok(())
+    }
+
     pub fn add_light(&mut self, l: Light) -> Result<usize> {
         let bad = !l.position.is_finite() || !l.intensity.is_finite() || l.intensity.min_element() < 0.0;
         let bad_dir = l.kind != LightKind::Point && (!l.direction.is_finite() || l.direction.length_squared() == 0.0);
         if bad || bad_dir {
             return Err(Error::invalid(format!("light '{}'", l.name), "non-finite or negative position, direction or intensity"));
+        }
+        if l.range.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
+            return Err(Error::invalid(format!("light '{}': range", l.name), "must be finite and > 0"));
+        }
+        if let LightKind::Spot { inner_cone, outer_cone } = l.kind {
+            if !(0.0 <= inner_cone && inner_cone <= outer_cone && outer_cone <= std::f32::consts::FRAC_PI_2) {
+                return Err(Error::invalid(format!("light '{}': cone", l.name), "needs 0 ≤ inner ≤ outer ≤ π/2"));
+            }
         }
         self.lights.push(Light { direction: l.direction.normalize_or_zero(), ..l });
         Ok(self.lights.len() - 1)
@@ -249,6 +302,48 @@ impl Scene {
 
     pub fn bounds(&self) -> Aabb {
         self.meshes.iter().fold(Aabb::EMPTY, |b, m| b.union(&m.bounds()))
+    }
+
+    /// Re-checks a scene whose public fields may have been filled by hand: every index in
+    /// range, every number finite, attribute arrays of matching length.
+    pub fn validate(&self) -> Result<()> {
+        for m in &self.materials {
+            let what = format!("material '{}'", m.name);
+            validate_material(m, &what)?;
+            if [m.base_color_texture, m.emissive_texture].into_iter().flatten().any(|t| t >= self.textures.len()) {
+                return Err(Error::invalid(what, "texture index out of range"));
+            }
+        }
+        for t in &self.textures {
+            if t.width == 0 || t.height == 0 || t.rgba8.len() as u64 != t.width as u64 * t.height as u64 * 4 {
+                return Err(Error::invalid(format!("texture '{}'", t.name), "texel count does not match its size"));
+            }
+        }
+        for m in &self.meshes {
+            let what = format!("mesh '{}'", m.name);
+            let n = m.positions.len();
+            if m.material >= self.materials.len() {
+                return Err(Error::invalid(what, "material index out of range"));
+            }
+            if m.normals.len() != n || m.uvs.len() != n || m.indices.len() % 3 != 0 || m.indices.iter().any(|&i| i as usize >= n) {
+                return Err(Error::invalid(what, "attribute lengths or indices inconsistent (add meshes with Scene::add_mesh)"));
+            }
+            if !m.positions.iter().all(|p| p.is_finite())
+                || !m.normals.iter().all(|p| p.is_finite())
+                || !m.uvs.iter().all(|p| p.is_finite())
+            {
+                return Err(Error::invalid(what, "non-finite vertex attribute"));
+            }
+        }
+        if let Some(e) = &self.environment {
+            e.validate()?;
+        }
+        if let Some(c) = &self.camera {
+            if !c.position.is_finite() || !c.world_from_camera.is_finite() {
+                return Err(Error::invalid("camera", "non-finite transform"));
+            }
+        }
+        Ok(())
     }
 
     pub fn specular_meshes(&self) -> impl Iterator<Item = (usize, &Mesh)> {
@@ -302,6 +397,9 @@ pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) 
     }
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(Error::invalid(format!("{what}: positions"), format!("vertex {i} is not finite ({:?})", mesh.positions[i])));
+    }
+    if mesh.positions.is_empty() || mesh.indices.is_empty() {
+        return Err(Error::invalid(format!("{what}: indices"), "mesh has no vertices or no triangles"));
     }
     if mesh.indices.len() % 3 != 0 {
         return Err(Error::invalid(

@@ -1,0 +1,125 @@
+//! The per-pass profiler: every pass of a frame is reported by its stable name with a
+//! positive GPU time, the Chrome trace JSON parses, and the CLI writes both.
+
+mod common;
+
+use std::path::Path;
+use std::process::Command;
+
+use specula::{Method, Quality};
+
+fn demo() -> specula::Scene {
+    specula::scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
+}
+
+fn small() -> Quality {
+    let mut q = Quality::default();
+    q.set("cube_size", "32").unwrap();
+    q.set("shadow_size", "32").unwrap();
+    q
+}
+
+#[test]
+fn every_pass_is_reported_with_positive_gpu_time() {
+    let ctx = common::gpu();
+    let scene = demo();
+    let plan = specula::plan(&scene, Method::Envmap, &small());
+    let f = specula::render(&ctx, &scene, Method::Envmap, &small(), 48, 32, 0, 1).unwrap();
+    let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
+    // The first frame uploads the textures; everything the plan names is there, in order.
+    let mut expected: Vec<&str> = plan.passes.clone();
+    expected.push("frame.readback");
+    assert_eq!(names, expected);
+    for p in &f.passes {
+        assert!(p.gpu_ms > 0.0, "{} has GPU time {}", p.name, p.gpu_ms);
+        assert!(p.cpu_ms >= 0.0);
+    }
+    assert!(f.memory_bytes() > 0);
+    let json: serde_json::Value = serde_json::from_str(&specula::profile::chrome_trace(&f.passes, &f.memory, &ctx.device_name)).unwrap();
+    let events = json["traceEvents"].as_array().unwrap();
+    for name in &names {
+        assert!(events.iter().any(|e| e["name"] == *name && e["ph"] == "X" && e["dur"].as_f64().unwrap() > 0.0), "{name} in trace");
+    }
+    assert_eq!(json["otherData"]["device_memory_total_bytes"].as_u64().unwrap(), f.memory_bytes());
+    common::assert_clean(&ctx);
+}
+
+fn specula() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_specula"))
+}
+
+#[test]
+fn cli_render_writes_image_profile_and_table() {
+    let dir = std::env::temp_dir().join(format!("specula-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, exr, trace) = (dir.join("a.png"), dir.join("a.exr"), dir.join("trace.json"));
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    for out in [&png, &exr] {
+        let o = specula()
+            .args([
+                "render",
+                scene,
+                "--method",
+                "envmap",
+                "--size",
+                "40x30",
+                "--validate",
+                "-q",
+                "cube_size=32",
+                "-q",
+                "shadow_size=32",
+                "--out",
+            ])
+            .arg(out)
+            .arg("--profile")
+            .arg(&trace)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&o.stdout);
+        assert!(o.status.success(), "{stdout}{}", String::from_utf8_lossy(&o.stderr));
+        for pass in ["shadow.generate", "envmap.generate", "scene.direct", "envmap.shade", "device memory", "validation: 0 error(s)"] {
+            assert!(stdout.contains(pass), "table lacks {pass}: {stdout}");
+        }
+    }
+    let img = image::open(&png).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    let env = specula::scene::load_environment(&exr).unwrap();
+    assert_eq!((env.width, env.height), (40, 30));
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&trace).unwrap()).unwrap();
+    assert!(json["traceEvents"].as_array().unwrap().len() > 4);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn cli_bad_input_is_one_line_and_nonzero() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let cases: &[&[&str]] = &[
+        &["render", "/nonexistent/scene.gltf", "--out", "/tmp/x.png"],
+        &["render", scene, "--method", "raytrace-everything", "--out", "/tmp/x.png"],
+        &["render", scene, "--size", "0x10", "--out", "/tmp/x.png"],
+        &["render", scene, "-q", "cube_size=3", "--out", "/tmp/x.png"],
+        &["render", scene, "-q", "fresnel=maybe", "--out", "/tmp/x.png"],
+        &["render", scene, "--out", "/tmp/x.bmp"],
+        &["render", scene, "--camera-pos", "1,nan,2", "--out", "/tmp/x.png"],
+        &["render", scene, "--device", "no-such-gpu", "--out", "/tmp/x.png"],
+        &["info", "/nonexistent.glb"],
+    ];
+    for args in cases {
+        let o = specula().args(*args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.starts_with("specula: ") && stderr.trim_end().lines().count() == 1, "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+#[test]
+fn cli_info_lists_classification() {
+    let o = specula().args(["info", concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf")]).output().unwrap();
+    let s = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success());
+    for want in ["mirror", "dielectric (solid)", "diffuse", "Point", "camera: at", "bounds:"] {
+        assert!(s.contains(want), "info lacks {want}: {s}");
+    }
+}
