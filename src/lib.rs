@@ -21,17 +21,15 @@ pub use quality::Quality;
 pub use renderer::{Frame, Renderer};
 pub use scene::Scene;
 
-/// Renders `scene` with `method`: `warmup` frames (pipelines compile lazily on some
+/// Renders `scene` with `method` at `(width, height)`: `warmup` frames (pipelines compile lazily on some
 /// drivers), then `frames` timed ones. Returns the last frame with the median per pass.
 pub fn render(
     ctx: &vk::Context,
     scene: &Scene,
     method: Method,
     quality: &Quality,
-    width: u32,
-    height: u32,
-    warmup: u32,
-    frames: u32,
+    (width, height): (u32, u32),
+    (warmup, frames): (u32, u32),
 ) -> Result<Frame> {
     let mut r = Renderer::new(ctx, scene, plan(scene, method, quality), width, height)?;
     let result = (|| {

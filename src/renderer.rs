@@ -100,13 +100,7 @@ impl Renderer {
             return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
         }
         let camera = scene.camera_or_default();
-        if !camera.position.is_finite()
-            || !camera.world_from_camera.is_finite()
-            || !(camera.yfov > 0.0 && camera.yfov < std::f32::consts::PI)
-            || !(camera.znear > 0.0)
-        {
-            return Err(Error::invalid("camera", "non-finite transform, or yfov outside (0, π), or znear ≤ 0"));
-        }
+        camera.validate()?;
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.
         let mut r = Renderer {
@@ -279,12 +273,7 @@ impl Renderer {
 
     /// Replaces the camera (the output size's aspect ratio still wins).
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        if !camera.position.is_finite()
-            || !camera.world_from_camera.is_finite()
-            || !(camera.yfov > 0.0 && camera.yfov < std::f32::consts::PI)
-        {
-            return Err(Error::invalid("camera", "non-finite transform or yfov outside (0, π)"));
-        }
+        camera.validate()?;
         self.camera = camera;
         Ok(())
     }

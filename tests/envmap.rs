@@ -135,7 +135,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.5), Vec3::ZERO, 1.0));
     let q = Quality::default();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, 16, 16, 0, 1).unwrap();
+    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["scene.direct", "frame.readback"]);
     assert!(f.memory.iter().all(|(n, _)| !n.starts_with("envmap") && !n.starts_with("shadow") && n != "scene.lights"), "{:?}", f.memory);
@@ -151,7 +151,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
             range: None,
         })
         .unwrap();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, 16, 16, 0, 1).unwrap();
+    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["shadow.generate", "scene.direct", "frame.readback"]);
     assert!(f.memory.iter().any(|(n, _)| n == "shadow.cubes"));
@@ -162,7 +162,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.3, 16, 8, m)).unwrap();
     let mut q = Quality::default();
     q.set("cube_size", "64").unwrap();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, 16, 16, 0, 1).unwrap();
+    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["shadow.generate", "envmap.generate", "scene.direct", "envmap.shade", "frame.readback"]);
     let cubes = f.memory.iter().find(|(n, _)| n == "envmap.cubes").unwrap().1;

@@ -24,7 +24,7 @@ fn every_pass_is_reported_with_positive_gpu_time() {
     let ctx = common::gpu();
     let scene = demo();
     let plan = specula::plan(&scene, Method::Envmap, &small());
-    let f = specula::render(&ctx, &scene, Method::Envmap, &small(), 48, 32, 0, 1).unwrap();
+    let f = specula::render(&ctx, &scene, Method::Envmap, &small(), (48, 32), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     // The first frame uploads the textures; everything the plan names is there, in order.
     let mut expected: Vec<&str> = plan.passes.clone();

@@ -170,7 +170,7 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Render { args, out, profile } => {
             let job = prepare(&args)?;
             let ctx = context(args.validate, &args.device)?;
-            let frame = specula::render(&ctx, &job.scene, job.method, &job.quality, job.width, job.height, args.warmup, args.frames)?;
+            let frame = specula::render(&ctx, &job.scene, job.method, &job.quality, (job.width, job.height), (args.warmup, args.frames))?;
             write_image(&out, &frame)?;
             println!("{} on {} ({}), {}x{}", job.method.name(), ctx.device_name, ctx.driver_info, job.width, job.height);
             print!("{}", specula::profile::table(&frame.passes, &frame.memory));
@@ -276,7 +276,7 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
     let ctx = context(validate, device)?;
     let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
     for &method in Method::ALL {
-        let frame = specula::render(&ctx, &scene, method, &Quality::default(), w, h, 2, 5)?;
+        let frame = specula::render(&ctx, &scene, method, &Quality::default(), (w, h), (2, 5))?;
         let png = outdir.join(format!("{}.png", method.name()));
         let exr = outdir.join(format!("{}.exr", method.name()));
         write_image(&png, &frame)?;

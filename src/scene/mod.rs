@@ -186,6 +186,15 @@ impl Camera {
         let world_from_camera = Mat4::look_to_rh(eye, dir, up).inverse();
         Camera { position: eye, world_from_camera, yfov, znear: 0.01, zfar: None }
     }
+    /// Finite transform, 0 < yfov < π, znear > 0.
+    pub fn validate(&self) -> Result<()> {
+        let fov_ok = self.yfov > 0.0 && self.yfov < std::f32::consts::PI;
+        if !self.position.is_finite() || !self.world_from_camera.is_finite() || !fov_ok || self.znear.is_nan() || self.znear <= 0.0 {
+            return Err(Error::invalid("camera", "non-finite transform, yfov outside (0, π) or znear ≤ 0"));
+        }
+        Ok(())
+    }
+
     pub fn forward(&self) -> Vec3 {
         -self.world_from_camera.z_axis.truncate().normalize()
     }
