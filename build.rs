@@ -19,6 +19,8 @@ fn main() {
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap());
     // A directory makes cargo rerun when any file below it changes (or is added).
     println!("cargo:rerun-if-changed=glsl");
+    println!("cargo:rerun-if-changed=build/shaderc.rs");
+    println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=GLSLANG_VALIDATOR");
 
     let mut sources = Vec::new();
