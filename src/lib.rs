@@ -48,3 +48,4 @@ pub fn render(
     r.destroy(ctx);
     result
 }
+pub mod ffi;

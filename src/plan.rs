@@ -14,15 +14,28 @@ use crate::scene::{LightKind, Scene};
 pub enum Method {
     /// Classic environment mapping (survey §3, §3.1).
     Envmap,
+    /// The exact CPU reference (`crate::reference`): Whitted ray tracing in the original
+    /// geometry, in f64. Ground truth for the tests and for `specula tradeoff`; it has no
+    /// GPU passes, and `Renderer::new` refuses its plan.
+    Reference,
 }
 
 impl Method {
-    pub const ALL: &'static [Method] = &[Method::Envmap];
+    /// Every method, GPU methods first; a new method joins the CLI, the demo and the
+    /// trade-off study by being listed here.
+    pub const ALL: &'static [Method] = &[Method::Envmap, Method::Reference];
 
     pub fn name(self) -> &'static str {
         match self {
             Method::Envmap => "envmap",
+            Method::Reference => "reference",
         }
+    }
+
+    /// Whether the method renders on the GPU (through `Renderer`); the reference renders
+    /// on the CPU (`reference::render_reference`).
+    pub fn is_gpu(self) -> bool {
+        !matches!(self, Method::Reference)
     }
 
     pub fn parse(s: &str) -> Result<Method> {
@@ -57,7 +70,23 @@ pub struct Plan {
     pub cube_near: f32,
 }
 
+/// The passes `Method::Reference` reports: one CPU pass, no maps (its shadows are exact
+/// shadow rays, its reflections and refractions traced rays).
+pub const REFERENCE_PASS: &str = "reference.trace";
+
 pub fn plan(scene: &Scene, method: Method, quality: &Quality) -> Plan {
+    if method == Method::Reference {
+        let diag = scene.bounds().diagonal();
+        return Plan {
+            method,
+            quality: quality.clone(),
+            shadow_cubes: Vec::new(),
+            shadow_planes: Vec::new(),
+            envmaps: Vec::new(),
+            passes: vec![REFERENCE_PASS],
+            cube_near: if diag > 0.0 { diag * 1e-5 } else { 1e-4 },
+        };
+    }
     let mut shadow_cubes = Vec::new();
     let mut shadow_planes = Vec::new();
     for (i, l) in scene.lights.iter().enumerate() {
@@ -67,6 +96,7 @@ pub fn plan(scene: &Scene, method: Method, quality: &Quality) -> Plan {
         }
     }
     let envmaps: Vec<EnvmapPlan> = match method {
+        Method::Reference => Vec::new(),
         Method::Envmap => scene
             .specular_meshes()
             .enumerate()

@@ -39,6 +39,10 @@ pub struct Quality {
     /// Overrides every specular object's reference point (world space, metres).
     pub ref_point: Option<Vec3>,
     pub shadow_size: u32,
+    /// Reference renderer: maximum number of specular bounces R followed (survey Table 1).
+    pub depth: u32,
+    /// Reference renderer: samples per pixel, a k×k stratified grid (k² = spp).
+    pub spp: u32,
 }
 
 /// A knob's documentation: one line each, shown by `specula knobs`.
@@ -71,6 +75,18 @@ pub const KNOBS: &[Knob] = &[
         doc: "reference point of every specular object's maps; auto = its bounding-box centre",
     },
     Knob { name: "shadow_size", values: "16..=4096 texels", default: "512", doc: "edge of each shadow distance map face" },
+    Knob {
+        name: "depth",
+        values: "1..=64 bounces",
+        default: "8",
+        doc: "reference: specular recursion depth R; paths still specular after R bounces end black",
+    },
+    Knob {
+        name: "spp",
+        values: "1, 4, 9, ..., 1024",
+        default: "16",
+        doc: "reference: samples per pixel on a k×k stratified grid (a perfect square; 1 = pixel centre)",
+    },
 ];
 
 impl Default for Quality {
@@ -82,6 +98,8 @@ impl Default for Quality {
             fresnel: FresnelMode::Schlick,
             ref_point: None,
             shadow_size: 512,
+            depth: 8,
+            spp: 16,
         }
     }
 }
@@ -101,6 +119,18 @@ impl Quality {
         match key {
             "cube_size" => self.cube_size = parse_size(key, value)?,
             "shadow_size" => self.shadow_size = parse_size(key, value)?,
+            "depth" => {
+                self.depth = match value.parse::<u32>() {
+                    Ok(n) if (1..=64).contains(&n) => n,
+                    _ => return Err(bad("1..=64")),
+                }
+            }
+            "spp" => {
+                self.spp = match value.parse::<u32>() {
+                    Ok(n) if (1..=1024).contains(&n) && n.isqrt().pow(2) == n => n,
+                    _ => return Err(bad("the perfect squares 1, 4, 9, ..., 1024")),
+                }
+            }
             "cube_precision" => {
                 self.cube_precision = match value {
                     "half" => Precision::Half,
@@ -168,6 +198,12 @@ mod tests {
         assert!(q.set_pair("ref_point=1,nan,3").is_err());
         assert!(q.set_pair("warp=9").is_err());
         assert!(q.set_pair("cube_size").is_err());
+        q.set_pair("depth=1").unwrap();
+        q.set_pair("spp=9").unwrap();
+        assert_eq!((q.depth, q.spp), (1, 9));
+        for bad in ["depth=0", "depth=65", "spp=8", "spp=0", "spp=2048", "spp=x"] {
+            assert!(q.set_pair(bad).is_err(), "{bad}");
+        }
         for k in KNOBS {
             let mut q = Quality::default();
             q.set(k.name, k.default).unwrap();

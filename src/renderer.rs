@@ -90,6 +90,7 @@ pub struct Renderer {
     flags: u32,
     light_count: u32,
     light_table: Vec<GpuLight>,
+    last_timings: Vec<PassTiming>,
 }
 
 impl Renderer {
@@ -130,6 +131,7 @@ impl Renderer {
             flags: 0,
             light_count: 0,
             light_table: Vec::new(),
+            last_timings: Vec::new(),
         };
         if let Err(e) = r.init(ctx, scene) {
             r.destroy(ctx);
@@ -363,6 +365,76 @@ impl Renderer {
         Ok(())
     }
 
+    /// Host-device mode: records a frame into the host's `cmd` and copies the result into
+    /// the host's image (same size; a bit-exact copy for R32G32B32A32_SFLOAT, a blit with
+    /// format conversion otherwise), leaving it in `final_layout`.
+    pub fn record_into(&mut self, ctx: &Context, cmd: vk::CommandBuffer, host: &mut Image, final_layout: vk::ImageLayout) -> Result<()> {
+        if host.width != self.width || host.height != self.height {
+            return Err(Error::invalid(
+                "target image",
+                format!("{}x{} but the renderer was configured for {}x{}", host.width, host.height, self.width, self.height),
+            ));
+        }
+        // The previous frame's timings, if the host has let it complete.
+        if let Some(t) = self.profiler.poll(ctx)? {
+            self.last_timings = t;
+            self.scene.release_staging(ctx);
+        }
+        self.record(ctx, cmd)?;
+        let mut rec = Recorder::resume(ctx, cmd, &mut self.profiler);
+        let open = rec.pass("frame.output").reads(&self.target, Access::TransferSrc).writes(host, Access::TransferDst).begin();
+        let layers = |aspect| vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 };
+        let c = vk::ImageAspectFlags::COLOR;
+        unsafe {
+            if host.format == self.target.format {
+                let region = vk::ImageCopy {
+                    src_subresource: layers(c),
+                    dst_subresource: layers(c),
+                    extent: vk::Extent3D { width: self.width, height: self.height, depth: 1 },
+                    ..Default::default()
+                };
+                ctx.device.cmd_copy_image(
+                    cmd,
+                    self.target.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    host.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[region],
+                );
+            } else {
+                let corner = vk::Offset3D { x: self.width as i32, y: self.height as i32, z: 1 };
+                let region = vk::ImageBlit {
+                    src_subresource: layers(c),
+                    src_offsets: [vk::Offset3D::default(), corner],
+                    dst_subresource: layers(c),
+                    dst_offsets: [vk::Offset3D::default(), corner],
+                };
+                ctx.device.cmd_blit_image(
+                    cmd,
+                    self.target.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    host.raw,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[region],
+                    vk::Filter::NEAREST,
+                );
+            }
+            let barriers = [host.release_to(final_layout)];
+            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barriers));
+        }
+        rec.end(open);
+        Ok(())
+    }
+
+    /// Per-pass timings of the last frame the GPU has completed (host-device mode polls
+    /// without waiting; standalone frames are always complete).
+    pub fn last_timings(&mut self, ctx: &Context) -> Result<&[PassTiming]> {
+        if let Some(t) = self.profiler.poll(ctx)? {
+            self.last_timings = t;
+        }
+        Ok(&self.last_timings)
+    }
+
     /// Standalone: records, submits and waits for one frame, then reads the image back.
     pub fn render(&mut self, ctx: &Context) -> Result<Frame> {
         if self.readback.is_none() {
@@ -377,6 +449,7 @@ impl Renderer {
         ctx.one_shot(|cmd| self.record(ctx, cmd))?;
         self.scene.release_staging(ctx);
         let passes = self.profiler.results(ctx)?;
+        self.last_timings = passes.clone();
         let rb = self.readback.as_ref().unwrap();
         let image = crate::vk::decode(self.target.format, self.width, self.height, 1, rb.read()?)?;
         let errors = ctx.validation.error_count();

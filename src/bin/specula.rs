@@ -77,6 +77,15 @@ enum Command {
     },
     /// List methods and accuracy knobs with their ranges and defaults.
     Knobs,
+    /// Time a method over several frames for each value of one knob, in one run, and print
+    /// per-pass medians with each variant's frame time relative to the first.
+    Bench {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// knob=v1,v2,... (e.g. cube_mode=six,multiview); without it, one variant.
+        #[arg(long)]
+        sweep: Option<String>,
+    },
     /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
     Demo {
         #[arg(default_value = "out")]
@@ -203,6 +212,7 @@ fn run(cmd: Command) -> specula::Result<()> {
             Ok(())
         }
         Command::Demo { outdir, size, validate, device } => demo(&outdir, &size, validate, &device),
+        Command::Bench { args, sweep } => bench(&args, sweep.as_deref()),
     }
 }
 
@@ -291,5 +301,51 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
     print!("{report}");
     let table = outdir.join("timings.txt");
     std::fs::write(&table, &report).map_err(|e| specula::Error::io(&table, e))?;
+    Ok(())
+}
+
+/// `specula bench`: every variant in the same process and run, so the machine's noise
+/// affects them alike; compare the ratios, not the absolute figures.
+fn bench(args: &RenderArgs, sweep: Option<&str>) -> specula::Result<()> {
+    let job = prepare(args)?;
+    let variants: Vec<(String, Quality)> = match sweep {
+        None => vec![("default".into(), job.quality.clone())],
+        Some(s) => {
+            let (key, values) = s.split_once('=').ok_or_else(|| specula::Error::invalid("--sweep", "expected knob=v1,v2,..."))?;
+            values
+                .split(',')
+                .map(|v| {
+                    let mut q = job.quality.clone();
+                    q.set(key, v)?;
+                    Ok((format!("{key}={v}"), q))
+                })
+                .collect::<specula::Result<_>>()?
+        }
+    };
+    let ctx = context(args.validate, &args.device)?;
+    println!(
+        "{} on {} ({}), {}x{}, median of {} frames after {} warm-up",
+        job.method.name(),
+        ctx.device_name,
+        ctx.driver_info,
+        job.width,
+        job.height,
+        args.frames,
+        args.warmup
+    );
+    let mut base = None;
+    for (label, q) in variants {
+        let f = specula::render(&ctx, &job.scene, job.method, &q, (job.width, job.height), (args.warmup, args.frames))?;
+        let ms = f.gpu_ms();
+        let b = *base.get_or_insert(ms);
+        println!(
+            "\n== {label}: frame {ms:.3} ms GPU ({:.2}x the first variant), {:.2} MiB device memory",
+            ms / b,
+            f.memory_bytes() as f64 / 1048576.0
+        );
+        for p in &f.passes {
+            println!("   {:<22} {:>9.3} ms GPU {:>8.3} ms CPU", p.name, p.gpu_ms, p.cpu_ms);
+        }
+    }
     Ok(())
 }

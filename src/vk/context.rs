@@ -26,6 +26,18 @@ pub struct DeviceOptions {
     pub device_filter: Option<String>,
 }
 
+/// What a host engine hands over in host-device mode.
+#[derive(Clone, Copy)]
+pub struct HostHandles {
+    pub get_instance_proc_addr: vk::PFN_vkGetInstanceProcAddr,
+    pub instance: vk::Instance,
+    pub physical_device: vk::PhysicalDevice,
+    pub device: vk::Device,
+    pub queue_family: u32,
+    /// The host enabled VK_EXT_debug_utils on its instance: object names and pass labels.
+    pub debug_utils: bool,
+}
+
 /// Messages the validation layer reported; tests fail on any error.
 #[derive(Debug, Default)]
 pub struct ValidationLog {
@@ -230,6 +242,48 @@ impl Context {
             Context::assemble(entry, instance, physical, device, queue_family, Some(queue), debug_instance, messenger, validation, true)?;
         ctx.owned = true;
         Ok(ctx)
+    }
+
+    /// Host-device mode (the FSR2/XeSS model): loads Vulkan through the host's
+    /// `vkGetInstanceProcAddr` and uses its instance, physical device and device. The host
+    /// keeps ownership: dropping the context destroys only what the library created. The
+    /// library never submits; it records into command buffers the host hands it.
+    ///
+    /// # Safety
+    /// The handles must be valid and created with `REQUIRED_DEVICE_EXTENSIONS` and the
+    /// features `required_features_supported` checks enabled; they must outlive the context.
+    pub unsafe fn from_host(host: &HostHandles) -> Result<Context> {
+        let entry = ash::Entry::from_static_fn(ash::StaticFn { get_instance_proc_addr: host.get_instance_proc_addr });
+        let instance = ash::Instance::load(entry.static_fn(), host.instance);
+        let device = ash::Device::load(instance.fp_v1_0(), host.device);
+        let props = instance.get_physical_device_properties(host.physical_device);
+        if vk::api_version_major(props.api_version) == 1 && vk::api_version_minor(props.api_version) < 3 {
+            return Err(Error::Unsupported("the host's physical device does not support Vulkan 1.3".into()));
+        }
+        required_features_supported(&instance, host.physical_device).map_err(Error::Unsupported)?;
+        let families = instance.get_physical_device_queue_family_properties(host.physical_device);
+        match families.get(host.queue_family as usize) {
+            Some(f) if f.queue_flags.contains(vk::QueueFlags::GRAPHICS) && f.timestamp_valid_bits > 0 => {}
+            _ => return Err(Error::invalid("queue_family", "is not a graphics queue family with timestamps on this physical device")),
+        }
+        let debug_instance = host.debug_utils.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
+        Context::assemble(
+            entry,
+            instance,
+            host.physical_device,
+            device,
+            host.queue_family,
+            None,
+            debug_instance,
+            vk::DebugUtilsMessengerEXT::null(),
+            Arc::new(ValidationLog::default()),
+            false,
+        )
+    }
+
+    /// Whether the library created (and will destroy) the instance and device.
+    pub fn owns_device(&self) -> bool {
+        self.owned
     }
 
     #[allow(clippy::too_many_arguments)]

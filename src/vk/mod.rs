@@ -8,7 +8,9 @@ mod readback;
 mod recorder;
 mod resource;
 
-pub use context::{required_features_supported, Context, DeviceOptions, MemoryRegistry, ValidationLog, REQUIRED_DEVICE_EXTENSIONS};
+pub use context::{
+    required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry, ValidationLog, REQUIRED_DEVICE_EXTENSIONS,
+};
 pub use readback::{decode, read_image, record_copy_to_buffer, ImageData};
 pub use recorder::{begin_rendering, OpenPass, PassTiming, Profiler, Recorder, Target};
 pub use resource::{format_bytes, is_depth, Access, Buffer, Image, ImageDesc, ImageKind, ImageState, MemoryLocation};

@@ -66,6 +66,21 @@ impl Profiler {
             .collect())
     }
 
+    /// The last recorded frame's timings if the GPU has finished it, without waiting
+    /// (host-device mode: the host decides when frames complete).
+    pub fn poll(&self, ctx: &Context) -> Result<Option<Vec<PassTiming>>> {
+        let n = self.names.len() as u32;
+        if n == 0 {
+            return Ok(None);
+        }
+        let mut ticks = vec![0u64; 2 * n as usize];
+        match unsafe { ctx.device.get_query_pool_results(self.pool, 0, &mut ticks, vk::QueryResultFlags::TYPE_64) } {
+            Ok(()) => self.results(ctx).map(Some),
+            Err(vk::Result::NOT_READY) => Ok(None),
+            Err(e) => Err(e).call("vkGetQueryPoolResults"),
+        }
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         if self.pool != vk::QueryPool::null() {
             unsafe { ctx.device.destroy_query_pool(self.pool, None) };
@@ -101,6 +116,11 @@ impl<'a> Recorder<'a> {
         unsafe { ctx.device.cmd_reset_query_pool(cmd, profiler.pool, 0, 2 * profiler.capacity) };
         profiler.names.clear();
         profiler.cpu_ms.clear();
+        Recorder { ctx, cmd, profiler }
+    }
+
+    /// Continues recording passes of a frame that `new` started (same query pool).
+    pub fn resume(ctx: &'a Context, cmd: vk::CommandBuffer, profiler: &'a mut Profiler) -> Recorder<'a> {
         Recorder { ctx, cmd, profiler }
     }
 

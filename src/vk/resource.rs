@@ -293,6 +293,45 @@ impl Image {
         }
     }
 
+    /// An image the host owns (host-device mode): the library records into it and tracks
+    /// its state for the frame, but never creates or destroys it.
+    pub fn external(raw: vk::Image, format: vk::Format, width: u32, height: u32, layout: vk::ImageLayout, name: &str) -> Image {
+        let mut img = Image::placeholder();
+        img.raw = raw;
+        img.format = format;
+        img.width = width;
+        img.height = height;
+        img.name = name.to_string();
+        img.state.set(ImageState {
+            stage: vk::PipelineStageFlags2::ALL_COMMANDS,
+            access: vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+            layout,
+        });
+        img
+    }
+
+    /// The barrier that leaves the image in `layout` for whatever comes next (host images).
+    pub(crate) fn release_to(&self, layout: vk::ImageLayout) -> vk::ImageMemoryBarrier2<'static> {
+        let from = self.state.get();
+        let to = ImageState {
+            stage: vk::PipelineStageFlags2::ALL_COMMANDS,
+            access: vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+            layout,
+        };
+        self.state.set(to);
+        vk::ImageMemoryBarrier2::default()
+            .src_stage_mask(from.stage)
+            .src_access_mask(from.access)
+            .dst_stage_mask(to.stage)
+            .dst_access_mask(to.access)
+            .old_layout(from.layout)
+            .new_layout(layout)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(self.raw)
+            .subresource_range(self.range())
+    }
+
     fn create_views(&mut self, ctx: &Context, usage: vk::ImageUsageFlags) -> Result<()> {
         let layers = self.kind.layers();
         let view_type = match self.kind {
