@@ -343,8 +343,9 @@ uint32_t specula_live_context_count(void);
 // The library version as VK_MAKE_API_VERSION(0, major, minor, patch). Thread-safe.
 uint32_t specula_version(void);
 
-// The message of the last failed specula_context_create* on this thread ("" if none).
-// Valid until the next create call on this thread. Thread-safe.
+// The message of the last failed specula_context_create* or specula_get_requirements on
+// this thread ("" if none). The pointer stays valid for the thread's lifetime; its text
+// changes with the next failure. Thread-safe.
 const char *specula_creation_error(void);
 
 // Fills `out` with what a host must enable (host-device mode). Thread-safe.
@@ -364,8 +365,9 @@ SpeculaResult specula_context_create_host(const SpeculaHostDesc *desc, SpeculaCo
 // destroyed handle returns SPECULA_ERROR_INVALID_HANDLE. Not thread-safe per context.
 SpeculaResult specula_context_destroy(SpeculaContext *ctx);
 
-// The message of the last failed call on `ctx` ("" if none). Valid until the next call
-// on `ctx`. Returns a static message for an invalid handle.
+// The message of the last failed call on `ctx` ("" if none). The pointer stays valid until
+// the context is destroyed; its text changes with the next failure. Returns a static
+// message for an invalid handle.
 const char *specula_context_last_error(const SpeculaContext *ctx);
 
 // Installs (or, with NULL, removes) a log callback for `ctx`.

@@ -312,7 +312,9 @@ pub struct SpeculaContext {
     /// Bumped on every scene change; a renderer built for an older scene is stale.
     scene_version: u64,
     renderer_version: u64,
-    last_error: CString,
+    /// NUL-terminated message of the last failed call, overwritten in place so that a
+    /// pointer the caller holds stays valid for the context's lifetime.
+    last_error: [u8; MESSAGE_BYTES],
     log: SpeculaLogCallback,
     log_user: *mut c_void,
     /// Dropped last: everything above that holds device objects is freed before it.
@@ -322,8 +324,26 @@ pub struct SpeculaContext {
 /// Live context pointers: a destroyed or foreign handle is detected, not dereferenced.
 static LIVE: Mutex<Option<HashSet<usize>>> = Mutex::new(None);
 
+const MESSAGE_BYTES: usize = 1024;
+
 thread_local! {
-    static CREATION_ERROR: RefCell<CString> = RefCell::new(CString::default());
+    /// Like `last_error`, per thread, for the create calls (which have no context yet).
+    static CREATION_ERROR: RefCell<Box<[u8; MESSAGE_BYTES]>> = RefCell::new(Box::new([0; MESSAGE_BYTES]));
+}
+
+/// Copies `msg` into `buf` NUL-terminated, truncated at a character boundary.
+fn store_message(buf: &mut [u8; MESSAGE_BYTES], msg: &str) {
+    let mut end = msg.len().min(MESSAGE_BYTES - 1);
+    while !msg.is_char_boundary(end) {
+        end -= 1;
+    }
+    buf[..end].copy_from_slice(&msg.as_bytes()[..end]);
+    buf[end] = 0;
+    for b in &mut buf[..end] {
+        if *b == 0 {
+            *b = b' ';
+        }
+    }
 }
 
 fn live_insert(p: *mut SpeculaContext) {
@@ -388,7 +408,7 @@ fn boundary(f: impl FnOnce() -> FfiResult<SpeculaResult>) -> Result<SpeculaResul
 
 impl SpeculaContext {
     fn set_error(&mut self, f: &Fail) {
-        self.last_error = CString::new(f.1.replace('\0', " ")).unwrap_or_default();
+        store_message(&mut self.last_error, &f.1);
         self.log(SPECULA_LOG_ERROR, &f.1);
     }
 
@@ -480,7 +500,7 @@ fn vec3(a: [f32; 3]) -> Vec3 {
 }
 
 fn set_creation_error(f: &Fail) {
-    CREATION_ERROR.with(|e| *e.borrow_mut() = CString::new(f.1.replace('\0', " ")).unwrap_or_default());
+    CREATION_ERROR.with(|e| store_message(&mut e.borrow_mut(), &f.1));
 }
 
 fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Context>) -> SpeculaResult {
@@ -498,7 +518,7 @@ fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Contex
             renderer: None,
             scene_version: 0,
             renderer_version: 0,
-            last_error: CString::default(),
+            last_error: [0; MESSAGE_BYTES],
             log: None,
             log_user: std::ptr::null_mut(),
             vk,
@@ -536,11 +556,12 @@ pub extern "C" fn specula_version() -> u32 {
     vk::make_api_version(0, v(env!("CARGO_PKG_VERSION_MAJOR")), v(env!("CARGO_PKG_VERSION_MINOR")), v(env!("CARGO_PKG_VERSION_PATCH")))
 }
 
-/// The message of the last failed specula_context_create* on this thread ("" if none).
-/// Valid until the next create call on this thread. Thread-safe.
+/// The message of the last failed specula_context_create* or specula_get_requirements on
+/// this thread ("" if none). The pointer stays valid for the thread's lifetime; its text
+/// changes with the next failure. Thread-safe.
 #[no_mangle]
 pub extern "C" fn specula_creation_error() -> *const c_char {
-    CREATION_ERROR.with(|e| e.borrow().as_ptr())
+    CREATION_ERROR.with(|e| e.borrow().as_ptr() as *const c_char)
 }
 
 /// Fills `out` with what a host must enable (host-device mode). Thread-safe.
@@ -548,7 +569,8 @@ pub extern "C" fn specula_creation_error() -> *const c_char {
 pub unsafe extern "C" fn specula_get_requirements(out: *mut SpeculaRequirements) -> SpeculaResult {
     let r = boundary(|| {
         header(out as *const SpeculaRequirements, SPECULA_STRUCT_REQUIREMENTS, "requirements")?;
-        // Static C strings of REQUIRED_DEVICE_EXTENSIONS (a test checks they agree).
+        let _: &[&CStr; 1] = &[ash::ext::robustness2::NAME]; // the one extension PTRS spells out
+                                                             // Static C strings of REQUIRED_DEVICE_EXTENSIONS (a test checks they agree).
         struct Ptrs([*const c_char; 1]);
         unsafe impl Sync for Ptrs {}
         static PTRS: Ptrs = Ptrs([c"VK_EXT_robustness2".as_ptr()]);
@@ -565,7 +587,10 @@ pub unsafe extern "C" fn specula_get_requirements(out: *mut SpeculaRequirements)
         o.null_descriptor = 1;
         Ok(SPECULA_SUCCESS)
     });
-    r.unwrap_or_else(|f| f.0)
+    r.unwrap_or_else(|f| {
+        set_creation_error(&f);
+        f.0
+    })
 }
 
 /// Standalone mode: creates a context with its own headless device. On failure `*out` is
@@ -623,14 +648,15 @@ pub unsafe extern "C" fn specula_context_destroy(ctx: *mut SpeculaContext) -> Sp
     }
 }
 
-/// The message of the last failed call on `ctx` ("" if none). Valid until the next call
-/// on `ctx`. Returns a static message for an invalid handle.
+/// The message of the last failed call on `ctx` ("" if none). The pointer stays valid until
+/// the context is destroyed; its text changes with the next failure. Returns a static
+/// message for an invalid handle.
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_last_error(ctx: *const SpeculaContext) -> *const c_char {
     if ctx.is_null() || !is_live(ctx) || (*ctx).magic != MAGIC {
         return c"invalid context handle (NULL, destroyed, or not a specula context)".as_ptr();
     }
-    (*ctx).last_error.as_ptr()
+    (*ctx).last_error.as_ptr() as *const c_char
 }
 
 /// Installs (or, with NULL, removes) a log callback for `ctx`.
@@ -875,6 +901,9 @@ pub unsafe extern "C" fn specula_context_record(
     target: *const SpeculaHostImage,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
+        if c.vk.owns_device() {
+            return fail(SPECULA_ERROR_WRONG_ORDER, "standalone context: render frames with specula_context_render");
+        }
         if command_buffer.is_null() {
             return fail(SPECULA_ERROR_NULL_POINTER, "command_buffer is NULL");
         }

@@ -8,12 +8,15 @@ pub use error::{Error, Result};
 pub mod cube;
 pub mod gpu_scene;
 pub mod methods;
+pub mod metrics;
 pub mod optics;
 pub mod plan;
 pub mod profile;
 pub mod quality;
+pub mod reference;
 pub mod renderer;
 pub mod shaders;
+pub mod tradeoff;
 pub mod vk;
 
 pub use plan::{plan, Method, Plan};

@@ -97,6 +97,9 @@ impl Renderer {
     /// Creates everything the plan needs at `width`×`height`. On error, everything created
     /// so far is destroyed again.
     pub fn new(ctx: &Context, scene: &Scene, plan: Plan, width: u32, height: u32) -> Result<Renderer> {
+        if !plan.method.is_gpu() {
+            return Err(Error::invalid("method", format!("'{}' renders on the CPU: use reference::render_reference", plan.method.name())));
+        }
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
             return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
         }

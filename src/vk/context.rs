@@ -140,6 +140,15 @@ pub fn required_features_supported(instance: &ash::Instance, pd: vk::PhysicalDev
     }
 }
 
+/// Validation errors reported by any context of this process, ever: a leaked Vulkan object
+/// shows up here, because the layer reports every child object still alive at
+/// vkDestroyDevice, after the context's own log is gone.
+static PROCESS_VALIDATION_ERRORS: AtomicU32 = AtomicU32::new(0);
+
+pub fn process_validation_errors() -> u32 {
+    PROCESS_VALIDATION_ERRORS.load(Ordering::Relaxed)
+}
+
 unsafe extern "system" fn debug_callback(
     severity: vk::DebugUtilsMessageSeverityFlagsEXT,
     _types: vk::DebugUtilsMessageTypeFlagsEXT,
@@ -154,6 +163,7 @@ unsafe extern "system" fn debug_callback(
     let msg = if (*data).p_message.is_null() { "".into() } else { CStr::from_ptr((*data).p_message).to_string_lossy() };
     if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
         log.errors.fetch_add(1, Ordering::Relaxed);
+        PROCESS_VALIDATION_ERRORS.fetch_add(1, Ordering::Relaxed);
         eprintln!("[vulkan validation error] {msg}");
         if let Ok(mut m) = log.messages.lock() {
             if m.len() < 64 {

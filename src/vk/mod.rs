@@ -9,7 +9,8 @@ mod recorder;
 mod resource;
 
 pub use context::{
-    required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry, ValidationLog, REQUIRED_DEVICE_EXTENSIONS,
+    process_validation_errors, required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry, ValidationLog,
+    REQUIRED_DEVICE_EXTENSIONS,
 };
 pub use readback::{decode, read_image, record_copy_to_buffer, ImageData};
 pub use recorder::{begin_rendering, OpenPass, PassTiming, Profiler, Recorder, Target};

@@ -1,0 +1,315 @@
+//! The exact CPU reference renderer: Whitted-style ray tracing in the original geometry
+//! (survey §2, Table 1: "exact, all") in f64, the ground truth that tests and
+//! `specula tradeoff` measure every GPU method against.
+//!
+//! - Geometry: every scene triangle in a SAH BVH (`bvh`), Möller–Trumbore hits.
+//! - Specular surfaces: *both* the reflected and the refracted branch are followed,
+//!   weighted by the Fresnel function of `Quality::fresnel` (survey eq. 1, 2),
+//!   deterministically, up to `Quality::depth` bounces; a path still specular after that
+//!   ends black. Branches whose path weight drops below `MIN_PATH_WEIGHT` in every channel
+//!   are not followed (their share is below the GPU maps' half-float precision).
+//! - Everything else is shaded as the GPU shades it (`shade`): emission + Lambertian
+//!   direct light with the glTF range window and spot cone, with exact shadow rays in place
+//!   of distance maps; rays that leave the scene see the same environment lookup.
+//! - The camera is the GPU's: the same pinhole, aspect ratio of the output size, near
+//!   plane (geometry nearer than `znear` along the view axis is clipped), pixel (x, y)
+//!   spanning [x, x+1]×[y, y+1] with row 0 at the top. `Quality::spp` samples per pixel on a
+//!   k×k stratified grid with a fixed hash jitter (1 sample = the pixel centre, as the GPU's
+//!   single sample), averaged (box filter).
+//! - Rows are rendered in parallel (rayon), the result is deterministic.
+
+pub mod bvh;
+pub mod shade;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::quality::{FresnelMode, Quality};
+use crate::scene::{Camera, Scene, SurfaceKind};
+use crate::vk::ImageData;
+use bvh::{Bvh, Hit};
+use shade::{ShadeLight, Sky, Textures};
+
+/// Path weights below this (every channel) are not traced further.
+pub const MIN_PATH_WEIGHT: f64 = 1e-6;
+
+/// A scene prepared for tracing: BVH, decoded textures, environment, lights.
+pub struct Tracer<'a> {
+    scene: &'a Scene,
+    bvh: Bvh,
+    textures: Textures,
+    sky: Sky,
+    lights: Vec<ShadeLight>,
+    fresnel: FresnelMode,
+    depth: u32,
+    /// Secondary and shadow rays start this far from the surface they leave (and skip its
+    /// triangle): a fixed fraction of the scene's size, so scaling the scene scales it.
+    epsilon: f64,
+}
+
+/// What one camera ray sees, pre-computed per pixel sample.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays {
+    eye: DVec3,
+    right: DVec3,
+    up: DVec3,
+    forward: DVec3,
+    tan_half: f64,
+    aspect: f64,
+    width: u32,
+    height: u32,
+    znear: f64,
+}
+
+impl CameraRays {
+    /// The GPU camera (`Renderer::camera_view_proj`: reversed-Z infinite perspective,
+    /// Vulkan y-down) as rays.
+    pub fn new(camera: &Camera, width: u32, height: u32) -> CameraRays {
+        let w = camera.world_from_camera.as_dmat4();
+        CameraRays {
+            eye: w.transform_point3(DVec3::ZERO),
+            right: w.transform_vector3(DVec3::X),
+            up: w.transform_vector3(DVec3::Y),
+            forward: w.transform_vector3(DVec3::NEG_Z),
+            tan_half: (camera.yfov as f64 * 0.5).tan(),
+            aspect: width as f64 / height as f64,
+            width,
+            height,
+            znear: camera.znear as f64,
+        }
+    }
+
+    /// The ray through image point (x, y) in pixels (pixel centres at half-integers): its
+    /// origin, unit direction and the ray parameter of the near plane.
+    pub fn ray(&self, x: f64, y: f64) -> (DVec3, DVec3, f64) {
+        let ndc_x = 2.0 * x / self.width as f64 - 1.0;
+        let ndc_y = 2.0 * y / self.height as f64 - 1.0;
+        // View space (x right, y up, −z forward) at unit depth.
+        let d = self.right * (ndc_x * self.tan_half * self.aspect) - self.up * (ndc_y * self.tan_half) + self.forward;
+        let len = d.length();
+        (self.eye, d / len, self.znear * len)
+    }
+}
+
+/// Sample `s` of `spp` = k² in pixel (x, y): the centre of stratum (s mod k, s div k),
+/// jittered within it by a fixed hash; spp = 1 is the pixel centre.
+pub fn sample_offset(x: u32, y: u32, s: u32, spp: u32) -> (f64, f64) {
+    if spp <= 1 {
+        return (0.5, 0.5);
+    }
+    let k = spp.isqrt().max(1);
+    let (i, j) = (s % k, s / k);
+    let h = hash(x, y, s);
+    let jx = (h & 0xffff) as f64 / 65536.0;
+    let jy = (h >> 16) as f64 / 65536.0;
+    ((i as f64 + jx) / k as f64, (j as f64 + jy) / k as f64)
+}
+
+/// A 32-bit integer hash (lowbias32 by Chris Wellons) of the pixel and sample.
+fn hash(x: u32, y: u32, s: u32) -> u32 {
+    let mut h = x.wrapping_mul(0x9E37_79B9) ^ y.wrapping_mul(0x85EB_CA6B) ^ s.wrapping_mul(0xC2B2_AE35);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7feb_352d);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846c_a68b);
+    h ^ (h >> 16)
+}
+
+impl<'a> Tracer<'a> {
+    /// Validates the scene and prepares it.
+    pub fn new(scene: &'a Scene, quality: &Quality) -> Result<Tracer<'a>> {
+        scene.validate()?;
+        if scene.triangle_count() == 0 {
+            return Err(Error::invalid("scene", "has no triangles to render"));
+        }
+        if !(1..=64).contains(&quality.depth) {
+            return Err(Error::invalid("knob depth", format!("{} is outside 1..=64", quality.depth)));
+        }
+        let diag = scene.bounds().diagonal() as f64;
+        Ok(Tracer {
+            scene,
+            bvh: Bvh::new(scene),
+            textures: Textures::new(&scene.textures),
+            sky: Sky::new(scene.environment.as_ref()),
+            lights: scene.lights.iter().map(ShadeLight::new).collect(),
+            fresnel: quality.fresnel,
+            depth: quality.depth,
+            epsilon: diag.max(f64::MIN_POSITIVE) * 1e-9,
+        })
+    }
+
+    /// Radiance arriving at `o` from direction `-d` (d a unit vector): what the ray
+    /// o + t d, t > t_min, sees, with `bounces` specular bounces left.
+    pub fn radiance(&self, o: DVec3, d: DVec3, t_min: f64, bounces: u32) -> DVec3 {
+        self.trace(o, d, t_min, None, bounces, DVec3::ONE)
+    }
+
+    fn trace(&self, o: DVec3, d: DVec3, t_min: f64, skip: Option<u32>, bounces: u32, weight: DVec3) -> DVec3 {
+        if !d.is_finite() || !o.is_finite() {
+            return DVec3::ZERO; // never a NaN colour
+        }
+        let Some(hit) = self.bvh.intersect(o, d, t_min, f64::INFINITY, skip) else {
+            return self.sky.radiance(d);
+        };
+        let surface = self.surface(&hit);
+        let m = &self.scene.materials[surface.material];
+        if m.kind == SurfaceKind::Diffuse {
+            return self.shade_diffuse(&surface, hit.triangle, d);
+        }
+        if bounces == 0 {
+            return DVec3::ZERO;
+        }
+        let split = shade::specular_split(m, self.fresnel, d, surface.normal);
+        let mut c = DVec3::ZERO;
+        for (dir, f) in [(split.r, split.fr), (split.t, split.ft)] {
+            let w = weight * f;
+            if w.max_element() >= MIN_PATH_WEIGHT {
+                c += f * self.trace(surface.position, dir.normalize(), self.epsilon, Some(hit.triangle), bounces - 1, w);
+            }
+        }
+        c
+    }
+
+    /// Position, interpolated unit normal, texture coordinates and material of a hit.
+    fn surface(&self, hit: &Hit) -> Surface {
+        let tri = &self.bvh.triangles[hit.triangle as usize];
+        let mesh = &self.scene.meshes[tri.mesh as usize];
+        let idx = &mesh.indices[3 * tri.tri as usize..3 * tri.tri as usize + 3];
+        let (u, v) = (hit.u, hit.v);
+        let w = 1.0 - u - v;
+        let n = |i: u32| mesh.normals[i as usize].as_dvec3();
+        let t = |i: u32| mesh.uvs[i as usize].as_dvec2();
+        let normal =
+            (n(idx[0]) * w + n(idx[1]) * u + n(idx[2]) * v).try_normalize().unwrap_or_else(|| tri.e1.cross(tri.e2).normalize_or(DVec3::Y));
+        Surface {
+            position: tri.v0 + tri.e1 * u + tri.e2 * v,
+            normal,
+            uv: t(idx[0]) * w + t(idx[1]) * u + t(idx[2]) * v,
+            material: mesh.material,
+        }
+    }
+
+    /// `shade_diffuse` of glsl/common/shading.glsl, seen along `d`: emission +
+    /// albedo/π Σ E cos θ · visibility, visibility by an exact shadow ray.
+    fn shade_diffuse(&self, s: &Surface, triangle: u32, d: DVec3) -> DVec3 {
+        let m = &self.scene.materials[s.material];
+        let albedo = shade::base_color(m, &self.textures, s.uv);
+        let n = if s.normal.dot(-d) < 0.0 { -s.normal } else { s.normal }; // two-sided
+        let mut sum = DVec3::ZERO;
+        for l in &self.lights {
+            let (wi, e, dist) = l.incident(s.position);
+            let cos_t = n.dot(wi);
+            if cos_t <= 0.0 {
+                continue;
+            }
+            let t_max = if dist.is_finite() { dist - self.epsilon } else { f64::INFINITY };
+            if !self.bvh.occluded(s.position, wi, self.epsilon, t_max, Some(triangle)) {
+                sum += e * cos_t;
+            }
+        }
+        shade::emission(m, &self.textures, s.uv) + albedo / std::f64::consts::PI * sum
+    }
+}
+
+struct Surface {
+    position: DVec3,
+    normal: DVec3,
+    uv: DVec2,
+    material: usize,
+}
+
+/// Renders `scene` exactly at `width`×`height` (camera: the scene's, or the default one
+/// that frames it, as the GPU renderer takes it) with `quality.spp` samples per pixel and
+/// `quality.depth` specular bounces. Linear radiance RGBA32F, alpha 1.
+pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32, u32)) -> Result<ImageData> {
+    if width == 0 || height == 0 || width > 16384 || height > 16384 {
+        return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
+    }
+    let spp = quality.spp;
+    if !(1..=1024).contains(&spp) || spp.isqrt().pow(2) != spp {
+        return Err(Error::invalid("knob spp", format!("{spp} is not a perfect square in 1..=1024")));
+    }
+    let camera = scene.camera_or_default();
+    camera.validate()?;
+    let tracer = Tracer::new(scene, quality)?;
+    let rays = CameraRays::new(&camera, width, height);
+    let mut data = vec![0f32; (width * height * 4) as usize];
+    data.par_chunks_mut(width as usize * 4).enumerate().for_each(|(y, row)| {
+        let y = y as u32;
+        for x in 0..width {
+            let mut c = DVec3::ZERO;
+            for s in 0..spp {
+                let (jx, jy) = sample_offset(x, y, s, spp);
+                let (o, d, t_min) = rays.ray(x as f64 + jx, y as f64 + jy);
+                c += tracer.radiance(o, d, t_min, tracer.depth);
+            }
+            c /= spp as f64;
+            let px = &mut row[4 * x as usize..4 * x as usize + 4];
+            px.copy_from_slice(&[c.x as f32, c.y as f32, c.z as f32, 1.0]);
+        }
+    });
+    Ok(ImageData { width, height, layers: 1, channels: 4, data })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{shapes, Material};
+    use glam::Vec3;
+
+    #[test]
+    fn strata_cover_the_pixel_once_each() {
+        for spp in [4u32, 16, 25] {
+            let k = spp.isqrt();
+            let mut seen = vec![false; spp as usize];
+            for s in 0..spp {
+                let (x, y) = sample_offset(3, 5, s, spp);
+                assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
+                let cell = (y * k as f64) as usize * k as usize + (x * k as f64) as usize;
+                assert!(!seen[cell], "stratum {cell} twice");
+                seen[cell] = true;
+            }
+        }
+        assert_eq!(sample_offset(7, 9, 0, 1), (0.5, 0.5));
+    }
+
+    /// The camera rays are those of the GPU's view-projection matrix: unprojecting a pixel
+    /// centre through `Renderer::camera_view_proj`'s construction gives the same direction.
+    #[test]
+    fn camera_rays_match_the_gpu_projection() {
+        let cam = Camera::look_at(Vec3::new(1.0, 2.0, 3.0), Vec3::new(-0.5, 0.2, 0.0), 0.9);
+        let (w, h) = (40u32, 30u32);
+        let mut proj = glam::DMat4::perspective_infinite_reverse_rh(cam.yfov as f64, w as f64 / h as f64, cam.znear as f64);
+        proj.y_axis.y = -proj.y_axis.y;
+        let inv = (proj * cam.view().as_dmat4()).inverse();
+        let rays = CameraRays::new(&cam, w, h);
+        for (x, y) in [(0.5, 0.5), (20.0, 15.0), (39.5, 2.5)] {
+            // Reversed-Z: ndc z = znear / depth; a far point keeps the f32 view matrix's
+            // rounding small relative to its distance.
+            let ndc = glam::DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, 1e-4, 1.0);
+            let p = inv * ndc;
+            let expected = (p.truncate() / p.w - rays.eye).normalize();
+            let (o, d, t_min) = rays.ray(x, y);
+            assert!((d - expected).length() < 1e-6, "{d} vs {expected}");
+            assert!((o - cam.position.as_dvec3()).length() < 1e-6);
+            // The near plane: t_min along d is znear along the view axis.
+            assert!((d.dot(rays.forward) * t_min / cam.znear as f64 - 1.0).abs() < 1e-6);
+        }
+    }
+
+    /// Emission only: every pixel that sees the emitter is exactly its radiance.
+    #[test]
+    fn emitter_is_seen_at_its_radiance() {
+        let mut s = Scene::new();
+        let m = s.add_material(Material { base_color: Vec3::ZERO, emissive: Vec3::new(0.25, 0.5, 2.0), ..Default::default() }).unwrap();
+        s.add_mesh(shapes::quad("q", Vec3::new(-1.0, -1.0, -1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0), 2, m)).unwrap();
+        s.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 0.5));
+        let mut q = Quality::default();
+        q.spp = 4;
+        let img = render_reference(&s, &q, (8, 8)).unwrap();
+        for p in img.data.chunks_exact(4) {
+            assert_eq!(p, [0.25, 0.5, 2.0, 1.0]);
+        }
+    }
+}

@@ -1,0 +1,143 @@
+/* misuse.c — every misuse the C ABI promises to survive, called from C: each returns its
+ * code and a message, and the process goes on. Exits 0 when every case behaved. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "specula.h"
+
+static int failures = 0;
+
+static void expect(const char *what, SpeculaResult got, SpeculaResult want, const char *message) {
+    int ok = got == want && message != NULL && (want == SPECULA_SUCCESS || strlen(message) > 0);
+    printf("%-44s %4d (want %4d) %s: %s\n", what, got, want, ok ? "ok" : "FAIL", message ? message : "(null)");
+    if (!ok) ++failures;
+}
+
+/* The call first, then its message: C leaves argument evaluation order open. */
+/* Same for the create calls, whose message lives per thread. */
+#define CREATE_CASE(what, call, want)                           \
+    do {                                                        \
+        SpeculaResult got_ = (call);                            \
+        expect(what, got_, (want), specula_creation_error());   \
+    } while (0)
+#define CASE(what, call, want)                                  \
+    do {                                                        \
+        SpeculaResult got_ = (call);                            \
+        expect(what, got_, (want), specula_context_last_error(ctx)); \
+    } while (0)
+
+int main(int argc, char **argv) {
+    const char *scene = argc > 1 ? argv[1] : "assets/demo/demo.gltf";
+    SpeculaContext *ctx = NULL;
+
+    /* Creation: NULL pointers, wrong tags and sizes. */
+    SpeculaContextDesc desc = {SPECULA_STRUCT_CONTEXT_DESC, sizeof desc, NULL, 1};
+    CREATE_CASE("create: NULL desc", specula_context_create(NULL, &ctx), SPECULA_ERROR_NULL_POINTER);
+    CREATE_CASE("create: NULL out", specula_context_create(&desc, NULL), SPECULA_ERROR_NULL_POINTER);
+    SpeculaContextDesc bad_tag = desc;
+    bad_tag.type = SPECULA_STRUCT_MESH_DESC;
+    CREATE_CASE("create: wrong struct tag", specula_context_create(&bad_tag, &ctx), SPECULA_ERROR_STRUCT_MISMATCH);
+    SpeculaContextDesc bad_size = desc;
+    bad_size.size = 4;
+    CREATE_CASE("create: wrong struct size", specula_context_create(&bad_size, &ctx), SPECULA_ERROR_STRUCT_MISMATCH);
+    SpeculaContextDesc no_device = desc;
+    no_device.device_name = "no-such-device-anywhere";
+    CREATE_CASE("create: no matching device", specula_context_create(&no_device, &ctx), SPECULA_ERROR_UNSUPPORTED);
+    SpeculaHostDesc null_host = {SPECULA_STRUCT_HOST_DESC, sizeof null_host};
+    CREATE_CASE("create_host: NULL handles", specula_context_create_host(&null_host, &ctx), SPECULA_ERROR_NULL_POINTER);
+    SpeculaRequirements req = {SPECULA_STRUCT_REQUIREMENTS, 8};
+    CREATE_CASE("requirements: wrong size", specula_get_requirements(&req), SPECULA_ERROR_STRUCT_MISMATCH);
+
+    if (specula_context_create(&desc, &ctx) != SPECULA_SUCCESS) {
+        printf("cannot create a context: %s\n", specula_creation_error());
+        return 1;
+    }
+    unsigned char pixels[64 * 64 * 4];
+    SpeculaRenderDesc render = {SPECULA_STRUCT_RENDER_DESC, sizeof render, SPECULA_METHOD_ENVMAP, 64, 64};
+
+    /* Calls in the wrong order. */
+    CASE("render before configure", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_ERROR_WRONG_ORDER);
+    uint32_t count = 0;
+    CASE("timings before configure", specula_get_pass_timings(ctx, NULL, 0, &count), SPECULA_ERROR_WRONG_ORDER);
+    CASE("configure an empty scene", specula_context_configure(ctx, &render), SPECULA_ERROR_INVALID_ARGUMENT);
+
+    /* Bad scene input. */
+    CASE("load_gltf: NULL path", specula_context_load_gltf(ctx, NULL), SPECULA_ERROR_NULL_POINTER);
+    CASE("load_gltf: missing file", specula_context_load_gltf(ctx, "/nonexistent/scene.gltf"), SPECULA_ERROR_IO);
+    SpeculaMaterialDesc glass = {SPECULA_STRUCT_MATERIAL_DESC, sizeof glass, SPECULA_SURFACE_DIELECTRIC, {1, 1, 1}, {0, 0, 0}, {1, 1, 1}, {0, 0, 0}, 0.0f, 0};
+    CASE("material: IOR 0", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.ior = -1.5f;
+    CASE("material: IOR < 0", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.ior = 1.5f;
+    glass.surface = 77;
+    CASE("material: unknown surface enum", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.surface = SPECULA_SURFACE_DIELECTRIC;
+    uint32_t mat = 99;
+    CASE("material: valid", specula_context_add_material(ctx, &glass, &mat), SPECULA_SUCCESS);
+    float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    uint32_t idx[3] = {0, 1, 2};
+    SpeculaMeshDesc mesh = {SPECULA_STRUCT_MESH_DESC, sizeof mesh, pos, NULL, 3, idx, 3, NULL, mat};
+    SpeculaMeshDesc m2 = mesh;
+    m2.positions = NULL;
+    CASE("mesh: NULL positions", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_NULL_POINTER);
+    uint32_t bad_idx[3] = {0, 1, 7};
+    m2 = mesh;
+    m2.indices = bad_idx;
+    CASE("mesh: index out of range", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    float nan_pos[9] = {0, 0, 0, NAN, 0, 0, 0, 1, 0};
+    m2 = mesh;
+    m2.positions = nan_pos;
+    CASE("mesh: NaN position", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    m2 = mesh;
+    m2.material = 12345;
+    CASE("mesh: material out of range", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    m2 = mesh;
+    m2.type = SPECULA_STRUCT_LIGHT_DESC;
+    CASE("mesh: wrong struct tag", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_STRUCT_MISMATCH);
+    SpeculaLightDesc light = {SPECULA_STRUCT_LIGHT_DESC, sizeof light, 9};
+    CASE("light: unknown kind enum", specula_context_add_light(ctx, &light), SPECULA_ERROR_INVALID_ARGUMENT);
+
+    /* Knobs and camera. */
+    CASE("knob: out of range", specula_context_set_knob(ctx, "cube_size", "100000"), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("knob: unknown", specula_context_set_knob(ctx, "warp_speed", "9"), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("knob: NULL value", specula_context_set_knob(ctx, "cube_size", NULL), SPECULA_ERROR_NULL_POINTER);
+    SpeculaCameraDesc cam = {SPECULA_STRUCT_CAMERA_DESC, sizeof cam, {0, 1, NAN}, {0, 0, 0}, 1.0f, 0.01f};
+    CASE("camera: NaN position", specula_context_set_camera(ctx, &cam), SPECULA_ERROR_INVALID_ARGUMENT);
+    cam.position[2] = 3.0f;
+    cam.yfov = 0.0f;
+    CASE("camera: zero field of view", specula_context_set_camera(ctx, &cam), SPECULA_ERROR_INVALID_ARGUMENT);
+
+    /* A valid frame, then misuse around it. */
+    CASE("load_gltf: demo", specula_context_load_gltf(ctx, scene), SPECULA_SUCCESS);
+    CASE("knob: cube_size=32", specula_context_set_knob(ctx, "cube_size", "32"), SPECULA_SUCCESS);
+    SpeculaRenderDesc bad_method = render;
+    bad_method.method = 42;
+    CASE("configure: unknown method enum", specula_context_configure(ctx, &bad_method), SPECULA_ERROR_INVALID_ARGUMENT);
+    SpeculaRenderDesc zero = render;
+    zero.width = 0;
+    CASE("configure: zero width", specula_context_configure(ctx, &zero), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("configure: valid", specula_context_configure(ctx, &render), SPECULA_SUCCESS);
+    CASE("render: unknown pixel format", specula_context_render(ctx, 5, pixels, sizeof pixels), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("render: buffer too small", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, 100), SPECULA_ERROR_BUFFER_TOO_SMALL);
+    CASE("render: NULL dst", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, NULL, sizeof pixels), SPECULA_ERROR_NULL_POINTER);
+    CASE("render: valid", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
+    SpeculaPassTiming one[1];
+    CASE("timings: capacity 1", specula_get_pass_timings(ctx, one, 1, &count), SPECULA_WARNING_TRUNCATED);
+    CASE("timings: NULL out with capacity", specula_get_pass_timings(ctx, NULL, 4, &count), SPECULA_ERROR_NULL_POINTER);
+    SpeculaHostImage target = {SPECULA_STRUCT_HOST_IMAGE, sizeof target, 1, 0, 109, 64, 64, 0, 7, NULL};
+    CASE("record on a standalone context", specula_context_record(ctx, (void *)1, &target), SPECULA_ERROR_WRONG_ORDER);
+    CASE("scene changed after configure", specula_context_add_material(ctx, &glass, NULL), SPECULA_SUCCESS);
+    CASE("render with a stale configuration", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_ERROR_WRONG_ORDER);
+
+    /* A destroyed handle, used again. */
+    expect("destroy", specula_context_destroy(ctx), SPECULA_SUCCESS, "");
+    CASE("destroy twice", specula_context_destroy(ctx), SPECULA_ERROR_INVALID_HANDLE);
+    CASE("render on a destroyed handle", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_ERROR_INVALID_HANDLE);
+    expect("set_knob on a foreign pointer", specula_context_set_knob((SpeculaContext *)pixels, "cube_size", "32"), SPECULA_ERROR_INVALID_HANDLE,
+           specula_context_last_error((SpeculaContext *)pixels));
+    expect("NULL handle", specula_context_configure(NULL, &render), SPECULA_ERROR_INVALID_HANDLE, specula_context_last_error(NULL));
+
+    printf("%d failure(s)\n", failures);
+    return failures ? 1 : 0;
+}
