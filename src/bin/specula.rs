@@ -1,4 +1,4 @@
-//! The specula command line: render, info, plan, knobs, demo.
+//! The specula command line: render, info, plan, knobs, demo, bench, compare, tradeoff.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use glam::Vec3;
 use specula::scene::{self, Camera};
-use specula::vk::{Context, DeviceOptions};
+use specula::vk::{Context, DeviceOptions, ImageData, PassTiming};
 use specula::{Method, Quality, Scene};
 
 #[derive(Parser)]
@@ -55,6 +55,33 @@ struct RenderArgs {
     frames: u32,
 }
 
+#[derive(clap::Args, Clone)]
+struct TradeoffArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
+    scene: PathBuf,
+    /// Output size WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256")]
+    size: String,
+    /// Base accuracy knobs key=value (repeatable); spp and depth set the reference's.
+    #[arg(long = "quality", short = 'q')]
+    quality: Vec<String>,
+    /// Equirectangular environment map.
+    #[arg(long)]
+    env: Option<PathBuf>,
+    /// Untimed frames before the timed ones (at least 1: the first frame uploads the scene).
+    #[arg(long, default_value_t = 2)]
+    warmup: u32,
+    /// Timed frames per configuration; the median per pass is reported.
+    #[arg(long, default_value_t = 5)]
+    frames: u32,
+    /// Enable the Khronos validation layer.
+    #[arg(long)]
+    validate: bool,
+    /// Device name filter (substring).
+    #[arg(long)]
+    device: Option<String>,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Render a scene to an image (.png: sRGB, clamped; .exr: linear radiance).
@@ -85,6 +112,27 @@ enum Command {
         /// knob=v1,v2,... (e.g. cube_mode=six,multiview); without it, one variant.
         #[arg(long)]
         sweep: Option<String>,
+    },
+    /// Image errors of TEST against REFERENCE (.exr linear, .png/.jpg sRGB-decoded): RMSE,
+    /// PSNR, max and p99 absolute error, mean FLIP.
+    Compare {
+        test: PathBuf,
+        reference: PathBuf,
+        /// Write the FLIP error map in false colour (PNG).
+        #[arg(long)]
+        error_image: Option<PathBuf>,
+    },
+    /// The speed–accuracy trade-off: every GPU method (× every --sweep combination) timed
+    /// and compared with the exact reference; writes tradeoff.csv and tradeoff.svg to --out.
+    Tradeoff {
+        #[command(flatten)]
+        args: TradeoffArgs,
+        /// knob=v1,v2,... (repeatable: the combinations multiply); ref_point values split on ';'.
+        #[arg(long)]
+        sweep: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "tradeoff")]
+        out: PathBuf,
     },
     /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
     Demo {
@@ -165,8 +213,7 @@ fn context(validate: bool, device: &Option<String>) -> specula::Result<Context> 
     Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })
 }
 
-fn write_image(path: &Path, frame: &specula::Frame) -> specula::Result<()> {
-    let img = &frame.image;
+fn write_image(path: &Path, img: &ImageData) -> specula::Result<()> {
     match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
         Some("exr") => scene::write_exr(path, img.width, img.height, &img.data),
         Some("png") => scene::write_png_srgb(path, img.width, img.height, &img.data),
@@ -178,9 +225,19 @@ fn run(cmd: Command) -> specula::Result<()> {
     match cmd {
         Command::Render { args, out, profile } => {
             let job = prepare(&args)?;
+            if !job.method.is_gpu() {
+                let (img, ms) = render_reference(&job.scene, &job.quality, (job.width, job.height))?;
+                write_image(&out, &img)?;
+                println!("{}", reference_summary(&job.quality, job.width, job.height, ms));
+                if let Some(p) = profile {
+                    let passes = [reference_timing(ms)];
+                    std::fs::write(&p, specula::profile::chrome_trace(&passes, &[], "CPU")).map_err(|e| specula::Error::io(&p, e))?;
+                }
+                return Ok(());
+            }
             let ctx = context(args.validate, &args.device)?;
             let frame = specula::render(&ctx, &job.scene, job.method, &job.quality, (job.width, job.height), (args.warmup, args.frames))?;
-            write_image(&out, &frame)?;
+            write_image(&out, &frame.image)?;
             println!("{} on {} ({}), {}x{}", job.method.name(), ctx.device_name, ctx.driver_info, job.width, job.height);
             print!("{}", specula::profile::table(&frame.passes, &frame.memory));
             if let Some(p) = profile {
@@ -213,6 +270,8 @@ fn run(cmd: Command) -> specula::Result<()> {
         }
         Command::Demo { outdir, size, validate, device } => demo(&outdir, &size, validate, &device),
         Command::Bench { args, sweep } => bench(&args, sweep.as_deref()),
+        Command::Compare { test, reference, error_image } => compare(&test, &reference, error_image.as_deref()),
+        Command::Tradeoff { args, sweep, out } => tradeoff(&args, &sweep, &out),
     }
 }
 

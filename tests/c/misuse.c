@@ -8,6 +8,14 @@
 
 static int failures = 0;
 
+/* The log callback sees every error message. */
+static int logged = 0;
+static char last_logged[256];
+static void on_log(void *user, SpeculaLogLevel level, const char *message) {
+    ++*(int *)user;
+    if (level == SPECULA_LOG_ERROR) snprintf(last_logged, sizeof last_logged, "%s", message);
+}
+
 static void expect(const char *what, SpeculaResult got, SpeculaResult want, const char *message) {
     int ok = got == want && message != NULL && (want == SPECULA_SUCCESS || strlen(message) > 0);
     printf("%-44s %4d (want %4d) %s: %s\n", what, got, want, ok ? "ok" : "FAIL", message ? message : "(null)");
@@ -55,6 +63,13 @@ int main(int argc, char **argv) {
     }
     unsigned char pixels[64 * 64 * 4];
     SpeculaRenderDesc render = {SPECULA_STRUCT_RENDER_DESC, sizeof render, SPECULA_METHOD_ENVMAP, 64, 64};
+
+    /* Version and log callback. */
+    expect("version is 0.1.x", (SpeculaResult)(specula_version() >> 12), (SpeculaResult)((0u << 10) | 1u), "VK_MAKE_API_VERSION(0, 0, 1, patch)");
+    CASE("set_log_callback", specula_context_set_log_callback(ctx, on_log, &logged), SPECULA_SUCCESS);
+    CASE("knob error goes to the log", specula_context_set_knob(ctx, "fresnel", "approximately"), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("log callback called with the message", logged == 1 && strstr(last_logged, "fresnel") ? 0 : -1, 0, last_logged);
+    CASE("remove log callback", specula_context_set_log_callback(ctx, NULL, NULL), SPECULA_SUCCESS);
 
     /* Calls in the wrong order. */
     CASE("render before configure", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_ERROR_WRONG_ORDER);
