@@ -170,3 +170,38 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     assert!(cubes < 2 * 64 * 64 * 6 * 8);
     common::assert_clean(&ctx);
 }
+
+/// An object with no geometry around it sees the environment map: a mirror sphere alone
+/// under an equirectangular sky whose upper half is blue and lower half is green reflects
+/// blue above its equator's reflection and green below; the background is the sky itself.
+#[test]
+fn lone_object_sees_the_environment_map() {
+    let ctx = common::gpu();
+    let mut scene = Scene::new();
+    let m = scene.add_material(common::mirror(0.5)).unwrap();
+    scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.5, 64, 32, m)).unwrap();
+    let (w, h) = (64u32, 32u32);
+    let mut sky = Vec::new();
+    for y in 0..h {
+        for _ in 0..w {
+            sky.extend_from_slice(if y < h / 2 { &[0.0, 0.0, 1.0, 1.0] } else { &[0.0, 1.0, 0.0, 1.0] });
+        }
+    }
+    scene.set_environment(specula::scene::EnvironmentMap { width: w, height: h, rgba32f: sky }).unwrap();
+    scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 0.9));
+    let mut q = Quality::default();
+    q.set("cube_size", "32").unwrap();
+    let p = plan(&scene, Method::Envmap, &q);
+    assert_eq!(p.passes, ["scene.upload", "envmap.generate", "scene.direct", "envmap.shade"]);
+    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (48, 48), (0, 1)).unwrap();
+    let px = |x: u32, y: u32| f.image.texel(0, x, y).to_vec();
+    // Background corners: the sky straight through.
+    assert!(px(1, 1)[2] > 0.99 && px(1, 1)[1] < 0.01, "upper background is blue: {:?}", px(1, 1));
+    assert!(px(1, 46)[1] > 0.99 && px(1, 46)[2] < 0.01, "lower background is green: {:?}", px(1, 46));
+    // On the sphere, above centre the reflection points up (blue), below it down (green),
+    // weighted by Fresnel ≥ F0 = 0.5.
+    let (top, bottom) = (px(24, 17), px(24, 31));
+    assert!(top[2] >= 0.49 && top[1] < 0.01, "upper sphere reflects the blue sky: {top:?}");
+    assert!(bottom[1] >= 0.49 && bottom[2] < 0.01, "lower sphere reflects the green ground: {bottom:?}");
+    common::assert_clean(&ctx);
+}

@@ -345,11 +345,22 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
     let ctx = context(validate, device)?;
     let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
     for &method in Method::ALL {
-        let frame = specula::render(&ctx, &scene, method, &Quality::default(), (w, h), (2, 5))?;
         let png = outdir.join(format!("{}.png", method.name()));
         let exr = outdir.join(format!("{}.exr", method.name()));
-        write_image(&png, &frame)?;
-        write_image(&exr, &frame)?;
+        if !method.is_gpu() {
+            let q = Quality::default();
+            let (img, ms) = render_reference(&scene, &q, (w, h))?;
+            write_image(&png, &img)?;
+            write_image(&exr, &img)?;
+            let trace = outdir.join(format!("{}.trace.json", method.name()));
+            std::fs::write(&trace, specula::profile::chrome_trace(&[reference_timing(ms)], &[], "CPU"))
+                .map_err(|e| specula::Error::io(&trace, e))?;
+            report += &format!("== method {} -> {}\n{}\n\n", method.name(), png.display(), reference_summary(&q, w, h, ms));
+            continue;
+        }
+        let frame = specula::render(&ctx, &scene, method, &Quality::default(), (w, h), (2, 5))?;
+        write_image(&png, &frame.image)?;
+        write_image(&exr, &frame.image)?;
         let trace = outdir.join(format!("{}.trace.json", method.name()));
         std::fs::write(&trace, specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name))
             .map_err(|e| specula::Error::io(&trace, e))?;
@@ -381,6 +392,28 @@ fn bench(args: &RenderArgs, sweep: Option<&str>) -> specula::Result<()> {
                 .collect::<specula::Result<_>>()?
         }
     };
+    if !job.method.is_gpu() {
+        println!(
+            "{} on the CPU ({} threads), {}x{}, median of {} renders",
+            job.method.name(),
+            rayon::current_num_threads(),
+            job.width,
+            job.height,
+            args.frames.max(1)
+        );
+        let mut base = None;
+        for (label, q) in variants {
+            let mut times = Vec::new();
+            for _ in 0..args.frames.max(1) {
+                times.push(render_reference(&job.scene, &q, (job.width, job.height))?.1);
+            }
+            times.sort_by(|a, b| a.total_cmp(b));
+            let ms = times[times.len() / 2];
+            let b = *base.get_or_insert(ms);
+            println!("== {label}: {ms:.1} ms CPU ({:.2}x the first variant)", ms / b);
+        }
+        return Ok(());
+    }
     let ctx = context(args.validate, &args.device)?;
     println!(
         "{} on {} ({}), {}x{}, median of {} frames after {} warm-up",
@@ -405,6 +438,130 @@ fn bench(args: &RenderArgs, sweep: Option<&str>) -> specula::Result<()> {
         for p in &f.passes {
             println!("   {:<22} {:>9.3} ms GPU {:>8.3} ms CPU", p.name, p.gpu_ms, p.cpu_ms);
         }
+    }
+    Ok(())
+}
+
+/// The exact CPU reference, timed (wall-clock milliseconds).
+fn render_reference(scene: &Scene, quality: &Quality, size: (u32, u32)) -> specula::Result<(ImageData, f64)> {
+    let t = std::time::Instant::now();
+    let img = specula::reference::render_reference(scene, quality, size)?;
+    Ok((img, t.elapsed().as_secs_f64() * 1e3))
+}
+
+fn reference_timing(ms: f64) -> PassTiming {
+    PassTiming { name: specula::plan::REFERENCE_PASS.into(), gpu_ms: 0.0, cpu_ms: ms, gpu_start_ms: 0.0 }
+}
+
+fn reference_summary(q: &Quality, w: u32, h: u32, ms: f64) -> String {
+    format!(
+        "reference on the CPU ({} threads), {w}x{h}, {} spp, depth {}, fresnel {:?}: {ms:.1} ms",
+        rayon::current_num_threads(),
+        q.spp,
+        q.depth,
+        q.fresnel
+    )
+}
+
+fn read_linear(path: &Path) -> specula::Result<ImageData> {
+    let e = scene::load_environment(path)?;
+    Ok(ImageData { width: e.width, height: e.height, layers: 1, channels: 4, data: e.rgba32f })
+}
+
+/// `specula compare`: the metrics of specula::metrics, and the FLIP map in false colour.
+fn compare(test: &Path, reference: &Path, error_image: Option<&Path>) -> specula::Result<()> {
+    let (t, r) = (read_linear(test)?, read_linear(reference)?);
+    let e = specula::metrics::compare(&t, &r)?;
+    println!("{} vs {} ({}x{})", test.display(), reference.display(), t.width, t.height);
+    println!("RMSE      {:.6}", e.rmse);
+    println!("PSNR      {:.2} dB", e.psnr);
+    println!("max |Δ|   {:.6}", e.max_abs);
+    println!("p99 |Δ|   {:.6}", e.p99_abs);
+    println!("mean FLIP {:.6}", e.flip);
+    if let Some(path) = error_image {
+        specula::metrics::write_error_png(path, &specula::metrics::flip_map(&t, &r)?, t.width, t.height)?;
+        println!("error image: {}", path.display());
+    }
+    Ok(())
+}
+
+/// `specula tradeoff`: the reference once, then every GPU method × every sweep variant,
+/// timed and compared; CSV, SVG plot and the images into `out`.
+fn tradeoff(a: &TradeoffArgs, sweeps: &[String], out: &Path) -> specula::Result<()> {
+    use specula::tradeoff::{csv, plot_svg, variants, Row, Sweep};
+    let render_args = RenderArgs {
+        scene: a.scene.clone(),
+        method: Method::ALL[0].name().into(),
+        size: a.size.clone(),
+        quality: a.quality.clone(),
+        env: a.env.clone(),
+        camera_pos: None,
+        camera_target: None,
+        fov: 60.0,
+        validate: a.validate,
+        device: a.device.clone(),
+        warmup: a.warmup,
+        frames: a.frames,
+    };
+    let job = prepare(&render_args)?;
+    let sweeps: Vec<Sweep> = sweeps.iter().map(|s| Sweep::parse(s)).collect::<specula::Result<_>>()?;
+    let variants = variants(&job.quality, &sweeps)?;
+    let methods: Vec<Method> = Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect();
+    std::fs::create_dir_all(out).map_err(|e| specula::Error::io(out, e))?;
+    let (w, h) = (job.width, job.height);
+
+    let bar = indicatif::ProgressBar::new((1 + methods.len() * variants.len()) as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} [{elapsed_precise}] {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(format!("reference ({} spp, depth {})", job.quality.spp, job.quality.depth));
+    let (reference, ref_ms) = render_reference(&job.scene, &job.quality, (w, h))?;
+    write_image(&out.join("reference.exr"), &reference)?;
+    write_image(&out.join("reference.png"), &reference)?;
+    bar.inc(1);
+
+    let ctx = context(a.validate, &a.device)?;
+    let mut rows = Vec::new();
+    for &method in &methods {
+        for (label, q) in &variants {
+            bar.set_message(format!("{} {label}", method.name()));
+            let frame = specula::render(&ctx, &job.scene, method, q, (w, h), (a.warmup.max(1), a.frames.max(1)))?;
+            let errors = specula::metrics::compare(&frame.image, &reference)?;
+            let stem = format!("{}-{}", method.name(), label.replace([' ', '=', ',', ';', '/'], "_"));
+            write_image(&out.join(format!("{stem}.png")), &frame.image)?;
+            rows.push(Row::new(method.name(), label, &frame.passes, errors));
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+
+    let csv_path = out.join("tradeoff.csv");
+    std::fs::write(&csv_path, csv(&rows)).map_err(|e| specula::Error::io(&csv_path, e))?;
+    let svg_path = out.join("tradeoff.svg");
+    let title =
+        format!("{} at {w}x{h} on {}: mean FLIP vs GPU time", a.scene.file_name().unwrap_or_default().to_string_lossy(), ctx.device_name);
+    plot_svg(&svg_path, &rows, &title)?;
+    println!(
+        "{} on {} ({}), {w}x{h}, median of {} frames after {} warm-up",
+        a.scene.display(),
+        ctx.device_name,
+        ctx.driver_info,
+        a.frames.max(1),
+        a.warmup.max(1)
+    );
+    println!("{}", reference_summary(&job.quality, w, h, ref_ms));
+    println!("\n{:<10} {:<40} {:>10} {:>10} {:>9} {:>9} {:>9}", "method", "knobs", "frame ms", "RMSE", "PSNR dB", "FLIP", "p99");
+    for r in &rows {
+        let e = &r.errors;
+        println!(
+            "{:<10} {:<40} {:>10.3} {:>10.5} {:>9.2} {:>9.5} {:>9.5}",
+            r.method, r.knobs, r.frame_ms, e.rmse, e.psnr, e.flip, e.p99_abs
+        );
+    }
+    println!("\nwrote {} and {}", csv_path.display(), svg_path.display());
+    if a.validate {
+        println!("validation: {} error(s), {} warning(s)", ctx.validation.error_count(), ctx.validation.warning_count());
     }
     Ok(())
 }
