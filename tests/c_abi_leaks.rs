@@ -52,7 +52,7 @@ unsafe fn cycle() {
     };
     let mut ctx = std::ptr::null_mut();
     assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS);
-    let mut mat = |surface, ior| {
+    let mat = |surface, ior| {
         let m = SpeculaMaterialDesc {
             r#type: SPECULA_STRUCT_MATERIAL_DESC,
             size: std::mem::size_of::<SpeculaMaterialDesc>() as u32,

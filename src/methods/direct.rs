@@ -4,9 +4,9 @@
 
 use ash::vk;
 
-use super::{destroy_pipelines, FrameInputs};
+use super::{begin_camera_rendering, destroy_pipelines, FrameInputs};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
+use crate::vk::{Access, Context, Image, Recorder};
 use crate::Result;
 
 pub const TARGET_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -88,21 +88,7 @@ impl SceneDirect {
         }
         let open = pass.begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let colors = [target.view];
-        begin_rendering(
-            ctx,
-            cmd,
-            &Target {
-                color: &colors,
-                depth: Some(depth.view),
-                width: target.width,
-                height: target.height,
-                view_mask: 0,
-                layer_count: 1,
-                clear_color: [0.0; 4],
-                clear: true,
-            },
-        );
+        begin_camera_rendering(ctx, cmd, target, depth, true);
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);

@@ -132,6 +132,22 @@ pub fn render_cube_faces(
     }
 }
 
+/// Starts rendering into the camera's colour and depth targets (cleared or kept).
+pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Image, depth: &Image, clear: bool) {
+    let colors = [target.view];
+    let t = Target {
+        color: &colors,
+        depth: Some(depth.view),
+        width: target.width,
+        height: target.height,
+        view_mask: 0,
+        layer_count: 1,
+        clear_color: [0.0; 4],
+        clear,
+    };
+    begin_rendering(ctx, cmd, &t);
+}
+
 /// The depth buffer cube rendering needs: six layers for multiview, one otherwise.
 pub fn cube_depth(ctx: &Context, name: &str, size: u32, mode: CubeMode) -> crate::Result<Image> {
     let kind = match mode {

@@ -19,6 +19,14 @@ fn alloc_err(name: &str, e: gpu_allocator::AllocationError) -> Error {
     }
 }
 
+/// Sub-allocates device memory for one resource (gpu-allocator, explicit).
+fn allocate(ctx: &Context, name: &str, requirements: vk::MemoryRequirements, location: MemoryLocation, linear: bool) -> Result<Allocation> {
+    let mut guard = ctx.allocator();
+    let allocator = guard.as_mut().ok_or_else(|| Error::invalid(name, "context is shutting down"))?;
+    let desc = AllocationCreateDesc { name, requirements, location, linear, allocation_scheme: AllocationScheme::GpuAllocatorManaged };
+    allocator.allocate(&desc).map_err(|e| alloc_err(name, e))
+}
+
 pub struct Buffer {
     pub raw: vk::Buffer,
     pub size: u64,
@@ -35,19 +43,11 @@ impl Buffer {
         let d = &ctx.device;
         let raw = unsafe { d.create_buffer(&vk::BufferCreateInfo::default().size(size).usage(usage), None) }.call("vkCreateBuffer")?;
         let req = unsafe { d.get_buffer_memory_requirements(raw) };
-        let allocation =
-            ctx.allocator().as_mut().ok_or_else(|| Error::invalid(name, "context is shutting down"))?.allocate(&AllocationCreateDesc {
-                name,
-                requirements: req,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            });
-        let allocation = match allocation {
+        let allocation = match allocate(ctx, name, req, location, true) {
             Ok(a) => a,
             Err(e) => {
                 unsafe { d.destroy_buffer(raw, None) };
-                return Err(alloc_err(name, e));
+                return Err(e);
             }
         };
         if let Err(e) = unsafe { d.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.call("vkBindBufferMemory") {
@@ -226,20 +226,11 @@ impl Image {
             .initial_layout(vk::ImageLayout::UNDEFINED);
         let raw = unsafe { d.create_image(&info, None) }.call("vkCreateImage")?;
         let req = unsafe { d.get_image_memory_requirements(raw) };
-        let allocation = ctx.allocator().as_mut().ok_or_else(|| Error::invalid(desc.name, "context is shutting down"))?.allocate(
-            &AllocationCreateDesc {
-                name: desc.name,
-                requirements: req,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
-            },
-        );
-        let allocation = match allocation {
+        let allocation = match allocate(ctx, desc.name, req, MemoryLocation::GpuOnly, false) {
             Ok(a) => a,
             Err(e) => {
                 unsafe { d.destroy_image(raw, None) };
-                return Err(alloc_err(desc.name, e));
+                return Err(e);
             }
         };
         let aspect = if is_depth(desc.format) { vk::ImageAspectFlags::DEPTH } else { vk::ImageAspectFlags::COLOR };

@@ -5,9 +5,9 @@
 use ash::vk;
 
 use crate::methods::direct::{DEPTH_FORMAT, TARGET_FORMAT};
-use crate::methods::{destroy_pipelines, FrameInputs};
+use crate::methods::{begin_camera_rendering, destroy_pipelines, FrameInputs};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
+use crate::vk::{Access, Context, Image, Recorder};
 use crate::Result;
 
 pub struct EnvmapShade {
@@ -42,21 +42,7 @@ impl EnvmapShade {
             .writes(depth, Access::DepthAttachment)
             .begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let colors = [target.view];
-        begin_rendering(
-            ctx,
-            cmd,
-            &Target {
-                color: &colors,
-                depth: Some(depth.view),
-                width: target.width,
-                height: target.height,
-                view_mask: 0,
-                layer_count: 1,
-                clear_color: [0.0; 4],
-                clear: false,
-            },
-        );
+        begin_camera_rendering(ctx, cmd, target, depth, false);
         f.bind(ctx, cmd, self.pipeline);
         for d in f.scene.draws.iter().filter(|d| d.specular) {
             f.draw(ctx, cmd, view, d);
