@@ -52,3 +52,4 @@ pub fn render(
     result
 }
 pub mod ffi;
+pub mod search;
