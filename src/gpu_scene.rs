@@ -42,8 +42,12 @@ pub struct GpuMaterial {
 pub struct GpuObject {
     pub material: u32,
     pub envmap_layer: i32,
-    pub pad: [u32; 2],
+    pub refractor_layer: i32,
+    pub pad: u32,
+    /// xyz; w: proxy sphere radius.
     pub reference_point: [f32; 4],
+    pub proxy_min: [f32; 4],
+    pub proxy_max: [f32; 4],
 }
 
 /// std430 twin of `Light`.

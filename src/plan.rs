@@ -7,13 +7,28 @@ use glam::Vec3;
 
 use crate::error::{Error, Result};
 use crate::quality::Quality;
-use crate::scene::{LightKind, Scene};
+use crate::scene::{LightKind, Scene, SurfaceKind};
 
 /// The rendering methods. Names are the CLI's `--method` values, a stable interface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum Method {
     /// Classic environment mapping (survey §3, §3.1).
     Envmap,
+    /// Localised environment mapping with a proxy sphere around the reference point (§3.2).
+    ProxySphere,
+    /// Localised environment mapping with a proxy box, the scene's bounding box (§3.2): the
+    /// "parallax-corrected cube map" of modern engines.
+    ProxyBox,
+    /// Single reflections and refractions traced in distance maps (§4.1, §4.2).
+    Distance,
+    /// Inter-object multiple reflections and refractions: distance maps regenerated in
+    /// cycles up to `depth`, or one cycle per frame with `frame_latency` (§4.3).
+    DistanceMulti,
+    /// Self refraction through refractor maps with total internal reflection, then the
+    /// environment's distance map (§4.4).
+    RefractorMap,
+    /// Wyman's two-pass image-space double refraction (§4.4).
+    ImageSpaceRefraction,
     /// The exact CPU reference (`crate::reference`): Whitted ray tracing in the original
     /// geometry, in f64. Ground truth for the tests and for `specula tradeoff`; it has no
     /// GPU passes, and `Renderer::new` refuses its plan.
@@ -23,11 +38,26 @@ pub enum Method {
 impl Method {
     /// Every method, GPU methods first; a new method joins the CLI, the demo and the
     /// trade-off study by being listed here.
-    pub const ALL: &'static [Method] = &[Method::Envmap, Method::Reference];
+    pub const ALL: &'static [Method] = &[
+        Method::Envmap,
+        Method::ProxySphere,
+        Method::ProxyBox,
+        Method::Distance,
+        Method::DistanceMulti,
+        Method::RefractorMap,
+        Method::ImageSpaceRefraction,
+        Method::Reference,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Method::Envmap => "envmap",
+            Method::ProxySphere => "proxy-sphere",
+            Method::ProxyBox => "proxy-box",
+            Method::Distance => "distance",
+            Method::DistanceMulti => "distance-multi",
+            Method::RefractorMap => "refractor-map",
+            Method::ImageSpaceRefraction => "image-space-refraction",
             Method::Reference => "reference",
         }
     }
@@ -36,6 +66,11 @@ impl Method {
     /// on the CPU (`reference::render_reference`).
     pub fn is_gpu(self) -> bool {
         !matches!(self, Method::Reference)
+    }
+
+    /// Whether the method's maps store distances (§4) rather than radiance alone (§3).
+    pub fn uses_distance_maps(self) -> bool {
+        matches!(self, Method::Distance | Method::DistanceMulti | Method::RefractorMap | Method::ImageSpaceRefraction)
     }
 
     pub fn parse(s: &str) -> Result<Method> {
@@ -68,6 +103,22 @@ pub struct Plan {
     pub passes: Vec<&'static str>,
     /// Near plane of cube-map rendering (metres), relative to the scene's size.
     pub cube_near: f32,
+    /// Distance-map cycles per frame (§4.3): 1, or `depth` for `distance-multi`.
+    pub cycles: u32,
+    /// Solid dielectrics that get a refractor map (`refractor-map`), in layer order.
+    pub refractors: Vec<usize>,
+    /// Solid dielectrics shaded by image-space double refraction.
+    pub image_space: Vec<usize>,
+    /// Proxy geometry (§3.2): sphere radius and box, world space.
+    pub proxy_radius: f32,
+    pub proxy_box: (Vec3, Vec3),
+}
+
+impl Plan {
+    /// Whether mesh `m` is a solid dielectric handled by the self-refraction passes.
+    pub fn self_refracted(&self, m: usize) -> bool {
+        self.refractors.contains(&m) || self.image_space.contains(&m)
+    }
 }
 
 /// The passes `Method::Reference` reports: one CPU pass, no maps (its shadows are exact
@@ -85,6 +136,11 @@ pub fn plan(scene: &Scene, method: Method, quality: &Quality) -> Plan {
             envmaps: Vec::new(),
             passes: vec![REFERENCE_PASS],
             cube_near: if diag > 0.0 { diag * 1e-5 } else { 1e-4 },
+            cycles: 0,
+            refractors: Vec::new(),
+            image_space: Vec::new(),
+            proxy_radius: 0.0,
+            proxy_box: (Vec3::ZERO, Vec3::ZERO),
         };
     }
     let mut shadow_cubes = Vec::new();
@@ -97,7 +153,7 @@ pub fn plan(scene: &Scene, method: Method, quality: &Quality) -> Plan {
     }
     let envmaps: Vec<EnvmapPlan> = match method {
         Method::Reference => Vec::new(),
-        Method::Envmap => scene
+        _ => scene
             .specular_meshes()
             .enumerate()
             .map(|(layer, (mesh, _))| EnvmapPlan {
@@ -119,14 +175,62 @@ pub fn plan(scene: &Scene, method: Method, quality: &Quality) -> Plan {
         shadow_cubes.clear();
         shadow_planes.clear();
     }
+    let solid = |m: usize| matches!(scene.materials[scene.meshes[m].material].kind, SurfaceKind::Dielectric { thin: false, .. });
+    let solids: Vec<usize> = envmaps.iter().map(|e| e.mesh).filter(|&m| solid(m)).collect();
+    let refractors = if method == Method::RefractorMap { solids.clone() } else { Vec::new() };
+    let image_space = if method == Method::ImageSpaceRefraction { solids } else { Vec::new() };
+    let cycles = match method {
+        Method::DistanceMulti if quality.frame_latency => 1,
+        Method::DistanceMulti => quality.depth,
+        _ => 1,
+    };
     if !envmaps.is_empty() {
-        passes.push("envmap.generate");
+        passes.push(if method.uses_distance_maps() { "distance.generate" } else { "envmap.generate" });
+    }
+    if !refractors.is_empty() {
+        passes.push("refractor.generate");
     }
     passes.push("scene.direct");
-    if !envmaps.is_empty() {
-        passes.push("envmap.shade");
+    if !image_space.is_empty() {
+        passes.push("image_space.backfaces");
     }
-    let diag = scene.bounds().diagonal();
+    let others = envmaps.iter().any(|e| !refractors.contains(&e.mesh) && !image_space.contains(&e.mesh));
+    if others {
+        passes.push(match method {
+            Method::ProxySphere | Method::ProxyBox => "proxy.shade",
+            m if m.uses_distance_maps() => "distance.search",
+            _ => "envmap.shade",
+        });
+    }
+    if !refractors.is_empty() {
+        passes.push("refractor.search");
+    }
+    if !image_space.is_empty() {
+        passes.push("image_space.refract");
+    }
+    let bounds = scene.bounds();
+    let proxy_radius = quality.proxy_radius.unwrap_or_else(|| {
+        let half = (bounds.max - bounds.min) * 0.5;
+        if bounds.is_empty() {
+            1.0
+        } else {
+            ((half.x + half.y + half.z) / 3.0).max(1e-6)
+        }
+    });
+    let diag = bounds.diagonal();
     let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
-    Plan { method, quality: quality.clone(), shadow_cubes, shadow_planes, envmaps, passes, cube_near }
+    Plan {
+        method,
+        quality: quality.clone(),
+        shadow_cubes,
+        shadow_planes,
+        envmaps,
+        passes,
+        cube_near,
+        cycles,
+        refractors,
+        image_space,
+        proxy_radius,
+        proxy_box: (bounds.min, bounds.max),
+    }
 }

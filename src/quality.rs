@@ -43,6 +43,20 @@ pub struct Quality {
     pub depth: u32,
     /// Reference renderer: samples per pixel, a k×k stratified grid (k² = spp).
     pub spp: u32,
+    /// Distance-map search (§4.1): linear steps (0: parallax correction only).
+    pub linear_steps: u32,
+    pub secant_steps: u32,
+    pub binary_steps: u32,
+    pub parallax_iterations: u32,
+    /// Early exit once | |l|/|l'| − 1 | ≤ this.
+    pub search_tolerance: f32,
+    /// Self refraction (§4.4): internal reflections followed inside a refractor.
+    pub internal_bounces: u32,
+    /// Inter-object reflections (§4.3): one map cycle per frame, reusing the last frame's.
+    pub frame_latency: bool,
+    /// Proxy sphere radius of `proxy-sphere` (§3.2), metres; `None`: the mean half-extent
+    /// of the scene's bounding box.
+    pub proxy_radius: Option<f32>,
 }
 
 /// A knob's documentation: one line each, shown by `specula knobs`.
@@ -87,6 +101,44 @@ pub const KNOBS: &[Knob] = &[
         default: "16",
         doc: "reference: samples per pixel on a k×k stratified grid (a perfect square; 1 = pixel centre)",
     },
+    Knob {
+        name: "linear_steps",
+        values: "0..=256",
+        default: "16",
+        doc: "distance-map linear search steps (§4.1.2); 0: parallax correction only",
+    },
+    Knob {
+        name: "secant_steps",
+        values: "0..=64",
+        default: "2",
+        doc: "secant (false position) refinement steps after the linear search (survey eq. 5)",
+    },
+    Knob { name: "binary_steps", values: "0..=64", default: "0", doc: "binary refinement steps after the linear search (§4.1.4)" },
+    Knob {
+        name: "parallax_iterations",
+        values: "1..=64",
+        default: "1",
+        doc: "parallax-correction iterations (survey eq. 4) when linear_steps = 0",
+    },
+    Knob { name: "search_tolerance", values: "0..=1", default: "0.001", doc: "search stops once | |l|/|l'| − 1 | is within this" },
+    Knob {
+        name: "internal_bounces",
+        values: "0..=16",
+        default: "2",
+        doc: "refractor-map: total internal reflections followed inside a refractor (§4.4)",
+    },
+    Knob {
+        name: "frame_latency",
+        values: "on|off",
+        default: "off",
+        doc: "distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)",
+    },
+    Knob {
+        name: "proxy_radius",
+        values: "auto|metres",
+        default: "auto",
+        doc: "proxy-sphere radius (§3.2); auto: mean half-extent of the scene's box",
+    },
 ];
 
 impl Default for Quality {
@@ -100,7 +152,22 @@ impl Default for Quality {
             shadow_size: 512,
             depth: 8,
             spp: 16,
+            linear_steps: 16,
+            secant_steps: 2,
+            binary_steps: 0,
+            parallax_iterations: 1,
+            search_tolerance: 1e-3,
+            internal_bounces: 2,
+            frame_latency: false,
+            proxy_radius: None,
         }
+    }
+}
+
+fn parse_count(key: &str, v: &str, lo: u32, hi: u32) -> Result<u32> {
+    match v.parse::<u32>() {
+        Ok(n) if (lo..=hi).contains(&n) => Ok(n),
+        _ => Err(Error::invalid(format!("knob {key}"), format!("'{v}' is not a whole number in {lo}..={hi}"))),
     }
 }
 
@@ -129,6 +196,33 @@ impl Quality {
                 self.spp = match value.parse::<u32>() {
                     Ok(n) if (1..=1024).contains(&n) && n.isqrt().pow(2) == n => n,
                     _ => return Err(bad("the perfect squares 1, 4, 9, ..., 1024")),
+                }
+            }
+            "linear_steps" => self.linear_steps = parse_count(key, value, 0, 256)?,
+            "secant_steps" => self.secant_steps = parse_count(key, value, 0, 64)?,
+            "binary_steps" => self.binary_steps = parse_count(key, value, 0, 64)?,
+            "parallax_iterations" => self.parallax_iterations = parse_count(key, value, 1, 64)?,
+            "internal_bounces" => self.internal_bounces = parse_count(key, value, 0, 16)?,
+            "search_tolerance" => {
+                self.search_tolerance = match value.parse::<f32>() {
+                    Ok(t) if (0.0..=1.0).contains(&t) => t,
+                    _ => return Err(bad("a number in 0..=1")),
+                }
+            }
+            "frame_latency" => {
+                self.frame_latency = match value {
+                    "on" => true,
+                    "off" => false,
+                    _ => return Err(bad("on|off")),
+                }
+            }
+            "proxy_radius" => {
+                self.proxy_radius = match value {
+                    "auto" => None,
+                    v => match v.parse::<f32>() {
+                        Ok(r) if r > 0.0 && r.is_finite() => Some(r),
+                        _ => return Err(bad("auto|a radius > 0 in metres")),
+                    },
                 }
             }
             "cube_precision" => {

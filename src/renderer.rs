@@ -9,10 +9,13 @@ use crate::cube::face_view_proj;
 use crate::error::{Error, Result};
 use crate::gpu_scene::{light_kind_code, GpuLight, GpuObject, GpuScene, GpuView};
 use crate::methods::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
-use crate::methods::envmap::{EnvmapGenerate, EnvmapShade};
+use crate::methods::envmap::{CubeMaps, MapKind};
+use crate::methods::image_space::Backfaces;
+use crate::methods::refractor::RefractorMaps;
+use crate::methods::shade::SpecularShade;
 use crate::methods::shadow::ShadowMaps;
-use crate::methods::{FrameInputs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
-use crate::plan::Plan;
+use crate::methods::{FrameInputs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_PROXY_BOX, PUSH_BYTES};
+use crate::plan::{Method, Plan};
 use crate::quality::FresnelMode;
 use crate::scene::{Camera, LightKind, Scene};
 use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image, Binding};
@@ -33,6 +36,14 @@ const BINDINGS: &[Binding] = &[
     (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
     (7, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
     (8, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+];
+
+/// The maps set's bindings (set 1 in glsl/common/scene.glsl and image_space/refract.vert).
+const MAP_BINDINGS: &[Binding] = &[
+    (0, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+    (1, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+    (2, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
+    (3, vk::DescriptorType::STORAGE_BUFFER, 1),
 ];
 
 /// A rendered frame: linear radiance RGBA32F, its per-pass profile and the device memory
@@ -63,6 +74,12 @@ struct ViewLayout {
     count: u32,
 }
 
+/// A descriptor set with its own pool.
+struct OwnedSet {
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+}
+
 pub struct Renderer {
     pub plan: Plan,
     pub width: u32,
@@ -80,8 +97,16 @@ pub struct Renderer {
     linear_repeat: vk::Sampler,
     nearest_clamp: vk::Sampler,
     shadows: ShadowMaps,
-    envmap_generate: Option<EnvmapGenerate>,
-    envmap_shade: Option<EnvmapShade>,
+    cube_maps: Option<CubeMaps>,
+    refractor_maps: Option<RefractorMaps>,
+    backfaces: Option<Backfaces>,
+    /// The method's camera passes: the one for specular objects in general, and the
+    /// self-refraction one for solid dielectrics (refractor-map, image-space).
+    shade: Option<SpecularShade>,
+    self_refraction: Option<SpecularShade>,
+    maps_layout: vk::DescriptorSetLayout,
+    /// `maps_sets[i]` samples `cube_maps.maps[i]`; the last one holds null maps.
+    maps_sets: Vec<OwnedSet>,
     direct: Option<SceneDirect>,
     pub target: Image,
     depth: Image,
@@ -124,8 +149,13 @@ impl Renderer {
             linear_repeat: vk::Sampler::null(),
             nearest_clamp: vk::Sampler::null(),
             shadows: ShadowMaps::default(),
-            envmap_generate: None,
-            envmap_shade: None,
+            cube_maps: None,
+            refractor_maps: None,
+            backfaces: None,
+            shade: None,
+            self_refraction: None,
+            maps_layout: vk::DescriptorSetLayout::null(),
+            maps_sets: Vec::new(),
             direct: None,
             target: Image::placeholder(),
             depth: Image::placeholder(),
@@ -171,11 +201,22 @@ impl Renderer {
         let mut objects: Vec<GpuObject> = scene
             .meshes
             .iter()
-            .map(|m| GpuObject { material: m.material as u32, envmap_layer: -1, pad: [0; 2], reference_point: [0.0; 4] })
+            .map(|m| GpuObject {
+                material: m.material as u32,
+                envmap_layer: -1,
+                refractor_layer: -1,
+                pad: 0,
+                reference_point: [0.0; 4],
+                proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
+                proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
+            })
             .collect();
         for e in &plan.envmaps {
             objects[e.mesh].envmap_layer = e.layer as i32;
-            objects[e.mesh].reference_point = e.reference_point.extend(1.0).to_array();
+            objects[e.mesh].reference_point = e.reference_point.extend(plan.proxy_radius).to_array();
+        }
+        for (k, &m) in plan.refractors.iter().enumerate() {
+            objects[m].refractor_layer = k as i32;
         }
         self.objects = Buffer::with_data(ctx, "scene.objects", &objects, vk::BufferUsageFlags::STORAGE_BUFFER)?;
 
@@ -191,14 +232,42 @@ impl Renderer {
         self.set_layout = descriptor_set_layout(ctx, "frame.set_layout", BINDINGS, stages)?;
         let (pool, set) = allocate_set(ctx, "frame.set", self.set_layout, BINDINGS)?;
         (self.pool, self.set) = (pool, set);
-        self.layout = pipeline_layout(ctx, "frame.layout", &[self.set_layout], 16, stages)?;
+        self.maps_layout = descriptor_set_layout(ctx, "maps.set_layout", MAP_BINDINGS, stages)?;
+        self.layout = pipeline_layout(ctx, "frame.layout", &[self.set_layout, self.maps_layout], PUSH_BYTES, stages)?;
         self.linear_repeat = sampler(ctx, "sampler.linear_repeat", vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)?;
         self.nearest_clamp = sampler(ctx, "sampler.nearest_clamp", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
 
         self.shadows = ShadowMaps::new(ctx, &self.plan, self.layout)?;
+        let method = self.plan.method;
         if !self.plan.envmaps.is_empty() {
-            self.envmap_generate = Some(EnvmapGenerate::new(ctx, &self.plan, self.layout)?);
-            self.envmap_shade = Some(EnvmapShade::new(ctx, self.layout)?);
+            let kind = if method.uses_distance_maps() { MapKind::Distance } else { MapKind::Radiance };
+            self.cube_maps = Some(CubeMaps::new(ctx, &self.plan, self.layout, kind)?);
+            let others = self.plan.envmaps.iter().any(|e| !self.plan.self_refracted(e.mesh));
+            if others {
+                let (name, fragment) = match method {
+                    Method::ProxySphere | Method::ProxyBox => ("proxy.shade", "envmap/proxy.frag"),
+                    m if m.uses_distance_maps() => ("distance.search", "distance/shade.frag"),
+                    _ => ("envmap.shade", "envmap/shade.frag"),
+                };
+                self.shade = Some(SpecularShade::new(ctx, self.layout, name, "scene/mesh.vert", fragment)?);
+            }
+        }
+        if !self.plan.refractors.is_empty() {
+            self.refractor_maps = Some(RefractorMaps::new(ctx, &self.plan, self.layout)?);
+            self.self_refraction =
+                Some(SpecularShade::new(ctx, self.layout, "refractor.search", "scene/mesh.vert", "refractor/search.frag")?);
+        }
+        if !self.plan.image_space.is_empty() {
+            self.backfaces = Some(Backfaces::new(ctx, scene, &self.plan, self.layout, self.width, self.height)?);
+            self.self_refraction =
+                Some(SpecularShade::new(ctx, self.layout, "image_space.refract", "image_space/refract.vert", "image_space/refract.frag")?);
+        }
+        if method.uses_distance_maps() {
+            let images = self.cube_maps.as_ref().map_or(0, |c| c.maps.len());
+            for i in 0..=images {
+                let (pool, set) = allocate_set(ctx, &format!("maps.set{i}"), self.maps_layout, MAP_BINDINGS)?;
+                self.maps_sets.push(OwnedSet { pool, set });
+            }
         }
         self.direct = Some(SceneDirect::new(ctx, self.layout)?);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED;
@@ -273,7 +342,30 @@ impl Renderer {
         write_image(ctx, self.set, 5, 0, cis, view(self.scene.environment.as_ref()), self.linear_repeat, ro);
         write_image(ctx, self.set, 6, 0, cis, view(self.shadows.cubes.as_ref()), self.nearest_clamp, ro);
         write_image(ctx, self.set, 7, 0, cis, view(self.shadows.planes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, 8, 0, cis, view(self.envmap_generate.as_ref().map(|g| &g.maps)), self.linear_repeat, ro);
+        let radiance = self.cube_maps.as_ref().filter(|c| c.kind == MapKind::Radiance).map(|c| &c.maps[0]);
+        write_image(ctx, self.set, 8, 0, cis, view(radiance), self.linear_repeat, ro);
+        // Maps sets: set i samples distance image i, the last one no distance map; all share
+        // the refractor maps, the back-face map and the thickness buffer.
+        let distance: Vec<&Image> = self.cube_maps.iter().filter(|c| c.kind == MapKind::Distance).flat_map(|c| c.maps.iter()).collect();
+        let last = self.maps_sets.len().saturating_sub(1);
+        for (i, s) in self.maps_sets.iter().enumerate() {
+            // The last set is all null: map generation declares set 1 but must not see
+            // maps that are not written yet.
+            let camera = i < last;
+            write_image(ctx, s.set, 0, 0, cis, view(distance.get(i).copied()), self.linear_repeat, ro);
+            write_image(
+                ctx,
+                s.set,
+                1,
+                0,
+                cis,
+                view(self.refractor_maps.as_ref().map(|r| &r.maps).filter(|_| camera)),
+                self.linear_repeat,
+                ro,
+            );
+            write_image(ctx, s.set, 2, 0, cis, view(self.backfaces.as_ref().map(|b| &b.map).filter(|_| camera)), self.nearest_clamp, ro);
+            write_buffer(ctx, s.set, 3, sb, buffer(self.backfaces.as_ref().map(|b| &b.thickness).filter(|_| camera)));
+        }
     }
 
     /// Replaces the camera (the output size's aspect ratio still wins).
@@ -283,9 +375,15 @@ impl Renderer {
         Ok(())
     }
 
-    /// The environment-map cube array (one cube per `plan.envmaps` entry), if planned.
+    /// The environment- or distance-map cube array the camera pass reads (one cube per
+    /// `plan.envmaps` entry), if planned.
     pub fn envmaps(&self) -> Option<&Image> {
-        self.envmap_generate.as_ref().map(|g| &g.maps)
+        self.cube_maps.as_ref().map(|c| c.current())
+    }
+
+    /// The refractor-map cube array (one cube per `plan.refractors` entry), if planned.
+    pub fn refractor_maps(&self) -> Option<&Image> {
+        self.refractor_maps.as_ref().map(|r| &r.maps)
     }
 
     /// The shadow cube array (one cube per `plan.shadow_cubes` entry), if planned.
@@ -341,24 +439,60 @@ impl Renderer {
         self.write_views()?;
         let mut rec = Recorder::new(ctx, cmd, &mut self.profiler);
         self.scene.record_upload(&mut rec);
-        let f = FrameInputs { scene: &self.scene, set: self.set, layout: self.layout, flags: self.flags, light_count: self.light_count };
+        let q = &self.plan.quality;
+        let f = FrameInputs {
+            scene: &self.scene,
+            set: self.set,
+            layout: self.layout,
+            flags: self.flags,
+            light_count: self.light_count,
+            search: [q.linear_steps, q.secant_steps, q.binary_steps, q.parallax_iterations],
+            tolerance: q.search_tolerance,
+            internal_bounces: q.internal_bounces,
+        };
         let scene_images: Vec<&Image> = f.scene.textures.iter().chain(f.scene.environment.iter()).collect();
+        let maps_sets: Vec<vk::DescriptorSet> = self.maps_sets.iter().map(|s| s.set).collect();
+        let empty_set = maps_sets.last().copied().unwrap_or(vk::DescriptorSet::null());
         self.shadows.record(&mut rec, &f, &self.views.shadow_cubes, &self.views.shadow_planes);
-        if let Some(g) = self.envmap_generate.as_mut() {
-            g.record(&mut rec, &f, &self.plan, &self.views.envmaps, scene_images.iter().copied().chain(self.shadows.sampled()));
+        if let Some(g) = self.cube_maps.as_mut() {
+            let sampled = scene_images.iter().copied().chain(self.shadows.sampled());
+            g.record(&mut rec, &f, &self.plan, &self.views.envmaps, &maps_sets, empty_set, sampled);
+        }
+        // Refractor maps are seen from the refractors' reference points: their views are
+        // the environment maps' views.
+        if let Some(r) = self.refractor_maps.as_mut() {
+            let views: Vec<u32> = self
+                .plan
+                .refractors
+                .iter()
+                .map(|m| self.plan.envmaps.iter().position(|e| e.mesh == *m).map_or(0, |i| self.views.envmaps[i]))
+                .collect();
+            r.record(&mut rec, &f, &self.plan, &views);
         }
         if let Some(d) = &self.direct {
-            d.record(
-                &mut rec,
-                &f,
-                self.views.camera,
-                &mut self.target,
-                &mut self.depth,
-                scene_images.iter().copied().chain(self.shadows.sampled()),
-            );
+            let sampled = scene_images.iter().copied().chain(self.shadows.sampled());
+            d.record(&mut rec, &f, self.views.camera, &mut self.target, &mut self.depth, sampled);
         }
-        if let (Some(s), Some(g)) = (&self.envmap_shade, &self.envmap_generate) {
-            s.record(&mut rec, &f, self.views.camera, &g.maps, &mut self.target, &mut self.depth);
+        let plan = &self.plan;
+        if let Some(b) = self.backfaces.as_mut() {
+            b.record(&mut rec, &f, self.views.camera, |d| plan.image_space.contains(&(d.mesh as usize)));
+        }
+        // The camera passes read the maps the last cycle wrote.
+        let current = self.cube_maps.as_ref().map_or(0, |c| c.latest);
+        let maps_set = maps_sets.get(current).copied();
+        let mut reads: Vec<&Image> = self.cube_maps.iter().map(|c| c.current()).collect();
+        reads.extend(self.refractor_maps.iter().map(|r| &r.maps));
+        reads.extend(self.backfaces.iter().map(|b| &b.map));
+        let proxy = if plan.method == Method::ProxyBox { FLAG_PROXY_BOX } else { 0 };
+        if let Some(s) = &self.shade {
+            s.record(&mut rec, &f, self.views.camera, reads.iter().copied(), maps_set, proxy, &mut self.target, &mut self.depth, |d| {
+                d.specular && !plan.self_refracted(d.mesh as usize)
+            });
+        }
+        if let Some(s) = &self.self_refraction {
+            s.record(&mut rec, &f, self.views.camera, reads.iter().copied(), maps_set, 0, &mut self.target, &mut self.depth, |d| {
+                plan.self_refracted(d.mesh as usize)
+            });
         }
         if let Some(rb) = &self.readback {
             let open = rec.pass("frame.readback").reads(&self.target, Access::TransferSrc).begin();
@@ -465,10 +599,16 @@ impl Renderer {
     /// Frees everything. The GPU must be idle with respect to this renderer's frames.
     pub fn destroy(&mut self, ctx: &Context) {
         self.shadows.destroy(ctx);
-        for g in self.envmap_generate.iter_mut() {
+        for g in self.cube_maps.iter_mut() {
             g.destroy(ctx);
         }
-        for s in self.envmap_shade.iter_mut() {
+        for r in self.refractor_maps.iter_mut() {
+            r.destroy(ctx);
+        }
+        for b in self.backfaces.iter_mut() {
+            b.destroy(ctx);
+        }
+        for s in self.shade.iter_mut().chain(self.self_refraction.iter_mut()) {
             s.destroy(ctx);
         }
         for d in self.direct.iter_mut() {
@@ -493,6 +633,12 @@ impl Renderer {
             if self.set_layout != vk::DescriptorSetLayout::null() {
                 d.destroy_descriptor_set_layout(self.set_layout, None);
             }
+            for s in self.maps_sets.drain(..) {
+                d.destroy_descriptor_pool(s.pool, None);
+            }
+            if self.maps_layout != vk::DescriptorSetLayout::null() {
+                d.destroy_descriptor_set_layout(self.maps_layout, None);
+            }
             for s in [self.linear_repeat, self.nearest_clamp] {
                 if s != vk::Sampler::null() {
                     d.destroy_sampler(s, None);
@@ -502,6 +648,7 @@ impl Renderer {
         self.layout = vk::PipelineLayout::null();
         self.pool = vk::DescriptorPool::null();
         self.set_layout = vk::DescriptorSetLayout::null();
+        self.maps_layout = vk::DescriptorSetLayout::null();
         self.linear_repeat = vk::Sampler::null();
         self.nearest_clamp = vk::Sampler::null();
     }

@@ -29,10 +29,12 @@ struct Material {
 
 struct Object {
     uint material;
-    int envmap_layer;    // cube index in the environment-map array, -1: none
+    int envmap_layer;    // cube index in the environment/distance-map arrays, -1: none
+    int refractor_layer; // cube index in the refractor-map array, -1: none
     uint pad0;
-    uint pad1;
-    vec4 reference_point;
+    vec4 reference_point; // xyz; w: proxy sphere radius (§3.2)
+    vec4 proxy_min;       // proxy box (§3.2), world space
+    vec4 proxy_max;
 };
 
 const uint LIGHT_POINT = 0u;
@@ -59,14 +61,33 @@ layout(set = 0, binding = 6) uniform samplerCubeArray shadow_cubes;
 layout(set = 0, binding = 7) uniform sampler2DArray shadow_planes;
 layout(set = 0, binding = 8) uniform samplerCubeArray envmaps;
 
+// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.
+layout(set = 1, binding = 0) uniform samplerCubeArray distance_maps;   // rgb radiance, a distance
+layout(set = 1, binding = 1) uniform samplerCubeArray refractor_maps;  // xyz normal, w distance
+layout(set = 1, binding = 2) uniform sampler2D backface_map;           // xyz normal, w distance from the eye
+
 const uint FLAG_FRESNEL_EXACT = 1u;
 const uint FLAG_HAS_ENVIRONMENT = 2u;
+// Specular objects drawn into maps search their own (previous-cycle) distance maps (§4.3).
+const uint FLAG_INTER_OBJECT = 4u;
+// Proxy geometry of localised environment mapping (§3.2): box, else sphere.
+const uint FLAG_PROXY_BOX = 8u;
+// First inter-object cycle: no map holds anything yet, specular objects in maps are black
+// (paths longer than the requested depth end black, as in the reference).
+const uint FLAG_FIRST_CYCLE = 16u;
 
 layout(push_constant) uniform Push {
     uint view;         // first view of this draw (multiview adds gl_ViewIndex)
     uint object;
     uint flags;
     uint light_count;
+    // Search knobs (§4.1): linear steps (0: parallax correction), secant steps, binary
+    // steps, parallax iterations.
+    uvec4 search;
+    float tolerance;         // early exit when | |l|/|l'| − 1 | ≤ tolerance
+    uint internal_bounces;   // self refraction: total internal reflections followed (§4.4)
+    uint pad0;
+    uint pad1;
 } push;
 
 #endif

@@ -40,6 +40,7 @@ pub fn sky_and_direct(
             depth_test: false,
             depth_write: false,
             view_mask,
+            cull: vk::CullModeFlags::NONE,
         },
     )?;
     let direct = graphics_pipeline(
@@ -55,6 +56,7 @@ pub fn sky_and_direct(
             depth_test: true,
             depth_write: true,
             view_mask,
+            cull: vk::CullModeFlags::NONE,
         },
     );
     match direct {

@@ -4,6 +4,9 @@
 
 pub mod direct;
 pub mod envmap;
+pub mod image_space;
+pub mod refractor;
+pub mod shade;
 pub mod shadow;
 
 use ash::vk;
@@ -20,10 +23,19 @@ pub struct Push {
     pub object: u32,
     pub flags: u32,
     pub light_count: u32,
+    /// linear steps (0: parallax correction), secant steps, binary steps, parallax iterations.
+    pub search: [u32; 4],
+    pub tolerance: f32,
+    pub internal_bounces: u32,
+    pub pad: [u32; 2],
 }
 
+pub const PUSH_BYTES: u32 = std::mem::size_of::<Push>() as u32;
 pub const FLAG_FRESNEL_EXACT: u32 = 1;
 pub const FLAG_HAS_ENVIRONMENT: u32 = 2;
+pub const FLAG_INTER_OBJECT: u32 = 4;
+pub const FLAG_PROXY_BOX: u32 = 8;
+pub const FLAG_FIRST_CYCLE: u32 = 16;
 
 /// What every pass needs to draw the scene: geometry, the frame's descriptor set and
 /// pipeline layout, and the frame-wide push-constant fields.
@@ -33,6 +45,9 @@ pub struct FrameInputs<'a> {
     pub layout: vk::PipelineLayout,
     pub flags: u32,
     pub light_count: u32,
+    pub search: [u32; 4],
+    pub tolerance: f32,
+    pub internal_bounces: u32,
 }
 
 impl FrameInputs<'_> {
@@ -44,8 +59,26 @@ impl FrameInputs<'_> {
         self.scene.bind_geometry(ctx, cmd);
     }
 
+    /// Binds a maps set (set 1) for the passes of §4.
+    pub fn bind_maps(&self, ctx: &Context, cmd: vk::CommandBuffer, maps: vk::DescriptorSet) {
+        unsafe { ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 1, &[maps], &[]) };
+    }
+
     pub fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32) {
-        let p = Push { view, object, flags: self.flags, light_count: self.light_count };
+        self.push_flags(ctx, cmd, view, object, self.flags);
+    }
+
+    pub fn push_flags(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32, flags: u32) {
+        let p = Push {
+            view,
+            object,
+            flags,
+            light_count: self.light_count,
+            search: self.search,
+            tolerance: self.tolerance,
+            internal_bounces: self.internal_bounces,
+            pad: [0; 2],
+        };
         unsafe {
             ctx.device.cmd_push_constants(
                 cmd,

@@ -50,6 +50,7 @@ impl ShadowMaps {
             depth_test: true,
             depth_write: true,
             view_mask,
+            cull: vk::CullModeFlags::NONE,
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };

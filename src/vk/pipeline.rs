@@ -127,6 +127,9 @@ pub struct GraphicsDesc<'a> {
     pub depth_write: bool,
     /// Multiview mask (0x3F renders all six cube faces in one pass).
     pub view_mask: u32,
+    /// Faces to cull; NONE draws both sides (rooms are seen from inside, refractors from
+    /// both sides), FRONT keeps back faces (image-space refraction's first pass).
+    pub cull: vk::CullModeFlags,
 }
 
 pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &GraphicsDesc) -> Result<vk::Pipeline> {
@@ -159,7 +162,10 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
     // Two-sided: rooms are seen from inside, refractors from both sides.
     let rs = vk::PipelineRasterizationStateCreateInfo::default()
         .polygon_mode(vk::PolygonMode::FILL)
-        .cull_mode(vk::CullModeFlags::NONE)
+        .cull_mode(desc.cull)
+        // With the y-flipped projections used here, glTF's counter-clockwise front faces
+        // stay counter-clockwise in the framebuffer (tests/image_space checks it).
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
     let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()

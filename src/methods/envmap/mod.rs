@@ -1,9 +1,7 @@
-//! Environment mapping (survey §3): `generate` rasterises each specular object's cube map
-//! from its reference point with the object left out; `shade` looks the map up in the
-//! reflected and refracted directions, ignoring the ray origin (§3.1).
+//! Environment mapping (survey §3) and, with distances stored alongside the radiance,
+//! distance maps (§4): `generate` rasterises each specular object's cube map from its
+//! reference point with the object left out. The shading passes are `methods::shade`.
 
 pub mod generate;
-pub mod shade;
 
-pub use generate::EnvmapGenerate;
-pub use shade::EnvmapShade;
+pub use generate::{CubeMaps, MapKind};

@@ -1,0 +1,35 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
+// the reference point (not window-space z). Specular objects other than the map's owner
+// reflect the environment map, or, in inter-object mode (§4.3), search their own maps of
+// the previous cycle.
+#include "common/specular.glsl"
+#include "common/traced.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_radiance_distance;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    vec3 n = normalize(in_normal);
+    vec3 eye = views[in_view].eye.xyz;
+    vec3 c;
+    if (m.kind == KIND_DIFFUSE) {
+        c = shade_diffuse(m, in_position, n, eye, in_uv);
+    } else {
+        SpecularSplit s = specular_split(m, in_position, n, eye);
+        bool inter = (push.flags & FLAG_INTER_OBJECT) != 0u && o.envmap_layer >= 0;
+        if (inter && (push.flags & FLAG_FIRST_CYCLE) != 0u) {
+            c = vec3(0.0);
+        } else {
+            c = s.fr * (inter ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
+            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * (inter ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
+        }
+    }
+    out_radiance_distance = vec4(c, length(in_position - eye));
+}

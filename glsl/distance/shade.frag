@@ -1,0 +1,22 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// distance.search: single reflections and refractions using the sampled geometry (§4.2):
+// the reflected and refracted rays are traced in the object's distance map and the hit
+// texel's radiance is weighted by Fresnel.
+#include "common/specular.glsl"
+#include "common/traced.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+    vec3 c = s.fr * traced_radiance(o, in_position, s.r);
+    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * traced_radiance(o, in_position, s.t);
+    out_color = vec4(c, 1.0);
+}

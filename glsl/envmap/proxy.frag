@@ -1,0 +1,44 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// proxy.shade: localised environment mapping (survey §3.2, Figure 15): the reflected or
+// refracted ray is intersected with a proxy of the environment, a sphere around the
+// reference point or a box (a "parallax-corrected cube map"), and the cube map is looked
+// up in the direction of the proxy hit.
+#include "common/specular.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+// Direction from the reference point to where the ray leaves the proxy.
+vec3 proxy_direction(Object o, vec3 p, vec3 dir) {
+    vec3 c = o.reference_point.xyz;
+    if ((push.flags & FLAG_PROXY_BOX) != 0u) {
+        // Exit of the slab intersection; a point outside the box keeps its direction.
+        vec3 inv = 1.0 / dir;
+        vec3 t0 = (o.proxy_min.xyz - p) * inv;
+        vec3 t1 = (o.proxy_max.xyz - p) * inv;
+        vec3 tmax = max(t0, t1);
+        float t = min(min(tmax.x, tmax.y), tmax.z);
+        return t > 0.0 ? p + dir * t - c : dir;
+    }
+    float r = o.reference_point.w;
+    vec3 x = p - c;
+    float b = dot(x, dir);
+    float disc = b * b - (dot(x, x) - r * r);
+    if (disc < 0.0) return dir;  // outside a proxy it misses: the direction alone
+    float t = -b + sqrt(disc);
+    return t > 0.0 ? x + dir * t : dir;
+}
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+    float layer = float(o.envmap_layer);
+    vec3 c = s.fr * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.r), layer), 0.0).rgb;
+    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.t), layer), 0.0).rgb;
+    out_color = vec4(c, 1.0);
+}

@@ -1,0 +1,55 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// image_space.refract: Wyman's front-face/back-face double refraction (survey §4.4). The
+// distance to the second interface is interpolated between d_V (back-face distance along
+// the view ray, from the first pass) and d_N (precomputed along the inverted normal) by the
+// angles of incidence and refraction; the back-face normal is fetched where that point
+// projects. The ray that leaves searches the environment's distance map.
+#include "common/specular.glsl"
+#include "common/traced.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 4) in float in_thickness;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    View v = views[in_view];
+    vec3 eye = v.eye.xyz;
+    vec3 p1 = in_position;
+    vec3 n1 = normalize(in_normal);
+    SpecularSplit s = specular_split(m, p1, n1, eye);
+    vec3 c = s.fr * traced_radiance(o, p1, s.r);
+    if (any(greaterThan(s.ft, vec3(0.0)))) {
+        vec3 i = normalize(p1 - eye);
+        if (dot(n1, i) > 0.0) n1 = -n1;
+        float theta_i = acos(clamp(-dot(i, n1), -1.0, 1.0));
+        float theta_t = acos(clamp(-dot(s.t, n1), -1.0, 1.0));
+        float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / m.nu.x;  // Snell's small-angle limit
+        ivec2 size = textureSize(backface_map, 0);
+        vec2 uv = gl_FragCoord.xy / vec2(size);
+        float d_v = max(textureLod(backface_map, uv, 0.0).w - length(p1 - eye), 0.0);
+        float d = ratio * d_v + (1.0 - ratio) * in_thickness;
+        vec3 p2 = p1 + s.t * d;
+        vec4 clip = v.view_proj * vec4(p2, 1.0);
+        vec2 uv2 = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+        vec3 n2 = textureLod(backface_map, uv2, 0.0).xyz;
+        n2 = dot(n2, n2) > 0.0 ? normalize(n2) : -n1;
+        if (dot(n2, s.t) < 0.0) n2 = -n2;  // outward, along the leaving ray
+        vec3 t2;
+        float ior = m.nu.x;
+        if (refract_dir(s.t, -n2, ior, t2)) {
+            vec3 f = material_fresnel(m, dot(s.t, n2), 1.0 / ior);
+            c += s.ft * (1.0 - f) * traced_radiance(o, p2, t2);
+        } else {
+            // Total internal reflection: the two-pass method has no third interface; the
+            // internally reflected ray looks the environment up as if it left here.
+            c += s.ft * traced_radiance(o, p2, reflect_dir(s.t, -n2));
+        }
+    }
+    out_color = vec4(c, 1.0);
+}

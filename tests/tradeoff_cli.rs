@@ -1,0 +1,116 @@
+//! The CLI of issue 3: `render --method reference` (CPU, no GPU plan), `compare` and
+//! `tradeoff` (every GPU method × every sweep combination against the reference, CSV and
+//! SVG plot). Small sizes: these run the real renderers.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SCENE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+
+fn specula() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_specula"));
+    c.env("SPECULA_DEVICE", "llvmpipe");
+    c
+}
+
+fn run(args: &[&str]) -> String {
+    let o = specula().args(args).output().unwrap();
+    let out = String::from_utf8_lossy(&o.stdout).to_string();
+    assert!(o.status.success(), "{args:?}: {out}{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+fn temp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("specula-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn reference_renders_on_the_cpu_and_compare_reports_metrics() {
+    let dir = temp("ref-cli");
+    let (reference, envmap, err) = (dir.join("ref.exr"), dir.join("env.exr"), dir.join("err.png"));
+    let out = run(&["render", SCENE, "--method", "reference", "--size", "40x30", "-q", "spp=4", "-q", "depth=3", "--out", s(&reference)]);
+    assert!(out.contains("reference on the CPU") && out.contains("4 spp, depth 3"), "{out}");
+    run(&["render", SCENE, "--method", "envmap", "--size", "40x30", "-q", "cube_size=32", "-q", "shadow_size=32", "--out", s(&envmap)]);
+    let out = run(&["compare", s(&envmap), s(&reference), "--error-image", s(&err)]);
+    for key in ["RMSE", "PSNR", "max |Δ|", "p99 |Δ|", "mean FLIP"] {
+        assert!(out.contains(key), "compare lacks {key}: {out}");
+    }
+    let psnr: f64 = out.lines().find(|l| l.starts_with("PSNR")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap();
+    assert!(psnr > 5.0 && psnr < 60.0, "envmap vs reference is neither garbage nor identical: {psnr}");
+    let img = image::open(&err).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    // An image compared with itself: zero error, infinite PSNR.
+    let out = run(&["compare", s(&reference), s(&reference)]);
+    assert!(out.contains("RMSE      0.000000") && out.contains("PSNR      inf dB"), "{out}");
+
+    // The reference's plan is one CPU pass; bad knobs are one-line errors.
+    let plan = run(&["plan", SCENE, "--method", "reference"]);
+    let json: serde_json::Value = serde_json::from_str(&plan).unwrap();
+    assert_eq!(json["passes"], serde_json::json!(["reference.trace"]));
+    assert_eq!(json["envmaps"], serde_json::json!([]));
+    for bad in [["-q", "spp=3"], ["-q", "depth=0"]] {
+        let o = specula().args(["render", SCENE, "--method", "reference", "--out", "/tmp/x.png"]).args(bad).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{bad:?}");
+        assert!(stderr.starts_with("specula: ") && stderr.trim_end().lines().count() == 1, "{stderr}");
+    }
+    let o = specula().args(["compare", s(&reference), "/nonexistent.exr"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(1));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
+    let dir = temp("tradeoff-cli");
+    let out = run(&[
+        "tradeoff",
+        SCENE,
+        "--size",
+        "32x32",
+        "-q",
+        "spp=1",
+        "-q",
+        "shadow_size=32",
+        "--sweep",
+        "cube_size=16,64",
+        "--sweep",
+        "cube_precision=half,single",
+        "--frames",
+        "1",
+        "--warmup",
+        "1",
+        "--validate",
+        "--out",
+        s(&dir),
+    ]);
+    assert!(out.contains("validation: 0 error(s)"), "{out}");
+    let csv = std::fs::read_to_string(dir.join("tradeoff.csv")).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(&header[..9], ["method", "knobs", "frame_ms", "rmse", "psnr_db", "flip_mean", "p99_abs", "max_abs", "pareto"]);
+    for pass in ["envmap.generate ms", "scene.direct ms", "envmap.shade ms"] {
+        assert!(header.contains(&pass), "no {pass} column: {}", lines[0]);
+    }
+    let gpu_methods: Vec<_> = specula::Method::ALL.iter().filter(|m| m.is_gpu()).collect();
+    assert_eq!(lines.len() - 1, gpu_methods.len() * 4, "one row per method and combination:\n{csv}");
+    let mut on_front = 0;
+    for l in &lines[1..] {
+        let f: Vec<&str> = l.split(',').collect();
+        let frame_ms: f64 = f[2].parse().unwrap();
+        let (rmse, psnr, flip): (f64, f64, f64) = (f[3].parse().unwrap(), f[4].parse().unwrap(), f[5].parse().unwrap());
+        assert!(frame_ms > 0.0 && rmse > 0.0 && psnr.is_finite() && flip > 0.0 && flip < 1.0, "{l}");
+        on_front += (f[8] == "true") as usize;
+    }
+    assert!(on_front >= 1, "a Pareto front exists");
+    assert!(lines.iter().any(|l| l.contains("cube_size=64 cube_precision=single")));
+    let svg = std::fs::read_to_string(dir.join("tradeoff.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("Pareto front"));
+    assert!(dir.join("reference.exr").exists());
+    std::fs::remove_dir_all(&dir).ok();
+}
