@@ -31,6 +31,7 @@ pub struct SearchResult {
     pub lookups: u32,
 }
 
+#[allow(clippy::neg_cmp_op_on_partial_ord)] // NaN counts as sky
 pub fn search_is_sky(stored: f64) -> bool {
     !(stored < SEARCH_SKY)
 }

@@ -27,13 +27,16 @@ void main() {
     for (uint bounce = 0u; bounce <= push.internal_bounces && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         search_map = 1;
         search_layer = float(o.refractor_layer);
-        SearchResult h = search_ray(pos - ref, dir);
+        // The ray starts on the refractor's own surface, where |l| = |l'|: start the search
+        // just inside, so that the surface it leaves is not mistaken for the one it meets.
+        float eps = 1e-2 * length(pos - ref);
+        SearchResult h = search_ray(pos + dir * eps - ref, dir);
         if (h.escaped) {  // an open refractor: the ray is out
             c += weight * traced_radiance(o, pos, dir);
             weight = vec3(0.0);
             break;
         }
-        vec3 hit = pos + dir * h.d;
+        vec3 hit = pos + dir * (eps + h.d);
         vec3 n2 = normalize(textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0).xyz);
         if (dot(n2, dir) < 0.0) n2 = -n2;       // the outward normal, along the leaving ray
         float cos_i = dot(dir, n2);
