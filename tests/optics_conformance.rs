@@ -116,6 +116,7 @@ struct Entry {
     case: Case,
 }
 
+#[allow(clippy::too_many_arguments)]
 fn push(t: &mut Vec<Entry>, what: impl Into<String>, op: u32, a: [f32; 4], b: [f32; 4], c: [f32; 4], d: [f32; 4], e: [f32; 4]) {
     t.push(Entry { what: what.into(), case: Case { op: [op, 0, 0, 0], a, b, c, d, e } });
 }
@@ -358,7 +359,7 @@ fn check_reflect(e: &Entry, g: &GpuResult, f: &mut Vec<String>) -> f64 {
         let bound = 8.0 * EPS * (i[k].abs() + 2.0 * sum * n[k].abs()) + 1e-45;
         let err = (g.r0[k] as f64 - cpu[k]).abs();
         worst = worst.max(err / bound);
-        if !(err <= bound) {
+        if err.is_nan() || err > bound {
             fail(f, e, format!("component {k}: GPU {} CPU {} |Δ| {err:e} > {bound:e}", g.r0[k], cpu[k]));
         }
     }
@@ -391,7 +392,7 @@ fn check_refract(e: &Entry, g: &GpuResult, f: &mut Vec<String>) -> f64 {
             let dcos = if cos_t > 0.0 { delta.sqrt().min(delta / cos_t) } else { delta.sqrt() };
             let bound = 8.0 * EPS * eta * (i.abs().max_element() + cos_i.abs()) + dcos + 8.0 * EPS;
             let err = (gpu_t - t).abs().max_element();
-            if !(err <= bound) {
+            if err.is_nan() || err > bound {
                 fail(f, e, format!("GPU {gpu_t} CPU {t} |Δ| {err:e} > {bound:e}"));
             }
             err / bound
@@ -426,7 +427,7 @@ fn check_fresnel(e: &Entry, what: &str, gpu: f32, cpu: f64, bound: f64, f: &mut 
     }
     assert!((0.0..=1.0).contains(&cpu), "{}: CPU {cpu} outside [0, 1]", e.what);
     let err = (gpu as f64 - cpu).abs();
-    if !(err <= bound) {
+    if err.is_nan() || err > bound {
         fail(f, e, format!("{what}: GPU {gpu} CPU {cpu} |Δ| {err:e} > {bound:e}"));
     }
     err / bound
@@ -528,7 +529,7 @@ fn check_ray(e: &Entry, g: &GpuResult, f: &mut Vec<String>) -> f64 {
             let mut worst: f64 = 0.0;
             for (name, (err, bound)) in ["u", "v", "t"].iter().zip(errs) {
                 worst = worst.max(err / bound);
-                if !(err <= bound) {
+                if err.is_nan() || err > bound {
                     fail(f, e, format!("{name}: GPU {:?} CPU {h:?} |Δ| {err:e} > {bound:e}", g.r0));
                 }
             }

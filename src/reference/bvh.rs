@@ -263,9 +263,8 @@ impl Bvh {
 /// cheaper.
 fn best_split(items: &[u32], boxes: &[Bounds], centroids: &[DVec3], cb: &Bounds, area: f64, n: usize) -> Option<(usize, f64)> {
     let mut best: Option<(f64, usize, f64)> = None;
-    for axis in 0..3 {
-        let (lo, hi) = (cb.min[axis], cb.max[axis]);
-        if !(hi > lo) {
+    for (axis, (lo, hi)) in cb.min.to_array().into_iter().zip(cb.max.to_array()).enumerate() {
+        if hi.is_nan() || lo.is_nan() || hi <= lo {
             continue;
         }
         let scale = BINS as f64 / (hi - lo);

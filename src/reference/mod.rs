@@ -305,8 +305,7 @@ mod tests {
         let m = s.add_material(Material { base_color: Vec3::ZERO, emissive: Vec3::new(0.25, 0.5, 2.0), ..Default::default() }).unwrap();
         s.add_mesh(shapes::quad("q", Vec3::new(-1.0, -1.0, -1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0), 2, m)).unwrap();
         s.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 0.5));
-        let mut q = Quality::default();
-        q.spp = 4;
+        let q = Quality { spp: 4, ..Default::default() };
         let img = render_reference(&s, &q, (8, 8)).unwrap();
         for p in img.data.chunks_exact(4) {
             assert_eq!(p, [0.25, 0.5, 2.0, 1.0]);
