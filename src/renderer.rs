@@ -381,6 +381,11 @@ impl Renderer {
         self.cube_maps.as_ref().map(|c| c.current())
     }
 
+    /// Image-space refraction's back-face map (xyz normal, w distance from the eye).
+    pub fn backface_map(&self) -> Option<&Image> {
+        self.backfaces.as_ref().map(|b| &b.map)
+    }
+
     /// The refractor-map cube array (one cube per `plan.refractors` entry), if planned.
     pub fn refractor_maps(&self) -> Option<&Image> {
         self.refractor_maps.as_ref().map(|r| &r.maps)

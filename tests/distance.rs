@@ -115,7 +115,8 @@ fn concave_occluder_residual_is_bounded_and_multi_map_no_worse() {
     let refimg = reference(&scene, &["spp=4", "depth=2"], size);
     let q = quality(&["cube_size=128", "ref_point=0,2,0"]);
     let single = errors(&gpu(&ctx, &scene, Method::Distance, &q, size), &refimg);
-    let multi = errors(&gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", "ref_point=0,2,0", "depth=2"]), size), &refimg);
+    let multi =
+        errors(&gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", "ref_point=0,2,0", "depth=2"]), size), &refimg);
     eprintln!("concave: distance {single}\n         distance-multi {multi}");
     assert!(single.psnr > 25.0, "{single}");
     assert!(multi.rmse <= single.rmse * 1.02, "multi {multi} vs single {single}");
@@ -126,7 +127,9 @@ fn concave_occluder_residual_is_bounded_and_multi_map_no_worse() {
 fn glass_scene(ior: f32) -> Scene {
     let mut s = Scene::new();
     common::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
-    let m = s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() }).unwrap();
+    let m = s
+        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() })
+        .unwrap();
     s.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.0, 1.5, 0.0), 0.6, 96, 48, m)).unwrap();
     s.camera = Some(Camera::look_at(Vec3::new(0.3, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 40f32.to_radians()));
     s
@@ -156,8 +159,14 @@ fn refractor_map_self_refraction() {
     // (0 bounces) brings the image closer to the reference.
     let scene = glass_scene(1.5);
     let refimg = reference(&scene, &["spp=4", "depth=8", "fresnel=exact"], size);
-    let none = errors(&gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=0"]), size), &refimg);
-    let four = errors(&gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4"]), size), &refimg);
+    let none = errors(
+        &gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=0"]), size),
+        &refimg,
+    );
+    let four = errors(
+        &gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4"]), size),
+        &refimg,
+    );
     eprintln!("TIR: 0 bounces {none}\n     4 bounces {four}");
     assert!(four.rmse < none.rmse, "internal reflections help: {four} vs {none}");
     // ν → 1: the sphere disappears.
@@ -214,5 +223,28 @@ fn inter_object_reflections_by_cycles_and_by_frame_latency() {
     eprintln!("frame latency: frame 1 {first}\n               frame {n} {last}");
     assert!(last.max_abs < 1e-5, "after {n} frames the latency mode equals {n} cycles: {last}");
     assert!(first.max_abs > 1e-2, "the first frame lacks the inter-reflections: {first}");
+    common::assert_clean(&ctx);
+}
+
+/// Wyman's first pass keeps the refractor's back faces: at the sphere's centre pixel the
+/// stored distance is that of the far side (|eye − centre| + r), its normal points away.
+#[test]
+fn image_space_first_pass_sees_back_faces() {
+    let ctx = common::gpu();
+    let scene = glass_scene(1.5);
+    let plan = specula::plan(&scene, Method::ImageSpaceRefraction, &quality(&["cube_size=32"]));
+    assert_eq!(plan.image_space, vec![24]);
+    let size = 64;
+    let mut r = specula::Renderer::new(&ctx, &scene, plan, size, size).unwrap();
+    r.render(&ctx).unwrap();
+    let map = specula::vk::read_image(&ctx, r.backface_map().unwrap()).unwrap();
+    let cam = scene.camera.unwrap();
+    let centre = Vec3::new(0.0, 1.5, 0.0);
+    let far = (cam.position - centre).length() + 0.6;
+    let t = map.texel(0, size / 2, size / 2);
+    assert!((t[3] - far).abs() < 0.02, "back-face distance {} vs far side {far}", t[3]);
+    let n = Vec3::new(t[0], t[1], t[2]);
+    assert!(n.dot(centre - cam.position) > 0.9 * (centre - cam.position).length(), "back-face normal {n} faces away");
+    r.destroy(&ctx);
     common::assert_clean(&ctx);
 }

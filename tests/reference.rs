@@ -169,3 +169,18 @@ fn envmap_vs_reference_on_the_demo_scene() {
     assert!(metrics::compare(&black, &reference).unwrap().psnr < e.psnr - 3.0);
     common::assert_clean(&ctx);
 }
+
+/// The reference has no GPU plan: its plan names one CPU pass and no maps, and building a
+/// GPU renderer for it is an error, never a frame.
+#[test]
+fn the_gpu_renderer_refuses_the_reference() {
+    let ctx = common::gpu();
+    let scene = demo();
+    let p = specula::plan(&scene, Method::Reference, &Quality::default());
+    assert_eq!(p.passes, [specula::plan::REFERENCE_PASS]);
+    assert!(p.envmaps.is_empty() && p.shadow_cubes.is_empty() && p.shadow_planes.is_empty());
+    let err = specula::render(&ctx, &scene, Method::Reference, &Quality::default(), (8, 8), (0, 1)).unwrap_err();
+    assert!(err.to_string().contains("renders on the CPU"), "{err}");
+    assert!(ctx.memory.snapshot().is_empty(), "nothing was allocated: {:?}", ctx.memory.snapshot());
+    common::assert_clean(&ctx);
+}

@@ -60,7 +60,7 @@ impl Backfaces {
             thickness: Buffer::placeholder(),
         };
         let r = (|| {
-            let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+            let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let format = vk::Format::R32G32B32A32_SFLOAT;
             me.map = Image::new(ctx, &ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage })?;
             me.depth = Image::new(

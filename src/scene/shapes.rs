@@ -23,10 +23,10 @@ pub fn uv_sphere(name: &str, center: Vec3, radius: f32, segments: u32, rings: u3
         for s in 0..segments {
             let (a, b, c, d) = (r * row + s, r * row + s + 1, (r + 1) * row + s, (r + 1) * row + s + 1);
             if r != 0 {
-                m.indices.extend([a, c, b]);
+                m.indices.extend([a, b, c]);
             }
             if r != rings - 1 {
-                m.indices.extend([b, c, d]);
+                m.indices.extend([b, d, c]);
             }
         }
     }
@@ -103,4 +103,32 @@ pub fn quadrant_room_hit(d: Vec3) -> (usize, usize) {
         _ => (0, 1),
     };
     (wall, (d[a1] > 0.0) as usize | (((d[a2] > 0.0) as usize) << 1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// glTF's convention: counter-clockwise seen from the side the normal points to.
+    fn outward_ccw(m: &Mesh) -> bool {
+        m.indices.chunks_exact(3).all(|t| {
+            let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+            let n = m.normals[t[0] as usize] + m.normals[t[1] as usize] + m.normals[t[2] as usize];
+            let f = (b - a).cross(c - a);
+            f.length_squared() < 1e-20 || f.dot(n) > 0.0
+        })
+    }
+
+    #[test]
+    fn shapes_wind_counter_clockwise_around_their_normals() {
+        assert!(outward_ccw(&uv_sphere("s", Vec3::ZERO, 1.0, 16, 8, 0)));
+        assert!(outward_ccw(&quad("q", Vec3::ZERO, Vec3::X, Vec3::Y, 3, 0)));
+        for m in quadrant_room(Vec3::ZERO, 1.0, 2, |_, _| 0) {
+            assert!(outward_ccw(&m), "{}", m.name);
+        }
+        let demo = crate::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
+        for m in &demo.meshes {
+            assert!(outward_ccw(m), "demo mesh {}", m.name);
+        }
+    }
 }
