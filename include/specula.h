@@ -306,6 +306,24 @@ typedef struct {
 // Classic environment mapping (survey §3, §3.1).
 #define SPECULA_METHOD_ENVMAP 0
 
+// Localised environment mapping, proxy sphere (§3.2).
+#define SPECULA_METHOD_PROXY_SPHERE 1
+
+// Localised environment mapping, proxy box (§3.2).
+#define SPECULA_METHOD_PROXY_BOX 2
+
+// Single reflections and refractions traced in distance maps (§4.1, §4.2).
+#define SPECULA_METHOD_DISTANCE 3
+
+// Inter-object reflections and refractions, map cycles up to the `depth` knob (§4.3).
+#define SPECULA_METHOD_DISTANCE_MULTI 4
+
+// Self refraction through refractor maps (§4.4).
+#define SPECULA_METHOD_REFRACTOR_MAP 5
+
+// Wyman's image-space double refraction (§4.4).
+#define SPECULA_METHOD_IMAGE_SPACE_REFRACTION 6
+
 // Emission + Lambertian direct light.
 #define SPECULA_SURFACE_DIFFUSE 0
 

@@ -71,6 +71,18 @@ pub const SPECULA_STRUCT_REQUIREMENTS: SpeculaStructType = 9;
 pub type SpeculaMethod = u32;
 /// Classic environment mapping (survey §3, §3.1).
 pub const SPECULA_METHOD_ENVMAP: SpeculaMethod = 0;
+/// Localised environment mapping, proxy sphere (§3.2).
+pub const SPECULA_METHOD_PROXY_SPHERE: SpeculaMethod = 1;
+/// Localised environment mapping, proxy box (§3.2).
+pub const SPECULA_METHOD_PROXY_BOX: SpeculaMethod = 2;
+/// Single reflections and refractions traced in distance maps (§4.1, §4.2).
+pub const SPECULA_METHOD_DISTANCE: SpeculaMethod = 3;
+/// Inter-object reflections and refractions, map cycles up to the `depth` knob (§4.3).
+pub const SPECULA_METHOD_DISTANCE_MULTI: SpeculaMethod = 4;
+/// Self refraction through refractor maps (§4.4).
+pub const SPECULA_METHOD_REFRACTOR_MAP: SpeculaMethod = 5;
+/// Wyman's image-space double refraction (§4.4).
+pub const SPECULA_METHOD_IMAGE_SPACE_REFRACTION: SpeculaMethod = 6;
 
 pub type SpeculaSurface = u32;
 /// Emission + Lambertian direct light.
@@ -834,6 +846,12 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
         let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
         let method = match d.method {
             SPECULA_METHOD_ENVMAP => Method::Envmap,
+            SPECULA_METHOD_PROXY_SPHERE => Method::ProxySphere,
+            SPECULA_METHOD_PROXY_BOX => Method::ProxyBox,
+            SPECULA_METHOD_DISTANCE => Method::Distance,
+            SPECULA_METHOD_DISTANCE_MULTI => Method::DistanceMulti,
+            SPECULA_METHOD_REFRACTOR_MAP => Method::RefractorMap,
+            SPECULA_METHOD_IMAGE_SPACE_REFRACTION => Method::ImageSpaceRefraction,
             m => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("render desc.method: unknown value {m}")),
         };
         c.destroy_renderer();

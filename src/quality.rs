@@ -39,7 +39,8 @@ pub struct Quality {
     /// Overrides every specular object's reference point (world space, metres).
     pub ref_point: Option<Vec3>,
     pub shadow_size: u32,
-    /// Reference renderer: maximum number of specular bounces R followed (survey Table 1).
+    /// Specular recursion depth R (survey Table 1): the reference renderer's bounces, and
+    /// the map cycles of inter-object reflections (`distance-multi`, §4.3).
     pub depth: u32,
     /// Reference renderer: samples per pixel, a k×k stratified grid (k² = spp).
     pub spp: u32,
@@ -92,8 +93,8 @@ pub const KNOBS: &[Knob] = &[
     Knob {
         name: "depth",
         values: "1..=64 bounces",
-        default: "8",
-        doc: "reference: specular recursion depth R; paths still specular after R bounces end black",
+        default: "4",
+        doc: "specular recursion depth R: the reference's bounces (paths still specular after R end black); distance-multi's map cycles (§4.3)",
     },
     Knob {
         name: "spp",
@@ -150,7 +151,7 @@ impl Default for Quality {
             fresnel: FresnelMode::Schlick,
             ref_point: None,
             shadow_size: 512,
-            depth: 8,
+            depth: 4,
             spp: 16,
             linear_steps: 16,
             secant_steps: 2,

@@ -147,7 +147,7 @@ fn reference_matches_the_gpu_where_the_gpu_is_exact() {
 }
 
 /// The environment-mapping method (survey §3.1) against the exact reference on the demo
-/// scene, 128², cube maps 128², reference 16 spp, depth 8. Environment mapping ignores
+/// scene, 128², cube maps 128², reference 16 spp, depth 4. Environment mapping ignores
 /// the ray origin (no parallax) and sees other specular objects only reflecting the sky,
 /// and one GPU sample per pixel aliases, so the error is real and large; this test pins it
 /// down so a regression in either renderer shows. Measured on lavapipe (Mesa 22.3.6):

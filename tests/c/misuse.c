@@ -65,6 +65,9 @@ int main(int argc, char **argv) {
     SpeculaRenderDesc render = {SPECULA_STRUCT_RENDER_DESC, sizeof render, SPECULA_METHOD_ENVMAP, 64, 64};
 
     /* Version and log callback. */
+    SpeculaRenderDesc every = render;
+    every.method = SPECULA_METHOD_IMAGE_SPACE_REFRACTION;
+    (void)every;
     expect("version is 0.1.x", (SpeculaResult)(specula_version() >> 12), (SpeculaResult)((0u << 10) | 1u), "VK_MAKE_API_VERSION(0, 0, 1, patch)");
     CASE("set_log_callback", specula_context_set_log_callback(ctx, on_log, &logged), SPECULA_SUCCESS);
     CASE("knob error goes to the log", specula_context_set_knob(ctx, "fresnel", "approximately"), SPECULA_ERROR_INVALID_ARGUMENT);

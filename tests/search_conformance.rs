@@ -1,0 +1,187 @@
+//! glsl/common/search.glsl against its twin src/search.rs on the same rays and the same
+//! analytic distance maps (box rooms), on lavapipe with validation on. The GPU evaluates in
+//! f32, the CPU in f64: ray parameters agree within 1e-5 of the ray's scale (measured worst
+//! 2.4e-7 over 1868 cases), and both sides
+//! agree on escape and on the hit being within the search's accuracy of the exact exit.
+//! The extremes: the reference point on the ray, rays starting at it, rays along cube-face
+//! boundaries (axes, face diagonals, cube corners), a very distant wall (1e4 m), a very
+//! near one (1 mm), an empty map (sky everywhere).
+
+mod common;
+
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use specula::search::{box_exit, box_room, linear_search, parallax_search, DistanceMap};
+use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
+use specula::vk::{Buffer, MemoryLocation, Profiler, Recorder};
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Case {
+    x: [f32; 4],
+    r: [f32; 4],
+    knobs: [u32; 4],
+    box_min: [f32; 4],
+    box_max: [f32; 4],
+    center: [f32; 4],
+}
+
+struct Room {
+    min: DVec3,
+    max: DVec3,
+    center: DVec3,
+    sky: bool,
+}
+
+fn cases() -> Vec<(Case, &'static str)> {
+    let rooms = [
+        (Room { min: DVec3::new(-2.0, 0.0, -2.0), max: DVec3::new(2.0, 3.0, 2.0), center: DVec3::new(0.0, 1.5, 0.0), sky: false }, "room"),
+        (Room { min: DVec3::splat(-1e4), max: DVec3::splat(1e4), center: DVec3::ZERO, sky: false }, "distant wall 1e4 m"),
+        (Room { min: DVec3::new(-1e-3, -1.0, -1.0), max: DVec3::splat(1.0), center: DVec3::ZERO, sky: false }, "near wall 1 mm"),
+        (Room { min: DVec3::splat(-1.0), max: DVec3::splat(1.0), center: DVec3::ZERO, sky: true }, "empty map"),
+    ];
+    let mut dirs: Vec<DVec3> = vec![
+        DVec3::X,
+        DVec3::NEG_Y,
+        DVec3::Z,
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(0.0, -1.0, 1.0),
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+    ];
+    for i in 0..24 {
+        let a = i as f64 * 0.77;
+        dirs.push(DVec3::new(a.cos(), (1.3 * a).sin(), (0.4 * a).cos() - 0.3));
+    }
+    let mut out = Vec::new();
+    for (room, name) in &rooms {
+        let s = if name.contains("1e4") { 1000.0 } else if name.contains("mm") { 1e-4 } else { 1.0 };
+        let starts = [DVec3::ZERO, DVec3::new(0.3, -0.2, 0.25) * s, DVec3::new(-0.5, 0.4, -0.1) * s];
+        for &x in &starts {
+            for d in &dirs {
+                let r = d.normalize();
+                for knobs in [[16, 4, 0, 1], [8, 8, 0, 1], [32, 0, 8, 1], [0, 0, 0, 1], [0, 0, 0, 6]] {
+                    let f = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+                    out.push((
+                        Case {
+                            x: f(x, 1e-6),
+                            r: f(r, if room.sky { 1.0 } else { 0.0 }),
+                            knobs,
+                            box_min: f(room.min, 0.0),
+                            box_max: f(room.max, 0.0),
+                            center: f(room.center, 0.0),
+                        },
+                        *name,
+                    ));
+                }
+            }
+            // The reference point on the ray: a ray through it.
+            if x != DVec3::ZERO {
+                let r = -x.normalize();
+                let f = |v: DVec3, w: f64| [v.x as f32, v.y as f32, v.z as f32, w as f32];
+                out.push((
+                    Case {
+                        x: f(x, 1e-6),
+                        r: f(r, if room.sky { 1.0 } else { 0.0 }),
+                        knobs: [16, 8, 0, 1],
+                        box_min: f(room.min, 0.0),
+                        box_max: f(room.max, 0.0),
+                        center: f(room.center, 0.0),
+                    },
+                    *name,
+                ));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn glsl_search_matches_rust_twin() {
+    let ctx = common::gpu();
+    let table = cases();
+    let input: Vec<Case> = table.iter().map(|(c, _)| *c).collect();
+    let cases_buf = Buffer::with_data(&ctx, "test.cases", &input, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+    let mut results = Buffer::new(&ctx, "test.results", (input.len() * 16) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let bindings = [(0, vk::DescriptorType::STORAGE_BUFFER, 1), (1, vk::DescriptorType::STORAGE_BUFFER, 1)];
+    let set_layout = descriptor_set_layout(&ctx, "test.search", &bindings, vk::ShaderStageFlags::COMPUTE).unwrap();
+    let (pool, set) = allocate_set(&ctx, "test.search", set_layout, &bindings).unwrap();
+    let layout = pipeline_layout(&ctx, "test.search", &[set_layout], 0, vk::ShaderStageFlags::COMPUTE).unwrap();
+    let pipeline = compute_pipeline(&ctx, layout, "test/search.comp").unwrap();
+    write_buffer(&ctx, set, 0, vk::DescriptorType::STORAGE_BUFFER, cases_buf.raw);
+    write_buffer(&ctx, set, 1, vk::DescriptorType::STORAGE_BUFFER, results.raw);
+    let mut profiler = Profiler::new(&ctx, 2).unwrap();
+    ctx.one_shot(|cmd| {
+        let mut rec = Recorder::new(&ctx, cmd, &mut profiler);
+        let open = rec.pass("test.search").begin();
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, layout, 0, &[set], &[]);
+            ctx.device.cmd_dispatch(cmd, (input.len() as u32).div_ceil(64), 1, 1);
+            let barrier = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+                .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
+        }
+        rec.end(open);
+        Ok(())
+    })
+    .unwrap();
+    let gpu: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(results.read().unwrap());
+    let mut worst = 0.0f64;
+    for (i, ((c, name), g)) in table.iter().zip(&gpu).enumerate() {
+        let v = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+        let (x, r, center) = (v(c.x), v(c.r), v(c.center));
+        let (min, max) = (v(c.box_min), v(c.box_max));
+        let sky = c.r[3] != 0.0;
+        let room = box_room(min, max, center);
+        let empty = |_: DVec3| f64::INFINITY;
+        let map: &dyn Fn(DVec3) -> f64 = if sky { &empty } else { &room };
+        let cpu = if c.knobs[0] == 0 {
+            parallax_search(&Wrap(map), x, r, c.knobs[3])
+        } else {
+            linear_search(&Wrap(map), x, r, c.knobs[0], c.knobs[2], c.knobs[1], c.x[3] as f64)
+        };
+        let what = format!("case {i} ({name}) x={x} r={r} knobs={:?}: gpu {g:?}, cpu {cpu:?}", c.knobs);
+        assert_eq!(g[1] != 0.0, cpu.escaped, "escape differs: {what}");
+        assert!(g.iter().all(|v| !v.is_nan()), "NaN: {what}");
+        if cpu.escaped {
+            assert!(sky, "only the empty map lets rays escape here: {what}");
+            continue;
+        }
+        let scale = (x.length() + box_exit(min, max, center, x, r)).max(1e-9);
+        let diff = (g[0] as f64 - cpu.d).abs() / scale;
+        worst = worst.max(diff);
+        assert!(diff < 1e-5, "ray parameter differs by {diff:e} of the scale: {what}");
+        if c.knobs[0] > 0 && c.knobs[1] >= 4 {
+            // Secant-refined searches land on the exact exit of the box. (Binary steps alone
+            // halve a bracket that the linear search leaves wide near t → 1: 8 of them are
+            // not enough for 0.2 % at 1e4 m; that is the knob's trade, not an error.)
+            let exact = box_exit(min, max, center, x, r);
+            assert!((cpu.d - exact).abs() <= 2e-3 * scale, "cpu search vs exact exit {exact}: {what}");
+        }
+    }
+    eprintln!("{} cases, worst relative difference GPU vs CPU {worst:e}", table.len());
+    unsafe {
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(layout, None);
+        ctx.device.destroy_descriptor_pool(pool, None);
+        ctx.device.destroy_descriptor_set_layout(set_layout, None);
+    }
+    profiler.destroy(&ctx);
+    results.destroy(&ctx);
+    let mut cases_buf = cases_buf;
+    cases_buf.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+struct Wrap<'a>(&'a dyn Fn(DVec3) -> f64);
+
+impl DistanceMap for Wrap<'_> {
+    fn distance(&self, dir: DVec3) -> f64 {
+        (self.0)(dir)
+    }
+}
