@@ -344,6 +344,7 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
     std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
     let ctx = context(validate, device)?;
     let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
+    let mut images: Vec<(&str, specula::vk::ImageData)> = Vec::new();
     for &method in Method::ALL {
         let png = outdir.join(format!("{}.png", method.name()));
         let exr = outdir.join(format!("{}.exr", method.name()));
@@ -356,6 +357,7 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
             std::fs::write(&trace, specula::profile::chrome_trace(&[reference_timing(ms)], &[], "CPU"))
                 .map_err(|e| specula::Error::io(&trace, e))?;
             report += &format!("== method {} -> {}\n{}\n\n", method.name(), png.display(), reference_summary(&q, w, h, ms));
+            images.push((method.name(), img));
             continue;
         }
         let frame = specula::render(&ctx, &scene, method, &Quality::default(), (w, h), (2, 5))?;
@@ -367,7 +369,19 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
         report += &format!("== method {} -> {} (median of 5 frames)\n", method.name(), png.display());
         report += &specula::profile::table(&frame.passes, &frame.memory);
         report.push('\n');
+        images.push((method.name(), frame.image));
     }
+    // Every method against the exact reference, and all of them side by side (the survey's
+    // Figures 20 and 24 in one sheet): methods.png, and methods.svg with labels.
+    if let Some((_, reference)) = images.iter().find(|(n, _)| *n == Method::Reference.name()) {
+        report += "== error against the reference\n";
+        for (name, img) in images.iter().filter(|(n, _)| *n != Method::Reference.name()) {
+            report += &format!("{name:<24} {}\n", specula::metrics::compare(img, reference)?);
+        }
+        report.push('\n');
+    }
+    write_composite(outdir, &images, w, h)?;
+    report += &format!("side by side: {}, {}\n", outdir.join("methods.png").display(), outdir.join("methods.svg").display());
     print!("{report}");
     let table = outdir.join("timings.txt");
     std::fs::write(&table, &report).map_err(|e| specula::Error::io(&table, e))?;
@@ -564,4 +578,40 @@ fn tradeoff(a: &TradeoffArgs, sweeps: &[String], out: &Path) -> specula::Result<
         println!("validation: {} error(s), {} warning(s)", ctx.validation.error_count(), ctx.validation.warning_count());
     }
     Ok(())
+}
+
+/// The demo's contact sheet: every method's image in a grid of four columns, as
+/// `methods.png` and as `methods.svg` (the same grid with each method's name, referencing
+/// the per-method PNGs beside it).
+fn write_composite(outdir: &Path, images: &[(&str, specula::vk::ImageData)], w: u32, h: u32) -> specula::Result<()> {
+    let cols = 4u32.min(images.len() as u32).max(1);
+    let rows = (images.len() as u32).div_ceil(cols);
+    let (sw, sh) = (cols * w, rows * h);
+    let mut sheet = vec![0f32; (sw * sh * 4) as usize];
+    for (i, (_, img)) in images.iter().enumerate() {
+        let (ox, oy) = ((i as u32 % cols) * w, (i as u32 / cols) * h);
+        for y in 0..h {
+            let src = (y * w * 4) as usize;
+            let dst = (((oy + y) * sw + ox) * 4) as usize;
+            sheet[dst..dst + (w * 4) as usize].copy_from_slice(&img.data[src..src + (w * 4) as usize]);
+        }
+    }
+    scene::write_png_srgb(&outdir.join("methods.png"), sw, sh, &sheet)?;
+    let label = 24;
+    let mut svg = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{sw}\" height=\"{}\" style=\"background:#111\">\n",
+        rows * (h + label)
+    );
+    for (i, (name, _)) in images.iter().enumerate() {
+        let (x, y) = ((i as u32 % cols) * w, (i as u32 / cols) * (h + label));
+        svg += &format!(
+            "<text x=\"{}\" y=\"{}\" fill=\"#eee\" font-family=\"sans-serif\" font-size=\"16\">{name}</text>\n<image x=\"{x}\" y=\"{}\" width=\"{w}\" height=\"{h}\" href=\"{name}.png\"/>\n",
+            x + 6,
+            y + 17,
+            y + label
+        );
+    }
+    svg += "</svg>\n";
+    let path = outdir.join("methods.svg");
+    std::fs::write(&path, svg).map_err(|e| specula::Error::io(&path, e))
 }
