@@ -56,7 +56,13 @@ fn cases() -> Vec<(Case, &'static str)> {
     }
     let mut out = Vec::new();
     for (room, name) in &rooms {
-        let s = if name.contains("1e4") { 1000.0 } else if name.contains("mm") { 1e-4 } else { 1.0 };
+        let s = if name.contains("1e4") {
+            1000.0
+        } else if name.contains("mm") {
+            1e-4
+        } else {
+            1.0
+        };
         let starts = [DVec3::ZERO, DVec3::new(0.3, -0.2, 0.25) * s, DVec3::new(-0.5, 0.4, -0.1) * s];
         for &x in &starts {
             for d in &dirs {
@@ -103,7 +109,9 @@ fn glsl_search_matches_rust_twin() {
     let table = cases();
     let input: Vec<Case> = table.iter().map(|(c, _)| *c).collect();
     let cases_buf = Buffer::with_data(&ctx, "test.cases", &input, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
-    let mut results = Buffer::new(&ctx, "test.results", (input.len() * 16) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let mut results =
+        Buffer::new(&ctx, "test.results", (input.len() * 16) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)
+            .unwrap();
     let bindings = [(0, vk::DescriptorType::STORAGE_BUFFER, 1), (1, vk::DescriptorType::STORAGE_BUFFER, 1)];
     let set_layout = descriptor_set_layout(&ctx, "test.search", &bindings, vk::ShaderStageFlags::COMPUTE).unwrap();
     let (pool, set) = allocate_set(&ctx, "test.search", set_layout, &bindings).unwrap();

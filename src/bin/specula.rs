@@ -130,6 +130,9 @@ enum Command {
         /// knob=v1,v2,... (repeatable: the combinations multiply); ref_point values split on ';'.
         #[arg(long)]
         sweep: Vec<String>,
+        /// Only these methods (repeatable); default every GPU method.
+        #[arg(long = "method")]
+        methods: Vec<String>,
         /// Output directory.
         #[arg(long, default_value = "tradeoff")]
         out: PathBuf,
@@ -271,7 +274,7 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Demo { outdir, size, validate, device } => demo(&outdir, &size, validate, &device),
         Command::Bench { args, sweep } => bench(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image } => compare(&test, &reference, error_image.as_deref()),
-        Command::Tradeoff { args, sweep, out } => tradeoff(&args, &sweep, &out),
+        Command::Tradeoff { args, sweep, methods, out } => tradeoff(&args, &sweep, &methods, &out),
     }
 }
 
@@ -501,7 +504,7 @@ fn compare(test: &Path, reference: &Path, error_image: Option<&Path>) -> specula
 
 /// `specula tradeoff`: the reference once, then every GPU method × every sweep variant,
 /// timed and compared; CSV, SVG plot and the images into `out`.
-fn tradeoff(a: &TradeoffArgs, sweeps: &[String], out: &Path) -> specula::Result<()> {
+fn tradeoff(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> specula::Result<()> {
     use specula::tradeoff::{csv, plot_svg, variants, Row, Sweep};
     let render_args = RenderArgs {
         scene: a.scene.clone(),
@@ -520,7 +523,14 @@ fn tradeoff(a: &TradeoffArgs, sweeps: &[String], out: &Path) -> specula::Result<
     let job = prepare(&render_args)?;
     let sweeps: Vec<Sweep> = sweeps.iter().map(|s| Sweep::parse(s)).collect::<specula::Result<_>>()?;
     let variants = variants(&job.quality, &sweeps)?;
-    let methods: Vec<Method> = Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect();
+    let mut methods: Vec<Method> = Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect();
+    if !only.is_empty() {
+        let wanted = only.iter().map(|n| Method::parse(n)).collect::<specula::Result<Vec<_>>>()?;
+        if let Some(m) = wanted.iter().find(|m| !m.is_gpu()) {
+            return Err(specula::Error::invalid("--method", format!("'{}' is the reference itself", m.name())));
+        }
+        methods.retain(|m| wanted.contains(m));
+    }
     std::fs::create_dir_all(out).map_err(|e| specula::Error::io(out, e))?;
     let (w, h) = (job.width, job.height);
 
@@ -598,10 +608,8 @@ fn write_composite(outdir: &Path, images: &[(&str, specula::vk::ImageData)], w: 
     }
     scene::write_png_srgb(&outdir.join("methods.png"), sw, sh, &sheet)?;
     let label = 24;
-    let mut svg = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{sw}\" height=\"{}\" style=\"background:#111\">\n",
-        rows * (h + label)
-    );
+    let mut svg =
+        format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{sw}\" height=\"{}\" style=\"background:#111\">\n", rows * (h + label));
     for (i, (name, _)) in images.iter().enumerate() {
         let (x, y) = ((i as u32 % cols) * w, (i as u32 / cols) * (h + label));
         svg += &format!(
