@@ -151,16 +151,23 @@ impl GpuScene {
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(gpu_material).collect();
 
         let mut out = GpuScene {
-            vertices: Buffer::with_data(ctx, "scene.vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?,
-            indices: Buffer::with_data(ctx, "scene.indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?,
-            materials: Buffer::with_data(ctx, "scene.materials", &materials, vk::BufferUsageFlags::STORAGE_BUFFER)?,
+            vertices: Buffer::placeholder(),
+            indices: Buffer::placeholder(),
+            materials: Buffer::placeholder(),
             textures: None,
             environment: None,
             draws,
             staging: Vec::new(),
             uploaded: false,
         };
-        if let Err(e) = out.create_images(ctx, scene) {
+        // Out of memory part-way frees what was made.
+        let made = (|| {
+            out.vertices = Buffer::with_data(ctx, "scene.vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?;
+            out.indices = Buffer::with_data(ctx, "scene.indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
+            out.materials = Buffer::with_data(ctx, "scene.materials", &materials, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+            out.create_images(ctx, scene)
+        })();
+        if let Err(e) = made {
             out.destroy(ctx);
             return Err(e);
         }
