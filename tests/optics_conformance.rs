@@ -56,56 +56,7 @@ fn d3(v: [f32; 4]) -> DVec3 {
 /// Runs every case through the compute shader and returns the results.
 fn run_on_gpu(cases: &[Case]) -> Vec<GpuResult> {
     let ctx = common::gpu();
-    let n = cases.len() as u32;
-    let mut input = Buffer::with_data(&ctx, "test.optics.cases", cases, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
-    let mut output = Buffer::new(
-        &ctx,
-        "test.optics.results",
-        (cases.len() * std::mem::size_of::<GpuResult>()) as u64,
-        vk::BufferUsageFlags::STORAGE_BUFFER,
-        MemoryLocation::GpuToCpu,
-    )
-    .unwrap();
-    let bindings = [(0, vk::DescriptorType::STORAGE_BUFFER, 1), (1, vk::DescriptorType::STORAGE_BUFFER, 1)];
-    let set_layout = descriptor_set_layout(&ctx, "test.optics.layout", &bindings, vk::ShaderStageFlags::COMPUTE).unwrap();
-    let (pool, set) = allocate_set(&ctx, "test.optics.set", set_layout, &bindings).unwrap();
-    let layout = pipeline_layout(&ctx, "test.optics.pipeline_layout", &[set_layout], 4, vk::ShaderStageFlags::COMPUTE).unwrap();
-    let pipeline = compute_pipeline(&ctx, layout, "test/optics.comp").unwrap();
-    write_buffer(&ctx, set, 0, vk::DescriptorType::STORAGE_BUFFER, input.raw);
-    write_buffer(&ctx, set, 1, vk::DescriptorType::STORAGE_BUFFER, output.raw);
-    let mut profiler = Profiler::new(&ctx, 2).unwrap();
-    ctx.one_shot(|cmd| {
-        let mut rec = Recorder::new(&ctx, cmd, &mut profiler);
-        let open = rec.pass("test.optics").begin();
-        unsafe {
-            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, layout, 0, &[set], &[]);
-            ctx.device.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::COMPUTE, 0, &n.to_le_bytes());
-            ctx.device.cmd_dispatch(cmd, n.div_ceil(64), 1, 1);
-            // The shader's writes become visible to the host that reads them after the fence.
-            let barrier = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
-                .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
-        }
-        rec.end(open);
-        Ok(())
-    })
-    .unwrap();
-    let timings = profiler.results(&ctx).unwrap();
-    assert_eq!(timings[0].name, "test.optics");
-    let results: Vec<GpuResult> = bytemuck::pod_collect_to_vec(&output.read().unwrap()[..cases.len() * 32]);
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(layout, None);
-        ctx.device.destroy_descriptor_pool(pool, None);
-        ctx.device.destroy_descriptor_set_layout(set_layout, None);
-    }
-    profiler.destroy(&ctx);
-    input.destroy(&ctx);
-    output.destroy(&ctx);
+    let results = common::run_cases(&ctx, "test/optics.comp", cases, &(cases.len() as u32).to_le_bytes());
     common::assert_clean(&ctx);
     results
 }

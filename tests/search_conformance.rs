@@ -9,12 +9,9 @@
 
 mod common;
 
-use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use specula::search::{box_exit, box_room, linear_search, parallax_search, DistanceMap};
-use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
-use specula::vk::{Buffer, MemoryLocation, Profiler, Recorder};
 
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
@@ -108,37 +105,7 @@ fn glsl_search_matches_rust_twin() {
     let ctx = common::gpu();
     let table = cases();
     let input: Vec<Case> = table.iter().map(|(c, _)| *c).collect();
-    let cases_buf = Buffer::with_data(&ctx, "test.cases", &input, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
-    let mut results =
-        Buffer::new(&ctx, "test.results", (input.len() * 16) as u64, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu)
-            .unwrap();
-    let bindings = [(0, vk::DescriptorType::STORAGE_BUFFER, 1), (1, vk::DescriptorType::STORAGE_BUFFER, 1)];
-    let set_layout = descriptor_set_layout(&ctx, "test.search", &bindings, vk::ShaderStageFlags::COMPUTE).unwrap();
-    let (pool, set) = allocate_set(&ctx, "test.search", set_layout, &bindings).unwrap();
-    let layout = pipeline_layout(&ctx, "test.search", &[set_layout], 0, vk::ShaderStageFlags::COMPUTE).unwrap();
-    let pipeline = compute_pipeline(&ctx, layout, "test/search.comp").unwrap();
-    write_buffer(&ctx, set, 0, vk::DescriptorType::STORAGE_BUFFER, cases_buf.raw);
-    write_buffer(&ctx, set, 1, vk::DescriptorType::STORAGE_BUFFER, results.raw);
-    let mut profiler = Profiler::new(&ctx, 2).unwrap();
-    ctx.one_shot(|cmd| {
-        let mut rec = Recorder::new(&ctx, cmd, &mut profiler);
-        let open = rec.pass("test.search").begin();
-        unsafe {
-            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
-            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, layout, 0, &[set], &[]);
-            ctx.device.cmd_dispatch(cmd, (input.len() as u32).div_ceil(64), 1, 1);
-            let barrier = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
-                .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
-        }
-        rec.end(open);
-        Ok(())
-    })
-    .unwrap();
-    let gpu: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(results.read().unwrap());
+    let gpu: Vec<[f32; 4]> = common::run_cases(&ctx, "test/search.comp", &input, &[]);
     let mut worst = 0.0f64;
     for (i, ((c, name), g)) in table.iter().zip(&gpu).enumerate() {
         let v = |a: [f32; 4]| DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
@@ -173,16 +140,6 @@ fn glsl_search_matches_rust_twin() {
         }
     }
     eprintln!("{} cases, worst relative difference GPU vs CPU {worst:e}", table.len());
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(layout, None);
-        ctx.device.destroy_descriptor_pool(pool, None);
-        ctx.device.destroy_descriptor_set_layout(set_layout, None);
-    }
-    profiler.destroy(&ctx);
-    results.destroy(&ctx);
-    let mut cases_buf = cases_buf;
-    cases_buf.destroy(&ctx);
     common::assert_clean(&ctx);
 }
 

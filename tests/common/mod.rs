@@ -52,3 +52,58 @@ pub fn mirror(f0: f32) -> Material {
 pub fn max_diff(a: &[f32], b: Vec3) -> f32 {
     (a[0] - b.x).abs().max((a[1] - b.y).abs()).max((a[2] - b.z).abs())
 }
+
+/// Runs `shader` (a compute shader with `local_size_x = 64`, binding 0: readonly input
+/// array, binding 1: output array) over `input` as one profiled pass, and returns `count`
+/// outputs. The conformance tests' harness: GLSL functions against their Rust twins.
+pub fn run_cases<I: bytemuck::Pod, O: bytemuck::Pod>(ctx: &Context, shader: &str, input: &[I], push: &[u8]) -> Vec<O> {
+    use ash::vk;
+    use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
+    use specula::vk::{Buffer, MemoryLocation, Profiler, Recorder};
+    let n = input.len() as u32;
+    let out_bytes = (input.len() * std::mem::size_of::<O>()) as u64;
+    let mut cases = Buffer::with_data(ctx, "test.cases", input, vk::BufferUsageFlags::STORAGE_BUFFER).unwrap();
+    let mut results = Buffer::new(ctx, "test.results", out_bytes, vk::BufferUsageFlags::STORAGE_BUFFER, MemoryLocation::GpuToCpu).unwrap();
+    let bindings = [(0, vk::DescriptorType::STORAGE_BUFFER, 1), (1, vk::DescriptorType::STORAGE_BUFFER, 1)];
+    let set_layout = descriptor_set_layout(ctx, "test.layout", &bindings, vk::ShaderStageFlags::COMPUTE).unwrap();
+    let (pool, set) = allocate_set(ctx, "test.set", set_layout, &bindings).unwrap();
+    let layout = pipeline_layout(ctx, "test.pipeline_layout", &[set_layout], push.len() as u32, vk::ShaderStageFlags::COMPUTE).unwrap();
+    let pipeline = compute_pipeline(ctx, layout, shader).unwrap();
+    write_buffer(ctx, set, 0, vk::DescriptorType::STORAGE_BUFFER, cases.raw);
+    write_buffer(ctx, set, 1, vk::DescriptorType::STORAGE_BUFFER, results.raw);
+    let mut profiler = Profiler::new(ctx, 2).unwrap();
+    ctx.one_shot(|cmd| {
+        let mut rec = Recorder::new(ctx, cmd, &mut profiler);
+        let open = rec.pass("test.cases").begin();
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, layout, 0, &[set], &[]);
+            if !push.is_empty() {
+                ctx.device.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::COMPUTE, 0, push);
+            }
+            ctx.device.cmd_dispatch(cmd, n.div_ceil(64), 1, 1);
+            // The shader's writes become visible to the host that reads them after the fence.
+            let barrier = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+                .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier));
+        }
+        rec.end(open);
+        Ok(())
+    })
+    .unwrap();
+    assert_eq!(profiler.results(ctx).unwrap()[0].name, "test.cases");
+    let out: Vec<O> = bytemuck::pod_collect_to_vec(&results.read().unwrap()[..out_bytes as usize]);
+    unsafe {
+        ctx.device.destroy_pipeline(pipeline, None);
+        ctx.device.destroy_pipeline_layout(layout, None);
+        ctx.device.destroy_descriptor_pool(pool, None);
+        ctx.device.destroy_descriptor_set_layout(set_layout, None);
+    }
+    profiler.destroy(ctx);
+    cases.destroy(ctx);
+    results.destroy(ctx);
+    out
+}
