@@ -8,11 +8,8 @@
 
 mod common;
 
-use ash::vk;
 use glam::{DVec3, Vec3};
 use specula::optics::*;
-use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
-use specula::vk::{Buffer, MemoryLocation, Profiler, Recorder};
 
 /// Unit roundoff of f32 (half an ULP at 1).
 const EPS: f64 = f32::EPSILON as f64 * 0.5;
