@@ -64,6 +64,13 @@ fn distance_map_beats_environment_map_for_a_mirror_in_a_corner() {
     let sphere = errors(&gpu(&ctx, &scene, Method::ProxySphere, &q, size), &refimg);
     eprintln!("               proxy-box {boxed}\n               proxy-sphere {sphere}");
     assert!(boxed.psnr > env.psnr + 6.0 && sphere.psnr > env.psnr, "proxies: box {boxed}, sphere {sphere}");
+    // Half-float distance maps (11-bit mantissa: 1 mm at 2 m) search as well as single.
+    let single = errors(
+        &gpu(&ctx, &scene, Method::Distance, &quality(&["cube_size=128", "ref_point=0,2,0", "cube_precision=single"]), size),
+        &refimg,
+    );
+    eprintln!("               distance, single precision {single}");
+    assert!((single.psnr - dist.psnr).abs() < 0.3, "half {dist} vs single {single}");
     common::assert_clean(&ctx);
 }
 
