@@ -145,29 +145,28 @@ pub fn linear_search(
     if d_p < 0.0 {
         return search_result(x, r, 0.0, true, lookups);
     }
-    for _ in 0..binary_steps {
-        let d = 0.5 * (d_l + d_p);
+    // One refinement probe at d: done within tolerance, else it replaces the bracket end
+    // of its kind (false position keeps one undershooting and one overshooting guess).
+    let mut probe = |d: f64, d_l: &mut f64, a_l: &mut f64, d_p: &mut f64, a_p: &mut f64| {
         let a = search_ratio(map, x, r, d, &mut lookups);
         if (a - 1.0).abs() <= tolerance {
-            return search_result(x, r, d, false, lookups);
+            return true;
         }
         if a < 1.0 {
-            (d_l, a_l) = (d, a);
+            (*d_l, *a_l) = (d, a);
         } else {
-            (d_p, a_p) = (d, a);
+            (*d_p, *a_p) = (d, a);
         }
-    }
-    for _ in 0..secant_steps {
-        // Survey eq. 5.
-        let d = d_l + (d_p - d_l) * (1.0 - a_l) / (a_p - a_l).max(1e-300);
-        let a = search_ratio(map, x, r, d, &mut lookups);
-        if (a - 1.0).abs() <= tolerance {
+        false
+    };
+    for i in 0..binary_steps + secant_steps {
+        let d = if i < binary_steps {
+            0.5 * (d_l + d_p)
+        } else {
+            d_l + (d_p - d_l) * (1.0 - a_l) / (a_p - a_l).max(1e-300) // survey eq. 5
+        };
+        if probe(d, &mut d_l, &mut a_l, &mut d_p, &mut a_p) {
             return search_result(x, r, d, false, lookups);
-        }
-        if a < 1.0 {
-            (d_l, a_l) = (d, a);
-        } else {
-            (d_p, a_p) = (d, a);
         }
     }
     let d = if (a_l - 1.0).abs() < (a_p - 1.0).abs() { d_l } else { d_p };

@@ -117,16 +117,11 @@ SearchResult linear_search(vec3 x, vec3 R, int steps, int binary_steps, int seca
         a_l = a;
     }
     if (d_p < 0.0) return search_result(x, R, 0.0, true, lookups);
-    for (int i = 0; i < binary_steps; ++i) {
-        float d = 0.5 * (d_l + d_p);
-        float a = search_ratio(x, R, d, lookups);
-        if (abs(a - 1.0) <= tolerance) return search_result(x, R, d, false, lookups);
-        if (a < 1.0) { d_l = d; a_l = a; } else { d_p = d; a_p = a; }
-    }
-    for (int i = 0; i < secant_steps; ++i) {
-        // Survey eq. 5: the ray meets the segment between the overshooting and the
-        // undershooting surface points.
-        float d = d_l + (d_p - d_l) * (1.0 - a_l) / max(a_p - a_l, 1e-30);
+    // Refinement: binary halvings, then secant steps (survey eq. 5: the ray meets the segment
+    // between the overshooting and the undershooting surface points). Each probe is done
+    // within tolerance, else replaces the bracket end of its kind (false position).
+    for (int i = 0; i < binary_steps + secant_steps; ++i) {
+        float d = i < binary_steps ? 0.5 * (d_l + d_p) : d_l + (d_p - d_l) * (1.0 - a_l) / max(a_p - a_l, 1e-30);
         float a = search_ratio(x, R, d, lookups);
         if (abs(a - 1.0) <= tolerance) return search_result(x, R, d, false, lookups);
         if (a < 1.0) { d_l = d; a_l = a; } else { d_p = d; a_p = a; }

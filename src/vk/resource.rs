@@ -303,20 +303,24 @@ impl Image {
 
     /// The barrier that leaves the image in `layout` for whatever comes next (host images).
     pub(crate) fn release_to(&self, layout: vk::ImageLayout) -> vk::ImageMemoryBarrier2<'static> {
-        let from = self.state.get();
         let to = ImageState {
             stage: vk::PipelineStageFlags2::ALL_COMMANDS,
             access: vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
             layout,
         };
-        self.state.set(to);
+        self.barrier_to(to)
+    }
+
+    /// The barrier from the tracked state to `to`; `to` becomes the tracked state.
+    fn barrier_to(&self, to: ImageState) -> vk::ImageMemoryBarrier2<'static> {
+        let from = self.state.replace(to);
         vk::ImageMemoryBarrier2::default()
             .src_stage_mask(from.stage)
             .src_access_mask(from.access)
             .dst_stage_mask(to.stage)
             .dst_access_mask(to.access)
             .old_layout(from.layout)
-            .new_layout(layout)
+            .new_layout(to.layout)
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .image(self.raw)
@@ -410,20 +414,7 @@ impl Image {
             self.state.set(ImageState { stage: from.stage | to.stage, access: from.access | to.access, layout: from.layout });
             return None;
         }
-        self.state.set(to);
-        Some(
-            vk::ImageMemoryBarrier2::default()
-                .src_stage_mask(from.stage)
-                .src_access_mask(from.access)
-                .dst_stage_mask(to.stage)
-                .dst_access_mask(to.access)
-                .old_layout(from.layout)
-                .new_layout(to.layout)
-                .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                .image(self.raw)
-                .subresource_range(self.range()),
-        )
+        Some(self.barrier_to(to))
     }
 
     pub fn byte_size(&self) -> u64 {
