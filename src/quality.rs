@@ -69,13 +69,13 @@ pub struct Knob {
 }
 
 pub const KNOBS: &[Knob] = &[
-    Knob { name: "cube_size", values: "16..=4096 texels", default: "256", doc: "edge of each face of an object's environment cube map" },
-    Knob { name: "cube_precision", values: "half|single", default: "half", doc: "radiance cube-map storage: RGBA16F or RGBA32F" },
+    Knob { name: "cube_size", values: "16..=4096 texels", default: "256", doc: "edge of each face of an object's cube maps (environment, distance, refractor)" },
+    Knob { name: "cube_precision", values: "half|single", default: "half", doc: "cube-map storage (radiance and distance): RGBA16F or RGBA32F" },
     Knob {
         name: "cube_mode",
         values: "six|multiview",
         default: "six",
-        doc: "cube faces in six passes or one multiview pass (six measured faster on lavapipe, BENCHMARKS.md)",
+        doc: "cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md)",
     },
     Knob {
         name: "fresnel",

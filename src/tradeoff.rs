@@ -100,9 +100,10 @@ fn csv_field(s: &str) -> String {
     }
 }
 
-/// `tradeoff.csv`: method, knobs, frame ms, the errors, Pareto membership, then one
-/// `<pass> ms` column per pass name any row has (empty where a row has no such pass).
-pub fn csv(rows: &[Row]) -> String {
+/// `tradeoff.csv`: method, knobs, frame ms, the errors, Pareto membership, the device and
+/// driver that ran it, then one `<pass> ms` column per pass name any row has (empty where a
+/// row has no such pass).
+pub fn csv(rows: &[Row], device: &str) -> String {
     let mut pass_names: Vec<&str> = Vec::new();
     for r in rows {
         for (n, _) in &r.passes {
@@ -112,7 +113,7 @@ pub fn csv(rows: &[Row]) -> String {
         }
     }
     let front = pareto_front(&rows.iter().map(|r| (r.frame_ms, plotted_error(&r.errors))).collect::<Vec<_>>());
-    let mut s = String::from("method,knobs,frame_ms,rmse,psnr_db,flip_mean,p99_abs,max_abs,pareto");
+    let mut s = String::from("method,knobs,frame_ms,rmse,psnr_db,flip_mean,p99_abs,max_abs,pareto,device");
     for n in &pass_names {
         let _ = write!(s, ",{} ms", csv_field(n));
     }
@@ -121,7 +122,7 @@ pub fn csv(rows: &[Row]) -> String {
         let e = &r.errors;
         let _ = write!(
             s,
-            "{},{},{:.4},{:.6},{:.3},{:.6},{:.6},{:.6},{}",
+            "{},{},{:.4},{:.6},{:.3},{:.6},{:.6},{:.6},{},{}",
             csv_field(&r.method),
             csv_field(&r.knobs),
             r.frame_ms,
@@ -130,7 +131,8 @@ pub fn csv(rows: &[Row]) -> String {
             e.flip,
             e.p99_abs,
             e.max_abs,
-            on_front
+            on_front,
+            csv_field(device)
         );
         for n in &pass_names {
             match r.passes.iter().find(|(p, _)| p == n) {
@@ -248,14 +250,14 @@ mod tests {
             Row::new("envmap", "ref_point=0,0,1", &[t("scene.direct", 1.0)], errors(0.2)),
         ];
         assert_eq!(rows[0].frame_ms, 2.0, "readback is not the method's time");
-        let s = csv(&rows);
+        let s = csv(&rows, "llvmpipe, Mesa");
         let lines: Vec<&str> = s.lines().collect();
         assert_eq!(
             lines[0],
-            "method,knobs,frame_ms,rmse,psnr_db,flip_mean,p99_abs,max_abs,pareto,envmap.generate ms,frame.readback ms,scene.direct ms"
+            "method,knobs,frame_ms,rmse,psnr_db,flip_mean,p99_abs,max_abs,pareto,device,envmap.generate ms,frame.readback ms,scene.direct ms"
         );
-        assert!(lines[1].starts_with("envmap,cube_size=32,2.0000,") && lines[1].ends_with(",true,2.0000,9.0000,"));
-        assert!(lines[2].starts_with("envmap,\"ref_point=0,0,1\",1.0000,") && lines[2].ends_with(",true,,,1.0000"));
+        assert!(lines[1].starts_with("envmap,cube_size=32,2.0000,") && lines[1].ends_with(",true,\"llvmpipe, Mesa\",2.0000,9.0000,"));
+        assert!(lines[2].starts_with("envmap,\"ref_point=0,0,1\",1.0000,") && lines[2].ends_with(",true,\"llvmpipe, Mesa\",,,1.0000"));
     }
 
     #[test]

@@ -265,9 +265,9 @@ fn run(cmd: Command) -> specula::Result<()> {
         }
         Command::Knobs => {
             println!("methods: {}", Method::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "));
-            println!("\n{:<16} {:<22} {:<9} description", "knob", "values", "default");
+            println!("\n{:<20} {:<22} {:<9} description", "knob", "values", "default");
             for k in specula::quality::KNOBS {
-                println!("{:<16} {:<22} {:<9} {}", k.name, k.values, k.default, k.doc);
+                println!("{:<20} {:<22} {:<9} {}", k.name, k.values, k.default, k.doc);
             }
             Ok(())
         }
@@ -561,7 +561,8 @@ fn tradeoff(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) ->
     bar.finish_and_clear();
 
     let csv_path = out.join("tradeoff.csv");
-    std::fs::write(&csv_path, csv(&rows)).map_err(|e| specula::Error::io(&csv_path, e))?;
+    let device = format!("{} ({})", ctx.device_name, ctx.driver_info);
+    std::fs::write(&csv_path, csv(&rows, &device)).map_err(|e| specula::Error::io(&csv_path, e))?;
     let svg_path = out.join("tradeoff.svg");
     let title =
         format!("{} at {w}x{h} on {}: mean FLIP vs GPU time", a.scene.file_name().unwrap_or_default().to_string_lossy(), ctx.device_name);
