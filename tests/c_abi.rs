@@ -124,6 +124,15 @@ fn examples_render_the_same_image_through_every_link_mode() {
         // Tolerance: none. Same device, same passes, and the host receives a copy.
         assert!(img == reference, "{name} ({tag}) differs from standalone (shared)");
     }
+    // The methods with the most moving parts, through the host's command buffers too:
+    // inter-object cycles (ping-pong maps, 4 cycles) and self refraction.
+    let (standalone, host) = (dir.join("standalone_shared"), dir.join("host_shared"));
+    for method in ["4", "5", "6"] {
+        let (a, b) = (dir.join(format!("m{method}_standalone.f32")), dir.join(format!("m{method}_host.f32")));
+        run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new(method)]);
+        run(&host, &[&scene, &b, Path::new(method)]);
+        assert!(read_f32(&a) == read_f32(&b), "method {method}: host-device image differs from standalone");
+    }
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -3,7 +3,7 @@
  * own command buffer, writing into its own image, submits and reads the image back.
  *
  *   cc -std=c11 -I include examples/c/host_vulkan.c -L target/release -lspecula -lvulkan -o host_vulkan
- *   ./host_vulkan assets/demo/demo.gltf out.f32
+ *   ./host_vulkan assets/demo/demo.gltf out.f32 [METHOD]
  *
  * out.f32: the linear RGBA32F radiance, raw (equal to standalone.c's for the same scene).
  * SPECULA_DEVICE selects the physical device by name; SPECULA_VALIDATE=1 enables the
@@ -57,7 +57,7 @@ static uint32_t memory_type(VkPhysicalDevice pd, uint32_t bits, VkMemoryProperty
 
 int main(int argc, char **argv) {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s SCENE.gltf OUT.f32\n", argv[0]);
+        fprintf(stderr, "usage: %s SCENE.gltf OUT.f32 [METHOD]\n", argv[0]);
         return 2;
     }
     int validate = getenv("SPECULA_VALIDATE") != NULL;
@@ -147,7 +147,8 @@ int main(int argc, char **argv) {
     specula_check(ctx, specula_context_load_gltf(ctx, argv[1]), "load_gltf");
     specula_check(ctx, specula_context_set_knob(ctx, "cube_size", "64"), "set_knob");
     specula_check(ctx, specula_context_set_knob(ctx, "shadow_size", "64"), "set_knob");
-    SpeculaRenderDesc rd = {SPECULA_STRUCT_RENDER_DESC, sizeof rd, SPECULA_METHOD_ENVMAP, W, H};
+    SpeculaMethod method = argc > 3 ? (SpeculaMethod)atoi(argv[3]) : SPECULA_METHOD_ENVMAP;
+    SpeculaRenderDesc rd = {SPECULA_STRUCT_RENDER_DESC, sizeof rd, method, W, H};
     specula_check(ctx, specula_context_configure(ctx, &rd), "configure");
 
     /* 7. Two frames (the first also uploads textures), each recorded into the engine's

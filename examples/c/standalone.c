@@ -2,9 +2,10 @@
  * scene, renders it with classic environment mapping and writes the image.
  *
  *   cc -std=c11 -I include examples/c/standalone.c -L target/release -lspecula -o standalone
- *   ./standalone assets/demo/demo.gltf out.ppm [out.f32]
+ *   ./standalone assets/demo/demo.gltf out.ppm [out.f32 [METHOD]]
  *
- * out.ppm: sRGB 8-bit; out.f32 (optional): the linear RGBA32F radiance, raw. */
+ * out.ppm: sRGB 8-bit; out.f32 (optional): the linear RGBA32F radiance, raw; METHOD: a
+ * SPECULA_METHOD_* value (default SPECULA_METHOD_ENVMAP). */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -23,7 +24,7 @@ static int check(SpeculaContext *ctx, SpeculaResult r, const char *what) {
 
 int main(int argc, char **argv) {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s SCENE.gltf OUT.ppm [OUT.f32]\n", argv[0]);
+        fprintf(stderr, "usage: %s SCENE.gltf OUT.ppm [OUT.f32 [METHOD]]\n", argv[0]);
         return 2;
     }
     SpeculaContextDesc desc = {SPECULA_STRUCT_CONTEXT_DESC, sizeof desc, NULL, getenv("SPECULA_VALIDATE") != NULL};
@@ -32,7 +33,8 @@ int main(int argc, char **argv) {
         fprintf(stderr, "specula_context_create: %s\n", specula_creation_error());
         return 1;
     }
-    SpeculaRenderDesc render = {SPECULA_STRUCT_RENDER_DESC, sizeof render, SPECULA_METHOD_ENVMAP, W, H};
+    SpeculaMethod method = argc > 4 ? (SpeculaMethod)atoi(argv[4]) : SPECULA_METHOD_ENVMAP;
+    SpeculaRenderDesc render = {SPECULA_STRUCT_RENDER_DESC, sizeof render, method, W, H};
     static unsigned char rgba8[W * H * 4];
     static float rgba32f[W * H * 4];
     int ok = check(ctx, specula_context_load_gltf(ctx, argv[1]), "load_gltf") &&
