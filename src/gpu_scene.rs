@@ -150,7 +150,7 @@ impl GpuScene {
         }
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(gpu_material).collect();
 
-        let mut out = GpuScene {
+        let out = GpuScene {
             vertices: Buffer::placeholder(),
             indices: Buffer::placeholder(),
             materials: Buffer::placeholder(),
@@ -160,18 +160,12 @@ impl GpuScene {
             staging: Vec::new(),
             uploaded: false,
         };
-        // Out of memory part-way frees what was made.
-        let made = (|| {
+        crate::vk::build(ctx, out, |out| {
             out.vertices = Buffer::with_data(ctx, "scene.vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?;
             out.indices = Buffer::with_data(ctx, "scene.indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
             out.materials = Buffer::with_data(ctx, "scene.materials", &materials, vk::BufferUsageFlags::STORAGE_BUFFER)?;
             out.create_images(ctx, scene)
-        })();
-        if let Err(e) = made {
-            out.destroy(ctx);
-            return Err(e);
-        }
-        Ok(out)
+        })
     }
 
     fn create_images(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
@@ -290,4 +284,10 @@ fn resampled(t: &crate::scene::Texture, w: u32, h: u32) -> Result<Vec<u8>> {
     let img = image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone())
         .ok_or_else(|| Error::invalid(format!("texture '{}'", t.name), "texel data does not match its size"))?;
     Ok(image::imageops::resize(&img, w, h, image::imageops::FilterType::Triangle).into_raw())
+}
+
+impl crate::vk::Owner for GpuScene {
+    fn destroy(&mut self, ctx: &Context) {
+        GpuScene::destroy(self, ctx)
+    }
 }

@@ -132,7 +132,7 @@ impl Renderer {
         camera.validate()?;
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.
-        let mut r = Renderer {
+        let r = Renderer {
             plan,
             width,
             height,
@@ -166,11 +166,7 @@ impl Renderer {
             light_table: Vec::new(),
             last_timings: Vec::new(),
         };
-        if let Err(e) = r.init(ctx, scene) {
-            r.destroy(ctx);
-            return Err(e);
-        }
-        Ok(r)
+        crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
 
     fn init(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
@@ -684,4 +680,10 @@ pub fn directional_view_proj(dir: Vec3, center: Vec3, radius: f32) -> Mat4 {
         Vec4::new(0.0, 0.0, 1.0, 1.0),
     );
     proj * view
+}
+
+impl crate::vk::Owner for Renderer {
+    fn destroy(&mut self, ctx: &Context) {
+        Renderer::destroy(self, ctx)
+    }
 }

@@ -14,7 +14,7 @@ use crate::optics::ray_triangle;
 use crate::plan::Plan;
 use crate::scene::Scene;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{begin_rendering, Access, Buffer, Context, Image, ImageDesc, ImageKind, Recorder, Target};
+use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
 pub struct Backfaces {
@@ -53,13 +53,13 @@ pub fn vertex_thickness(scene: &Scene, meshes: &[usize]) -> Vec<f32> {
 
 impl Backfaces {
     pub fn new(ctx: &Context, scene: &Scene, plan: &Plan, layout: vk::PipelineLayout, width: u32, height: u32) -> Result<Backfaces> {
-        let mut me = Backfaces {
+        let me = Backfaces {
             map: Image::placeholder(),
             depth: Image::placeholder(),
             pipeline: vk::Pipeline::null(),
             thickness: Buffer::placeholder(),
         };
-        let r = (|| {
+        build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let format = vk::Format::R32G32B32A32_SFLOAT;
             me.map = Image::new(ctx, &ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage })?;
@@ -97,14 +97,7 @@ impl Backfaces {
                 },
             )?;
             Ok(())
-        })();
-        match r {
-            Ok(()) => Ok(me),
-            Err(e) => {
-                me.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 
     /// The nearest back face of the refractors `which` selects, from view `view`.
@@ -141,5 +134,11 @@ impl Backfaces {
         self.thickness.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
+    }
+}
+
+impl Owner for Backfaces {
+    fn destroy(&mut self, ctx: &Context) {
+        Backfaces::destroy(self, ctx)
     }
 }

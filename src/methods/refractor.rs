@@ -10,7 +10,7 @@ use crate::methods::{cube_depth, destroy_pipelines, render_cube_faces, view_mask
 use crate::plan::Plan;
 use crate::quality::CubeMode;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{Access, Context, Image, ImageDesc, ImageKind, Recorder};
+use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};
 use crate::Result;
 
 pub struct RefractorMaps {
@@ -25,9 +25,9 @@ impl RefractorMaps {
     pub fn new(ctx: &Context, plan: &Plan, layout: vk::PipelineLayout) -> Result<RefractorMaps> {
         let q = &plan.quality;
         let format = radiance_format(q.cube_precision);
-        let mut me =
+        let me =
             RefractorMaps { maps: Image::placeholder(), depth: Image::placeholder(), pipeline: vk::Pipeline::null(), mode: q.cube_mode };
-        let r = (|| {
+        build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let kind = ImageKind::CubeArray { cubes: plan.refractors.len() as u32 };
             me.maps =
@@ -50,14 +50,7 @@ impl RefractorMaps {
                 },
             )?;
             Ok(())
-        })();
-        match r {
-            Ok(()) => Ok(me),
-            Err(e) => {
-                me.destroy(ctx);
-                Err(e)
-            }
-        }
+        })
     }
 
     /// `views[k]`: first of the six views of refractor k (its reference point).
@@ -81,5 +74,11 @@ impl RefractorMaps {
         self.depth.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
+    }
+}
+
+impl Owner for RefractorMaps {
+    fn destroy(&mut self, ctx: &Context) {
+        RefractorMaps::destroy(self, ctx)
     }
 }

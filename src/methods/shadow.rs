@@ -8,7 +8,7 @@ use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameIn
 use crate::plan::Plan;
 use crate::quality::CubeMode;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{begin_rendering, Access, Context, Image, ImageDesc, ImageKind, Recorder, Target};
+use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
 /// Clear value of distance maps: nothing in that direction.
@@ -28,12 +28,7 @@ pub struct ShadowMaps {
 impl ShadowMaps {
     /// Creates what the plan's lights need; nothing when there are none.
     pub fn new(ctx: &Context, plan: &Plan, layout: vk::PipelineLayout) -> Result<ShadowMaps> {
-        let mut s = ShadowMaps::default();
-        if let Err(e) = s.init(ctx, plan, layout) {
-            s.destroy(ctx);
-            return Err(e);
-        }
-        Ok(s)
+        build(ctx, ShadowMaps::default(), |s| s.init(ctx, plan, layout))
     }
 
     fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout) -> Result<()> {
@@ -144,5 +139,11 @@ impl ShadowMaps {
         destroy_pipelines(ctx, &mut [self.cube_pipeline, self.plane_pipeline]);
         self.cube_pipeline = vk::Pipeline::null();
         self.plane_pipeline = vk::Pipeline::null();
+    }
+}
+
+impl Owner for ShadowMaps {
+    fn destroy(&mut self, ctx: &Context) {
+        ShadowMaps::destroy(self, ctx)
     }
 }

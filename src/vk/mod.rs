@@ -14,4 +14,22 @@ pub use context::{
 };
 pub use readback::{decode, read_image, record_copy_to_buffer, ImageData};
 pub use recorder::{begin_rendering, OpenPass, PassTiming, Profiler, Recorder, Target};
+/// An owner of device objects whose `destroy` frees whatever exists, a partly built owner
+/// included (handles start null or as placeholders).
+pub trait Owner {
+    fn destroy(&mut self, ctx: &Context);
+}
+
+/// Finishes building `me` with `init`; on error frees what was made, so a failure part-way
+/// (out of memory, a missing feature) loses nothing.
+pub fn build<T: Owner>(ctx: &Context, mut me: T, init: impl FnOnce(&mut T) -> crate::Result<()>) -> crate::Result<T> {
+    match init(&mut me) {
+        Ok(()) => Ok(me),
+        Err(e) => {
+            me.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
 pub use resource::{format_bytes, is_depth, Access, Buffer, Image, ImageDesc, ImageKind, ImageState, MemoryLocation};

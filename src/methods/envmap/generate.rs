@@ -15,7 +15,7 @@ use crate::methods::{cube_depth, destroy_pipelines, render_cube_faces, view_mask
 use crate::plan::Plan;
 use crate::quality::{CubeMode, Precision};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{Access, Context, Image, ImageDesc, ImageKind, Recorder};
+use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};
 use crate::Result;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -57,7 +57,7 @@ impl CubeMaps {
         let format = radiance_format(q.cube_precision);
         let inter_object = plan.method == crate::plan::Method::DistanceMulti;
         let images = if inter_object && (plan.cycles > 1 || q.frame_latency) { 2 } else { 1 };
-        let mut me = CubeMaps {
+        let me = CubeMaps {
             kind,
             maps: Vec::new(),
             depth: Image::placeholder(),
@@ -70,11 +70,7 @@ impl CubeMaps {
             frames: 0,
             latest: 0,
         };
-        if let Err(e) = me.init(ctx, plan, layout, format, images) {
-            me.destroy(ctx);
-            return Err(e);
-        }
-        Ok(me)
+        build(ctx, me, |me| me.init(ctx, plan, layout, format, images))
     }
 
     fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, format: vk::Format, images: usize) -> Result<()> {
@@ -212,5 +208,11 @@ impl CubeMaps {
         destroy_pipelines(ctx, &mut [self.sky, self.surface]);
         self.sky = vk::Pipeline::null();
         self.surface = vk::Pipeline::null();
+    }
+}
+
+impl Owner for CubeMaps {
+    fn destroy(&mut self, ctx: &Context) {
+        CubeMaps::destroy(self, ctx)
     }
 }
