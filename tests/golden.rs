@@ -1,0 +1,92 @@
+//! Behaviour kept across refactors: every GPU method, with a few knob variants, renders the
+//! demo scene and a glass-and-mirror test scene to exactly the same bits as the images
+//! recorded in `tests/golden/images.txt` (FNV-1a 64 of the RGBA32F pixels). The table was
+//! written by the code before the method-registry refactor; a change that alters any pixel
+//! of any method fails here. Regenerate on purpose only: `SPECULA_UPDATE_GOLDEN=1 cargo test
+//! --test golden`, and say in the commit which images changed and why.
+
+mod common;
+
+use glam::Vec3;
+use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
+use specula::{Method, Quality};
+
+fn fnv(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+fn mirror_and_glass() -> Scene {
+    let mut s = Scene::new();
+    common::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
+    let glass = s
+        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })
+        .unwrap();
+    let mirror = s.add_material(common::mirror(0.9)).unwrap();
+    s.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.6, 1.5, 0.0), 0.5, 32, 16, glass)).unwrap();
+    s.add_mesh(shapes::uv_sphere("mirror", Vec3::new(-0.7, 1.5, -0.2), 0.5, 32, 16, mirror)).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 2.2), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
+    s
+}
+
+/// (label, method, knobs, frames): every GPU method at its defaults, and the knobs that
+/// switch code paths (multiview, single precision, exact Fresnel, parallax only, binary
+/// search, frame latency over two frames).
+fn cases() -> Vec<(String, Method, Vec<&'static str>, u32)> {
+    let mut v = Vec::new();
+    for &m in Method::ALL.iter().filter(|m| m.is_gpu()) {
+        v.push((m.name().to_string(), m, vec![], 1));
+    }
+    let variants: &[(&str, Method, &[&str], u32)] = &[
+        ("distance+multiview", Method::Distance, &["cube_mode=multiview"], 1),
+        ("distance+single", Method::Distance, &["cube_precision=single"], 1),
+        ("distance+exact", Method::Distance, &["fresnel=exact"], 1),
+        ("distance+parallax", Method::Distance, &["linear_steps=0", "parallax_iterations=3"], 1),
+        ("distance+binary", Method::Distance, &["binary_steps=4", "secant_steps=0"], 1),
+        ("distance-multi+depth2", Method::DistanceMulti, &["depth=2"], 1),
+        ("distance-multi+latency", Method::DistanceMulti, &["frame_latency=on"], 2),
+        ("refractor-map+bounces0", Method::RefractorMap, &["internal_bounces=0"], 1),
+        ("envmap+multiview", Method::Envmap, &["cube_mode=multiview"], 1),
+    ];
+    for (label, m, knobs, frames) in variants {
+        v.push((label.to_string(), *m, knobs.to_vec(), *frames));
+    }
+    v
+}
+
+#[test]
+fn every_method_renders_the_recorded_bits() {
+    let ctx = common::gpu();
+    let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
+    let scenes = [("demo", demo), ("mirror_and_glass", mirror_and_glass())];
+    let mut lines = Vec::new();
+    for (scene_name, scene) in &scenes {
+        for (label, method, knobs, frames) in cases() {
+            let mut q = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+            for k in &knobs {
+                q.set_pair(k).unwrap();
+            }
+            // Frame latency needs a second frame to read the first one's maps.
+            let f = specula::render(&ctx, scene, method, &q, (40, 30), (frames - 1, 1)).unwrap();
+            let bytes: Vec<u8> = f.image.data.iter().flat_map(|x| x.to_bits().to_le_bytes()).collect();
+            lines.push(format!("{scene_name} {label} {:016x}", fnv(&bytes)));
+        }
+    }
+    common::assert_clean(&ctx);
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/images.txt");
+    let got = lines.join("\n") + "\n";
+    if std::env::var_os("SPECULA_UPDATE_GOLDEN").is_some() {
+        std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
+        std::fs::write(path, &got).unwrap();
+    }
+    let want = std::fs::read_to_string(path).unwrap_or_default();
+    let want: std::collections::HashMap<&str, &str> =
+        want.lines().filter_map(|l| l.rsplit_once(' ')).collect();
+    let mut bad = Vec::new();
+    for l in &lines {
+        let (key, hash) = l.rsplit_once(' ').unwrap();
+        if want.get(key) != Some(&hash) {
+            bad.push(format!("{key}: got {hash}, recorded {:?}", want.get(key)));
+        }
+    }
+    assert!(bad.is_empty(), "images differ from the recorded bits:\n{}", bad.join("\n"));
+}
