@@ -4,7 +4,7 @@
 use glam::Vec3;
 use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::vk::{Context, DeviceOptions};
-use specula::{Method, Quality};
+use specula::Quality;
 
 fn main() -> specula::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -30,7 +30,7 @@ fn main() -> specula::Result<()> {
     q.set("spp", "4")?;
     let size = 256u32;
     let mut images = vec![specula::reference::render_reference(&s, &q, (size, size))?];
-    for m in [Method::Distance, Method::RefractorMap, Method::ImageSpaceRefraction] {
+    for m in [specula::methods::DISTANCE, specula::methods::REFRACTOR_MAP, specula::methods::IMAGE_SPACE_REFRACTION] {
         images.push(specula::render(&ctx, &s, m, &q, (size, size), (0, 1))?.image);
     }
     let mut row = vec![0f32; (size * size * 4) as usize * images.len()];

@@ -59,3 +59,14 @@ impl<T> VkCall<T> for std::result::Result<T, ash::vk::Result> {
         })
     }
 }
+
+/// A value for an error message: at most 64 characters (a 100 kB value is not echoed back
+/// in full), with "…" where it was cut.
+pub fn clip(s: &str) -> String {
+    const MAX: usize = 64;
+    if s.chars().count() <= MAX {
+        s.to_string()
+    } else {
+        s.chars().take(MAX).collect::<String>() + "…"
+    }
+}

@@ -526,7 +526,7 @@ fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Contex
             magic: MAGIC,
             scene: Scene::new(),
             quality: Quality::default(),
-            method: Method::Envmap,
+            method: crate::methods::ENVMAP,
             renderer: None,
             scene_version: 0,
             renderer_version: 0,
@@ -845,13 +845,13 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
     with_ctx(ctx, |c| {
         let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
         let method = match d.method {
-            SPECULA_METHOD_ENVMAP => Method::Envmap,
-            SPECULA_METHOD_PROXY_SPHERE => Method::ProxySphere,
-            SPECULA_METHOD_PROXY_BOX => Method::ProxyBox,
-            SPECULA_METHOD_DISTANCE => Method::Distance,
-            SPECULA_METHOD_DISTANCE_MULTI => Method::DistanceMulti,
-            SPECULA_METHOD_REFRACTOR_MAP => Method::RefractorMap,
-            SPECULA_METHOD_IMAGE_SPACE_REFRACTION => Method::ImageSpaceRefraction,
+            SPECULA_METHOD_ENVMAP => crate::methods::ENVMAP,
+            SPECULA_METHOD_PROXY_SPHERE => crate::methods::PROXY_SPHERE,
+            SPECULA_METHOD_PROXY_BOX => crate::methods::PROXY_BOX,
+            SPECULA_METHOD_DISTANCE => crate::methods::DISTANCE,
+            SPECULA_METHOD_DISTANCE_MULTI => crate::methods::DISTANCE_MULTI,
+            SPECULA_METHOD_REFRACTOR_MAP => crate::methods::REFRACTOR_MAP,
+            SPECULA_METHOD_IMAGE_SPACE_REFRACTION => crate::methods::IMAGE_SPACE_REFRACTION,
             m => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("render desc.method: unknown value {m}")),
         };
         c.destroy_renderer();

@@ -43,7 +43,8 @@ pub struct GpuObject {
     pub material: u32,
     pub envmap_layer: i32,
     pub refractor_layer: i32,
-    pub pad: u32,
+    /// `MapShading::code()` of its method.
+    pub map_shading: u32,
     /// xyz; w: proxy sphere radius.
     pub reference_point: [f32; 4],
     pub proxy_min: [f32; 4],

@@ -6,6 +6,7 @@ pub mod scene;
 
 pub use error::{Error, Result};
 pub mod cube;
+pub mod frame;
 pub mod gpu_scene;
 pub mod methods;
 pub mod metrics;
@@ -19,22 +20,35 @@ pub mod shaders;
 pub mod tradeoff;
 pub mod vk;
 
-pub use plan::{plan, Method, Plan};
+pub use methods::{Choice, Method};
+pub use plan::{plan, plan_with, Choices, Plan};
 pub use quality::Quality;
 pub use renderer::{Frame, Renderer};
 pub use scene::Scene;
 
-/// Renders `scene` with `method` at `(width, height)`: `warmup` frames (pipelines compile lazily on some
-/// drivers), then `frames` timed ones. Returns the last frame with the median per pass.
+/// Renders `scene` with `method` (or `Choice::Auto`) at `(width, height)`: `warmup` frames
+/// (pipelines compile lazily on some drivers), then `frames` timed ones. Returns the last
+/// frame with the median per pass.
 pub fn render(
     ctx: &vk::Context,
     scene: &Scene,
-    method: Method,
+    method: impl Into<Choice>,
     quality: &Quality,
+    size: (u32, u32),
+    frames: (u32, u32),
+) -> Result<Frame> {
+    render_plan(ctx, scene, plan(scene, method, quality), size, frames)
+}
+
+/// Renders a plan (per-object methods: `plan_with`), as `render`.
+pub fn render_plan(
+    ctx: &vk::Context,
+    scene: &Scene,
+    plan: Plan,
     (width, height): (u32, u32),
     (warmup, frames): (u32, u32),
 ) -> Result<Frame> {
-    let mut r = Renderer::new(ctx, scene, plan(scene, method, quality), width, height)?;
+    let mut r = Renderer::new(ctx, scene, plan, width, height)?;
     let result = (|| {
         for _ in 0..warmup {
             r.render(ctx)?;

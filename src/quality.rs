@@ -1,10 +1,12 @@
-//! Accuracy knobs. Each knob is written once here: name, unit, range, default and what it
-//! does; the CLI (`--quality key=value`), the Rust API and the C ABI all go through
-//! `Quality::set`.
+//! Accuracy knobs. Each knob is declared once, in `KNOBS`: its name, values (range and
+//! unit), default, what it does, and its parser and printer. The CLI (`-q key=value`), the
+//! Rust API, the C ABI, `specula knobs`, `specula plan` and the README test all go through
+//! that table. A knob means one thing: `depth` is the exact renderers' recursion depth,
+//! `cycles` the inter-object map cycles of `distance-multi`.
 
 use glam::Vec3;
 
-use crate::error::{Error, Result};
+use crate::error::{clip, Error, Result};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub enum FresnelMode {
@@ -30,6 +32,15 @@ pub enum Precision {
     Single,
 }
 
+/// What `--method auto` optimises when it picks a method per object.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Planner {
+    /// The most accurate method that serves the object.
+    Accuracy,
+    /// A cheaper rung: single distance maps for mirrors, image-space refraction for solids.
+    Speed,
+}
+
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Quality {
     pub cube_size: u32,
@@ -39,9 +50,11 @@ pub struct Quality {
     /// Overrides every specular object's reference point (world space, metres).
     pub ref_point: Option<Vec3>,
     pub shadow_size: u32,
-    /// Specular recursion depth R (survey Table 1): the reference renderer's bounces, and
-    /// the map cycles of inter-object reflections (`distance-multi`, §4.3).
+    /// Specular recursion depth R (survey Table 1) of the exact renderers (the reference):
+    /// paths still specular after R bounces end black.
     pub depth: u32,
+    /// Inter-object map cycles of `distance-multi` (§4.3).
+    pub cycles: u32,
     /// Reference renderer: samples per pixel, a k×k stratified grid (k² = spp).
     pub spp: u32,
     /// Distance-map search (§4.1): linear steps (0: parallax correction only).
@@ -58,87 +71,229 @@ pub struct Quality {
     /// Proxy sphere radius of `proxy-sphere` (§3.2), metres; `None`: the mean half-extent
     /// of the scene's bounding box.
     pub proxy_radius: Option<f32>,
+    /// What `--method auto` optimises.
+    pub planner: Planner,
 }
 
-/// A knob's documentation: one line each, shown by `specula knobs`.
+/// One knob, declared once.
 pub struct Knob {
     pub name: &'static str,
+    /// Accepted values with their unit, as `specula knobs` and the README show them.
     pub values: &'static str,
     pub default: &'static str,
     pub doc: &'static str,
+    /// Parses a textual value into the knob's field; the error says what is accepted.
+    pub set: fn(&mut Quality, &str) -> std::result::Result<(), String>,
+    /// The field's value, as `set` accepts it.
+    pub get: fn(&Quality) -> String,
 }
 
+fn count(v: &str, lo: u32, hi: u32) -> std::result::Result<u32, String> {
+    match v.trim().parse::<i64>() {
+        Ok(n) if (lo as i64..=hi as i64).contains(&n) => Ok(n as u32),
+        Ok(n) => Err(format!("{n} is outside {lo}..={hi}")),
+        Err(_) => Err(format!("'{}' is not a whole number (expected {lo}..={hi})", clip(v))),
+    }
+}
+
+fn real(v: &str, lo: f32, hi: f32) -> std::result::Result<f32, String> {
+    match v.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() && (lo..=hi).contains(&x) => Ok(x),
+        Ok(x) if x.is_nan() => Err(format!("NaN is not a number in {lo}..={hi}")),
+        Ok(x) => Err(format!("{x} is outside {lo}..={hi}")),
+        Err(_) => Err(format!("'{}' is not a number (expected {lo}..={hi})", clip(v))),
+    }
+}
+
+fn one_of<T: Copy>(v: &str, options: &[(&str, T)]) -> std::result::Result<T, String> {
+    options.iter().find(|(n, _)| *n == v).map(|(_, t)| *t).ok_or_else(|| {
+        let names: Vec<_> = options.iter().map(|(n, _)| *n).collect();
+        format!("'{}' is not one of {}", clip(v), names.join(", "))
+    })
+}
+
+fn name_of<T: PartialEq>(t: T, options: &[(&'static str, T)]) -> String {
+    options.iter().find(|(_, o)| *o == t).map_or("?", |(n, _)| n).to_string()
+}
+
+const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single", Precision::Single)];
+const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
+const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
+const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
+const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
+
 pub const KNOBS: &[Knob] = &[
-    Knob { name: "cube_size", values: "16..=4096 texels", default: "256", doc: "edge of each face of an object's cube maps (environment, distance, refractor)" },
-    Knob { name: "cube_precision", values: "half|single", default: "half", doc: "cube-map storage (radiance and distance): RGBA16F or RGBA32F" },
+    Knob {
+        name: "cube_size",
+        values: "16..=4096 texels",
+        default: "256",
+        doc: "edge of each face of an object's cube maps (environment, distance, refractor)",
+        set: |q, v| Ok(q.cube_size = count(v, 16, 4096)?),
+        get: |q| q.cube_size.to_string(),
+    },
+    Knob {
+        name: "cube_precision",
+        values: "half|single",
+        default: "half",
+        doc: "cube-map storage (radiance and distance): RGBA16F or RGBA32F",
+        set: |q, v| Ok(q.cube_precision = one_of(v, PRECISIONS)?),
+        get: |q| name_of(q.cube_precision, PRECISIONS),
+    },
     Knob {
         name: "cube_mode",
         values: "six|multiview",
         default: "six",
         doc: "cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md)",
+        set: |q, v| Ok(q.cube_mode = one_of(v, CUBE_MODES)?),
+        get: |q| name_of(q.cube_mode, CUBE_MODES),
     },
     Knob {
         name: "fresnel",
         values: "schlick|exact",
         default: "schlick",
         doc: "Schlick's approximation (survey eq. 2) or the exact Fresnel equations",
+        set: |q, v| Ok(q.fresnel = one_of(v, FRESNEL)?),
+        get: |q| name_of(q.fresnel, FRESNEL),
     },
     Knob {
         name: "ref_point",
         values: "auto|x,y,z (metres)",
         default: "auto",
-        doc: "reference point of every specular object's maps; auto = its bounding-box centre",
+        doc: "reference point of every specular object's maps; auto = its bounding-box centre, moved when that lies inside or next to another object",
+        set: |q, v| {
+            if v == "auto" {
+                q.ref_point = None;
+                return Ok(());
+            }
+            let parts: Vec<&str> = v.split(',').collect();
+            let nums: Vec<f32> = parts.iter().filter_map(|s| s.trim().parse::<f32>().ok()).filter(|x| x.is_finite()).collect();
+            if parts.len() != 3 || nums.len() != 3 {
+                return Err(format!("'{}' is not auto or x,y,z with three finite numbers", clip(v)));
+            }
+            q.ref_point = Some(Vec3::new(nums[0], nums[1], nums[2]));
+            Ok(())
+        },
+        get: |q| q.ref_point.map_or("auto".into(), |p| format!("{},{},{}", p.x, p.y, p.z)),
     },
-    Knob { name: "shadow_size", values: "16..=4096 texels", default: "512", doc: "edge of each shadow distance map face" },
+    Knob {
+        name: "shadow_size",
+        values: "16..=4096 texels",
+        default: "512",
+        doc: "edge of each shadow distance map face",
+        set: |q, v| Ok(q.shadow_size = count(v, 16, 4096)?),
+        get: |q| q.shadow_size.to_string(),
+    },
     Knob {
         name: "depth",
         values: "1..=64 bounces",
+        default: "16",
+        doc: "specular recursion depth R of the exact renderers (the reference): paths still specular after R bounces end black; the default is converged for glass",
+        set: |q, v| Ok(q.depth = count(v, 1, 64)?),
+        get: |q| q.depth.to_string(),
+    },
+    Knob {
+        name: "cycles",
+        values: "1..=16 cycles",
         default: "4",
-        doc: "specular recursion depth R: the reference's bounces (paths still specular after R end black); distance-multi's map cycles (§4.3)",
+        doc: "distance-multi: distance-map generation cycles per frame (§4.3); cycle k shows k specular bounces in the maps",
+        set: |q, v| Ok(q.cycles = count(v, 1, 16)?),
+        get: |q| q.cycles.to_string(),
     },
     Knob {
         name: "spp",
         values: "1, 4, 9, ..., 1024",
         default: "16",
         doc: "reference: samples per pixel on a k×k stratified grid (a perfect square; 1 = pixel centre)",
+        set: |q, v| {
+            let n = count(v, 1, 1024)?;
+            if n.isqrt().pow(2) != n {
+                return Err(format!("{n} is not a perfect square (1, 4, 9, ..., 1024)"));
+            }
+            q.spp = n;
+            Ok(())
+        },
+        get: |q| q.spp.to_string(),
     },
     Knob {
         name: "linear_steps",
         values: "0..=256",
         default: "16",
         doc: "distance-map linear search steps (§4.1.2); 0: parallax correction only",
+        set: |q, v| Ok(q.linear_steps = count(v, 0, 256)?),
+        get: |q| q.linear_steps.to_string(),
     },
     Knob {
         name: "secant_steps",
         values: "0..=64",
         default: "2",
         doc: "secant (false position) refinement steps after the linear search (survey eq. 5)",
+        set: |q, v| Ok(q.secant_steps = count(v, 0, 64)?),
+        get: |q| q.secant_steps.to_string(),
     },
-    Knob { name: "binary_steps", values: "0..=64", default: "0", doc: "binary refinement steps after the linear search (§4.1.4)" },
+    Knob {
+        name: "binary_steps",
+        values: "0..=64",
+        default: "0",
+        doc: "binary refinement steps after the linear search (§4.1.4)",
+        set: |q, v| Ok(q.binary_steps = count(v, 0, 64)?),
+        get: |q| q.binary_steps.to_string(),
+    },
     Knob {
         name: "parallax_iterations",
         values: "1..=64",
         default: "1",
         doc: "parallax-correction iterations (survey eq. 4) when linear_steps = 0",
+        set: |q, v| Ok(q.parallax_iterations = count(v, 1, 64)?),
+        get: |q| q.parallax_iterations.to_string(),
     },
-    Knob { name: "search_tolerance", values: "0..=1", default: "0.001", doc: "search stops once | |l|/|l'| − 1 | is within this" },
+    Knob {
+        name: "search_tolerance",
+        values: "0..=1",
+        default: "0.001",
+        doc: "search stops once | |l|/|l'| − 1 | is within this",
+        set: |q, v| Ok(q.search_tolerance = real(v, 0.0, 1.0)?),
+        get: |q| q.search_tolerance.to_string(),
+    },
     Knob {
         name: "internal_bounces",
         values: "0..=16",
         default: "2",
         doc: "refractor-map: total internal reflections followed inside a refractor (§4.4)",
+        set: |q, v| Ok(q.internal_bounces = count(v, 0, 16)?),
+        get: |q| q.internal_bounces.to_string(),
     },
     Knob {
         name: "frame_latency",
         values: "on|off",
         default: "off",
         doc: "distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)",
+        set: |q, v| Ok(q.frame_latency = one_of(v, ON_OFF)?),
+        get: |q| name_of(q.frame_latency, ON_OFF),
     },
     Knob {
         name: "proxy_radius",
         values: "auto|metres",
         default: "auto",
         doc: "proxy-sphere radius (§3.2); auto: mean half-extent of the scene's box",
+        set: |q, v| {
+            q.proxy_radius = match v {
+                "auto" => None,
+                v => match v.trim().parse::<f32>() {
+                    Ok(r) if r > 0.0 && r.is_finite() => Some(r),
+                    _ => return Err(format!("'{}' is not auto or a radius > 0 in metres", clip(v))),
+                },
+            };
+            Ok(())
+        },
+        get: |q| q.proxy_radius.map_or("auto".into(), |r| r.to_string()),
+    },
+    Knob {
+        name: "planner",
+        values: "accuracy|speed",
+        default: "accuracy",
+        doc: "what --method auto optimises: the most accurate method per object, or a cheaper rung (single distance maps, image-space refraction)",
+        set: |q, v| Ok(q.planner = one_of(v, PLANNERS)?),
+        get: |q| name_of(q.planner, PLANNERS),
     },
 ];
 
@@ -151,7 +306,8 @@ impl Default for Quality {
             fresnel: FresnelMode::Schlick,
             ref_point: None,
             shadow_size: 512,
-            depth: 4,
+            depth: 16,
+            cycles: 4,
             spp: 16,
             linear_steps: 16,
             secant_steps: 2,
@@ -161,118 +317,33 @@ impl Default for Quality {
             internal_bounces: 2,
             frame_latency: false,
             proxy_radius: None,
+            planner: Planner::Accuracy,
         }
     }
 }
 
-fn parse_count(key: &str, v: &str, lo: u32, hi: u32) -> Result<u32> {
-    match v.parse::<u32>() {
-        Ok(n) if (lo..=hi).contains(&n) => Ok(n),
-        _ => Err(Error::invalid(format!("knob {key}"), format!("'{v}' is not a whole number in {lo}..={hi}"))),
-    }
-}
-
-fn parse_size(key: &str, v: &str) -> Result<u32> {
-    let n: u32 = v.parse().map_err(|_| Error::invalid(format!("knob {key}"), format!("'{v}' is not a whole number")))?;
-    if !(16..=4096).contains(&n) {
-        return Err(Error::invalid(format!("knob {key}"), format!("{n} is outside 16..=4096")));
-    }
-    Ok(n)
+pub fn knob(name: &str) -> Option<&'static Knob> {
+    KNOBS.iter().find(|k| k.name == name)
 }
 
 impl Quality {
     /// Sets one knob from its textual value.
     pub fn set(&mut self, key: &str, value: &str) -> Result<()> {
-        let bad = |expected: &str| Error::invalid(format!("knob {key}"), format!("'{value}' is not one of {expected}"));
-        match key {
-            "cube_size" => self.cube_size = parse_size(key, value)?,
-            "shadow_size" => self.shadow_size = parse_size(key, value)?,
-            "depth" => {
-                self.depth = match value.parse::<u32>() {
-                    Ok(n) if (1..=64).contains(&n) => n,
-                    _ => return Err(bad("1..=64")),
-                }
-            }
-            "spp" => {
-                self.spp = match value.parse::<u32>() {
-                    Ok(n) if (1..=1024).contains(&n) && n.isqrt().pow(2) == n => n,
-                    _ => return Err(bad("the perfect squares 1, 4, 9, ..., 1024")),
-                }
-            }
-            "linear_steps" => self.linear_steps = parse_count(key, value, 0, 256)?,
-            "secant_steps" => self.secant_steps = parse_count(key, value, 0, 64)?,
-            "binary_steps" => self.binary_steps = parse_count(key, value, 0, 64)?,
-            "parallax_iterations" => self.parallax_iterations = parse_count(key, value, 1, 64)?,
-            "internal_bounces" => self.internal_bounces = parse_count(key, value, 0, 16)?,
-            "search_tolerance" => {
-                self.search_tolerance = match value.parse::<f32>() {
-                    Ok(t) if (0.0..=1.0).contains(&t) => t,
-                    _ => return Err(bad("a number in 0..=1")),
-                }
-            }
-            "frame_latency" => {
-                self.frame_latency = match value {
-                    "on" => true,
-                    "off" => false,
-                    _ => return Err(bad("on|off")),
-                }
-            }
-            "proxy_radius" => {
-                self.proxy_radius = match value {
-                    "auto" => None,
-                    v => match v.parse::<f32>() {
-                        Ok(r) if r > 0.0 && r.is_finite() => Some(r),
-                        _ => return Err(bad("auto|a radius > 0 in metres")),
-                    },
-                }
-            }
-            "cube_precision" => {
-                self.cube_precision = match value {
-                    "half" => Precision::Half,
-                    "single" => Precision::Single,
-                    _ => return Err(bad("half|single")),
-                }
-            }
-            "cube_mode" => {
-                self.cube_mode = match value {
-                    "six" => CubeMode::SixPasses,
-                    "multiview" => CubeMode::Multiview,
-                    _ => return Err(bad("six|multiview")),
-                }
-            }
-            "fresnel" => {
-                self.fresnel = match value {
-                    "schlick" => FresnelMode::Schlick,
-                    "exact" => FresnelMode::Exact,
-                    _ => return Err(bad("schlick|exact")),
-                }
-            }
-            "ref_point" => {
-                self.ref_point = if value == "auto" {
-                    None
-                } else {
-                    let v: Vec<f32> = value
-                        .split(',')
-                        .map(|s| s.trim().parse::<f32>())
-                        .collect::<std::result::Result<_, _>>()
-                        .map_err(|_| bad("auto|x,y,z"))?;
-                    if v.len() != 3 || v.iter().any(|x| !x.is_finite()) {
-                        return Err(bad("auto|x,y,z with three finite numbers"));
-                    }
-                    Some(Vec3::new(v[0], v[1], v[2]))
-                }
-            }
-            _ => {
-                let known: Vec<_> = KNOBS.iter().map(|k| k.name).collect();
-                return Err(Error::invalid("knob", format!("unknown knob '{key}' (known: {})", known.join(", "))));
-            }
-        }
-        Ok(())
+        let Some(k) = knob(key) else {
+            let known: Vec<_> = KNOBS.iter().map(|k| k.name).collect();
+            return Err(Error::invalid("knob", format!("unknown knob '{}' (known: {})", clip(key), known.join(", "))));
+        };
+        (k.set)(self, value.trim()).map_err(|m| Error::invalid(format!("knob {key}"), format!("{m} ({})", k.values)))
+    }
+
+    /// A knob's value in the form `set` accepts ("" for an unknown name).
+    pub fn get(&self, key: &str) -> String {
+        knob(key).map_or(String::new(), |k| (k.get)(self))
     }
 
     /// Parses `key=value`.
     pub fn set_pair(&mut self, pair: &str) -> Result<()> {
-        let (k, v) = pair.split_once('=').ok_or_else(|| Error::invalid("knob", format!("'{pair}' is not key=value")))?;
+        let (k, v) = pair.split_once('=').ok_or_else(|| Error::invalid("knob", format!("'{}' is not key=value", clip(pair))))?;
         self.set(k.trim(), v.trim())
     }
 }
@@ -295,14 +366,27 @@ mod tests {
         assert!(q.set_pair("cube_size").is_err());
         q.set_pair("depth=1").unwrap();
         q.set_pair("spp=9").unwrap();
-        assert_eq!((q.depth, q.spp), (1, 9));
-        for bad in ["depth=0", "depth=65", "spp=8", "spp=0", "spp=2048", "spp=x"] {
+        q.set_pair("cycles=3").unwrap();
+        assert_eq!((q.depth, q.spp, q.cycles), (1, 9, 3));
+        for bad in ["depth=0", "depth=65", "spp=8", "spp=0", "spp=2048", "spp=x", "cycles=0", "cycles=17", "planner=fast"] {
             assert!(q.set_pair(bad).is_err(), "{bad}");
         }
         for k in KNOBS {
             let mut q = Quality::default();
             q.set(k.name, k.default).unwrap();
             assert_eq!(q, Quality::default(), "documented default of {} is the real default", k.name);
+            assert_eq!(Quality::default().get(k.name), k.default, "get() of {} prints the documented default", k.name);
         }
+    }
+
+    #[test]
+    fn messages_name_the_range() {
+        let mut q = Quality::default();
+        let e = q.set("linear_steps", "-32").unwrap_err().to_string();
+        assert!(e.contains("-32 is outside 0..=256"), "{e}");
+        let e = q.set("search_tolerance", "NaN").unwrap_err().to_string();
+        assert!(e.contains("NaN is not a number in 0..=1"), "{e}");
+        let long = "9".repeat(100_000);
+        assert!(q.set("cube_size", &long).unwrap_err().to_string().len() < 300);
     }
 }

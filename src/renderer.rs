@@ -1,21 +1,21 @@
-//! Runs a Plan: creates every resource the plan names (and nothing else), records a frame
-//! into a command buffer it is handed, and in standalone mode submits it and reads the
-//! image back with the frame's per-pass profile.
+//! Runs a Plan: creates the stages the plan lists (and nothing else), records them in
+//! order into a command buffer it is handed, and in standalone mode submits the frame and
+//! reads the image back with its per-pass profile. It names no method: the plan's stages
+//! come from the methods' descriptions (`methods::registry`), their passes from the
+//! methods' folders and `frame`.
 
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 
 use crate::cube::face_view_proj;
 use crate::error::{Error, Result};
+use crate::frame::camera::CameraShade;
+use crate::frame::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
+use crate::frame::shadow::ShadowMaps;
+use crate::frame::stage::{FrameIo, LayerField, MapSets, Maps, Stage, StageInit, ViewLayout};
+use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, PUSH_BYTES};
 use crate::gpu_scene::{light_kind_code, GpuLight, GpuObject, GpuScene, GpuView};
-use crate::methods::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
-use crate::methods::envmap::{CubeMaps, MapKind};
-use crate::methods::image_space::Backfaces;
-use crate::methods::refractor::RefractorMaps;
-use crate::methods::shade::SpecularShade;
-use crate::methods::shadow::ShadowMaps;
-use crate::methods::{FrameInputs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_PROXY_BOX, PUSH_BYTES};
-use crate::plan::{Method, Plan};
+use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::{Camera, LightKind, Scene};
 use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image, Binding};
@@ -64,16 +64,6 @@ impl Frame {
     }
 }
 
-/// Indices into the frame's view table.
-#[derive(Clone, Debug, Default)]
-struct ViewLayout {
-    camera: u32,
-    shadow_cubes: Vec<u32>,
-    shadow_planes: Vec<u32>,
-    envmaps: Vec<u32>,
-    count: u32,
-}
-
 /// A descriptor set with its own pool.
 struct OwnedSet {
     pool: vk::DescriptorPool,
@@ -96,18 +86,14 @@ pub struct Renderer {
     layout: vk::PipelineLayout,
     linear_repeat: vk::Sampler,
     nearest_clamp: vk::Sampler,
-    shadows: ShadowMaps,
-    cube_maps: Option<CubeMaps>,
-    refractor_maps: Option<RefractorMaps>,
-    backfaces: Option<Backfaces>,
-    /// The method's camera passes: the one for specular objects in general, and the
-    /// self-refraction one for solid dielectrics (refractor-map, image-space).
-    shade: Option<SpecularShade>,
-    self_refraction: Option<SpecularShade>,
+    /// The plan's stages, in recording order.
+    stages: Vec<Box<dyn Stage>>,
+    /// The frame's shared maps (every stage's images), by descriptor slot.
+    maps: Maps,
     maps_layout: vk::DescriptorSetLayout,
-    /// `maps_sets[i]` samples `cube_maps.maps[i]`; the last one holds null maps.
-    maps_sets: Vec<OwnedSet>,
-    direct: Option<SceneDirect>,
+    /// Set-1 descriptor sets, each with its own pool.
+    owned_sets: Vec<OwnedSet>,
+    sets: MapSets,
     pub target: Image,
     depth: Image,
     readback: Option<Buffer>,
@@ -122,8 +108,8 @@ impl Renderer {
     /// Creates everything the plan needs at `width`×`height`. On error, everything created
     /// so far is destroyed again.
     pub fn new(ctx: &Context, scene: &Scene, plan: Plan, width: u32, height: u32) -> Result<Renderer> {
-        if !plan.method.is_gpu() {
-            return Err(Error::invalid("method", format!("'{}' renders on the CPU: use reference::render_reference", plan.method.name())));
+        if !plan.is_gpu() {
+            return Err(Error::invalid("method", format!("'{}' renders on the CPU: use reference::render_reference", plan.choice.name())));
         }
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
             return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
@@ -148,15 +134,11 @@ impl Renderer {
             layout: vk::PipelineLayout::null(),
             linear_repeat: vk::Sampler::null(),
             nearest_clamp: vk::Sampler::null(),
-            shadows: ShadowMaps::default(),
-            cube_maps: None,
-            refractor_maps: None,
-            backfaces: None,
-            shade: None,
-            self_refraction: None,
+            stages: Vec::new(),
+            maps: Maps::default(),
             maps_layout: vk::DescriptorSetLayout::null(),
-            maps_sets: Vec::new(),
-            direct: None,
+            owned_sets: Vec::new(),
+            sets: MapSets::default(),
             target: Image::placeholder(),
             depth: Image::placeholder(),
             readback: None,
@@ -201,18 +183,24 @@ impl Renderer {
                 material: m.material as u32,
                 envmap_layer: -1,
                 refractor_layer: -1,
-                pad: 0,
+                map_shading: 0,
                 reference_point: [0.0; 4],
                 proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
                 proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
             })
             .collect();
-        for e in &plan.envmaps {
-            objects[e.mesh].envmap_layer = e.layer as i32;
-            objects[e.mesh].reference_point = e.reference_point.extend(plan.proxy_radius).to_array();
-        }
-        for (k, &m) in plan.refractors.iter().enumerate() {
-            objects[m].refractor_layer = k as i32;
+        for o in &plan.objects {
+            let g = &mut objects[o.mesh];
+            g.reference_point = o.reference_point.extend(plan.proxy_radius).to_array();
+            g.map_shading = o.map_shading.code();
+            // The object's layer in each map array, by the slot the map fills.
+            for m in &o.maps {
+                match m.layer_field {
+                    Some(LayerField::Envmap) => g.envmap_layer = m.layer as i32,
+                    Some(LayerField::Refractor) => g.refractor_layer = m.layer as i32,
+                    None => {}
+                }
+            }
         }
         self.objects = Buffer::with_data(ctx, "scene.objects", &objects, vk::BufferUsageFlags::STORAGE_BUFFER)?;
 
@@ -233,39 +221,18 @@ impl Renderer {
         self.linear_repeat = sampler(ctx, "sampler.linear_repeat", vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)?;
         self.nearest_clamp = sampler(ctx, "sampler.nearest_clamp", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
 
-        self.shadows = ShadowMaps::new(ctx, &self.plan, self.layout)?;
-        let method = self.plan.method;
-        if !self.plan.envmaps.is_empty() {
-            let kind = if method.uses_distance_maps() { MapKind::Distance } else { MapKind::Radiance };
-            self.cube_maps = Some(CubeMaps::new(ctx, &self.plan, self.layout, kind)?);
-            let others = self.plan.envmaps.iter().any(|e| !self.plan.self_refracted(e.mesh));
-            if others {
-                let (name, fragment) = match method {
-                    Method::ProxySphere | Method::ProxyBox => ("proxy.shade", "envmap/proxy.frag"),
-                    m if m.uses_distance_maps() => ("distance.search", "distance/shade.frag"),
-                    _ => ("envmap.shade", "envmap/shade.frag"),
-                };
-                self.shade = Some(SpecularShade::new(ctx, self.layout, name, "scene/mesh.vert", fragment)?);
-            }
-        }
-        if !self.plan.refractors.is_empty() {
-            self.refractor_maps = Some(RefractorMaps::new(ctx, &self.plan, self.layout)?);
-            self.self_refraction =
-                Some(SpecularShade::new(ctx, self.layout, "refractor.search", "scene/mesh.vert", "refractor/search.frag")?);
-        }
-        if !self.plan.image_space.is_empty() {
-            self.backfaces = Some(Backfaces::new(ctx, scene, &self.plan, self.layout, self.width, self.height)?);
-            self.self_refraction =
-                Some(SpecularShade::new(ctx, self.layout, "image_space.refract", "image_space/refract.vert", "image_space/refract.frag")?);
-        }
-        if method.uses_distance_maps() {
-            let images = self.cube_maps.as_ref().map_or(0, |c| c.maps.len());
-            for i in 0..=images {
+        self.create_stages(ctx, scene)?;
+        // Set-1 sets over the distance images (none without distance maps): one for map
+        // generation and one for the camera passes per image, and an all-null one.
+        let images = self.maps.distance.len();
+        if images > 0 || self.maps.refractor.is_some() || self.maps.backfaces.is_some() {
+            for i in 0..2 * images + 1 {
                 let (pool, set) = allocate_set(ctx, &format!("maps.set{i}"), self.maps_layout, MAP_BINDINGS)?;
-                self.maps_sets.push(OwnedSet { pool, set });
+                self.owned_sets.push(OwnedSet { pool, set });
             }
+            let sets: Vec<vk::DescriptorSet> = self.owned_sets.iter().map(|s| s.set).collect();
+            self.sets = MapSets { generate: sets[..images].to_vec(), camera: sets[images..2 * images].to_vec(), empty: sets[2 * images] };
         }
-        self.direct = Some(SceneDirect::new(ctx, self.layout)?);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED;
         self.target = Image::new(
             ctx,
@@ -336,32 +303,47 @@ impl Renderer {
         write_buffer(ctx, self.set, 3, sb, buffer(self.lights.as_ref()));
         write_image(ctx, self.set, 4, 0, cis, view(self.scene.textures.as_ref()), self.linear_repeat, ro);
         write_image(ctx, self.set, 5, 0, cis, view(self.scene.environment.as_ref()), self.linear_repeat, ro);
-        write_image(ctx, self.set, 6, 0, cis, view(self.shadows.cubes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, 7, 0, cis, view(self.shadows.planes.as_ref()), self.nearest_clamp, ro);
-        let radiance = self.cube_maps.as_ref().filter(|c| c.kind == MapKind::Radiance).map(|c| &c.maps[0]);
-        write_image(ctx, self.set, 8, 0, cis, view(radiance), self.linear_repeat, ro);
-        // Maps sets: set i samples distance image i, the last one no distance map; all share
-        // the refractor maps, the back-face map and the thickness buffer.
-        let distance: Vec<&Image> = self.cube_maps.iter().filter(|c| c.kind == MapKind::Distance).flat_map(|c| c.maps.iter()).collect();
-        let last = self.maps_sets.len().saturating_sub(1);
-        for (i, s) in self.maps_sets.iter().enumerate() {
-            // The last set is all null: map generation declares set 1 but must not see
-            // maps that are not written yet.
-            let camera = i < last;
-            write_image(ctx, s.set, 0, 0, cis, view(distance.get(i).copied()), self.linear_repeat, ro);
-            write_image(
-                ctx,
-                s.set,
-                1,
-                0,
-                cis,
-                view(self.refractor_maps.as_ref().map(|r| &r.maps).filter(|_| camera)),
-                self.linear_repeat,
-                ro,
-            );
-            write_image(ctx, s.set, 2, 0, cis, view(self.backfaces.as_ref().map(|b| &b.map).filter(|_| camera)), self.nearest_clamp, ro);
-            write_buffer(ctx, s.set, 3, sb, buffer(self.backfaces.as_ref().map(|b| &b.thickness).filter(|_| camera)));
+        write_image(ctx, self.set, 6, 0, cis, view(self.maps.shadow_cubes.as_ref()), self.nearest_clamp, ro);
+        write_image(ctx, self.set, 7, 0, cis, view(self.maps.shadow_planes.as_ref()), self.nearest_clamp, ro);
+        write_image(ctx, self.set, 8, 0, cis, view(self.maps.radiance.as_ref()), self.linear_repeat, ro);
+        // Generation sets sample the refractor maps (made first) but no camera-space map;
+        // camera sets sample everything; the empty set nothing.
+        let refractor = view(self.maps.refractor.as_ref());
+        let backfaces = view(self.maps.backfaces.as_ref());
+        let thickness = buffer(self.maps.thickness.as_ref());
+        let null_image = vk::ImageView::null();
+        let mut all: Vec<(vk::DescriptorSet, vk::ImageView, vk::ImageView, vk::ImageView, vk::Buffer)> = Vec::new();
+        for (i, d) in self.maps.distance.iter().enumerate() {
+            all.push((self.sets.generate[i], d.view, refractor, null_image, vk::Buffer::null()));
+            all.push((self.sets.camera[i], d.view, refractor, backfaces, thickness));
         }
+        if self.sets.empty != vk::DescriptorSet::null() {
+            all.push((self.sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
+        }
+        for (set, distance, refractor, backfaces, thickness) in all {
+            write_image(ctx, set, 0, 0, cis, distance, self.linear_repeat, ro);
+            write_image(ctx, set, 1, 0, cis, refractor, self.linear_repeat, ro);
+            write_image(ctx, set, 2, 0, cis, backfaces, self.nearest_clamp, ro);
+            write_buffer(ctx, set, 3, sb, thickness);
+        }
+    }
+
+    /// Creates the plan's stages in order; each map stage puts its images into `maps`.
+    fn create_stages(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
+        let init =
+            StageInit { ctx, scene, gpu: &self.scene, plan: &self.plan, layout: self.layout, width: self.width, height: self.height };
+        for spec in &self.plan.stages {
+            let stage: Box<dyn Stage> = match spec {
+                // The scene records its own upload (first frame only).
+                StageSpec::Upload => continue,
+                StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
+                StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout)?),
+                StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
+                StageSpec::Camera(c) => Box::new(CameraShade::new(ctx, self.layout, c)?),
+            };
+            self.stages.push(stage);
+        }
+        Ok(())
     }
 
     /// Replaces the camera (the output size's aspect ratio still wins).
@@ -371,25 +353,25 @@ impl Renderer {
         Ok(())
     }
 
-    /// The environment- or distance-map cube array the camera pass reads (one cube per
-    /// `plan.envmaps` entry), if planned.
+    /// The environment- or distance-map cube array the camera passes read (one cube per
+    /// object of that map), if planned.
     pub fn envmaps(&self) -> Option<&Image> {
-        self.cube_maps.as_ref().map(|c| c.current())
+        self.maps.distance.get(self.maps.distance_latest).or(self.maps.radiance.as_ref())
     }
 
     /// Image-space refraction's back-face map (xyz normal, w distance from the eye).
     pub fn backface_map(&self) -> Option<&Image> {
-        self.backfaces.as_ref().map(|b| &b.map)
+        self.maps.backfaces.as_ref()
     }
 
-    /// The refractor-map cube array (one cube per `plan.refractors` entry), if planned.
+    /// The refractor-map cube array (one cube per refractor), if planned.
     pub fn refractor_maps(&self) -> Option<&Image> {
-        self.refractor_maps.as_ref().map(|r| &r.maps)
+        self.maps.refractor.as_ref()
     }
 
     /// The shadow cube array (one cube per `plan.shadow_cubes` entry), if planned.
     pub fn shadow_cubes(&self) -> Option<&Image> {
-        self.shadows.cubes.as_ref()
+        self.maps.shadow_cubes.as_ref()
     }
 
     pub fn camera(&self) -> &Camera {
@@ -447,53 +429,21 @@ impl Renderer {
             layout: self.layout,
             flags: self.flags,
             light_count: self.light_count,
-            search: [q.linear_steps, q.secant_steps, q.binary_steps, q.parallax_iterations],
+            search: SearchKnobs::of(q),
             tolerance: q.search_tolerance,
             internal_bounces: q.internal_bounces,
         };
-        let scene_images: Vec<&Image> = f.scene.textures.iter().chain(f.scene.environment.iter()).collect();
-        let maps_sets: Vec<vk::DescriptorSet> = self.maps_sets.iter().map(|s| s.set).collect();
-        let empty_set = maps_sets.last().copied().unwrap_or(vk::DescriptorSet::null());
-        self.shadows.record(&mut rec, &f, &self.views.shadow_cubes, &self.views.shadow_planes);
-        if let Some(g) = self.cube_maps.as_mut() {
-            let sampled = scene_images.iter().copied().chain(self.shadows.sampled());
-            g.record(&mut rec, &f, &self.plan, &self.views.envmaps, &maps_sets, empty_set, sampled);
-        }
-        // Refractor maps are seen from the refractors' reference points: their views are
-        // the environment maps' views.
-        if let Some(r) = self.refractor_maps.as_mut() {
-            let views: Vec<u32> = self
-                .plan
-                .refractors
-                .iter()
-                .map(|m| self.plan.envmaps.iter().position(|e| e.mesh == *m).map_or(0, |i| self.views.envmaps[i]))
-                .collect();
-            r.record(&mut rec, &f, &self.plan, &views);
-        }
-        if let Some(d) = &self.direct {
-            let sampled = scene_images.iter().copied().chain(self.shadows.sampled());
-            d.record(&mut rec, &f, self.views.camera, &mut self.target, &mut self.depth, sampled);
-        }
-        let plan = &self.plan;
-        if let Some(b) = self.backfaces.as_mut() {
-            b.record(&mut rec, &f, self.views.camera, |d| plan.image_space.contains(&(d.mesh as usize)));
-        }
-        // The camera passes read the maps the last cycle wrote.
-        let current = self.cube_maps.as_ref().map_or(0, |c| c.latest);
-        let maps_set = maps_sets.get(current).copied();
-        let mut reads: Vec<&Image> = self.cube_maps.iter().map(|c| c.current()).collect();
-        reads.extend(self.refractor_maps.iter().map(|r| &r.maps));
-        reads.extend(self.backfaces.iter().map(|b| &b.map));
-        let proxy = if plan.method == Method::ProxyBox { FLAG_PROXY_BOX } else { 0 };
-        if let Some(s) = &self.shade {
-            s.record(&mut rec, &f, self.views.camera, reads.iter().copied(), maps_set, proxy, &mut self.target, &mut self.depth, |d| {
-                d.specular && !plan.self_refracted(d.mesh as usize)
-            });
-        }
-        if let Some(s) = &self.self_refraction {
-            s.record(&mut rec, &f, self.views.camera, reads.iter().copied(), maps_set, 0, &mut self.target, &mut self.depth, |d| {
-                plan.self_refracted(d.mesh as usize)
-            });
+        let mut io = FrameIo {
+            plan: &self.plan,
+            views: &self.views,
+            target: &mut self.target,
+            depth: &mut self.depth,
+            maps: &mut self.maps,
+            sets: &self.sets,
+            scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
+        };
+        for stage in &mut self.stages {
+            stage.record(&mut rec, &f, &mut io);
         }
         if let Some(rb) = &self.readback {
             let open = rec.pass("frame.readback").reads(&self.target, Access::TransferSrc).begin();
@@ -599,22 +549,11 @@ impl Renderer {
 
     /// Frees everything. The GPU must be idle with respect to this renderer's frames.
     pub fn destroy(&mut self, ctx: &Context) {
-        self.shadows.destroy(ctx);
-        for g in self.cube_maps.iter_mut() {
-            g.destroy(ctx);
-        }
-        for r in self.refractor_maps.iter_mut() {
-            r.destroy(ctx);
-        }
-        for b in self.backfaces.iter_mut() {
-            b.destroy(ctx);
-        }
-        for s in self.shade.iter_mut().chain(self.self_refraction.iter_mut()) {
+        for s in &mut self.stages {
             s.destroy(ctx);
         }
-        for d in self.direct.iter_mut() {
-            d.destroy(ctx);
-        }
+        self.stages.clear();
+        self.maps.destroy(ctx);
         self.target.destroy(ctx);
         self.depth.destroy(ctx);
         for b in [Some(&mut self.view_buffer), Some(&mut self.objects), self.lights.as_mut(), self.readback.as_mut()].into_iter().flatten()
@@ -634,7 +573,7 @@ impl Renderer {
             if self.set_layout != vk::DescriptorSetLayout::null() {
                 d.destroy_descriptor_set_layout(self.set_layout, None);
             }
-            for s in self.maps_sets.drain(..) {
+            for s in self.owned_sets.drain(..) {
                 d.destroy_descriptor_pool(s.pool, None);
             }
             if self.maps_layout != vk::DescriptorSetLayout::null() {
@@ -650,6 +589,7 @@ impl Renderer {
         self.pool = vk::DescriptorPool::null();
         self.set_layout = vk::DescriptorSetLayout::null();
         self.maps_layout = vk::DescriptorSetLayout::null();
+        self.sets = MapSets::default();
         self.linear_repeat = vk::Sampler::null();
         self.nearest_clamp = vk::Sampler::null();
     }

@@ -11,7 +11,7 @@ use specula::quality::CubeMode;
 use specula::scene::{shapes, Camera, Scene};
 use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_image};
 use specula::vk::{read_image, Access, Image, ImageDesc, ImageKind, Profiler, Recorder};
-use specula::{plan, Method, Quality, Renderer};
+use specula::{plan, Quality, Renderer};
 
 #[test]
 fn compute_pass_writes_known_pattern() {
@@ -79,7 +79,7 @@ fn graphics_pass_draws_known_pixels() {
     common::emissive_room(&mut scene, Vec3::ZERO, 1.0);
     scene.camera = Some(Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 90f32.to_radians()));
     let (w, h) = (64u32, 48u32);
-    let p = plan(&scene, Method::Envmap, &Quality::default());
+    let p = plan(&scene, specula::methods::ENVMAP, &Quality::default());
     assert_eq!(p.passes, vec!["scene.direct"], "no lights, no specular objects: nothing else");
     let mut r = Renderer::new(&ctx, &scene, p, w, h).unwrap();
     let frame = r.render(&ctx).unwrap();
@@ -122,7 +122,7 @@ fn cube_faces_follow_vulkan_table(mode: &str) {
     q.set("cube_size", "32").unwrap();
     q.set("cube_mode", mode).unwrap();
     q.set("cube_precision", "single").unwrap();
-    let p = plan(&scene, Method::Envmap, &q);
+    let p = plan(&scene, specula::methods::ENVMAP, &q);
     assert_eq!(p.quality.cube_mode, if mode == "six" { CubeMode::SixPasses } else { CubeMode::Multiview });
     let mut r = Renderer::new(&ctx, &scene, p, 16, 16).unwrap();
     r.render(&ctx).unwrap();
@@ -161,7 +161,7 @@ fn renderer_frees_every_allocation() {
     let mut q = Quality::default();
     q.set("cube_size", "32").unwrap();
     q.set("shadow_size", "32").unwrap();
-    let mut r = Renderer::new(&ctx, &scene, plan(&scene, Method::Envmap, &q), 32, 32).unwrap();
+    let mut r = Renderer::new(&ctx, &scene, plan(&scene, specula::methods::ENVMAP, &q), 32, 32).unwrap();
     r.render(&ctx).unwrap();
     assert!(!ctx.memory.snapshot().is_empty());
     r.destroy(&ctx);

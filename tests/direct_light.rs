@@ -5,7 +5,7 @@ mod common;
 
 use glam::Vec3;
 use specula::scene::{shapes, Camera, Light, LightKind, Material, Scene};
-use specula::{Method, Quality};
+use specula::Quality;
 
 const ALBEDO: f32 = 0.5;
 
@@ -42,7 +42,7 @@ fn point_light_follows_inverse_square_and_cosine() {
     let ctx = common::gpu();
     let mut s = floor_scene(false);
     s.add_light(light(LightKind::Point, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 10.0)).unwrap();
-    let f = specula::render(&ctx, &s, Method::Envmap, &Quality::default(), (64, 64), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap();
     for (x, y) in [(32, 32), (10, 20), (50, 40), (5, 60)] {
         let p = floor_point(x, y);
         let d = Vec3::new(0.0, 2.0, 0.0) - p;
@@ -60,7 +60,7 @@ fn occluder_casts_a_shadow_from_point_and_directional_lights() {
     for kind in [LightKind::Point, LightKind::Directional, LightKind::Spot { inner_cone: 0.5, outer_cone: 0.7 }] {
         let mut s = floor_scene(true);
         s.add_light(light(kind, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 2.0)).unwrap();
-        let f = specula::render(&ctx, &s, Method::Envmap, &Quality::default(), (64, 64), (0, 1)).unwrap();
+        let f = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap();
         let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
         assert!(names.contains(&"shadow.generate"));
         // A lit floor point away from the occluder gets exactly the direct light.
@@ -100,7 +100,7 @@ fn emission_is_radiance() {
     let mut s = floor_scene(false);
     s.materials[0].emissive = Vec3::new(0.25, 0.5, 2.0);
     s.materials[0].base_color = Vec3::ZERO;
-    let f = specula::render(&ctx, &s, Method::Envmap, &Quality::default(), (64, 64), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap();
     assert_eq!(&f.image.texel(0, 20, 30)[..3], &[0.25, 0.5, 2.0]);
     common::assert_clean(&ctx);
 }

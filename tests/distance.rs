@@ -52,21 +52,21 @@ fn distance_map_beats_environment_map_for_a_mirror_in_a_corner() {
     // The reference point at the room's centre, far from the sphere: classic environment
     // mapping ignores the ray origin and reflects the wrong walls (§3, Figure 14).
     let q = quality(&["cube_size=128", "ref_point=0,2,0"]);
-    let env = errors(&gpu(&ctx, &scene, Method::Envmap, &q, size), &refimg);
-    let dist = errors(&gpu(&ctx, &scene, Method::Distance, &q, size), &refimg);
+    let env = errors(&gpu(&ctx, &scene, specula::methods::ENVMAP, &q, size), &refimg);
+    let dist = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
     eprintln!("corner mirror: envmap {env}\n               distance {dist}");
     // Measured: envmap 20.06 dB, distance 36.29 dB.
     assert!(env.psnr > 17.0, "envmap {env}");
     assert!(dist.psnr > 33.0, "distance {dist}");
     assert!(dist.psnr - env.psnr > 12.0, "margin {:.2} dB", dist.psnr - env.psnr);
     // The proxy box is the room itself here: localisation recovers most of the parallax.
-    let boxed = errors(&gpu(&ctx, &scene, Method::ProxyBox, &q, size), &refimg);
-    let sphere = errors(&gpu(&ctx, &scene, Method::ProxySphere, &q, size), &refimg);
+    let boxed = errors(&gpu(&ctx, &scene, specula::methods::PROXY_BOX, &q, size), &refimg);
+    let sphere = errors(&gpu(&ctx, &scene, specula::methods::PROXY_SPHERE, &q, size), &refimg);
     eprintln!("               proxy-box {boxed}\n               proxy-sphere {sphere}");
     assert!(boxed.psnr > env.psnr + 6.0 && sphere.psnr > env.psnr, "proxies: box {boxed}, sphere {sphere}");
     // Half-float distance maps (11-bit mantissa: 1 mm at 2 m) search as well as single.
     let single = errors(
-        &gpu(&ctx, &scene, Method::Distance, &quality(&["cube_size=128", "ref_point=0,2,0", "cube_precision=single"]), size),
+        &gpu(&ctx, &scene, specula::methods::DISTANCE, &quality(&["cube_size=128", "ref_point=0,2,0", "cube_precision=single"]), size),
         &refimg,
     );
     eprintln!("               distance, single precision {single}");
@@ -88,7 +88,7 @@ fn secant_steps_converge_monotonically() {
     let mut rmse = Vec::new();
     for secant in [0, 1, 2, 4, 8, 16] {
         let q = quality(&["cube_size=128", "ref_point=0,2,0", "linear_steps=4", "search_tolerance=0", &format!("secant_steps={secant}")]);
-        let e = errors(&gpu(&ctx, &scene, Method::Distance, &q, size), &refimg);
+        let e = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
         eprintln!("secant {secant:2}: {e}");
         rmse.push(e.rmse);
     }
@@ -121,9 +121,11 @@ fn concave_occluder_residual_is_bounded_and_multi_map_no_worse() {
     let size = 80;
     let refimg = reference(&scene, &["spp=4", "depth=2"], size);
     let q = quality(&["cube_size=128", "ref_point=0,2,0"]);
-    let single = errors(&gpu(&ctx, &scene, Method::Distance, &q, size), &refimg);
-    let multi =
-        errors(&gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", "ref_point=0,2,0", "depth=2"]), size), &refimg);
+    let single = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
+    let multi = errors(
+        &gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", "ref_point=0,2,0", "cycles=2"]), size),
+        &refimg,
+    );
     eprintln!("concave: distance {single}\n         distance-multi {multi}");
     assert!(single.psnr > 25.0, "{single}");
     assert!(multi.rmse <= single.rmse * 1.02, "multi {multi} vs single {single}");
@@ -154,9 +156,9 @@ fn refractor_map_self_refraction() {
         let scene = glass_scene(ior);
         let refimg = reference(&scene, &["spp=4", "depth=8", "fresnel=exact"], size);
         let q = quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4", "linear_steps=16", "secant_steps=4"]);
-        let rm = errors(&gpu(&ctx, &scene, Method::RefractorMap, &q, size), &refimg);
-        let single = errors(&gpu(&ctx, &scene, Method::Distance, &q, size), &refimg);
-        let wyman = errors(&gpu(&ctx, &scene, Method::ImageSpaceRefraction, &q, size), &refimg);
+        let rm = errors(&gpu(&ctx, &scene, specula::methods::REFRACTOR_MAP, &q, size), &refimg);
+        let single = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
+        let wyman = errors(&gpu(&ctx, &scene, specula::methods::IMAGE_SPACE_REFRACTION, &q, size), &refimg);
         eprintln!("glass ν={ior}: refractor-map {rm}\n           distance {single}\n           image-space {wyman}");
         assert!(rm.psnr > floor, "ν={ior}: {rm}");
         assert!(rm.rmse < single.rmse, "ν={ior}: refractor map {rm} vs single interface {single}");
@@ -167,11 +169,11 @@ fn refractor_map_self_refraction() {
     let scene = glass_scene(1.5);
     let refimg = reference(&scene, &["spp=4", "depth=8", "fresnel=exact"], size);
     let none = errors(
-        &gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=0"]), size),
+        &gpu(&ctx, &scene, specula::methods::REFRACTOR_MAP, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=0"]), size),
         &refimg,
     );
     let four = errors(
-        &gpu(&ctx, &scene, Method::RefractorMap, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4"]), size),
+        &gpu(&ctx, &scene, specula::methods::REFRACTOR_MAP, &quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4"]), size),
         &refimg,
     );
     eprintln!("TIR: 0 bounces {none}\n     4 bounces {four}");
@@ -181,8 +183,8 @@ fn refractor_map_self_refraction() {
     common::emissive_room(&mut empty, Vec3::new(0.0, 2.0, 0.0), 2.0);
     empty.camera = glass_scene(1.0001).camera;
     let q = quality(&["cube_size=128", "fresnel=exact"]);
-    let without = gpu(&ctx, &empty, Method::RefractorMap, &q, size);
-    let almost = errors(&gpu(&ctx, &glass_scene(1.0001), Method::RefractorMap, &q, size), &without);
+    let without = gpu(&ctx, &empty, specula::methods::REFRACTOR_MAP, &q, size);
+    let almost = errors(&gpu(&ctx, &glass_scene(1.0001), specula::methods::REFRACTOR_MAP, &q, size), &without);
     eprintln!("ν=1.0001 vs no sphere: {almost}");
     assert!(almost.psnr > 35.0, "{almost}");
     common::assert_clean(&ctx);
@@ -201,11 +203,12 @@ fn inter_object_reflections_by_cycles_and_by_frame_latency() {
     scene.add_mesh(shapes::uv_sphere("b", Vec3::new(0.7, 1.5, 0.0), 0.5, 64, 32, m)).unwrap();
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 1.6, 1.8), Vec3::new(0.0, 1.5, 0.0), 55f32.to_radians()));
     let size = 80;
-    let depth1 = gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", "depth=1"]), size);
+    // Cycle k of the maps shows k specular bounces: the reference at depth k.
+    let depth1 = gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", "cycles=1"]), size);
     for depth in 1..=4 {
         let d = format!("depth={depth}");
         let refimg = reference(&scene, &["spp=4", &d], size);
-        let img = gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", &d]), size);
+        let img = gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", &format!("cycles={depth}")]), size);
         let e = errors(&img, &refimg);
         let stale = errors(&depth1, &refimg);
         eprintln!("depth {depth}: distance-multi {e} (depth-1 image: {:.2} dB)", stale.psnr);
@@ -216,8 +219,8 @@ fn inter_object_reflections_by_cycles_and_by_frame_latency() {
     }
     // Frame latency: one cycle per frame; after n frames the maps hold n cycles.
     let n = 3;
-    let cycled = gpu(&ctx, &scene, Method::DistanceMulti, &quality(&["cube_size=128", "depth=3"]), size);
-    let plan = specula::plan(&scene, Method::DistanceMulti, &quality(&["cube_size=128", "frame_latency=on"]));
+    let cycled = gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", "cycles=3"]), size);
+    let plan = specula::plan(&scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", "frame_latency=on"]));
     assert_eq!(plan.cycles, 1);
     let mut r = specula::Renderer::new(&ctx, &scene, plan, size, size).unwrap();
     let mut frames = Vec::new();
@@ -239,8 +242,8 @@ fn inter_object_reflections_by_cycles_and_by_frame_latency() {
 fn image_space_first_pass_sees_back_faces() {
     let ctx = common::gpu();
     let scene = glass_scene(1.5);
-    let plan = specula::plan(&scene, Method::ImageSpaceRefraction, &quality(&["cube_size=32"]));
-    assert_eq!(plan.image_space, vec![24]);
+    let plan = specula::plan(&scene, specula::methods::IMAGE_SPACE_REFRACTION, &quality(&["cube_size=32"]));
+    assert_eq!(plan.objects_with(specula::methods::IMAGE_SPACE_REFRACTION), vec![24]);
     let size = 64;
     let mut r = specula::Renderer::new(&ctx, &scene, plan, size, size).unwrap();
     r.render(&ctx).unwrap();

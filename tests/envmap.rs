@@ -6,7 +6,7 @@ mod common;
 use glam::{DVec3, Vec3};
 use specula::optics::{fresnel_f0, fresnel_schlick, reflect_dir};
 use specula::scene::{shapes, Camera, Scene};
-use specula::{plan, Method, Quality, Renderer};
+use specula::{plan, Quality, Renderer};
 
 const F0: f32 = 0.3;
 
@@ -26,7 +26,7 @@ fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
     scene.camera = Some(Camera::look_at(eye, Vec3::ZERO, yfov));
     let mut q = Quality::default();
     q.set("cube_size", "128").unwrap();
-    let p = plan(&scene, Method::Envmap, &q);
+    let p = plan(&scene, specula::methods::ENVMAP, &q);
     assert_eq!(p.envmaps.len(), 1);
     assert_eq!(p.envmaps[0].reference_point, Vec3::ZERO);
     let (w, h) = (96u32, 96u32);
@@ -116,7 +116,7 @@ fn exact_fresnel_and_refraction_run_clean() {
     let mut q = Quality::default();
     q.set("fresnel", "exact").unwrap();
     q.set("cube_size", "32").unwrap();
-    let mut r = Renderer::new(&ctx, &scene, plan(&scene, Method::Envmap, &q), 32, 32).unwrap();
+    let mut r = Renderer::new(&ctx, &scene, plan(&scene, specula::methods::ENVMAP, &q), 32, 32).unwrap();
     let f = r.render(&ctx).unwrap();
     let centre = f.image.texel(0, 16, 16);
     let wall = common::quadrant_color(4, 0); // +Z wall behind the camera, quadrant (−x, −y)
@@ -135,7 +135,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.5), Vec3::ZERO, 1.0));
     let q = Quality::default();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["scene.direct", "frame.readback"]);
     assert!(f.memory.iter().all(|(n, _)| !n.starts_with("envmap") && !n.starts_with("shadow") && n != "scene.lights"), "{:?}", f.memory);
@@ -151,7 +151,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
             range: None,
         })
         .unwrap();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["shadow.generate", "scene.direct", "frame.readback"]);
     assert!(f.memory.iter().any(|(n, _)| n == "shadow.cubes"));
@@ -162,7 +162,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.3, 16, 8, m)).unwrap();
     let mut q = Quality::default();
     q.set("cube_size", "64").unwrap();
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (16, 16), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert_eq!(names, ["shadow.generate", "envmap.generate", "scene.direct", "envmap.shade", "frame.readback"]);
     let cubes = f.memory.iter().find(|(n, _)| n == "envmap.cubes").unwrap().1;
@@ -191,9 +191,9 @@ fn lone_object_sees_the_environment_map() {
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 2.0), Vec3::ZERO, 0.9));
     let mut q = Quality::default();
     q.set("cube_size", "32").unwrap();
-    let p = plan(&scene, Method::Envmap, &q);
+    let p = plan(&scene, specula::methods::ENVMAP, &q);
     assert_eq!(p.passes, ["scene.upload", "envmap.generate", "scene.direct", "envmap.shade"]);
-    let f = specula::render(&ctx, &scene, Method::Envmap, &q, (48, 48), (0, 1)).unwrap();
+    let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (48, 48), (0, 1)).unwrap();
     let px = |x: u32, y: u32| f.image.texel(0, x, y).to_vec();
     // Background corners: the sky straight through.
     assert!(px(1, 1)[2] > 0.99 && px(1, 1)[1] < 0.01, "upper background is blue: {:?}", px(1, 1));

@@ -12,7 +12,7 @@ use specula::metrics::{self, ImageErrors};
 use specula::reference::render_reference;
 use specula::scene::{shapes, Camera, EnvironmentMap, LightKind, Material, Scene, SurfaceKind};
 use specula::vk::ImageData;
-use specula::{Method, Quality};
+use specula::Quality;
 
 fn demo() -> Scene {
     specula::scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
@@ -90,14 +90,14 @@ fn glass_of_index_almost_one_is_invisible() {
     open.add_mesh(shapes::uv_sphere("glass", Vec3::ZERO, 0.5, 96, 48, g)).unwrap();
     open.camera = Some(Camera::look_at(Vec3::new(0.3, 0.5, 1.8), Vec3::ZERO, 45f32.to_radians()));
     q.spp = 1;
-    let gpu = specula::render(&ctx, &open, Method::Envmap, &q, (64, 64), (0, 1)).unwrap();
+    let gpu = specula::render(&ctx, &open, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap();
     // Without the sphere: the bare sky (a renderer needs a triangle: a speck behind the
     // camera, out of view).
     let mut bare = open.clone();
     bare.meshes.clear();
     let speck = bare.add_material(Material::default()).unwrap();
     bare.add_mesh(shapes::quad("speck", Vec3::new(0.3, 0.5, 5.0), Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.0, 0.01, 0.0), 1, speck)).unwrap();
-    let sky_only = specula::render(&ctx, &bare, Method::Envmap, &q, (64, 64), (0, 1)).unwrap().image;
+    let sky_only = specula::render(&ctx, &bare, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap().image;
     let e = errors(&gpu.image, &sky_only);
     println!("GPU envmap, ν = 1.0001 sphere vs the bare sky: {e}");
     assert!(all_finite(&gpu.image));
@@ -119,11 +119,11 @@ fn scaled_scenes_render_the_same_image() {
     let ctx = common::gpu();
     let q = quality(&["cube_size=64", "shadow_size=256", "spp=1"]);
     let base = demo();
-    let gpu1 = specula::render(&ctx, &base, Method::Envmap, &q, (64, 64), (0, 1)).unwrap();
+    let gpu1 = specula::render(&ctx, &base, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap();
     let ref1 = render_reference(&base, &q, (64, 64)).unwrap();
     for s in [1e-3f32, 1e3] {
         let scaled = scale_scene(&base, s);
-        let gpu = specula::render(&ctx, &scaled, Method::Envmap, &q, (64, 64), (0, 1)).unwrap();
+        let gpu = specula::render(&ctx, &scaled, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap();
         let e = errors(&gpu.image, &gpu1.image);
         println!("GPU, scale {s:e}: {e}");
         assert!(all_finite(&gpu.image));
@@ -178,9 +178,9 @@ fn grazing_incidence_on_a_planar_mirror() {
     let eye = Vec3::new(0.0, 0.02, 10.0);
     scene.camera = Some(Camera::look_at(eye, Vec3::new(0.0, 0.0, -10.0), 10f32.to_radians()));
     let q = quality(&["cube_size=128", "spp=1"]);
-    let p = specula::plan(&scene, Method::Envmap, &q);
+    let p = specula::plan(&scene, specula::methods::ENVMAP, &q);
     assert_eq!(p.envmaps[0].reference_point.y, 0.0, "the reference point lies on the mirror");
-    let gpu = specula::render(&ctx, &scene, Method::Envmap, &q, (64, 64), (0, 1)).unwrap();
+    let gpu = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap();
     let cpu = render_reference(&scene, &q, (64, 64)).unwrap();
     assert!(all_finite(&gpu.image) && all_finite(&cpu));
     let e = errors(&gpu.image, &cpu);
@@ -217,10 +217,10 @@ fn reference_point_on_the_surface() {
     scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.5, 96, 48, m)).unwrap();
     scene.camera = Some(Camera::look_at(Vec3::new(0.3, 0.4, 1.4), Vec3::ZERO, 50f32.to_radians()));
     let reference = render_reference(&scene, &quality(&["spp=4"]), (64, 64)).unwrap();
-    let centre = specula::render(&ctx, &scene, Method::Envmap, &quality(&["cube_size=64"]), (64, 64), (0, 1)).unwrap();
+    let centre = specula::render(&ctx, &scene, specula::methods::ENVMAP, &quality(&["cube_size=64"]), (64, 64), (0, 1)).unwrap();
     let pole_q = quality(&["cube_size=64", "ref_point=0,0.5,0"]);
-    assert_eq!(specula::plan(&scene, Method::Envmap, &pole_q).envmaps[0].reference_point, Vec3::new(0.0, 0.5, 0.0));
-    let pole = specula::render(&ctx, &scene, Method::Envmap, &pole_q, (64, 64), (0, 1)).unwrap();
+    assert_eq!(specula::plan(&scene, specula::methods::ENVMAP, &pole_q).envmaps[0].reference_point, Vec3::new(0.0, 0.5, 0.0));
+    let pole = specula::render(&ctx, &scene, specula::methods::ENVMAP, &pole_q, (64, 64), (0, 1)).unwrap();
     assert!(all_finite(&pole.image));
     let (ec, ep) = (errors(&centre.image, &reference), errors(&pole.image, &reference));
     println!("reference point at the centre: {ec}\nreference point on the surface: {ep}");
@@ -249,8 +249,8 @@ fn half_and_single_precision_cube_maps() {
     let scene = demo();
     let half_q = quality(&["cube_size=64", "shadow_size=256", "cube_precision=half"]);
     let single_q = quality(&["cube_size=64", "shadow_size=256", "cube_precision=single"]);
-    let half = specula::render(&ctx, &scene, Method::Envmap, &half_q, (64, 64), (0, 1)).unwrap();
-    let single = specula::render(&ctx, &scene, Method::Envmap, &single_q, (64, 64), (0, 1)).unwrap();
+    let half = specula::render(&ctx, &scene, specula::methods::ENVMAP, &half_q, (64, 64), (0, 1)).unwrap();
+    let single = specula::render(&ctx, &scene, specula::methods::ENVMAP, &single_q, (64, 64), (0, 1)).unwrap();
     let cube_bytes = |f: &specula::Frame| f.memory.iter().find(|(n, _)| n == "envmap.cubes").unwrap().1;
     assert_eq!(cube_bytes(&single), 2 * cube_bytes(&half));
     let mut worst = 0.0f32;

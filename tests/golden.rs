@@ -37,15 +37,15 @@ fn cases() -> Vec<(String, Method, Vec<&'static str>, u32)> {
         v.push((m.name().to_string(), m, vec![], 1));
     }
     let variants: &[(&str, Method, &[&str], u32)] = &[
-        ("distance+multiview", Method::Distance, &["cube_mode=multiview"], 1),
-        ("distance+single", Method::Distance, &["cube_precision=single"], 1),
-        ("distance+exact", Method::Distance, &["fresnel=exact"], 1),
-        ("distance+parallax", Method::Distance, &["linear_steps=0", "parallax_iterations=3"], 1),
-        ("distance+binary", Method::Distance, &["binary_steps=4", "secant_steps=0"], 1),
-        ("distance-multi+depth2", Method::DistanceMulti, &["depth=2"], 1),
-        ("distance-multi+latency", Method::DistanceMulti, &["frame_latency=on"], 2),
-        ("refractor-map+bounces0", Method::RefractorMap, &["internal_bounces=0"], 1),
-        ("envmap+multiview", Method::Envmap, &["cube_mode=multiview"], 1),
+        ("distance+multiview", specula::methods::DISTANCE, &["cube_mode=multiview"], 1),
+        ("distance+single", specula::methods::DISTANCE, &["cube_precision=single"], 1),
+        ("distance+exact", specula::methods::DISTANCE, &["fresnel=exact"], 1),
+        ("distance+parallax", specula::methods::DISTANCE, &["linear_steps=0", "parallax_iterations=3"], 1),
+        ("distance+binary", specula::methods::DISTANCE, &["binary_steps=4", "secant_steps=0"], 1),
+        ("distance-multi+depth2", specula::methods::DISTANCE_MULTI, &["cycles=2"], 1),
+        ("distance-multi+latency", specula::methods::DISTANCE_MULTI, &["frame_latency=on"], 2),
+        ("refractor-map+bounces0", specula::methods::REFRACTOR_MAP, &["internal_bounces=0"], 1),
+        ("envmap+multiview", specula::methods::ENVMAP, &["cube_mode=multiview"], 1),
     ];
     for (label, m, knobs, frames) in variants {
         v.push((label.to_string(), *m, knobs.to_vec(), *frames));
@@ -79,8 +79,7 @@ fn every_method_renders_the_recorded_bits() {
         std::fs::write(path, &got).unwrap();
     }
     let want = std::fs::read_to_string(path).unwrap_or_default();
-    let want: std::collections::HashMap<&str, &str> =
-        want.lines().filter_map(|l| l.rsplit_once(' ')).collect();
+    let want: std::collections::HashMap<&str, &str> = want.lines().filter_map(|l| l.rsplit_once(' ')).collect();
     let mut bad = Vec::new();
     for l in &lines {
         let (key, hash) = l.rsplit_once(' ').unwrap();

@@ -6,7 +6,7 @@ mod common;
 use std::path::Path;
 use std::process::Command;
 
-use specula::{Method, Quality};
+use specula::Quality;
 
 fn demo() -> specula::Scene {
     specula::scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
@@ -23,8 +23,8 @@ fn small() -> Quality {
 fn every_pass_is_reported_with_positive_gpu_time() {
     let ctx = common::gpu();
     let scene = demo();
-    let plan = specula::plan(&scene, Method::Envmap, &small());
-    let f = specula::render(&ctx, &scene, Method::Envmap, &small(), (48, 32), (0, 1)).unwrap();
+    let plan = specula::plan(&scene, specula::methods::ENVMAP, &small());
+    let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &small(), (48, 32), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
     // The first frame uploads the textures; everything the plan names is there, in order.
     let mut expected: Vec<&str> = plan.passes.clone();

@@ -10,7 +10,7 @@ use glam::{DVec3, Vec3};
 use specula::optics::{fresnel_f0, fresnel_schlick, reflect_dir};
 use specula::reference::render_reference;
 use specula::scene::{shapes, Camera, EnvironmentMap, Scene};
-use specula::{metrics, Method, Quality};
+use specula::{metrics, Quality};
 
 fn demo() -> Scene {
     specula::scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
@@ -129,7 +129,7 @@ fn reference_matches_the_gpu_where_the_gpu_is_exact() {
     let (w, h) = (96u32, 96u32);
     let mut q = Quality { spp: 1, ..Default::default() };
     q.set("shadow_size", "1024").unwrap();
-    let gpu = specula::render(&ctx, &scene, Method::Envmap, &q, (w, h), (0, 1)).unwrap();
+    let gpu = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (w, h), (0, 1)).unwrap();
     let cpu = render_reference(&scene, &q, (w, h)).unwrap();
     let close = gpu
         .image
@@ -158,7 +158,7 @@ fn envmap_vs_reference_on_the_demo_scene() {
     let scene = demo();
     let mut q = Quality::default();
     q.set("cube_size", "128").unwrap();
-    let gpu = specula::render(&ctx, &scene, Method::Envmap, &q, (128, 128), (0, 1)).unwrap();
+    let gpu = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (128, 128), (0, 1)).unwrap();
     let reference = render_reference(&scene, &q, (128, 128)).unwrap();
     let e = metrics::compare(&gpu.image, &reference).unwrap();
     println!("envmap vs reference, demo 128²: {e}");
@@ -176,10 +176,10 @@ fn envmap_vs_reference_on_the_demo_scene() {
 fn the_gpu_renderer_refuses_the_reference() {
     let ctx = common::gpu();
     let scene = demo();
-    let p = specula::plan(&scene, Method::Reference, &Quality::default());
+    let p = specula::plan(&scene, specula::methods::REFERENCE, &Quality::default());
     assert_eq!(p.passes, [specula::plan::REFERENCE_PASS]);
     assert!(p.envmaps.is_empty() && p.shadow_cubes.is_empty() && p.shadow_planes.is_empty());
-    let err = specula::render(&ctx, &scene, Method::Reference, &Quality::default(), (8, 8), (0, 1)).unwrap_err();
+    let err = specula::render(&ctx, &scene, specula::methods::REFERENCE, &Quality::default(), (8, 8), (0, 1)).unwrap_err();
     assert!(err.to_string().contains("renders on the CPU"), "{err}");
     assert!(ctx.memory.snapshot().is_empty(), "nothing was allocated: {:?}", ctx.memory.snapshot());
     common::assert_clean(&ctx);

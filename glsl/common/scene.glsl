@@ -31,11 +31,18 @@ struct Object {
     uint material;
     int envmap_layer;    // cube index in the environment/distance-map arrays, -1: none
     int refractor_layer; // cube index in the refractor-map array, -1: none
-    uint pad0;
+    uint map_shading;    // how it looks in other objects' distance maps: MAP_SHADING_*
     vec4 reference_point; // xyz; w: proxy sphere radius (§3.2)
     vec4 proxy_min;       // proxy box (§3.2), world space
     vec4 proxy_max;
 };
+
+// How a specular object is drawn into the other objects' distance maps (§4.3), when the
+// frame runs inter-object cycles (FLAG_INTER_OBJECT): the environment only, its own
+// distance map of the previous cycle, or self refraction in its refractor map (§4.4).
+const uint MAP_SHADING_SKY = 0u;
+const uint MAP_SHADING_TRACED = 1u;
+const uint MAP_SHADING_REFRACTOR = 2u;
 
 const uint LIGHT_POINT = 0u;
 const uint LIGHT_SPOT = 1u;
@@ -81,9 +88,11 @@ layout(push_constant) uniform Push {
     uint object;
     uint flags;
     uint light_count;
-    // Search knobs (§4.1): linear steps (0: parallax correction), secant steps, binary
-    // steps, parallax iterations.
-    uvec4 search;
+    // Search knobs (§4.1).
+    uint linear_steps;        // 0: parallax correction only
+    uint secant_steps;
+    uint binary_steps;
+    uint parallax_iterations;
     float tolerance;         // early exit when | |l|/|l'| − 1 | ≤ tolerance
     uint internal_bounces;   // self refraction: total internal reflections followed (§4.4)
     uint pad0;

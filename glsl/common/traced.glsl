@@ -17,8 +17,8 @@ float search_lookup(vec3 dir) {
 
 // The knobs decide: linear steps 0 means parallax correction alone.
 SearchResult search_ray(vec3 x, vec3 dir) {
-    if (push.search.x == 0u) return parallax_search(x, dir, int(max(push.search.w, 1u)));
-    return linear_search(x, dir, int(push.search.x), int(push.search.z), int(push.search.y), push.tolerance);
+    if (push.linear_steps == 0u) return parallax_search(x, dir, int(max(push.parallax_iterations, 1u)));
+    return linear_search(x, dir, int(push.linear_steps), int(push.binary_steps), int(push.secant_steps), push.tolerance);
 }
 
 // Radiance arriving at world point p from direction dir, traced in the distance map of

@@ -2,10 +2,10 @@
 #extension GL_GOOGLE_include_directive : require
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
 // the reference point (not window-space z). Specular objects other than the map's owner
-// reflect the environment map, or, in inter-object mode (§4.3), search their own maps of
-// the previous cycle.
-#include "common/specular.glsl"
-#include "common/traced.glsl"
+// reflect the environment map, or, in inter-object mode (§4.3), are shaded by their own
+// method from their maps of the previous cycle: searched in their distance map, or self
+// refracted in their refractor map (§4.4).
+#include "distance/refractor/trace.glsl"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -23,9 +23,11 @@ void main() {
         c = shade_diffuse(m, in_position, n, eye, in_uv);
     } else {
         SpecularSplit s = specular_split(m, in_position, n, eye);
-        bool inter = (push.flags & FLAG_INTER_OBJECT) != 0u && o.envmap_layer >= 0;
+        bool inter = (push.flags & FLAG_INTER_OBJECT) != 0u && o.map_shading != MAP_SHADING_SKY;
         if (inter && (push.flags & FLAG_FIRST_CYCLE) != 0u) {
             c = vec3(0.0);
+        } else if (inter && o.map_shading == MAP_SHADING_REFRACTOR) {
+            c = refractor_radiance(o, m, in_position, n, eye);
         } else {
             c = s.fr * (inter ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
             if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * (inter ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));

@@ -376,9 +376,9 @@ fn demo(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -> s
     }
     // Every method against the exact reference, and all of them side by side (the survey's
     // Figures 20 and 24 in one sheet): methods.png, and methods.svg with labels.
-    if let Some((_, reference)) = images.iter().find(|(n, _)| *n == Method::Reference.name()) {
+    if let Some((_, reference)) = images.iter().find(|(n, _)| *n == specula::methods::REFERENCE.name()) {
         report += "== error against the reference\n";
-        for (name, img) in images.iter().filter(|(n, _)| *n != Method::Reference.name()) {
+        for (name, img) in images.iter().filter(|(n, _)| *n != specula::methods::REFERENCE.name()) {
             report += &format!("{name:<24} {}\n", specula::metrics::compare(img, reference)?);
         }
         report.push('\n');

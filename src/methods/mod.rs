@@ -1,218 +1,53 @@
-//! One module per family of the survey, mirroring `glsl/`; one file per pass, each with
-//! its resources in one struct (`new` creates everything, `destroy` frees everything) and
-//! a `record` that reads like a sentence: declare reads and writes, render, close.
+//! The method registry and one module per family of the survey, mirroring `glsl/`: each
+//! family describes its methods once (`registry::MethodInfo`) and owns the passes that
+//! make their maps. The frame's own passes (upload, shadows, direct light, the camera
+//! passes' machinery) live in `crate::frame`.
+//!
+//! Adding a method: its descriptor and passes in its family's folder, its shaders in
+//! `glsl/<family>/`, its tests, and one line below.
 
-pub mod direct;
+pub mod distance;
 pub mod envmap;
-pub mod image_space;
-pub mod refractor;
-pub mod shade;
-pub mod shadow;
+pub mod registry;
 
-use ash::vk;
+pub use crate::reference::REFERENCE;
+pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
+pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
+pub use registry::{Choice, Method, MethodInfo, ObjectClass};
 
-use crate::gpu_scene::{Draw, GpuScene};
-use crate::quality::CubeMode;
-use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
+/// Every registered method, GPU methods first: the CLI's list, `specula knobs`, the C
+/// header's constants, the README tables, `tradeoff` and the demo read this.
+pub const ALL: &[Method] = &[ENVMAP, PROXY_SPHERE, PROXY_BOX, DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP, IMAGE_SPACE_REFRACTION, REFERENCE];
 
-/// Push constants of every scene-drawing shader (`Push` in glsl/common/scene.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Push {
-    pub view: u32,
-    pub object: u32,
-    pub flags: u32,
-    pub light_count: u32,
-    /// linear steps (0: parallax correction), secant steps, binary steps, parallax iterations.
-    pub search: [u32; 4],
-    pub tolerance: f32,
-    pub internal_bounces: u32,
-    pub pad: [u32; 2],
-}
+/// Every object class, for methods that serve them all.
+pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
 
-pub const PUSH_BYTES: u32 = std::mem::size_of::<Push>() as u32;
-pub const FLAG_FRESNEL_EXACT: u32 = 1;
-pub const FLAG_HAS_ENVIRONMENT: u32 = 2;
-pub const FLAG_INTER_OBJECT: u32 = 4;
-pub const FLAG_PROXY_BOX: u32 = 8;
-pub const FLAG_FIRST_CYCLE: u32 = 16;
+#[cfg(test)]
+mod tests {
+    use super::*;
 
-/// What every pass needs to draw the scene: geometry, the frame's descriptor set and
-/// pipeline layout, and the frame-wide push-constant fields.
-pub struct FrameInputs<'a> {
-    pub scene: &'a GpuScene,
-    pub set: vk::DescriptorSet,
-    pub layout: vk::PipelineLayout,
-    pub flags: u32,
-    pub light_count: u32,
-    pub search: [u32; 4],
-    pub tolerance: f32,
-    pub internal_bounces: u32,
-}
-
-impl FrameInputs<'_> {
-    pub fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, pipeline: vk::Pipeline) {
-        unsafe {
-            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
-            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.set], &[]);
-        }
-        self.scene.bind_geometry(ctx, cmd);
+    #[test]
+    fn registry_is_consistent() {
+        registry::check(ALL).unwrap();
     }
 
-    /// Binds a maps set (set 1) for the passes of §4.
-    pub fn bind_maps(&self, ctx: &Context, cmd: vk::CommandBuffer, maps: vk::DescriptorSet) {
-        unsafe { ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 1, &[maps], &[]) };
+    #[test]
+    fn registry_refuses_duplicates() {
+        static COPY: MethodInfo = MethodInfo { name: "distance", abi: 77, ..*DISTANCE.0 };
+        assert!(registry::check(&[DISTANCE, Method(&COPY)]).unwrap_err().contains("named 'distance'"));
+        static SAME_NUMBER: MethodInfo = MethodInfo { name: "other", ..*DISTANCE.0 };
+        assert!(registry::check(&[DISTANCE, Method(&SAME_NUMBER)]).unwrap_err().contains("C ABI number"));
+        static BAD_KNOB: MethodInfo = MethodInfo { name: "other", abi: 78, knobs: &["warp"], ..*DISTANCE.0 };
+        assert!(registry::check(&[Method(&BAD_KNOB)]).unwrap_err().contains("unknown knob"));
     }
 
-    pub fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32) {
-        self.push_flags(ctx, cmd, view, object, self.flags);
-    }
-
-    pub fn push_flags(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32, flags: u32) {
-        let p = Push {
-            view,
-            object,
-            flags,
-            light_count: self.light_count,
-            search: self.search,
-            tolerance: self.tolerance,
-            internal_bounces: self.internal_bounces,
-            pad: [0; 2],
-        };
-        unsafe {
-            ctx.device.cmd_push_constants(
-                cmd,
-                self.layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&p),
-            )
-        };
-    }
-
-    pub fn draw(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, d: &Draw) {
-        self.push(ctx, cmd, view, d.mesh);
-        unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
-    }
-
-    /// The full-screen sky triangle (bound pipeline must be a sky pipeline).
-    pub fn draw_sky(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32) {
-        self.push(ctx, cmd, view, 0);
-        unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
-    }
-}
-
-/// Renders the six faces of cube `cube` of `color` (a cube or cube-array attachment),
-/// either in six passes or in one multiview pass. `draw(cmd, view)` records the draws of
-/// one pass whose first view is `view` (the face's view, or the cube's first view with
-/// multiview, where the shader adds gl_ViewIndex).
-#[allow(clippy::too_many_arguments)]
-pub fn render_cube_faces(
-    rec: &Recorder,
-    color: &Image,
-    depth: &mut Image,
-    cube: u32,
-    view_base: u32,
-    mode: CubeMode,
-    clear_color: [f32; 4],
-    mut draw: impl FnMut(vk::CommandBuffer, u32),
-) {
-    let (ctx, cmd) = (rec.ctx, rec.cmd);
-    let size = color.width;
-    match mode {
-        CubeMode::Multiview => {
-            rec.barrier(depth, Access::DepthAttachment);
-            let colors = [color.group_view(cube)];
-            begin_rendering(
-                ctx,
-                cmd,
-                &Target {
-                    color: &colors,
-                    depth: Some(depth.group_view(0)),
-                    width: size,
-                    height: size,
-                    view_mask: 0x3F,
-                    layer_count: 1,
-                    clear_color,
-                    clear: true,
-                },
-            );
-            draw(cmd, view_base);
-            unsafe { ctx.device.cmd_end_rendering(cmd) };
-        }
-        CubeMode::SixPasses => {
-            for face in 0..6 {
-                rec.barrier(depth, Access::DepthAttachment);
-                let colors = [color.layer_view(6 * cube + face)];
-                begin_rendering(
-                    ctx,
-                    cmd,
-                    &Target {
-                        color: &colors,
-                        depth: Some(depth.view),
-                        width: size,
-                        height: size,
-                        view_mask: 0,
-                        layer_count: 1,
-                        clear_color,
-                        clear: true,
-                    },
-                );
-                draw(cmd, view_base + face);
-                unsafe { ctx.device.cmd_end_rendering(cmd) };
+    #[test]
+    fn every_whole_scene_method_covers_every_class() {
+        for m in ALL {
+            for c in EVERY_CLASS {
+                let served = m.can_serve(*c) || m.fallback.is_some_and(|f| f.can_serve(*c));
+                assert!(served, "{} leaves a {} without a method", m.name, c.label());
             }
-        }
-    }
-}
-
-/// Starts rendering into the camera's colour and depth targets (cleared or kept).
-pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Image, depth: &Image, clear: bool) {
-    let colors = [target.view];
-    let t = Target {
-        color: &colors,
-        depth: Some(depth.view),
-        width: target.width,
-        height: target.height,
-        view_mask: 0,
-        layer_count: 1,
-        clear_color: [0.0; 4],
-        clear,
-    };
-    begin_rendering(ctx, cmd, &t);
-}
-
-/// The depth buffer cube rendering needs: six layers for multiview, one otherwise.
-pub fn cube_depth(ctx: &Context, name: &str, size: u32, mode: CubeMode) -> crate::Result<Image> {
-    let kind = match mode {
-        CubeMode::Multiview => crate::vk::ImageKind::D2Array { layers: 6 },
-        CubeMode::SixPasses => crate::vk::ImageKind::D2,
-    };
-    Image::new(
-        ctx,
-        &crate::vk::ImageDesc {
-            name,
-            format: vk::Format::D32_SFLOAT,
-            width: size,
-            height: size,
-            kind,
-            usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        },
-    )
-}
-
-pub fn view_mask(mode: CubeMode) -> u32 {
-    match mode {
-        CubeMode::Multiview => 0x3F,
-        CubeMode::SixPasses => 0,
-    }
-}
-
-/// Destroys pipelines that were created (null handles are skipped).
-pub fn destroy_pipelines(ctx: &Context, pipelines: &mut [vk::Pipeline]) {
-    for p in pipelines.iter_mut() {
-        if *p != vk::Pipeline::null() {
-            unsafe { ctx.device.destroy_pipeline(*p, None) };
-            *p = vk::Pipeline::null();
         }
     }
 }

@@ -31,6 +31,21 @@ use crate::vk::ImageData;
 use bvh::{Bvh, Hit};
 use shade::{ShadeLight, Sky, Textures};
 
+/// The exact CPU reference as a registered method: it has no GPU passes (`Renderer::new`
+/// refuses its plan); `reference::render_reference` renders it.
+pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::methods::MethodInfo {
+    name: "reference",
+    abi: 99,
+    section: "§2, Table 1",
+    family: "reference",
+    summary: "the exact CPU reference (f64, SAH BVH, Möller–Trumbore): Whitted recursion through both the reflected and the refracted branch weighted by Fresnel, up to `depth` bounces, the GPU's non-specular shading with exact shadow rays, `spp` stratified samples per pixel, both cores (rayon). Ground truth for the tests and `specula tradeoff`",
+    serves: crate::methods::EVERY_CLASS,
+    knobs: &["depth", "spp", "fresnel"],
+    gpu: None,
+    fallback: None,
+    rule: |_, _| None,
+});
+
 /// Path weights below this (every channel) are not traced further.
 pub const MIN_PATH_WEIGHT: f64 = 1e-6;
 

@@ -655,7 +655,8 @@ impl<'a> Importer<'a> {
 
         let material_index = self.material_index(&material)?;
         let name = format!("{}/{p}", mesh.name().map(str::to_string).unwrap_or_else(|| m.to_string()));
-        let mesh_value = Mesh { name, positions, normals, uvs, indices, material: material_index, reference_point };
+        let mesh_value =
+            Mesh { name, positions, normals, uvs, indices, material: material_index, reference_point, aliases: Vec::new(), method: None };
         let file = self.file;
         self.scene.add_mesh(mesh_value).map_err(|e| {
             map_invalid(file, e, |suffix| match suffix {

@@ -96,9 +96,15 @@ pub struct Mesh {
     pub uvs: Vec<Vec2>,
     pub indices: Vec<u32>,
     pub material: usize,
-    /// Reference point for the maps of a specular object (§3); `None` means the centre
-    /// of the mesh's bounding box.
+    /// Reference point for the maps of a specular object (§3); `None`: chosen by the
+    /// planner (the centre of the mesh's bounding box unless that lies inside another
+    /// object).
     pub reference_point: Option<Vec3>,
+    /// Other names that address this object (`--object NAME=METHOD`, the C ABI): the glTF
+    /// mesh name when the object is named after its node.
+    pub aliases: Vec<String>,
+    /// The method the scene file asks for (`extras.specula.method`), if any.
+    pub method: Option<String>,
 }
 
 impl Mesh {

@@ -10,8 +10,10 @@
 
 use ash::vk;
 
-use crate::methods::direct::DEPTH_FORMAT;
-use crate::methods::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
+use crate::frame::direct::DEPTH_FORMAT;
+use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
+use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
+use crate::methods::distance::distance_images;
 use crate::plan::Plan;
 use crate::quality::{CubeMode, Precision};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
@@ -26,11 +28,13 @@ pub enum MapKind {
     Distance,
 }
 
+/// The cube-map pass of one kind; its images are `Maps::radiance` or `Maps::distance`
+/// (one cube per object, layer = position in `objects`; two distance images only for
+/// inter-object cycles).
 pub struct CubeMaps {
     pub kind: MapKind,
-    /// Cube-map arrays, one cube per specular object (layer = `EnvmapPlan::layer`); two
-    /// only for inter-object cycles.
-    pub maps: Vec<Image>,
+    /// Meshes, in layer order.
+    objects: Vec<usize>,
     depth: Image,
     sky: vk::Pipeline,
     surface: vk::Pipeline,
@@ -40,8 +44,11 @@ pub struct CubeMaps {
     inter_object: bool,
     /// Frames recorded so far (frame-latency mode reads the previous frame's maps).
     frames: u64,
-    /// Which image the last recorded cycle wrote.
-    pub latest: usize,
+}
+
+/// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
+pub fn create_radiance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Radiance)?))
 }
 
 pub fn radiance_format(p: Precision) -> vk::Format {
@@ -52,38 +59,50 @@ pub fn radiance_format(p: Precision) -> vk::Format {
 }
 
 impl CubeMaps {
-    pub fn new(ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, kind: MapKind) -> Result<CubeMaps> {
+    pub fn new(init: &StageInit, objects: &[usize], maps: &mut Maps, kind: MapKind) -> Result<CubeMaps> {
+        let (ctx, plan) = (init.ctx, init.plan);
         let q = &plan.quality;
         let format = radiance_format(q.cube_precision);
-        let inter_object = plan.method == crate::plan::Method::DistanceMulti;
-        let images = if inter_object && (plan.cycles > 1 || q.frame_latency) { 2 } else { 1 };
+        let inter_object = kind == MapKind::Distance && plan.inter_object;
+        let images = if kind == MapKind::Distance { distance_images(plan) as usize } else { 1 };
         let me = CubeMaps {
             kind,
-            maps: Vec::new(),
+            objects: objects.to_vec(),
             depth: Image::placeholder(),
             sky: vk::Pipeline::null(),
             surface: vk::Pipeline::null(),
             mode: q.cube_mode,
             cycles: plan.cycles.max(1),
-            frame_latency: q.frame_latency && inter_object,
+            frame_latency: plan.frame_latency && inter_object,
             inter_object,
             frames: 0,
-            latest: 0,
         };
-        build(ctx, me, |me| me.init(ctx, plan, layout, format, images))
+        build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
 
-    fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, format: vk::Format, images: usize) -> Result<()> {
+    fn init(
+        &mut self,
+        ctx: &Context,
+        plan: &Plan,
+        layout: vk::PipelineLayout,
+        format: vk::Format,
+        images: usize,
+        maps: &mut Maps,
+    ) -> Result<()> {
         let q = &plan.quality;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
-        let kind = ImageKind::CubeArray { cubes: plan.envmaps.len() as u32 };
+        let kind = ImageKind::CubeArray { cubes: self.objects.len() as u32 };
         let base = match self.kind {
             MapKind::Radiance => "envmap.cubes",
             MapKind::Distance => "distance.cubes",
         };
         for i in 0..images {
             let name = if images == 1 { base.to_string() } else { format!("{base}.{}", ["ping", "pong"][i]) };
-            self.maps.push(Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube_size, height: q.cube_size, kind, usage })?);
+            let image = Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube_size, height: q.cube_size, kind, usage })?;
+            match self.kind {
+                MapKind::Radiance => maps.radiance = Some(image),
+                MapKind::Distance => maps.distance.push(image),
+            }
         }
         self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube_size, q.cube_mode)?;
         let (sky, surface) = match self.kind {
@@ -128,54 +147,68 @@ impl CubeMaps {
         Ok(())
     }
 
-    pub fn pass_name(&self) -> &'static str {
+    /// The images of this kind in the frame's maps.
+    fn images(&self, maps: &mut Maps) -> Vec<Image> {
+        match self.kind {
+            MapKind::Radiance => maps.radiance.take().into_iter().collect(),
+            MapKind::Distance => std::mem::take(&mut maps.distance),
+        }
+    }
+
+    fn put_back(&self, maps: &mut Maps, mut images: Vec<Image>) {
+        match self.kind {
+            MapKind::Radiance => maps.radiance = images.pop(),
+            MapKind::Distance => maps.distance = images,
+        }
+    }
+}
+
+impl Stage for CubeMaps {
+    fn name(&self) -> &'static str {
         match self.kind {
             MapKind::Radiance => "envmap.generate",
             MapKind::Distance => "distance.generate",
         }
     }
 
-    /// Records this frame's cycles. `views[i]` is the first of the six views of
-    /// plan.envmaps[i]; `read_sets[i]` is the maps set (set 1) that samples `maps[i]`;
-    /// `empty_set` holds null descriptors (distance-map shaders always declare set 1).
-    #[allow(clippy::too_many_arguments)]
-    pub fn record<'a>(
-        &mut self,
-        rec: &mut Recorder,
-        f: &FrameInputs,
-        plan: &Plan,
-        views: &[u32],
-        read_sets: &[vk::DescriptorSet],
-        empty_set: vk::DescriptorSet,
-        sampled: impl Iterator<Item = &'a Image>,
-    ) {
+    /// Records this frame's cycles. The maps set (set 1) `io.sets.generate[i]` samples
+    /// distance image i (and the refractor maps); `io.sets.empty` holds null descriptors
+    /// (distance-map shaders always declare set 1).
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let cycles = if self.frame_latency { 1 } else { self.cycles };
+        // The images are taken out of the frame's maps while this pass writes them.
+        let mut images = self.images(io.maps);
+        let count = images.len();
         let first_write = if self.frame_latency { (self.frames % 2) as usize } else { 0 };
-        let mut pass = rec.pass(self.pass_name());
-        for m in &mut self.maps {
+        let mut pass = rec.pass(self.name());
+        for m in &mut images {
             pass = pass.writes(m, Access::ColorAttachment);
         }
-        for img in sampled {
+        let refractor = io.maps.refractor.as_ref().filter(|_| self.kind == MapKind::Distance);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(refractor) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
         let ctx = rec.ctx;
+        let mut latest = 0;
         for cycle in 0..cycles {
-            let write = (first_write + cycle as usize) % self.maps.len();
-            let read = (write + 1) % self.maps.len();
+            let write = (first_write + cycle as usize) % count;
+            let read = (write + 1) % count;
             // The first cycle ever (or of this frame, without latency) has no maps to read.
             let first = if self.frame_latency { self.frames == 0 } else { cycle == 0 };
             let flags = if self.inter_object { FLAG_INTER_OBJECT | if first { FLAG_FIRST_CYCLE } else { 0 } } else { 0 };
             if self.inter_object && !first {
-                rec.barrier(&mut self.maps[read], Access::FragmentSampled);
+                rec.barrier(&mut images[read], Access::FragmentSampled);
             }
-            rec.barrier(&mut self.maps[write], Access::ColorAttachment);
-            let (target, depth) = (&self.maps[write], &mut self.depth);
-            let read_set = if self.inter_object && !first { read_sets.get(read).copied().unwrap_or(empty_set) } else { empty_set };
+            rec.barrier(&mut images[write], Access::ColorAttachment);
+            let (target, depth) = (&images[write], &mut self.depth);
+            let read_set =
+                if self.inter_object && !first { io.sets.generate.get(read).copied().unwrap_or(io.sets.empty) } else { io.sets.empty };
             let uses_maps = self.kind == MapKind::Distance;
             let clear = [0.0, 0.0, 0.0, if self.kind == MapKind::Distance { 1e30 } else { 0.0 }];
-            for (e, &view) in plan.envmaps.iter().zip(views) {
-                render_cube_faces(rec, target, depth, e.layer, view, self.mode, clear, |cmd, v| {
+            for (layer, &mesh) in self.objects.iter().enumerate() {
+                let view = io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views");
+                render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
                     f.bind(ctx, cmd, self.sky);
                     f.push_flags(ctx, cmd, v, 0, f.flags | flags);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
@@ -183,27 +216,23 @@ impl CubeMaps {
                     if uses_maps {
                         f.bind_maps(ctx, cmd, read_set);
                     }
-                    for d in f.scene.draws.iter().filter(|d| d.mesh as usize != e.mesh) {
+                    for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh) {
                         f.push_flags(ctx, cmd, v, d.mesh, f.flags | flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
                     }
                 });
             }
-            self.latest = write;
+            latest = write;
         }
         self.frames += 1;
         rec.end(open);
-    }
-
-    /// The maps the camera pass reads: those the last cycle wrote.
-    pub fn current(&self) -> &Image {
-        &self.maps[self.latest]
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        for m in &mut self.maps {
-            m.destroy(ctx);
+        self.put_back(io.maps, images);
+        if self.kind == MapKind::Distance {
+            io.maps.distance_latest = latest;
         }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
         self.depth.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.sky, self.surface]);
         self.sky = vk::Pipeline::null();
@@ -213,6 +242,6 @@ impl CubeMaps {
 
 impl Owner for CubeMaps {
     fn destroy(&mut self, ctx: &Context) {
-        CubeMaps::destroy(self, ctx)
+        Stage::destroy(self, ctx)
     }
 }

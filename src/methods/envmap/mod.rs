@@ -1,7 +1,92 @@
-//! Environment mapping (survey §3) and, with distances stored alongside the radiance,
-//! distance maps (§4): `generate` rasterises each specular object's cube map from its
-//! reference point with the object left out. The shading passes are `methods::shade`.
+//! Environment mapping (survey §3): one radiance cube map per specular object, rasterised
+//! from its reference point without the object (`generate`, shared with the distance maps
+//! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
+//! towards where the ray leaves a proxy of the environment (§3.2).
 
 pub mod generate;
 
 pub use generate::{CubeMaps, MapKind};
+
+use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
+use crate::frame::FLAG_PROXY_BOX;
+use crate::methods::registry::{CameraPass, GpuSpec, MapShading, Method, MethodInfo, Verdict};
+use crate::methods::EVERY_CLASS;
+use crate::plan::facts::ObjectFacts;
+use crate::plan::Plan;
+use crate::quality::Quality;
+
+/// `envmap.generate`: the radiance cube maps.
+pub const RADIANCE_CUBES: MapInfo = MapInfo {
+    name: "envmap.generate",
+    order: order::ENVIRONMENT_MAPS,
+    cube: true,
+    layer_field: Some(LayerField::Envmap),
+    create: generate::create_radiance,
+    bytes: radiance_bytes,
+    describe: |q, _| describe_cube(q),
+};
+
+fn radiance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {
+    let s = p.quality.cube_size as u64;
+    6 * s * s * cube_texel_bytes(&p.quality) * objects as u64
+}
+
+const KNOBS: &[&str] = &["cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point"];
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+const fn spec(camera: CameraPass) -> GpuSpec {
+    GpuSpec { maps: &[RADIANCE_CUBES], camera, map_shading: MapShading::Sky, cycles: one }
+}
+
+const SHADE: CameraPass =
+    CameraPass { name: "envmap.shade", vertex: "scene/mesh.vert", fragment: "envmap/shade.frag", flags: 0, order: order::CAMERA };
+
+const fn proxy(flags: u32) -> CameraPass {
+    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA }
+}
+
+pub const ENVMAP: Method = Method(&MethodInfo {
+    name: "envmap",
+    abi: 0,
+    section: "§3, §3.1",
+    family: "envmap",
+    summary: "classic environment mapping: one cube map per specular object, rasterised from its reference point without the object; looked up in the reflected / refracted direction, weighted by Fresnel",
+    serves: EVERY_CLASS,
+    knobs: KNOBS,
+    gpu: Some(spec(SHADE)),
+    fallback: None,
+    rule: |_, _| Some(Verdict { score: 1.0, reason: "classic environment map: the cheapest lookup, but it ignores where the ray starts (§3.1)".into() }),
+});
+
+pub const PROXY_SPHERE: Method = Method(&MethodInfo {
+    name: "proxy-sphere",
+    abi: 1,
+    section: "§3.2",
+    family: "envmap",
+    summary: "localised environment mapping: the ray is intersected with a sphere around the reference point (`proxy_radius`) and the cube map looked up towards the hit",
+    serves: EVERY_CLASS,
+    knobs: &["cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "proxy_radius"],
+    gpu: Some(spec(proxy(0))),
+    fallback: None,
+    rule: |_, _| Some(Verdict { score: 1.1, reason: "proxy sphere: localised by a sphere around the reference point (§3.2)".into() }),
+});
+
+pub const PROXY_BOX: Method = Method(&MethodInfo {
+    name: "proxy-box",
+    abi: 2,
+    section: "§3.2",
+    family: "envmap",
+    summary: "the same with the scene's bounding box as proxy (what engines call a parallax-corrected cube map)",
+    serves: EVERY_CLASS,
+    knobs: KNOBS,
+    gpu: Some(spec(proxy(FLAG_PROXY_BOX))),
+    fallback: None,
+    rule: proxy_box_rule,
+});
+
+fn proxy_box_rule(_: &ObjectFacts, _: &Quality) -> Option<Verdict> {
+    Some(Verdict { score: 1.2, reason: "proxy box: localised by the scene's box, one cube-map fetch per ray (§3.2)".into() })
+}

@@ -4,9 +4,10 @@
 
 use ash::vk;
 
+use super::stage::{FrameIo, Stage};
 use super::{begin_camera_rendering, destroy_pipelines, FrameInputs};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
-use crate::vk::{Access, Context, Image, Recorder};
+use crate::vk::{Access, Context, Recorder};
 use crate::Result;
 
 pub const TARGET_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -73,24 +74,22 @@ impl SceneDirect {
         let (sky, direct) = sky_and_direct(ctx, layout, TARGET_FORMAT, 0, "scene")?;
         Ok(SceneDirect { sky, direct })
     }
+}
 
-    /// Clears `target`, draws the sky, then every non-specular mesh from view `view`.
-    pub fn record<'a>(
-        &self,
-        rec: &mut Recorder,
-        f: &FrameInputs,
-        view: u32,
-        target: &mut Image,
-        depth: &mut Image,
-        sampled: impl Iterator<Item = &'a Image>,
-    ) {
-        let mut pass = rec.pass("scene.direct").writes(target, Access::ColorAttachment).writes(depth, Access::DepthAttachment);
-        for img in sampled {
+impl Stage for SceneDirect {
+    fn name(&self) -> &'static str {
+        "scene.direct"
+    }
+
+    /// Clears the target, draws the sky, then every non-specular mesh from the camera.
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let mut pass = rec.pass("scene.direct").writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
-        let (ctx, cmd) = (rec.ctx, rec.cmd);
-        begin_camera_rendering(ctx, cmd, target, depth, true);
+        let (ctx, cmd, view) = (rec.ctx, rec.cmd, io.views.camera);
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, true);
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);
@@ -101,7 +100,7 @@ impl SceneDirect {
         rec.end(open);
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    fn destroy(&mut self, ctx: &Context) {
         destroy_pipelines(ctx, &mut [self.sky, self.direct]);
         self.sky = vk::Pipeline::null();
         self.direct = vk::Pipeline::null();

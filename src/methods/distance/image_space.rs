@@ -1,29 +1,33 @@
 //! Wyman's image-space double refraction (survey §4.4): `image_space.backfaces` renders the
 //! refractors' back faces from the camera (normal and distance from the eye); the camera
-//! pass `image_space.refract` (`methods::shade` with image_space/refract.vert) reads them,
+//! pass `image_space.refract` (glsl/distance/image_space/refract.*) reads them,
 //! with each vertex's distance through the object along its inverted normal (d_N),
 //! precomputed here once by casting rays against the object's own triangles.
 
 use ash::vk;
 use glam::DVec3;
 
-use crate::gpu_scene::Draw;
-use crate::methods::direct::DEPTH_FORMAT;
-use crate::methods::{destroy_pipelines, FrameInputs};
+use crate::frame::direct::DEPTH_FORMAT;
+use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
+use crate::frame::{destroy_pipelines, FrameInputs};
 use crate::optics::ray_triangle;
-use crate::plan::Plan;
 use crate::scene::Scene;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
+/// The pass; its images are `Maps::backfaces` (camera-sized: xyz back-face normal, w its
+/// distance from the eye, 0: no refractor) and `Maps::thickness` (d_N per vertex of the
+/// scene's vertex buffer, 0 for other meshes).
 pub struct Backfaces {
-    /// Camera-sized: xyz back-face normal, w its distance from the eye (0: no refractor).
-    pub map: Image,
+    objects: Vec<usize>,
     depth: Image,
     pipeline: vk::Pipeline,
-    /// d_N per vertex of the scene's vertex buffer (0 for other meshes).
-    pub thickness: Buffer,
+}
+
+/// `BACKFACES`' constructor.
+pub fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    Ok(Box::new(Backfaces::new(init, objects, maps)?))
 }
 
 /// Distance from each vertex through its own mesh along the inverted normal (Wyman's d_N).
@@ -52,17 +56,14 @@ pub fn vertex_thickness(scene: &Scene, meshes: &[usize]) -> Vec<f32> {
 }
 
 impl Backfaces {
-    pub fn new(ctx: &Context, scene: &Scene, plan: &Plan, layout: vk::PipelineLayout, width: u32, height: u32) -> Result<Backfaces> {
-        let me = Backfaces {
-            map: Image::placeholder(),
-            depth: Image::placeholder(),
-            pipeline: vk::Pipeline::null(),
-            thickness: Buffer::placeholder(),
-        };
+    pub fn new(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Backfaces> {
+        let (ctx, scene, layout, width, height) = (init.ctx, init.scene, init.layout, init.width, init.height);
+        let me = Backfaces { objects: objects.to_vec(), depth: Image::placeholder(), pipeline: vk::Pipeline::null() };
         build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let format = vk::Format::R32G32B32A32_SFLOAT;
-            me.map = Image::new(ctx, &ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage })?;
+            maps.backfaces =
+                Some(Image::new(ctx, &ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage })?);
             me.depth = Image::new(
                 ctx,
                 &ImageDesc {
@@ -74,19 +75,19 @@ impl Backfaces {
                     usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
                 },
             )?;
-            me.thickness = Buffer::with_data(
+            maps.thickness = Some(Buffer::with_data(
                 ctx,
                 "image_space.thickness",
-                &vertex_thickness(scene, &plan.image_space),
+                &vertex_thickness(scene, &me.objects),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
-            )?;
+            )?);
             me.pipeline = graphics_pipeline(
                 ctx,
                 layout,
                 &GraphicsDesc {
                     name: "image_space.backfaces",
                     vertex: "scene/mesh.vert",
-                    fragment: "image_space/backfaces.frag",
+                    fragment: "distance/image_space/backfaces.frag",
                     vertex_input: VertexInput::Mesh,
                     color_formats: &[format],
                     depth_format: Some(DEPTH_FORMAT),
@@ -99,21 +100,25 @@ impl Backfaces {
             Ok(())
         })
     }
+}
 
-    /// The nearest back face of the refractors `which` selects, from view `view`.
-    pub fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, view: u32, which: impl Fn(&Draw) -> bool) {
-        let open = rec
-            .pass("image_space.backfaces")
-            .writes(&mut self.map, Access::ColorAttachment)
-            .writes(&mut self.depth, Access::DepthAttachment)
-            .begin();
+impl Stage for Backfaces {
+    fn name(&self) -> &'static str {
+        "image_space.backfaces"
+    }
+
+    /// The nearest back face of this pass's refractors, from the camera.
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let Some(map) = io.maps.backfaces.as_mut() else { return };
+        let open =
+            rec.pass("image_space.backfaces").writes(map, Access::ColorAttachment).writes(&mut self.depth, Access::DepthAttachment).begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let colors = [self.map.view];
+        let colors = [map.view];
         let t = Target {
             color: &colors,
             depth: Some(self.depth.view),
-            width: self.map.width,
-            height: self.map.height,
+            width: map.width,
+            height: map.height,
             view_mask: 0,
             layer_count: 1,
             clear_color: [0.0; 4],
@@ -121,17 +126,15 @@ impl Backfaces {
         };
         begin_rendering(ctx, cmd, &t);
         f.bind(ctx, cmd, self.pipeline);
-        for d in f.scene.draws.iter().filter(|d| which(d)) {
-            f.draw(ctx, cmd, view, d);
+        for d in f.scene.draws.iter().filter(|d| self.objects.contains(&(d.mesh as usize))) {
+            f.draw(ctx, cmd, io.views.camera, d);
         }
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         rec.end(open);
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
-        self.map.destroy(ctx);
+    fn destroy(&mut self, ctx: &Context) {
         self.depth.destroy(ctx);
-        self.thickness.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
     }
@@ -139,6 +142,6 @@ impl Backfaces {
 
 impl Owner for Backfaces {
     fn destroy(&mut self, ctx: &Context) {
-        Backfaces::destroy(self, ctx)
+        Stage::destroy(self, ctx)
     }
 }

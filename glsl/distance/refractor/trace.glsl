@@ -1,23 +1,17 @@
-#version 460
-#extension GL_GOOGLE_include_directive : require
-// refractor.search: self refraction with a refractor map (survey §4.4): the refracted ray
-// is searched inside the object's own refractor map, refracted out with Snell's law, or
-// reflected internally on total internal reflection, up to `internal_bounces` times; each
-// ray that leaves searches the environment's distance map. Fresnel weights every interface.
+// Self refraction with a refractor map (survey §4.4): the refracted ray is searched inside
+// the object's own refractor map, refracted out with Snell's law, or reflected internally
+// on total internal reflection, up to `internal_bounces` times; each ray that leaves
+// searches the environment's distance map. Fresnel weights every interface. Used by the
+// camera pass (refractor.search) and, for inter-object cycles, by distance-map generation.
+#ifndef REFRACTOR_TRACE_GLSL
+#define REFRACTOR_TRACE_GLSL
 #include "common/specular.glsl"
 #include "common/traced.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
-layout(location = 3) flat in uint in_view;
-layout(location = 0) out vec4 out_color;
-
-void main() {
-    Object o = objects[push.object];
-    Material m = materials[o.material];
-    vec3 p = in_position;
-    SpecularSplit s = specular_split(m, p, normalize(in_normal), views[in_view].eye.xyz);
+// Radiance leaving point p of solid refractor o (material m, interpolated normal n)
+// towards eye.
+vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
+    SpecularSplit s = specular_split(m, p, n, eye);
     vec3 c = s.fr * traced_radiance(o, p, s.r);
     vec3 weight = s.ft;
     vec3 pos = p;
@@ -51,5 +45,6 @@ void main() {
         dir = reflect_dir(dir, -n2);
         pos = hit;
     }
-    out_color = vec4(c, 1.0);
+    return c;
 }
+#endif

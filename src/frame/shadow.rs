@@ -4,6 +4,7 @@
 
 use ash::vk;
 
+use super::stage::{FrameIo, Maps, Stage, StageInit};
 use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::plan::Plan;
 use crate::quality::CubeMode;
@@ -14,11 +15,10 @@ use crate::Result;
 /// Clear value of distance maps: nothing in that direction.
 pub const FAR: f32 = 3.0e38;
 
+/// The shadow pass; its maps live in `Maps::shadow_cubes` and `Maps::shadow_planes`.
 #[derive(Default)]
 pub struct ShadowMaps {
-    pub cubes: Option<Image>,
     cube_depth: Option<Image>,
-    pub planes: Option<Image>,
     plane_depth: Option<Image>,
     cube_pipeline: vk::Pipeline,
     plane_pipeline: vk::Pipeline,
@@ -26,12 +26,12 @@ pub struct ShadowMaps {
 }
 
 impl ShadowMaps {
-    /// Creates what the plan's lights need; nothing when there are none.
-    pub fn new(ctx: &Context, plan: &Plan, layout: vk::PipelineLayout) -> Result<ShadowMaps> {
-        build(ctx, ShadowMaps::default(), |s| s.init(ctx, plan, layout))
+    /// Creates what the plan's lights need (the maps into `maps`).
+    pub fn create(init: &StageInit, maps: &mut Maps) -> Result<Box<dyn Stage>> {
+        Ok(Box::new(build(init.ctx, ShadowMaps::default(), |s| s.init(init.ctx, init.plan, init.layout, maps))?))
     }
 
-    fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout) -> Result<()> {
+    fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, maps: &mut Maps) -> Result<()> {
         let size = plan.quality.shadow_size;
         let mode = plan.quality.cube_mode;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -49,7 +49,7 @@ impl ShadowMaps {
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };
-            self.cubes = Some(Image::new(
+            maps.shadow_cubes = Some(Image::new(
                 ctx,
                 &ImageDesc { name: "shadow.cubes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
             )?);
@@ -59,7 +59,7 @@ impl ShadowMaps {
         }
         if !plan.shadow_planes.is_empty() {
             let kind = ImageKind::D2Array { layers: plan.shadow_planes.len() as u32 };
-            self.planes = Some(Image::new(
+            maps.shadow_planes = Some(Image::new(
                 ctx,
                 &ImageDesc { name: "shadow.planes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
             )?);
@@ -76,24 +76,30 @@ impl ShadowMaps {
         }
         Ok(())
     }
+}
 
-    /// `cube_views`: first view of each cube light; `plane_views`: view of each plane.
-    pub fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, cube_views: &[u32], plane_views: &[u32]) {
-        if self.cubes.is_none() && self.planes.is_none() {
+impl Stage for ShadowMaps {
+    fn name(&self) -> &'static str {
+        "shadow.generate"
+    }
+
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let maps = &mut *io.maps;
+        if maps.shadow_cubes.is_none() && maps.shadow_planes.is_none() {
             return;
         }
         let mut pass = rec.pass("shadow.generate");
-        if let Some(c) = self.cubes.as_mut() {
+        if let Some(c) = maps.shadow_cubes.as_mut() {
             pass = pass.writes(c, Access::ColorAttachment);
         }
-        if let Some(p) = self.planes.as_mut() {
+        if let Some(p) = maps.shadow_planes.as_mut() {
             pass = pass.writes(p, Access::ColorAttachment);
         }
         let open = pass.begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let clear = [FAR, 0.0, 0.0, 0.0];
-        if let (Some(cubes), Some(depth), Some(mode)) = (self.cubes.as_ref(), self.cube_depth.as_mut(), self.mode) {
-            for (k, &view) in cube_views.iter().enumerate() {
+        if let (Some(cubes), Some(depth), Some(mode)) = (maps.shadow_cubes.as_ref(), self.cube_depth.as_mut(), self.mode) {
+            for (k, &view) in io.views.shadow_cubes.iter().enumerate() {
                 render_cube_faces(rec, cubes, depth, k as u32, view, mode, clear, |cmd, v| {
                     f.bind(ctx, cmd, self.cube_pipeline);
                     for d in &f.scene.draws {
@@ -102,8 +108,8 @@ impl ShadowMaps {
                 });
             }
         }
-        if let (Some(planes), Some(depth)) = (self.planes.as_ref(), self.plane_depth.as_mut()) {
-            for (j, &view) in plane_views.iter().enumerate() {
+        if let (Some(planes), Some(depth)) = (maps.shadow_planes.as_ref(), self.plane_depth.as_mut()) {
+            for (j, &view) in io.views.shadow_planes.iter().enumerate() {
                 rec.barrier(depth, Access::DepthAttachment);
                 let colors = [planes.layer_view(j as u32)];
                 let t = Target {
@@ -127,13 +133,8 @@ impl ShadowMaps {
         rec.end(open);
     }
 
-    /// Declares the maps as read by a later pass's fragment shaders.
-    pub fn sampled(&self) -> impl Iterator<Item = &Image> {
-        self.cubes.iter().chain(self.planes.iter())
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        for img in [&mut self.cubes, &mut self.cube_depth, &mut self.planes, &mut self.plane_depth].into_iter().flatten() {
+    fn destroy(&mut self, ctx: &Context) {
+        for img in [&mut self.cube_depth, &mut self.plane_depth].into_iter().flatten() {
             img.destroy(ctx);
         }
         destroy_pipelines(ctx, &mut [self.cube_pipeline, self.plane_pipeline]);
@@ -144,6 +145,6 @@ impl ShadowMaps {
 
 impl Owner for ShadowMaps {
     fn destroy(&mut self, ctx: &Context) {
-        ShadowMaps::destroy(self, ctx)
+        Stage::destroy(self, ctx)
     }
 }

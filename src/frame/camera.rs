@@ -1,0 +1,78 @@
+//! The camera pass of a specular method: its objects drawn over `scene.direct`'s colour and
+//! depth with the method's shaders (`registry::CameraPass`: `envmap.shade` §3.1,
+//! `proxy.shade` §3.2, `distance.search` §4.2, `refractor.search` §4.4,
+//! `image_space.refract` §4.4 …). One struct serves every method; the plan says which.
+
+use ash::vk;
+
+use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
+use crate::frame::stage::{FrameIo, Stage};
+use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs};
+use crate::plan::CameraPlan;
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::{Access, Context, Recorder};
+use crate::Result;
+
+pub struct CameraShade {
+    name: &'static str,
+    pipeline: vk::Pipeline,
+    /// (mesh, push flags), the draws of this pass.
+    objects: Vec<(usize, u32)>,
+}
+
+impl CameraShade {
+    pub fn new(ctx: &Context, layout: vk::PipelineLayout, plan: &CameraPlan) -> Result<CameraShade> {
+        let pipeline = graphics_pipeline(
+            ctx,
+            layout,
+            &GraphicsDesc {
+                name: plan.name,
+                vertex: plan.pass.vertex,
+                fragment: plan.pass.fragment,
+                vertex_input: VertexInput::Mesh,
+                color_formats: &[TARGET_FORMAT],
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                depth_write: true,
+                view_mask: 0,
+                cull: vk::CullModeFlags::NONE,
+            },
+        )?;
+        Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone() })
+    }
+}
+
+impl Stage for CameraShade {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    /// Draws this pass's objects from the camera, sampling every map the frame holds
+    /// (those the last cycle wrote).
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let reads = io.maps.camera_reads();
+        let mut pass = rec.pass(self.name).writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
+        for img in reads {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, false);
+        f.bind(ctx, cmd, self.pipeline);
+        if let Some(&set) = io.sets.camera.get(io.maps.distance_latest) {
+            f.bind_maps(ctx, cmd, set);
+        }
+        for d in f.scene.draws.iter() {
+            let Some(&(_, flags)) = self.objects.iter().find(|(m, _)| *m == d.mesh as usize) else { continue };
+            f.push_flags(ctx, cmd, io.views.camera, d.mesh, f.flags | flags);
+            unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+        }
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        rec.end(open);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        destroy_pipelines(ctx, &mut [self.pipeline]);
+        self.pipeline = vk::Pipeline::null();
+    }
+}

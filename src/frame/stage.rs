@@ -1,0 +1,200 @@
+//! What the renderer runs: a plan's stages, each one profiled pass with its own resources.
+//! The renderer creates the stages the plan lists, records them in order and frees them; it
+//! knows the frame's shared map slots (the descriptor bindings every shader sees) but no
+//! method.
+
+use ash::vk;
+
+use crate::frame::FrameInputs;
+use crate::gpu_scene::GpuScene;
+use crate::plan::Plan;
+use crate::quality::Quality;
+use crate::scene::Scene;
+use crate::vk::{Buffer, Context, Image, Recorder};
+use crate::Result;
+
+/// Positions of the frame's passes: a plan's stages are recorded in this order.
+pub mod order {
+    pub const UPLOAD: u32 = 0;
+    pub const SHADOWS: u32 = 10;
+    /// Maps that depend on geometry alone (refractor maps): before the radiance maps, whose
+    /// generation may search them.
+    pub const GEOMETRY_MAPS: u32 = 15;
+    pub const ENVIRONMENT_MAPS: u32 = 20;
+    pub const DIRECT: u32 = 30;
+    /// Camera-space maps (image-space refraction's back faces).
+    pub const CAMERA_MAPS: u32 = 40;
+    pub const CAMERA: u32 = 50;
+}
+
+/// One recorded pass with its resources (`new` creates everything, `destroy` frees it).
+pub trait Stage {
+    /// The stable profiler key.
+    fn name(&self) -> &'static str;
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo);
+    /// Frees everything; the GPU must be idle with respect to the renderer's frames.
+    fn destroy(&mut self, ctx: &Context);
+}
+
+/// The frame's shared maps, one per descriptor slot (glsl/common/scene.glsl). A map stage
+/// creates the images of its slot; the camera passes and later map stages sample them; the
+/// renderer writes the descriptors and frees the images.
+#[derive(Default)]
+pub struct Maps {
+    /// Set 0, binding 6: shadow distance cubes of point and spot lights.
+    pub shadow_cubes: Option<Image>,
+    /// Set 0, binding 7: planar shadow distance maps of directional lights.
+    pub shadow_planes: Option<Image>,
+    /// Set 0, binding 8: radiance cube maps (§3), one cube per object.
+    pub radiance: Option<Image>,
+    /// Set 1, binding 0: distance cube maps (§4), one cube per object; two images
+    /// (ping-pong) for inter-object cycles.
+    pub distance: Vec<Image>,
+    /// Which distance image the last cycle wrote: the one the camera passes read.
+    pub distance_latest: usize,
+    /// Set 1, binding 1: refractor maps (§4.4).
+    pub refractor: Option<Image>,
+    /// Set 1, binding 2: camera-space back faces (image-space refraction, §4.4).
+    pub backfaces: Option<Image>,
+    /// Set 1, binding 3: per-vertex thickness of image-space refraction.
+    pub thickness: Option<Buffer>,
+}
+
+impl Maps {
+    /// Every map image the camera passes sample: the current one of each slot.
+    pub fn camera_reads(&self) -> Vec<&Image> {
+        let mut v: Vec<&Image> = Vec::new();
+        v.extend(self.radiance.iter());
+        v.extend(self.distance.get(self.distance_latest));
+        v.extend(self.refractor.iter());
+        v.extend(self.backfaces.iter());
+        v
+    }
+
+    pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
+        self.shadow_cubes.iter().chain(self.shadow_planes.iter())
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        for i in self.shadow_cubes.iter_mut().chain(self.shadow_planes.iter_mut()).chain(self.radiance.iter_mut()) {
+            i.destroy(ctx);
+        }
+        for i in self.distance.iter_mut().chain(self.refractor.iter_mut()).chain(self.backfaces.iter_mut()) {
+            i.destroy(ctx);
+        }
+        for b in self.thickness.iter_mut() {
+            b.destroy(ctx);
+        }
+        *self = Maps::default();
+    }
+}
+
+/// Set-1 descriptor sets over the maps: `generate[i]` for map generation reading distance
+/// image `i` (no camera-space maps), `camera[i]` for the camera passes, `empty` all null.
+#[derive(Default)]
+pub struct MapSets {
+    pub generate: Vec<vk::DescriptorSet>,
+    pub camera: Vec<vk::DescriptorSet>,
+    pub empty: vk::DescriptorSet,
+}
+
+/// Indices into the frame's view table.
+#[derive(Clone, Debug, Default)]
+pub struct ViewLayout {
+    pub camera: u32,
+    pub shadow_cubes: Vec<u32>,
+    pub shadow_planes: Vec<u32>,
+    /// First of the six views of `plan.envmaps[i]` (its reference point).
+    pub envmaps: Vec<u32>,
+    pub count: u32,
+}
+
+impl ViewLayout {
+    /// The first cube view of mesh `mesh`'s reference point, if it has cube maps.
+    pub fn cube_of(&self, plan: &Plan, mesh: usize) -> Option<u32> {
+        plan.envmaps.iter().position(|e| e.mesh == mesh).map(|i| self.envmaps[i])
+    }
+}
+
+/// What a stage reads and writes while it records, besides the frame inputs.
+pub struct FrameIo<'a> {
+    pub plan: &'a Plan,
+    pub views: &'a ViewLayout,
+    pub target: &'a mut Image,
+    pub depth: &'a mut Image,
+    pub maps: &'a mut Maps,
+    pub sets: &'a MapSets,
+    /// Images every pass that shades diffuse surfaces samples (textures, environment).
+    pub scene_images: Vec<&'a Image>,
+}
+
+/// What a stage's constructor may look at.
+pub struct StageInit<'a> {
+    pub ctx: &'a Context,
+    pub scene: &'a Scene,
+    pub gpu: &'a GpuScene,
+    pub plan: &'a Plan,
+    pub layout: vk::PipelineLayout,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A map kind some method needs for its objects (the radiance cubes of §3, the distance
+/// cubes of §4, refractor maps, back faces …): one pass for all the objects that need it,
+/// declared once in its family's folder.
+#[derive(Clone, Copy)]
+pub struct MapInfo {
+    /// The pass name (stable profiler key), e.g. `distance.generate`.
+    pub name: &'static str,
+    pub order: u32,
+    /// Whether the map is a cube around each object's reference point (it then needs the
+    /// object's six views).
+    pub cube: bool,
+    /// Which field of the object's GPU record holds its layer in this map's array.
+    pub layer_field: Option<LayerField>,
+    /// Creates the pass for `objects` (mesh indices, layer = position) and its images in
+    /// `maps`.
+    pub create: fn(&StageInit, &[usize], &mut Maps) -> Result<Box<dyn Stage>>,
+    /// Device memory of its images for `objects` objects at a `width`×`height` camera.
+    pub bytes: fn(&Plan, u32, (u32, u32)) -> u64,
+    /// What one object's map is, for `specula plan` (e.g. "cube 6×256² RGBA16F").
+    pub describe: fn(&Quality, (u32, u32)) -> String,
+}
+
+impl std::fmt::Debug for MapInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+impl PartialEq for MapInfo {
+    fn eq(&self, o: &MapInfo) -> bool {
+        self.name == o.name
+    }
+}
+
+/// The fields of `Object` (glsl/common/scene.glsl) that index map arrays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayerField {
+    /// `envmap_layer`: the radiance (set 0, binding 8) or distance (set 1, binding 0) cubes.
+    Envmap,
+    /// `refractor_layer`: the refractor maps (set 1, binding 1).
+    Refractor,
+}
+
+/// Bytes per texel of the cube maps at a precision.
+pub fn cube_texel_bytes(q: &Quality) -> u64 {
+    match q.cube_precision {
+        crate::quality::Precision::Half => 8,
+        crate::quality::Precision::Single => 16,
+    }
+}
+
+/// "cube 6×256² RGBA16F"
+pub fn describe_cube(q: &Quality) -> String {
+    let f = match q.cube_precision {
+        crate::quality::Precision::Half => "RGBA16F",
+        crate::quality::Precision::Single => "RGBA32F",
+    };
+    format!("cube 6×{}² {f}", q.cube_size)
+}

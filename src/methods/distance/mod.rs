@@ -1,0 +1,235 @@
+//! Ray tracing in the sampled geometry (survey §4.1–§4.4): distance maps (radiance and the
+//! Euclidean distance from the reference point) searched by the reflected and refracted
+//! rays; inter-object cycles (§4.3); self refraction through refractor maps (§4.4) and
+//! Wyman's image-space double refraction (§4.4).
+
+pub mod image_space;
+pub mod refractor;
+
+use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
+use crate::methods::envmap::generate::{CubeMaps, MapKind};
+use crate::methods::registry::{CameraPass, GpuSpec, MapShading, Method, MethodInfo, ObjectClass, Verdict};
+use crate::methods::EVERY_CLASS;
+use crate::plan::facts::ObjectFacts;
+use crate::plan::Plan;
+use crate::quality::Quality;
+use crate::Result;
+
+/// `distance.generate`: the distance cube maps (two images, ping-pong, for inter-object
+/// cycles).
+pub const DISTANCE_CUBES: MapInfo = MapInfo {
+    name: "distance.generate",
+    order: order::ENVIRONMENT_MAPS,
+    cube: true,
+    layer_field: Some(LayerField::Envmap),
+    create: create_distance,
+    bytes: distance_bytes,
+    describe: |q, _| describe_cube(q),
+};
+
+fn create_distance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Distance)?))
+}
+
+/// Images the distance maps need: two for cycles that read the previous cycle's maps.
+pub fn distance_images(p: &Plan) -> u64 {
+    if p.inter_object && (p.cycles > 1 || p.frame_latency) {
+        2
+    } else {
+        1
+    }
+}
+
+fn distance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {
+    let s = p.quality.cube_size as u64;
+    6 * s * s * cube_texel_bytes(&p.quality) * objects as u64 * distance_images(p)
+}
+
+/// `refractor.generate`: each solid refractor's own normal + distance cube map.
+pub const REFRACTOR_CUBES: MapInfo = MapInfo {
+    name: "refractor.generate",
+    order: order::GEOMETRY_MAPS,
+    cube: true,
+    layer_field: Some(LayerField::Refractor),
+    create: refractor::create,
+    bytes: |p, n, _| {
+        let s = p.quality.cube_size as u64;
+        6 * s * s * cube_texel_bytes(&p.quality) * n as u64
+    },
+    describe: |q, _| describe_cube(q) + " (normal, distance)",
+};
+
+/// `image_space.backfaces`: the refractors' back faces from the camera.
+pub const BACKFACES: MapInfo = MapInfo {
+    name: "image_space.backfaces",
+    order: order::CAMERA_MAPS,
+    cube: false,
+    layer_field: None,
+    create: image_space::create,
+    bytes: |_, _, (w, h)| w as u64 * h as u64 * 16,
+    describe: |_, _| "camera-sized RGBA32F back-face normals and depths + per-vertex thickness".into(),
+};
+
+const SEARCH_KNOBS: &[&str] = &[
+    "cube_size",
+    "cube_precision",
+    "cube_mode",
+    "fresnel",
+    "ref_point",
+    "linear_steps",
+    "secant_steps",
+    "binary_steps",
+    "parallax_iterations",
+    "search_tolerance",
+];
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+const SEARCH: CameraPass =
+    CameraPass { name: "distance.search", vertex: "scene/mesh.vert", fragment: "distance/search.frag", flags: 0, order: order::CAMERA };
+
+const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
+
+pub const DISTANCE: Method = Method(&MethodInfo {
+    name: "distance",
+    abi: 3,
+    section: "§4.1, §4.2",
+    family: "distance",
+    summary: "distance maps (radiance + Euclidean distance from the reference point); reflected and refracted rays traced in them by linear search on the projected segment, secant and binary refinement, or parallax correction (eq. 4, 5)",
+    serves: EVERY_CLASS,
+    knobs: SEARCH_KNOBS,
+    gpu: Some(GpuSpec { maps: &[DISTANCE_CUBES], camera: SEARCH, map_shading: MapShading::Sky, cycles: one }),
+    fallback: None,
+    rule: distance_rule,
+});
+
+fn distance_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
+    let fraction = f.visible_fraction;
+    let convex = if fraction < 0.98 {
+        format!("; only {:.0} % of it is visible from its reference point (a single layer misses the rest)", 100.0 * fraction)
+    } else {
+        String::new()
+    };
+    match f.class {
+        ObjectClass::SolidDielectric => {
+            Some(Verdict { score: 1.5, reason: "distance map: refracts once at the entry surface only".into() })
+        }
+        _ if q.planner.speed() => {
+            Some(Verdict { score: 3.0, reason: format!("{}: distance map, one search per ray (planner=speed){convex}", f.class.label()) })
+        }
+        _ if !f.sees_specular.is_empty() => Some(Verdict {
+            score: 2.0,
+            reason: format!("{}: distance map; other specular objects in view want inter-object cycles{convex}", f.class.label()),
+        }),
+        _ => Some(Verdict {
+            score: 3.0,
+            reason: format!("{}: distance map, the ray traced in the sampled geometry (§4.1){convex}", f.class.label()),
+        }),
+    }
+}
+
+pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
+    name: "distance-multi",
+    abi: 4,
+    section: "§4.3",
+    family: "distance",
+    summary: "inter-object reflections and refractions: each object's distance map regenerated in `cycles` cycles, specular objects in maps searching their own previous-cycle maps; `frame_latency=on` does one cycle per frame instead",
+    serves: EVERY_CLASS,
+    knobs: &[
+        "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "parallax_iterations", "search_tolerance", "cycles", "frame_latency",
+    ],
+    gpu: Some(GpuSpec {
+        maps: &[DISTANCE_CUBES],
+        camera: SEARCH,
+        map_shading: MapShading::Traced,
+        cycles: |q| if q.frame_latency { 1 } else { q.cycles },
+    }),
+    fallback: None,
+    rule: multi_rule,
+});
+
+fn multi_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
+    if f.class == ObjectClass::SolidDielectric || f.sees_specular.is_empty() || q.planner.speed() {
+        return None;
+    }
+    Some(Verdict {
+        score: 4.0,
+        reason: format!(
+            "{} that sees {} other specular object(s): distance maps in inter-object cycles (§4.3)",
+            f.class.label(),
+            f.sees_specular.len()
+        ),
+    })
+}
+
+pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
+    name: "refractor-map",
+    abi: 5,
+    section: "§4.4",
+    family: "distance",
+    summary: "self refraction: each solid refractor's own normal + distance cube map, the refracted ray searched inside it, refracted out (Snell) or internally reflected up to `internal_bounces` times, then traced in the environment's distance map",
+    serves: SOLIDS,
+    knobs: &[
+        "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "parallax_iterations", "search_tolerance", "internal_bounces",
+    ],
+    gpu: Some(GpuSpec {
+        maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1 },
+        map_shading: MapShading::Refractor,
+        cycles: one,
+    }),
+    fallback: Some(DISTANCE),
+    rule: refractor_rule,
+});
+
+fn refractor_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
+    let convex = f.visible_fraction >= 0.98 && f.watertight;
+    let score = if q.planner.speed() {
+        2.0
+    } else if convex {
+        4.0
+    } else {
+        2.5
+    };
+    let why = if convex {
+        "solid convex dielectric: self refraction in its refractor map, with total internal reflection (§4.4)".to_string()
+    } else {
+        format!(
+            "solid dielectric, {} and {:.0} % visible from its reference point: the refractor map sees only part of it, but it is the best self-refraction method available",
+            if f.watertight { "closed" } else { "open" },
+            100.0 * f.visible_fraction
+        )
+    };
+    Some(Verdict { score, reason: why })
+}
+
+pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
+    name: "image-space-refraction",
+    abi: 6,
+    section: "§4.4",
+    family: "distance",
+    summary: "Wyman's two-pass double refraction: back-face normals and depths from the camera, per-vertex thickness along the inverted normal, the exit ray traced in the distance map",
+    serves: SOLIDS,
+    knobs: SEARCH_KNOBS,
+    gpu: Some(GpuSpec {
+        maps: &[DISTANCE_CUBES, BACKFACES],
+        camera: CameraPass {
+            name: "image_space.refract",
+            vertex: "distance/image_space/refract.vert",
+            fragment: "distance/image_space/refract.frag",
+            flags: 0,
+            order: order::CAMERA + 2,
+        },
+        map_shading: MapShading::Sky,
+        cycles: one,
+    }),
+    fallback: Some(DISTANCE),
+    rule: |_, q| {
+        Some(Verdict {
+            score: if q.planner.speed() { 3.0 } else { 2.0 },
+            reason: "solid dielectric: image-space double refraction, two interfaces from one extra camera pass (§4.4)".into(),
+        })
+    },
+});

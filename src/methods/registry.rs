@@ -1,0 +1,262 @@
+//! The method registry. Every method is described once, in its family's folder, by one
+//! `MethodInfo`: its CLI name, its stable C ABI number, its survey section, the objects it
+//! can serve, the knobs it reads, how it plans (the maps it needs, its camera pass, its
+//! map cycles) and its rule for `--method auto`. Everything that lists methods — the CLI,
+//! `specula knobs`, the C header's `SPECULA_METHOD_*`, the README tables, `tradeoff`, the
+//! demo — reads `methods::ALL`.
+
+use crate::error::{Error, Result};
+use crate::frame::stage::MapInfo;
+use crate::plan::facts::ObjectFacts;
+use crate::quality::Quality;
+use crate::scene::SurfaceKind;
+
+/// What kind of specular object a method can serve (survey §1.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ObjectClass {
+    /// Ideal mirror (conductor or dielectric reflectance, no transmission).
+    Mirror,
+    /// Thin-walled dielectric: reflection plus undeviated transmission.
+    ThinDielectric,
+    /// Solid dielectric: refraction in and out, possibly total internal reflection.
+    SolidDielectric,
+}
+
+impl ObjectClass {
+    pub fn of(kind: &SurfaceKind) -> Option<ObjectClass> {
+        match kind {
+            SurfaceKind::Diffuse => None,
+            SurfaceKind::Mirror { .. } => Some(ObjectClass::Mirror),
+            SurfaceKind::Dielectric { thin: true, .. } => Some(ObjectClass::ThinDielectric),
+            SurfaceKind::Dielectric { thin: false, .. } => Some(ObjectClass::SolidDielectric),
+        }
+    }
+
+    pub fn label(self) -> &'static str {
+        match self {
+            ObjectClass::Mirror => "mirror",
+            ObjectClass::ThinDielectric => "thin dielectric",
+            ObjectClass::SolidDielectric => "solid dielectric",
+        }
+    }
+}
+
+/// How a specular object appears in the other objects' distance maps (survey §4.3): what
+/// the map-generation shader does when it draws it (`map_shading` in `Object`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum MapShading {
+    /// Reflects and refracts the environment map only (one bounce).
+    Sky,
+    /// Traced in its own distance map of the previous cycle (inter-object cycles).
+    Traced,
+    /// Self refraction in its own refractor map, then its own distance map of the previous
+    /// cycle (§4.4 composed with §4.3).
+    Refractor,
+}
+
+impl MapShading {
+    /// The code the shaders read (`MAP_SHADING_*` in glsl/common/scene.glsl).
+    pub fn code(self) -> u32 {
+        match self {
+            MapShading::Sky => 0,
+            MapShading::Traced => 1,
+            MapShading::Refractor => 2,
+        }
+    }
+}
+
+/// A method's camera pass: its objects drawn over `scene.direct`'s colour and depth with
+/// its shaders. Methods that name the same pass share it (and must name the same shaders).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraPass {
+    /// Stable profiler key, e.g. `distance.search`.
+    pub name: &'static str,
+    pub vertex: &'static str,
+    pub fragment: &'static str,
+    /// Push-constant flags of this method's draws (e.g. `FLAG_PROXY_BOX`).
+    pub flags: u32,
+    /// Position among the frame's passes (`frame::stage::order`).
+    pub order: u32,
+}
+
+/// What the planner's rule says about one object: a score (higher wins) and why.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Verdict {
+    pub score: f32,
+    pub reason: String,
+}
+
+pub type Rule = fn(&ObjectFacts, &Quality) -> Option<Verdict>;
+
+/// How a GPU method plans an object.
+#[derive(Clone, Copy)]
+pub struct GpuSpec {
+    /// The maps the object needs, in the order they are generated; each map kind is one
+    /// pass for all the objects that need it.
+    pub maps: &'static [MapInfo],
+    pub camera: CameraPass,
+    /// How the object looks in the other objects' distance maps.
+    pub map_shading: MapShading,
+    /// Distance-map cycles per frame this method asks for (§4.3).
+    pub cycles: fn(&Quality) -> u32,
+}
+
+/// One method, described once.
+pub struct MethodInfo {
+    /// The CLI's `--method` value and the C ABI's name, a stable interface.
+    pub name: &'static str,
+    /// `SPECULA_METHOD_<NAME>` in the C header, a stable interface.
+    pub abi: u32,
+    /// Survey section(s).
+    pub section: &'static str,
+    /// `src/methods/<family>/` and `glsl/<family>/`.
+    pub family: &'static str,
+    /// One sentence for the README's method table and `specula knobs`.
+    pub summary: &'static str,
+    pub serves: &'static [ObjectClass],
+    /// Knob names (`quality::KNOBS`) this method reads.
+    pub knobs: &'static [&'static str],
+    /// `None`: a CPU method (the reference).
+    pub gpu: Option<GpuSpec>,
+    /// For objects it cannot serve when it is asked for the whole scene (`--method`): the
+    /// method those objects get instead (e.g. refractor-map leaves mirrors to distance).
+    pub fallback: Option<Method>,
+    /// The planner's rule: when this method is the right choice for an object, and why.
+    pub rule: Rule,
+}
+
+/// A handle to a registered method: copyable, compared by name.
+#[derive(Clone, Copy)]
+pub struct Method(pub &'static MethodInfo);
+
+impl PartialEq for Method {
+    fn eq(&self, o: &Method) -> bool {
+        self.0.name == o.0.name
+    }
+}
+impl Eq for Method {}
+
+impl std::fmt::Debug for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0.name)
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.0.name)
+    }
+}
+
+impl serde::Serialize for Method {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.0.name)
+    }
+}
+
+impl std::ops::Deref for Method {
+    type Target = MethodInfo;
+    fn deref(&self) -> &MethodInfo {
+        self.0
+    }
+}
+
+impl Method {
+    /// Every registered method, GPU methods first (`methods::ALL`).
+    pub const ALL: &'static [Method] = crate::methods::ALL;
+
+    pub fn name(self) -> &'static str {
+        self.0.name
+    }
+
+    /// Whether the method renders on the GPU (through `Renderer`); the reference renders
+    /// on the CPU (`reference::render_reference`).
+    pub fn is_gpu(self) -> bool {
+        self.0.gpu.is_some()
+    }
+
+    pub fn can_serve(self, class: ObjectClass) -> bool {
+        self.0.serves.contains(&class)
+    }
+
+    pub fn parse(s: &str) -> Result<Method> {
+        Method::ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
+            Error::invalid("method", format!("unknown method '{}' (known: auto, {})", crate::error::clip(s), names.join(", ")))
+        })
+    }
+
+    pub fn by_abi(n: u32) -> Option<Method> {
+        Method::ALL.iter().copied().find(|m| m.abi == n)
+    }
+}
+
+/// The C ABI number of `--method auto` (`SPECULA_METHOD_AUTO`).
+pub const ABI_AUTO: u32 = 100;
+
+/// A whole-scene choice: one method for every specular object, or the planner.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum Choice {
+    Auto,
+    Method(Method),
+}
+
+impl Choice {
+    pub fn parse(s: &str) -> Result<Choice> {
+        if s == "auto" {
+            Ok(Choice::Auto)
+        } else {
+            Method::parse(s).map(Choice::Method)
+        }
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            Choice::Auto => "auto",
+            Choice::Method(m) => m.name(),
+        }
+    }
+}
+
+impl From<Method> for Choice {
+    fn from(m: Method) -> Choice {
+        Choice::Method(m)
+    }
+}
+
+/// Checks the registry: names and numbers unique, every knob a method reads exists, every
+/// fallback serves what the method does not, methods sharing a camera pass share its
+/// shaders. `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
+pub fn check(all: &[Method]) -> std::result::Result<(), String> {
+    for (i, a) in all.iter().enumerate() {
+        for b in &all[i + 1..] {
+            if a.name == b.name {
+                return Err(format!("two methods are named '{}'", a.name));
+            }
+            if a.abi == b.abi {
+                return Err(format!("'{}' and '{}' share C ABI number {}", a.name, b.name, a.abi));
+            }
+            if let (Some(ga), Some(gb)) = (a.gpu, b.gpu) {
+                let (ca, cb) = (ga.camera, gb.camera);
+                if ca.name == cb.name && (ca.vertex != cb.vertex || ca.fragment != cb.fragment) {
+                    return Err(format!("'{}' and '{}' share pass {} with different shaders", a.name, b.name, ca.name));
+                }
+            }
+        }
+        if a.abi == ABI_AUTO || a.name == "auto" {
+            return Err(format!("'{}' claims the name or number of auto", a.name));
+        }
+        for k in a.knobs {
+            if !crate::quality::KNOBS.iter().any(|n| n.name == *k) {
+                return Err(format!("'{}' reads unknown knob '{k}'", a.name));
+            }
+        }
+        if let Some(f) = a.fallback {
+            if !f.is_gpu() || a.is_gpu() != f.is_gpu() {
+                return Err(format!("'{}' falls back to '{}' of another kind", a.name, f.name));
+            }
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,370 @@
+//! Geometry facts the planner decides from, computed once per mesh and cached: planarity,
+//! watertightness, convexity from the reference point (the area fraction of the surface
+//! visible from it), whether other specular objects are visible from it, and whether the
+//! automatic reference point lies inside or too close to another object (a reference
+//! point inside another object sees nothing but that object: it is moved).
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
+use glam::{DVec3, Vec3};
+
+use crate::methods::registry::ObjectClass;
+use crate::optics::ray_triangle;
+use crate::quality::Quality;
+use crate::reference::bvh::Bvh;
+use crate::scene::{Mesh, Scene};
+
+/// Facts of one specular object in its scene.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ObjectFacts {
+    pub mesh: usize,
+    pub class: ObjectClass,
+    /// All vertices within 1e-4 of the object's size of one plane, normals agreeing.
+    pub planar: bool,
+    /// Every edge shared by exactly two triangles (positions welded).
+    pub watertight: bool,
+    /// Area fraction of the surface visible from the reference point (1: convex from it,
+    /// as a single-layer map needs). Computed for `auto` only, else 1.
+    pub visible_fraction: f32,
+    /// Other specular objects visible from the reference point (mesh indices).
+    pub sees_specular: Vec<usize>,
+    pub reference_point: Vec3,
+    pub reference_note: Option<String>,
+    pub triangles: usize,
+}
+
+/// The facts of every specular object of a scene.
+pub struct SceneFacts {
+    pub objects: Vec<ObjectFacts>,
+}
+
+/// What depends on the mesh alone.
+#[derive(Clone, Debug)]
+struct MeshFacts {
+    planar: bool,
+    watertight: bool,
+}
+
+static CACHE: Mutex<Option<HashMap<u64, Arc<MeshFacts>>>> = Mutex::new(None);
+
+fn mesh_hash(m: &Mesh) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u32| {
+        for b in x.to_le_bytes() {
+            h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for p in &m.positions {
+        eat(p.x.to_bits());
+        eat(p.y.to_bits());
+        eat(p.z.to_bits());
+    }
+    for n in &m.normals {
+        eat(n.x.to_bits() ^ n.y.to_bits().rotate_left(11) ^ n.z.to_bits().rotate_left(22));
+    }
+    for &i in &m.indices {
+        eat(i);
+    }
+    h
+}
+
+fn mesh_facts(m: &Mesh) -> Arc<MeshFacts> {
+    let key = mesh_hash(m);
+    if let Some(f) = CACHE.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).cloned())) {
+        return f;
+    }
+    let f = Arc::new(MeshFacts { planar: is_planar(m), watertight: is_watertight(m) });
+    if let Ok(mut c) = CACHE.lock() {
+        let map = c.get_or_insert_with(HashMap::new);
+        if map.len() > 1024 {
+            map.clear();
+        }
+        map.insert(key, f.clone());
+    }
+    f
+}
+
+/// All vertices within 1e-4 · diagonal of the area-weighted plane, and every vertex normal
+/// within ~2.5° of its normal.
+pub fn is_planar(m: &Mesh) -> bool {
+    let diag = m.bounds().diagonal() as f64;
+    if m.indices.len() < 3 || diag <= 0.0 {
+        return false;
+    }
+    let p = |i: u32| m.positions[i as usize].as_dvec3();
+    let mut n = DVec3::ZERO;
+    for t in m.indices.chunks_exact(3) {
+        n += (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+    }
+    let Some(n) = n.try_normalize() else { return false };
+    let o = m.positions[0].as_dvec3();
+    let flat = m.positions.iter().all(|v| (v.as_dvec3() - o).dot(n).abs() <= 1e-4 * diag);
+    let normals = m.normals.iter().all(|v| v.as_dvec3().normalize_or_zero().dot(n).abs() >= 0.999);
+    flat && normals
+}
+
+/// Every edge (positions welded at 1e-6 of the size) shared by exactly two triangles.
+pub fn is_watertight(m: &Mesh) -> bool {
+    if m.indices.len() < 12 {
+        return false;
+    }
+    let scale = 1e-6 * m.bounds().diagonal().max(1e-30);
+    let key = |v: Vec3| ((v.x / scale).round() as i64, (v.y / scale).round() as i64, (v.z / scale).round() as i64);
+    let mut ids: HashMap<(i64, i64, i64), u32> = HashMap::new();
+    let weld: Vec<u32> = m
+        .positions
+        .iter()
+        .map(|&v| {
+            let n = ids.len() as u32;
+            *ids.entry(key(v)).or_insert(n)
+        })
+        .collect();
+    let mut edges: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in m.indices.chunks_exact(3) {
+        let w = [weld[t[0] as usize], weld[t[1] as usize], weld[t[2] as usize]];
+        if w[0] == w[1] || w[1] == w[2] || w[0] == w[2] {
+            continue; // degenerate: no edge
+        }
+        for k in 0..3 {
+            let (a, b) = (w[k], w[(k + 1) % 3]);
+            *edges.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    !edges.is_empty() && edges.values().all(|&c| c == 2)
+}
+
+/// Crossings of the ray o + t d (t > 0) with mesh `m`'s triangles: odd = inside.
+fn crossings(m: &Mesh, o: DVec3, d: DVec3) -> usize {
+    let p = |i: u32| m.positions[i as usize].as_dvec3();
+    m.indices.chunks_exact(3).filter(|t| ray_triangle(o, d, p(t[0]), p(t[1]), p(t[2]), 0.0, f64::INFINITY).is_some()).count()
+}
+
+/// Distance from point x to triangle (a, b, c) (Ericson's closest point).
+fn point_triangle_distance(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (ab, ac, ap) = (b - a, c - a, x - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return x.distance(a);
+    }
+    let bp = x - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return x.distance(b);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return x.distance(a + ab * (d1 / (d1 - d3)));
+    }
+    let cp = x - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return x.distance(c);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return x.distance(a + ac * (d2 / (d2 - d6)));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return x.distance(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    x.distance(a + ab * (vb * denom) + ac * (vc * denom))
+}
+
+fn distance_to_mesh(m: &Mesh, x: DVec3) -> f64 {
+    let p = |i: u32| m.positions[i as usize].as_dvec3();
+    m.indices.chunks_exact(3).map(|t| point_triangle_distance(x, p(t[0]), p(t[1]), p(t[2]))).fold(f64::INFINITY, f64::min)
+}
+
+/// Why point x cannot serve as object `own`'s reference point: it lies inside another
+/// (closed) object, or closer to another object's surface than `clearance`.
+fn blocked(scene: &Scene, own: usize, x: Vec3, clearance: f64) -> Option<String> {
+    let xd = x.as_dvec3();
+    for (i, m) in scene.meshes.iter().enumerate() {
+        if i == own || m.indices.is_empty() {
+            continue;
+        }
+        let b = m.bounds();
+        let margin = Vec3::splat(clearance as f32);
+        if x.cmplt(b.min - margin).any() || x.cmpgt(b.max + margin).any() {
+            continue;
+        }
+        // Parity along three skewed directions, majority vote (robust to a ray grazing an edge).
+        let dirs = [DVec3::new(1.0, 0.123, 0.057), DVec3::new(-0.071, 1.0, 0.193), DVec3::new(0.137, -0.089, -1.0)];
+        let inside = dirs.iter().filter(|d| crossings(m, xd, d.normalize()) % 2 == 1).count() >= 2;
+        if inside && mesh_facts(m).watertight {
+            return Some(format!("inside '{}'", m.name));
+        }
+        let d = distance_to_mesh(m, xd);
+        if d < clearance {
+            return Some(format!("{d:.3e} m from '{}'", m.name));
+        }
+    }
+    None
+}
+
+/// The automatic reference point of object `mesh`: its box centre, or, when that lies
+/// inside or next to another object, the first of its area centroid and eight points
+/// around the centre that is clear; with the reason.
+fn reference_point(scene: &Scene, mesh: usize) -> (Vec3, Option<String>) {
+    let m = &scene.meshes[mesh];
+    let b = m.bounds();
+    let centre = b.center();
+    let clearance = 1e-3 * b.diagonal().max(1e-30) as f64;
+    let Some(why) = blocked(scene, mesh, centre, clearance) else { return (centre, None) };
+    let half = (b.max - b.min) * 0.5;
+    let mut candidates = vec![area_centroid(m)];
+    for s in [0.25f32, 0.5] {
+        for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+            candidates.push(centre + axis * half * s);
+            candidates.push(centre - axis * half * s);
+        }
+    }
+    for c in candidates {
+        if blocked(scene, mesh, c, clearance).is_none() {
+            return (c, Some(format!("moved from the box centre ({:.3}, {:.3}, {:.3}), which lies {why}", centre.x, centre.y, centre.z)));
+        }
+    }
+    (centre, Some(format!("the box centre lies {why} and no nearby point is clear: kept (the map sees mostly that object)")))
+}
+
+fn area_centroid(m: &Mesh) -> Vec3 {
+    let p = |i: u32| m.positions[i as usize].as_dvec3();
+    let (mut sum, mut area) = (DVec3::ZERO, 0.0);
+    for t in m.indices.chunks_exact(3) {
+        let a = (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length() * 0.5;
+        sum += (p(t[0]) + p(t[1]) + p(t[2])) / 3.0 * a;
+        area += a;
+    }
+    if area > 0.0 {
+        (sum / area).as_vec3()
+    } else {
+        m.bounds().center()
+    }
+}
+
+/// Area fraction of mesh `m`'s triangles whose centroid is the first surface of the mesh
+/// along the ray from `x` (at most 4096 triangles, strided).
+fn visible_fraction(m: &Mesh, x: Vec3) -> f32 {
+    let own = Scene { meshes: vec![Mesh { material: 0, ..m.clone() }], materials: vec![Default::default()], ..Default::default() };
+    let bvh = Bvh::new(&own);
+    let n = m.triangle_count();
+    if n == 0 {
+        return 1.0;
+    }
+    let step = n.div_ceil(4096);
+    let (xd, p) = (x.as_dvec3(), |i: u32| m.positions[i as usize].as_dvec3());
+    let (mut seen, mut total) = (0.0, 0.0);
+    for k in (0..n).step_by(step) {
+        let t = &m.indices[3 * k..3 * k + 3];
+        let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
+        let area = (b - a).cross(c - a).length() * 0.5;
+        if area <= 0.0 {
+            continue;
+        }
+        let to = (a + b + c) / 3.0 - xd;
+        let dist = to.length();
+        total += area;
+        let Some(d) = to.try_normalize() else {
+            seen += area;
+            continue;
+        };
+        match bvh.intersect(xd, d, 0.0, f64::INFINITY, None) {
+            Some(h) if h.t < dist * (1.0 - 1e-4) && h.triangle as usize != k => {}
+            _ => seen += area,
+        }
+    }
+    if total > 0.0 {
+        (seen / total) as f32
+    } else {
+        1.0
+    }
+}
+
+/// Specular objects other than `mesh` that rays from `x` reach first (512 directions).
+fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> Vec<usize> {
+    let mut out = Vec::new();
+    let n = 512;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let eps = 1e-6 * scene.bounds().diagonal().max(1e-30) as f64;
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let phi = golden * i as f64;
+        let d = DVec3::new(r * phi.cos(), z, r * phi.sin());
+        let mut o = x.as_dvec3();
+        // Step through the object's own surface (the map leaves it out).
+        for _ in 0..32 {
+            let Some(h) = bvh.intersect(o, d, eps, f64::INFINITY, None) else { break };
+            let hit_mesh = bvh.triangles[h.triangle as usize].mesh as usize;
+            if hit_mesh == mesh {
+                o += d * (h.t + eps);
+                continue;
+            }
+            if scene.materials[scene.meshes[hit_mesh].material].kind.is_specular() && !out.contains(&hit_mesh) {
+                out.push(hit_mesh);
+            }
+            break;
+        }
+    }
+    out.sort_unstable();
+    out
+}
+
+impl SceneFacts {
+    /// Facts of every specular object. `deep`: also convexity and mutual visibility (ray
+    /// casting; the planner needs them, a fixed method does not).
+    pub fn new(scene: &Scene, quality: &Quality, deep: bool) -> SceneFacts {
+        let bvh = if deep && !scene.meshes.is_empty() { Some(Bvh::new(scene)) } else { None };
+        let objects = scene
+            .specular_meshes()
+            .filter_map(|(i, m)| {
+                let class = ObjectClass::of(&scene.materials[m.material].kind)?;
+                let (reference_point, reference_note) = match (quality.ref_point, m.reference_point) {
+                    (Some(p), _) => (p, Some("set by the ref_point knob".to_string())),
+                    (None, Some(p)) => (p, Some("set by the scene (extras.specula.reference_point)".to_string())),
+                    (None, None) => reference_point(scene, i),
+                };
+                let mf = mesh_facts(m);
+                let (visible, sees) = match &bvh {
+                    Some(b) => (visible_fraction(m, reference_point), visible_specular(scene, b, i, reference_point)),
+                    None => (1.0, Vec::new()),
+                };
+                Some(ObjectFacts {
+                    mesh: i,
+                    class,
+                    planar: mf.planar,
+                    watertight: mf.watertight,
+                    visible_fraction: visible,
+                    sees_specular: sees,
+                    reference_point,
+                    reference_note,
+                    triangles: m.triangle_count(),
+                })
+            })
+            .collect();
+        SceneFacts { objects }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::shapes;
+
+    #[test]
+    fn sphere_is_closed_and_convex_quad_is_planar() {
+        let s = shapes::uv_sphere("s", Vec3::ZERO, 1.0, 24, 12, 0);
+        assert!(is_watertight(&s));
+        assert!(!is_planar(&s));
+        assert!(visible_fraction(&s, Vec3::ZERO) > 0.999);
+        let q = shapes::quad("q", Vec3::ZERO, Vec3::X, Vec3::Z, 3, 0);
+        assert!(is_planar(&q));
+        assert!(!is_watertight(&q));
+        // From outside, a sphere shows about half its surface.
+        let f = visible_fraction(&s, Vec3::new(0.0, 0.0, 10.0));
+        assert!((0.3..0.6).contains(&f), "{f}");
+    }
+}

@@ -1,0 +1,494 @@
+//! Scene + choices → Plan: "model only what the scene requires". The plan holds, for each
+//! specular object, its method (chosen by the user, by the scene file or by the planner,
+//! with the reason) and that method's maps; per light a shadow map; and the frame's
+//! ordered stages, which are exactly what the renderer records. A scene without specular
+//! objects gets no map pass and no cube map; one without punctual lights no shadow map.
+
+pub mod facts;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+use crate::frame::stage::{order, MapInfo};
+pub use crate::methods::registry::{CameraPass, Choice, MapShading, Method, ObjectClass, Verdict};
+use crate::quality::{Planner, Quality};
+use crate::scene::{LightKind, Scene};
+use facts::ObjectFacts;
+
+/// One cube-mapped object's views: the six faces around its reference point.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct EnvmapPlan {
+    pub mesh: usize,
+    /// Index of the object among the plan's cube-mapped objects.
+    pub layer: u32,
+    pub reference_point: Vec3,
+}
+
+/// One map an object gets.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ObjectMap {
+    /// The pass that makes it.
+    pub pass: &'static str,
+    /// The object's layer in that pass's map array.
+    pub layer: u32,
+    #[serde(skip)]
+    pub layer_field: Option<crate::frame::stage::LayerField>,
+    pub what: String,
+    pub bytes: u64,
+}
+
+/// One specular object's plan.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ObjectPlan {
+    pub mesh: usize,
+    pub name: String,
+    pub class: ObjectClass,
+    pub method: Method,
+    /// Why this method: the user's choice, the scene file's, or the planner's rule.
+    pub reason: String,
+    pub reference_point: Vec3,
+    /// Set when the automatic reference point had to move (or could not).
+    pub reference_note: Option<String>,
+    /// How the object appears in the other objects' distance maps.
+    pub map_shading: MapShading,
+    pub maps: Vec<ObjectMap>,
+    /// The passes that draw or map this object.
+    pub passes: Vec<&'static str>,
+    /// The knobs its method reads, with their values in force.
+    pub knobs: Vec<(&'static str, String)>,
+}
+
+/// A map pass over all the objects that need that map.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MapPlan {
+    #[serde(skip)]
+    pub info: MapInfo,
+    pub name: &'static str,
+    /// Meshes, in layer order.
+    pub objects: Vec<usize>,
+    pub bytes: u64,
+}
+
+/// A camera pass over the objects of the methods that share it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CameraPlan {
+    #[serde(skip)]
+    pub pass: CameraPass,
+    pub name: &'static str,
+    /// (mesh, push flags of its method).
+    pub objects: Vec<(usize, u32)>,
+}
+
+impl PartialEq for CameraPlan {
+    fn eq(&self, o: &CameraPlan) -> bool {
+        self.name == o.name && self.objects == o.objects
+    }
+}
+
+/// One stage of the frame, in recording order.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum StageSpec {
+    /// `scene.upload`: textures and the environment map, first frame only.
+    Upload,
+    /// `shadow.generate`.
+    Shadows,
+    /// `scene.direct`.
+    Direct,
+    Map(MapPlan),
+    Camera(CameraPlan),
+}
+
+impl StageSpec {
+    pub fn name(&self) -> &'static str {
+        match self {
+            StageSpec::Upload => "scene.upload",
+            StageSpec::Shadows => "shadow.generate",
+            StageSpec::Direct => "scene.direct",
+            StageSpec::Map(m) => m.name,
+            StageSpec::Camera(c) => c.name,
+        }
+    }
+    fn order(&self) -> u32 {
+        match self {
+            StageSpec::Upload => order::UPLOAD,
+            StageSpec::Shadows => order::SHADOWS,
+            StageSpec::Direct => order::DIRECT,
+            StageSpec::Map(m) => m.info.order,
+            StageSpec::Camera(c) => c.pass.order,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Plan {
+    /// What was asked for the whole scene (`--method`).
+    pub choice: Choice,
+    pub quality: Quality,
+    /// Lights that get a cube distance map (point and spot), in cube order.
+    pub shadow_cubes: Vec<usize>,
+    /// Directional lights, each with a planar distance map, in layer order.
+    pub shadow_planes: Vec<usize>,
+    /// Every specular object, in mesh order.
+    pub objects: Vec<ObjectPlan>,
+    /// The objects with cube maps around their reference points (their views).
+    pub envmaps: Vec<EnvmapPlan>,
+    /// What the renderer records, in order.
+    pub stages: Vec<StageSpec>,
+    /// The stages' names, in order: the stable profiler keys.
+    pub passes: Vec<&'static str>,
+    /// Near plane of cube-map rendering (metres), relative to the scene's size.
+    pub cube_near: f32,
+    /// Distance-map cycles per frame (§4.3).
+    pub cycles: u32,
+    /// Whether specular objects in distance maps search their own maps of the previous
+    /// cycle (§4.3): a method asks for it, or methods are mixed and must compose.
+    pub inter_object: bool,
+    /// Inter-object cycles, one per frame, reusing the previous frame's maps.
+    pub frame_latency: bool,
+    /// Proxy geometry (§3.2): sphere radius and box, world space.
+    pub proxy_radius: f32,
+    pub proxy_box: (Vec3, Vec3),
+}
+
+impl Plan {
+    pub fn object(&self, mesh: usize) -> Option<&ObjectPlan> {
+        self.objects.iter().find(|o| o.mesh == mesh)
+    }
+
+    /// The map pass named `name`, if planned.
+    pub fn map(&self, name: &str) -> Option<&MapPlan> {
+        self.stages.iter().find_map(|s| match s {
+            StageSpec::Map(m) if m.name == name => Some(m),
+            _ => None,
+        })
+    }
+
+    /// Meshes whose method is `m`.
+    pub fn objects_with(&self, m: Method) -> Vec<usize> {
+        self.objects.iter().filter(|o| o.method == m).map(|o| o.mesh).collect()
+    }
+
+    /// Whether every object's method renders on the GPU.
+    pub fn is_gpu(&self) -> bool {
+        self.objects.iter().all(|o| o.method.is_gpu()) && !matches!(self.choice, Choice::Method(m) if !m.is_gpu())
+    }
+
+    /// Device memory the plan's maps will hold (bytes), excluding the frame's own images.
+    pub fn map_bytes(&self) -> u64 {
+        self.stages.iter().map(|s| if let StageSpec::Map(m) = s { m.bytes } else { 0 }).sum()
+    }
+}
+
+/// Per-object choices: the whole scene's method and per-object overrides by name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Choices {
+    pub method: Choice,
+    /// (glTF node or mesh name, method): overrides `method` and the scene file.
+    pub objects: Vec<(String, Method)>,
+}
+
+impl Choices {
+    pub fn all(method: impl Into<Choice>) -> Choices {
+        Choices { method: method.into(), objects: Vec::new() }
+    }
+}
+
+impl Default for Choices {
+    fn default() -> Choices {
+        Choices::all(Choice::Auto)
+    }
+}
+
+/// The pass `reference` reports: one CPU pass, no maps.
+pub const REFERENCE_PASS: &str = "reference.trace";
+
+/// The plan of one method for the whole scene (objects it cannot serve get its fallback).
+pub fn plan(scene: &Scene, method: impl Into<Choice>, quality: &Quality) -> Plan {
+    let choices = Choices::all(method);
+    // A whole-scene method cannot fail: the registry checks that every method either
+    // serves every class or falls back to one that does.
+    plan_with(scene, &choices, quality).unwrap_or_else(|e| unreachable_plan(scene, quality, e))
+}
+
+fn unreachable_plan(scene: &Scene, quality: &Quality, e: Error) -> Plan {
+    debug_assert!(false, "whole-scene plan failed: {e}");
+    plan_with(scene, &Choices::all(crate::methods::REFERENCE), quality).expect("the reference serves every object")
+}
+
+/// Which method an object gets, and why.
+fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quality) -> Result<(Method, String)> {
+    let mesh = &scene.meshes[facts.mesh];
+    let class = facts.class;
+    let check = |m: Method, source: &str| -> Result<(Method, String)> {
+        if m.can_serve(class) {
+            Ok((m, format!("{source}: {}", m.name)))
+        } else {
+            let serves: Vec<_> = m.serves.iter().map(|c| c.label()).collect();
+            Err(Error::invalid(
+                format!("object '{}'", mesh.name),
+                format!("method '{}' cannot serve a {} (it serves: {})", m.name, class.label(), serves.join(", ")),
+            ))
+        }
+    };
+    if let Some((_, m)) = choices.objects.iter().rev().find(|(n, _)| names_object(scene, facts.mesh, n)) {
+        return check(*m, "chosen for this object");
+    }
+    if let Choice::Method(m) = choices.method {
+        if m.can_serve(class) {
+            return Ok((m, format!("--method {}", m.name)));
+        }
+        if let Some(f) = m.fallback.filter(|f| f.can_serve(class)) {
+            return Ok((f, format!("--method {} does not serve a {}: its fallback {}", m.name, class.label(), f.name)));
+        }
+        return check(m, "--method");
+    }
+    if let Some(name) = &mesh.method {
+        let m = Method::parse(name).map_err(|e| Error::invalid(format!("object '{}' extras.specula.method", mesh.name), e.to_string()))?;
+        return check(m, "the scene file's extras.specula.method");
+    }
+    auto(facts, quality)
+}
+
+/// The planner: every GPU method that serves the object says how well it fits; the best
+/// score wins (registry order breaks ties).
+pub fn auto(facts: &ObjectFacts, quality: &Quality) -> Result<(Method, String)> {
+    let mut best: Option<(Method, Verdict)> = None;
+    for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.can_serve(facts.class)) {
+        if let Some(v) = (m.rule)(facts, quality) {
+            if best.as_ref().is_none_or(|(_, b)| v.score > b.score) {
+                best = Some((m, v));
+            }
+        }
+    }
+    best.map(|(m, v)| (m, format!("auto: {}", v.reason)))
+        .ok_or_else(|| Error::invalid(format!("object {}", facts.mesh), format!("no method serves a {}", facts.class.label())))
+}
+
+/// Whether `name` addresses mesh `m` (its node or mesh name; meshes imported from glTF
+/// are named after their node, with the mesh name kept as an alias).
+pub fn names_object(scene: &Scene, m: usize, name: &str) -> bool {
+    let mesh = &scene.meshes[m];
+    mesh.name == name || mesh.aliases.iter().any(|a| a == name)
+}
+
+/// Checks that every per-object choice names a specular object of the scene.
+fn check_names(scene: &Scene, choices: &Choices) -> Result<()> {
+    for (name, _) in &choices.objects {
+        let specular: Vec<&str> = scene.specular_meshes().map(|(_, m)| m.name.as_str()).collect();
+        let found = scene.meshes.iter().enumerate().find(|(i, _)| names_object(scene, *i, name));
+        match found {
+            None => {
+                return Err(Error::invalid(
+                    "object",
+                    format!("no object is named '{}' (specular objects: {})", crate::error::clip(name), specular.join(", ")),
+                ))
+            }
+            Some((i, _)) if !scene.materials[scene.meshes[i].material].kind.is_specular() => {
+                return Err(Error::invalid(
+                    format!("object '{name}'"),
+                    format!(
+                        "is not specular (material '{}'): only specular objects take a method",
+                        scene.materials[scene.meshes[i].material].name
+                    ),
+                ))
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+/// The plan for per-object choices.
+pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<Plan> {
+    check_names(scene, choices)?;
+    let bounds = scene.bounds();
+    let diag = bounds.diagonal();
+    let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
+    let proxy_radius = quality.proxy_radius.unwrap_or_else(|| {
+        let half = (bounds.max - bounds.min) * 0.5;
+        if bounds.is_empty() {
+            1.0
+        } else {
+            ((half.x + half.y + half.z) / 3.0).max(1e-6)
+        }
+    });
+    let auto_needed = matches!(choices.method, Choice::Auto);
+    let scene_facts = facts::SceneFacts::new(scene, quality, auto_needed);
+    let mut objects = Vec::new();
+    for f in &scene_facts.objects {
+        let (method, reason) = choose(scene, f, choices, quality)?;
+        objects.push(ObjectPlan {
+            mesh: f.mesh,
+            name: scene.meshes[f.mesh].name.clone(),
+            class: f.class,
+            method,
+            reason,
+            reference_point: f.reference_point,
+            reference_note: f.reference_note.clone(),
+            map_shading: MapShading::Sky,
+            maps: Vec::new(),
+            passes: Vec::new(),
+            knobs: method.knobs.iter().map(|k| (*k, quality.get(k))).collect(),
+        });
+    }
+    let mut p = Plan {
+        choice: choices.method,
+        quality: quality.clone(),
+        shadow_cubes: Vec::new(),
+        shadow_planes: Vec::new(),
+        objects,
+        envmaps: Vec::new(),
+        stages: Vec::new(),
+        passes: Vec::new(),
+        cube_near,
+        cycles: 1,
+        inter_object: false,
+        frame_latency: false,
+        proxy_radius,
+        proxy_box: (bounds.min, bounds.max),
+    };
+    if !p.is_gpu() {
+        p.stages.clear();
+        p.passes = vec![REFERENCE_PASS];
+        p.cycles = 0;
+        return Ok(p);
+    }
+    // A whole-scene method keeps its own behaviour (its fallbacks do not compose); mixed
+    // choices compose through inter-object cycles.
+    let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();
+    stages(scene, &mut p, !whole_scene);
+    Ok(p)
+}
+
+/// Derives the frame's stages from the objects' methods.
+fn stages(scene: &Scene, p: &mut Plan, compose: bool) {
+    let q = p.quality.clone();
+    let has_diffuse = scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular());
+    let mut stages = Vec::new();
+    if !scene.textures.is_empty() || scene.environment.is_some() {
+        stages.push(StageSpec::Upload);
+    }
+    // Shadows matter only where a diffuse surface receives light.
+    if has_diffuse {
+        for (i, l) in scene.lights.iter().enumerate() {
+            match l.kind {
+                LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),
+                LightKind::Directional => p.shadow_planes.push(i),
+            }
+        }
+    }
+    if !(p.shadow_cubes.is_empty() && p.shadow_planes.is_empty()) {
+        stages.push(StageSpec::Shadows);
+    }
+    stages.push(StageSpec::Direct);
+
+    // Inter-object cycles (§4.3): asked for by a method, or needed so that mixed methods
+    // compose (a mirror's map shows the refractor-mapped glass refracting the room).
+    let gpu = |m: Method| m.gpu.expect("GPU plan");
+    let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
+    let mixed = methods.windows(2).any(|w| w[0] != w[1]);
+    let asks = methods.iter().any(|&m| gpu(m).map_shading == MapShading::Traced);
+    let composes = compose && mixed && methods.iter().any(|&m| gpu(m).map_shading == MapShading::Refractor);
+    p.inter_object = asks || composes;
+    p.frame_latency = asks && q.frame_latency;
+    p.cycles = methods.iter().map(|&m| (gpu(m).cycles)(&q)).max().unwrap_or(1).max(1);
+    if composes && !p.frame_latency {
+        p.cycles = p.cycles.max(2);
+    }
+    if p.frame_latency {
+        p.cycles = 1;
+    }
+
+    // Maps: one pass per map kind over the objects that need it, layers in mesh order.
+    let mut maps: Vec<MapPlan> = Vec::new();
+    let mut cameras: Vec<CameraPlan> = Vec::new();
+    for o in &mut p.objects {
+        let spec = gpu(o.method);
+        o.map_shading = if p.inter_object { spec.map_shading } else { MapShading::Sky };
+        for info in spec.maps {
+            let k = match maps.iter().position(|m| m.name == info.name) {
+                Some(k) => k,
+                None => {
+                    maps.push(MapPlan { info: *info, name: info.name, objects: Vec::new(), bytes: 0 });
+                    maps.len() - 1
+                }
+            };
+            o.maps.push(ObjectMap {
+                pass: info.name,
+                layer: maps[k].objects.len() as u32,
+                layer_field: info.layer_field,
+                what: (info.describe)(&q, (0, 0)),
+                bytes: 0,
+            });
+            maps[k].objects.push(o.mesh);
+            o.passes.push(info.name);
+        }
+        let cam = spec.camera;
+        match cameras.iter_mut().find(|c| c.name == cam.name) {
+            Some(c) => c.objects.push((o.mesh, cam.flags)),
+            None => cameras.push(CameraPlan { pass: cam, name: cam.name, objects: vec![(o.mesh, cam.flags)] }),
+        }
+        o.passes.push(cam.name);
+    }
+    // The cube-mapped objects and their views.
+    for o in &p.objects {
+        let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.info.cube));
+        if cube {
+            p.envmaps.push(EnvmapPlan { mesh: o.mesh, layer: p.envmaps.len() as u32, reference_point: o.reference_point });
+        }
+    }
+    for m in &mut maps {
+        m.bytes = (m.info.bytes)(p, m.objects.len() as u32, (0, 0));
+    }
+    for o in &mut p.objects {
+        for om in &mut o.maps {
+            let m = maps.iter().find(|m| m.name == om.pass).expect("planned map");
+            om.bytes = m.bytes / m.objects.len().max(1) as u64;
+        }
+    }
+    stages.extend(maps.into_iter().map(StageSpec::Map));
+    stages.extend(cameras.into_iter().map(StageSpec::Camera));
+    // Stable sort: equal orders keep their registry order.
+    stages.sort_by_key(|s| s.order());
+    p.passes = stages.iter().map(|s| s.name()).collect();
+    p.stages = stages;
+}
+
+/// `specula plan`'s table: per object its method, reason, maps, passes and knobs.
+pub fn table(p: &Plan, scene: &Scene) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(s, "method {} · {} specular object(s) · passes: {}", p.choice.name(), p.objects.len(), p.passes.join(", "));
+    if p.inter_object {
+        let _ = writeln!(s, "inter-object cycles: {}{}", p.cycles, if p.frame_latency { " (one per frame, frame latency)" } else { "" });
+    }
+    for o in &p.objects {
+        let mat = &scene.materials[scene.meshes[o.mesh].material];
+        let _ = writeln!(s, "\n{} ({}, material '{}'): {}", o.name, o.class.label(), mat.name, o.method.name);
+        let _ = writeln!(s, "  reason     {}", o.reason);
+        let r = o.reference_point;
+        let _ = writeln!(
+            s,
+            "  ref point  ({:.4}, {:.4}, {:.4}){}",
+            r.x,
+            r.y,
+            r.z,
+            o.reference_note.as_ref().map_or(String::new(), |n| format!(" — {n}"))
+        );
+        for m in &o.maps {
+            let _ = writeln!(s, "  map        {} layer {}: {} ({:.2} MiB)", m.pass, m.layer, m.what, m.bytes as f64 / (1 << 20) as f64);
+        }
+        let _ = writeln!(s, "  passes     {}", o.passes.join(", "));
+        let knobs: Vec<String> = o.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect();
+        let _ = writeln!(s, "  knobs      {}", if knobs.is_empty() { "-".into() } else { knobs.join(" ") });
+    }
+    let _ = writeln!(s, "\nmaps: {:.2} MiB", p.map_bytes() as f64 / (1 << 20) as f64);
+    s
+}
+
+impl Planner {
+    pub fn speed(self) -> bool {
+        self == Planner::Speed
+    }
+}
