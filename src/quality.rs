@@ -250,7 +250,7 @@ pub const KNOBS: &[Knob] = &[
         name: "search_tolerance",
         values: "0..=1",
         default: "0.001",
-        doc: "search stops once | |l|/|l'| − 1 | is within this",
+        doc: "search stops once ‖l‖/‖l′‖ is within this of 1",
         set: |q, v| Ok(q.search_tolerance = real(v, 0.0, 1.0)?),
         get: |q| q.search_tolerance.to_string(),
     },

@@ -1,0 +1,53 @@
+//! Tables generated from the registry and the knob table: the README's method and knob
+//! tables and `specula knobs` print these, so no list of methods or knobs is written by
+//! hand anywhere (tests/readme.rs checks the README against them).
+
+use crate::methods::{Method, ObjectClass};
+use crate::quality::KNOBS;
+
+fn serves(m: Method) -> String {
+    let all = [ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
+    if all.iter().all(|c| m.can_serve(*c)) {
+        return "any".into();
+    }
+    m.serves.iter().map(|c| c.label()).collect::<Vec<_>>().join(", ")
+}
+
+/// The README's method table (Markdown).
+pub fn method_table() -> String {
+    let mut s = String::from("| `--method` | C ABI | survey | serves | what it does |\n|---|---|---|---|---|\n");
+    s += "| `auto` | `SPECULA_METHOD_AUTO` | | any | the planner: per specular object the method whose rule fits it best (`specula plan SCENE` says which and why); `planner=speed` takes cheaper rungs |\n";
+    for m in Method::ALL {
+        s += &format!("| `{}` | `SPECULA_METHOD_{}` | {} | {} | {} |\n", m.name, abi_name(*m), m.section, serves(*m), m.summary);
+    }
+    s
+}
+
+/// The C header's constant name of a method: `SPECULA_METHOD_<NAME>`.
+pub fn abi_name(m: Method) -> String {
+    m.name.to_uppercase().replace('-', "_")
+}
+
+/// The README's knob table (Markdown): name, values, default, doc, and the methods that read it.
+pub fn knob_table() -> String {
+    let mut s = String::from("| knob | values | default | what it does | read by |\n|---|---|---|---|---|\n");
+    for k in KNOBS {
+        let readers: Vec<&str> = Method::ALL.iter().filter(|m| m.knobs.contains(&k.name)).map(|m| m.name).collect();
+        let readers = if k.name == "planner" { "auto".to_string() } else if readers.is_empty() { "every frame".into() } else { readers.join(", ") };
+        s += &format!("| `{}` | {} | {} | {} | {} |\n", k.name, cell(k.values), k.default, cell(k.doc), readers);
+    }
+    s
+}
+
+/// Replaces the text between `<!-- NAME:begin -->` and `<!-- NAME:end -->` in `doc`.
+pub fn splice(doc: &str, name: &str, content: &str) -> Option<String> {
+    let (b, e) = (format!("<!-- {name}:begin -->\n"), format!("<!-- {name}:end -->"));
+    let i = doc.find(&b)? + b.len();
+    let j = doc[i..].find(&e)? + i;
+    Some(format!("{}{}{}", &doc[..i], content, &doc[j..]))
+}
+
+/// A table cell: alternatives written `a|b` in the code read `a, b` in Markdown.
+pub fn cell(s: &str) -> String {
+    s.replace(" | ", ", ").replace('|', ", ")
+}
