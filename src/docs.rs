@@ -33,7 +33,13 @@ pub fn knob_table() -> String {
     let mut s = String::from("| knob | values | default | what it does | read by |\n|---|---|---|---|---|\n");
     for k in KNOBS {
         let readers: Vec<&str> = Method::ALL.iter().filter(|m| m.knobs.contains(&k.name)).map(|m| m.name).collect();
-        let readers = if k.name == "planner" { "auto".to_string() } else if readers.is_empty() { "every frame".into() } else { readers.join(", ") };
+        let readers = if k.name == "planner" {
+            "auto".to_string()
+        } else if readers.is_empty() {
+            "every frame".into()
+        } else {
+            readers.join(", ")
+        };
         s += &format!("| `{}` | {} | {} | {} | {} |\n", k.name, cell(k.values), k.default, cell(k.doc), readers);
     }
     s

@@ -24,7 +24,7 @@ fn mirror_and_glass() -> Scene {
     let mirror = s.add_material(common::mirror(0.9)).unwrap();
     s.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.6, 1.5, 0.0), 0.5, 32, 16, glass)).unwrap();
     s.add_mesh(shapes::uv_sphere("mirror", Vec3::new(-0.7, 1.5, -0.2), 0.5, 32, 16, mirror)).unwrap();
-    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 2.2), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
     s
 }
 

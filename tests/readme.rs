@@ -15,10 +15,15 @@ fn readme_tables_are_the_registry() {
     }
     assert!(readme == updated, "README tables are stale: run SPECULA_UPDATE_README=1 cargo test --test readme");
     for m in specula::Method::ALL {
-        assert!(readme.contains(&format!("| `{}` | `SPECULA_METHOD_{}` |", m.name(), specula::docs::abi_name(*m))), "README lacks {}", m.name());
+        assert!(
+            readme.contains(&format!("| `{}` | `SPECULA_METHOD_{}` |", m.name(), specula::docs::abi_name(*m))),
+            "README lacks {}",
+            m.name()
+        );
     }
     for k in specula::quality::KNOBS {
-        let row = readme.lines().find(|l| l.starts_with(&format!("| `{}` |", k.name))).unwrap_or_else(|| panic!("README lacks knob {}", k.name));
+        let row =
+            readme.lines().find(|l| l.starts_with(&format!("| `{}` |", k.name))).unwrap_or_else(|| panic!("README lacks knob {}", k.name));
         let cells: Vec<&str> = row.split('|').map(str::trim).collect();
         assert_eq!((cells[2].to_string(), cells[3]), (specula::docs::cell(k.values), k.default), "README range and default of {}", k.name);
     }
