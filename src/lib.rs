@@ -7,6 +7,7 @@ pub mod scene;
 pub use error::{Error, Result};
 pub mod cube;
 pub mod gpu_scene;
+pub mod image;
 pub mod methods;
 pub mod metrics;
 pub mod optics;
