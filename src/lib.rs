@@ -6,6 +6,7 @@ pub mod scene;
 
 pub use error::{Error, Result};
 pub mod cube;
+pub mod demo;
 pub mod gpu_scene;
 pub mod image;
 pub mod methods;
