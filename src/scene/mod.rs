@@ -8,11 +8,11 @@
 //! radiance.
 
 mod environment;
-mod gltf_import;
+mod gltf;
 pub mod shapes;
 
+pub use self::gltf::load;
 pub use environment::*;
-pub use gltf_import::load;
 
 use glam::{Mat4, Vec2, Vec3};
 
