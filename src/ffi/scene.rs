@@ -74,24 +74,17 @@ pub unsafe extern "C" fn specula_context_add_mesh(
         if !transform.is_finite() || transform.determinant() == 0.0 {
             return fail(SPECULA_ERROR_INVALID_ARGUMENT, "mesh.transform is not finite or not invertible");
         }
-        let normal_m = transform.inverse().transpose();
         let mut mesh = Mesh {
             name: format!("mesh{}", c.scene.meshes.len()),
-            positions: pos.chunks_exact(3).map(|p| transform.transform_point3(Vec3::new(p[0], p[1], p[2]))).collect(),
+            positions: pos.chunks_exact(3).map(Vec3::from_slice).collect(),
             indices: std::slice::from_raw_parts(d.indices, d.index_count as usize).to_vec(),
             material: d.material as usize,
             ..Default::default()
         };
         if !d.normals.is_null() {
-            let nrm = std::slice::from_raw_parts(d.normals, 3 * n);
-            mesh.normals =
-                nrm.chunks_exact(3).map(|v| normal_m.transform_vector3(Vec3::new(v[0], v[1], v[2])).normalize_or_zero()).collect();
+            mesh.normals = std::slice::from_raw_parts(d.normals, 3 * n).chunks_exact(3).map(Vec3::from_slice).collect();
         }
-        if transform.determinant() < 0.0 {
-            for t in mesh.indices.chunks_exact_mut(3) {
-                t.swap(1, 2);
-            }
-        }
+        mesh.transform(transform);
         let i = c.scene.add_mesh(mesh)?;
         c.scene_version += 1;
         if !out_index.is_null() {

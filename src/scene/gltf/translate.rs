@@ -2,7 +2,7 @@
 //! node hierarchy with its world transforms, meshes (primitive modes, texture coordinates,
 //! `extras.specula`), materials (mirror, dielectric, diffuse), punctual lights, the camera.
 
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::json::validation::Checked;
 use gltf::mesh::{Mode, Semantic};
@@ -190,7 +190,7 @@ impl Importer<'_> {
         if let Some(k) = raw_indices.iter().position(|&i| i as usize >= n) {
             return Err(self.err(idx_field, format!("index {} (element {k}) is out of range: only {n} vertices", raw_indices[k])));
         }
-        let mut indices = match mode {
+        let indices = match mode {
             Mode::Triangles => {
                 if raw_indices.len() % 3 != 0 {
                     return Err(self.err(count_field, format!("{} indices is not a whole number of triangles", raw_indices.len())));
@@ -222,29 +222,13 @@ impl Importer<'_> {
         }
 
         // To world space.
-        let positions: Vec<Vec3> = local_positions.iter().map(|&v| world.transform_point3(v)).collect();
-        if let Some(i) = positions.iter().position(|v| !v.is_finite()) {
+        let mut geometry = Mesh { positions: local_positions, normals, uvs, indices, ..Mesh::default() };
+        geometry.transform(world);
+        if let Some(i) = geometry.positions.iter().position(|v| !v.is_finite()) {
             return Err(self.err(
                 format!("nodes[{}]", node.index()),
                 format!("the node's world transform makes vertex {i} of {pos_field} non-finite"),
             ));
-        }
-        let linear = Mat3::from_mat4(world);
-        let det = linear.determinant();
-        if !normals.is_empty() {
-            if det.is_finite() && det != 0.0 {
-                let normal_matrix = linear.inverse().transpose();
-                for nrm in &mut normals {
-                    *nrm = (normal_matrix * *nrm).normalize_or_zero();
-                }
-            } else {
-                normals.clear(); // degenerate transform: let add_mesh compute them
-            }
-        }
-        if det < 0.0 {
-            for t in indices.chunks_exact_mut(3) {
-                t.swap(1, 2);
-            }
         }
 
         // Reference point: node extras first, then the mesh's.
@@ -262,7 +246,7 @@ impl Importer<'_> {
 
         let material_index = self.material_index(&material)?;
         let name = format!("{}/{p}", mesh.name().map(str::to_string).unwrap_or_else(|| m.to_string()));
-        let mesh_value = Mesh { name, positions, normals, uvs, indices, material: material_index, reference_point };
+        let mesh_value = Mesh { name, material: material_index, reference_point, ..geometry };
         let file = self.file;
         self.scene.add_mesh(mesh_value).map_err(|e| {
             map_invalid(file, e, |suffix| match suffix {
