@@ -57,3 +57,18 @@ pub fn splice(doc: &str, name: &str, content: &str) -> Option<String> {
 pub fn cell(s: &str) -> String {
     s.replace(" | ", ", ").replace('|', ", ")
 }
+
+/// The C header's method constants, generated from the registry (tests/c_header.rs puts
+/// them after the includes of include/specula.h).
+pub fn c_method_defines() -> String {
+    let mut s = String::from("/* Rendering methods (SpeculaMethod), generated from the method registry: the same names\n * as the CLI's --method. SPECULA_METHOD_AUTO lets the planner choose per object. */\n");
+    s += &format!(
+        "/* the planner: per specular object the method whose rule fits it best */\n#define SPECULA_METHOD_AUTO {}\n",
+        crate::methods::registry::ABI_AUTO
+    );
+    for m in Method::ALL {
+        let cpu = if m.is_gpu() { "" } else { " (CPU only: specula_context_configure refuses it)" };
+        s += &format!("/* {} ({}){cpu} */\n#define SPECULA_METHOD_{} {}\n", m.name, m.section, abi_name(*m), m.abi);
+    }
+    s
+}

@@ -6,9 +6,11 @@ pub mod scene;
 
 pub use error::{Error, Result};
 pub mod cube;
+pub mod demo;
 pub mod docs;
 pub mod frame;
 pub mod gpu_scene;
+pub mod image;
 pub mod methods;
 pub mod metrics;
 pub mod optics;

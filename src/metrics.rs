@@ -12,8 +12,8 @@
 //! and p99 are then ∞ and PSNR −∞ (a broken image never looks close).
 
 use crate::error::{Error, Result};
+use crate::image::ImageData;
 use crate::scene::linear_to_srgb;
-use crate::vk::ImageData;
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ImageErrors {

@@ -1,14 +1,18 @@
 //! The speed–accuracy trade-off study behind `specula tradeoff`: knob sweeps, one row per
 //! (method, knob values) with its median GPU time per pass and its errors against the
 //! exact reference, the Pareto front of (time, error), `tradeoff.csv` and an SVG plot.
-//! The CLI drives the rendering; everything here is plain data, so it is tested alone.
+//! [`run`] drives the rendering (the CLI only parses its arguments and prints the table);
+//! everything else here is plain data, so it is tested alone.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::error::{Error, Result};
+use crate::methods::{Choice, Method};
 use crate::metrics::ImageErrors;
 use crate::quality::Quality;
+use crate::scene::Scene;
+use crate::vk::{Context, DeviceOptions};
 
 /// One `--sweep knob=v1,v2,…`.
 #[derive(Clone, Debug, PartialEq)]
@@ -204,6 +208,117 @@ pub fn plot_svg(path: &Path, rows: &[Row], title: &str) -> Result<()> {
     chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+/// What [`run`] measures.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub scene: Scene,
+    /// The scene's name in the plot's title (e.g. its file name).
+    pub scene_name: String,
+    /// Base knobs of every variant; `spp` and `depth` also set the reference's.
+    pub quality: Quality,
+    /// The combinations multiply (see [`variants`]).
+    pub sweeps: Vec<Sweep>,
+    /// The choices to measure (GPU methods or `auto`); empty: `auto` and every GPU method
+    /// of the registry. The reference is not one.
+    pub methods: Vec<Choice>,
+    pub size: (u32, u32),
+    /// Untimed frames per configuration (at least 1: the first frame uploads the scene).
+    pub warmup: u32,
+    /// Timed frames per configuration (at least 1); the median per pass is kept.
+    pub frames: u32,
+    /// The device the GPU methods run on.
+    pub device: DeviceOptions,
+    /// Output directory (created): reference.exr/.png, one PNG per row, tradeoff.csv and
+    /// tradeoff.svg.
+    pub out: PathBuf,
+}
+
+/// How far [`run`] has come, for a progress bar.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Progress {
+    /// The study has `steps` steps: the reference, then one per method × variant.
+    Start { steps: u64 },
+    /// A step begins (what it renders).
+    Begin(String),
+    /// The step that began last is done.
+    Done,
+    /// Every step is done (the CSV and the plot are written next).
+    Finished,
+}
+
+/// What [`run`] measured and wrote.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// One per method × variant, in that order.
+    pub rows: Vec<Row>,
+    /// Wall-clock milliseconds of the CPU reference.
+    pub reference_ms: f64,
+    pub device_name: String,
+    pub driver_info: String,
+    pub csv: PathBuf,
+    pub svg: PathBuf,
+    /// Validation layer messages over the whole study: (errors, warnings).
+    pub validation: (u32, u32),
+}
+
+/// The study behind `specula tradeoff`: the exact reference once, then every method ×
+/// every sweep variant rendered, timed and compared with it; writes the images,
+/// `tradeoff.csv` and `tradeoff.svg` into `cfg.out`.
+pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
+    let variants = variants(&cfg.quality, &cfg.sweeps)?;
+    let methods: Vec<Choice> = if cfg.methods.is_empty() {
+        std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method)).collect()
+    } else {
+        if let Some(m) = cfg.methods.iter().find(|m| matches!(m, Choice::Method(m) if !m.is_gpu())) {
+            return Err(Error::invalid("--method", format!("'{}' is the reference itself", m.name())));
+        }
+        cfg.methods.clone()
+    };
+    let out = cfg.out.as_path();
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let (w, h) = cfg.size;
+
+    progress(Progress::Start { steps: (1 + methods.len() * variants.len()) as u64 });
+    progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.spp, cfg.quality.depth)));
+    let t = std::time::Instant::now();
+    let reference = crate::reference::render_reference(&cfg.scene, &cfg.quality, (w, h))?;
+    let reference_ms = t.elapsed().as_secs_f64() * 1e3;
+    reference.write_exr(&out.join("reference.exr"))?;
+    reference.write_png_srgb(&out.join("reference.png"))?;
+    progress(Progress::Done);
+
+    let ctx = Context::new(&cfg.device)?;
+    let mut rows = Vec::new();
+    for &method in &methods {
+        for (label, q) in &variants {
+            progress(Progress::Begin(format!("{} {label}", method.name())));
+            let frame = crate::render(&ctx, &cfg.scene, method, q, (w, h), (cfg.warmup.max(1), cfg.frames.max(1)))?;
+            let errors = crate::metrics::compare(&frame.image, &reference)?;
+            let stem = format!("{}-{}", method.name(), label.replace([' ', '=', ',', ';', '/'], "_"));
+            frame.image.write_png_srgb(&out.join(format!("{stem}.png")))?;
+            rows.push(Row::new(method.name(), label, &frame.passes, errors));
+            progress(Progress::Done);
+        }
+    }
+    progress(Progress::Finished);
+
+    let csv_path = out.join("tradeoff.csv");
+    let device = format!("{} ({})", ctx.device_name, ctx.driver_info);
+    std::fs::write(&csv_path, csv(&rows, &device)).map_err(|e| Error::io(&csv_path, e))?;
+    let svg_path = out.join("tradeoff.svg");
+    let title = format!("{} at {w}x{h} on {}: mean FLIP vs GPU time", cfg.scene_name, ctx.device_name);
+    plot_svg(&svg_path, &rows, &title)?;
+    Ok(Report {
+        rows,
+        reference_ms,
+        device_name: ctx.device_name.clone(),
+        driver_info: ctx.driver_info.clone(),
+        csv: csv_path,
+        svg: svg_path,
+        validation: (ctx.validation.error_count(), ctx.validation.warning_count()),
+    })
 }
 
 #[cfg(test)]

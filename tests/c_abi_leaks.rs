@@ -113,7 +113,7 @@ unsafe fn cycle() {
     let rd = SpeculaRenderDesc {
         r#type: SPECULA_STRUCT_RENDER_DESC,
         size: std::mem::size_of::<SpeculaRenderDesc>() as u32,
-        method: SPECULA_METHOD_ENVMAP,
+        method: specula::methods::ENVMAP.abi,
         width: 16,
         height: 16,
     };

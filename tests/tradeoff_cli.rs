@@ -97,8 +97,13 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
     for pass in ["envmap.generate ms", "scene.direct ms", "envmap.shade ms"] {
         assert!(header.contains(&pass), "no {pass} column: {}", lines[0]);
     }
-    let gpu_methods: Vec<_> = specula::Method::ALL.iter().filter(|m| m.is_gpu()).collect();
+    // `auto` and every GPU method of the registry, each under its name.
+    let gpu_methods: Vec<&str> =
+        std::iter::once("auto").chain(specula::Method::ALL.iter().filter(|m| m.is_gpu()).map(|m| m.name())).collect();
     assert_eq!(lines.len() - 1, gpu_methods.len() * 4, "one row per method and combination:\n{csv}");
+    for m in &gpu_methods {
+        assert_eq!(lines[1..].iter().filter(|l| l.split(',').next() == Some(m)).count(), 4, "{m}");
+    }
     let mut on_front = 0;
     for l in &lines[1..] {
         let f: Vec<&str> = l.split(',').collect();

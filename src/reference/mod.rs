@@ -25,9 +25,9 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::image::ImageData;
 use crate::quality::{FresnelMode, Quality};
 use crate::scene::{Camera, Scene, SurfaceKind};
-use crate::vk::ImageData;
 use bvh::{Bvh, Hit};
 use shade::{ShadeLight, Sky, Textures};
 

@@ -8,13 +8,13 @@
 //! radiance.
 
 mod environment;
-mod gltf_import;
+mod gltf;
 pub mod shapes;
 
+pub use self::gltf::load;
 pub use environment::*;
-pub use gltf_import::load;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::error::{Error, Result};
 
@@ -108,6 +108,38 @@ pub struct Mesh {
 }
 
 impl Mesh {
+    /// Applies an object-to-world transform in place: positions (and the reference point)
+    /// by `world`; normals by the inverse transpose of its linear (upper 3×3) part and
+    /// renormalised, or dropped (so that [`Scene::add_mesh`] computes them) when that part
+    /// is singular or not finite; a mirroring transform (negative determinant) swaps the
+    /// last two indices of every triangle so that the winding stays counter-clockwise.
+    /// Used by the glTF importer (node world transforms) and the C ABI (`transform`).
+    pub fn transform(&mut self, world: Mat4) {
+        for p in &mut self.positions {
+            *p = world.transform_point3(*p);
+        }
+        let linear = Mat3::from_mat4(world);
+        let det = linear.determinant();
+        if !self.normals.is_empty() {
+            if det.is_finite() && det != 0.0 {
+                let normal_matrix = linear.inverse().transpose();
+                for nrm in &mut self.normals {
+                    *nrm = (normal_matrix * *nrm).normalize_or_zero();
+                }
+            } else {
+                self.normals.clear(); // degenerate transform: let add_mesh compute them
+            }
+        }
+        if det < 0.0 {
+            for t in self.indices.chunks_exact_mut(3) {
+                t.swap(1, 2);
+            }
+        }
+        if let Some(p) = &mut self.reference_point {
+            *p = world.transform_point3(*p);
+        }
+    }
+
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(self.positions.iter().copied())
     }
@@ -465,4 +497,43 @@ pub fn compute_normals(positions: &[Vec3], indices: &[u32]) -> Vec<Vec3> {
         }
     }
     n.into_iter().map(|v| v.try_normalize().unwrap_or(Vec3::Y)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle() -> Mesh {
+        Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: vec![Vec3::Z; 3],
+            indices: vec![0, 1, 2],
+            reference_point: Some(Vec3::X),
+            ..Mesh::default()
+        }
+    }
+
+    #[test]
+    fn transform_moves_points_and_keeps_normals_perpendicular() {
+        let world = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0));
+        let mut m = triangle();
+        m.normals = vec![Vec3::new(1.0, 1.0, 0.0).normalize(); 3];
+        m.transform(world);
+        assert_eq!(m.positions, [Vec3::new(1.0, 2.0, 3.0), Vec3::new(3.0, 2.0, 3.0), Vec3::new(1.0, 3.0, 3.0)]);
+        assert_eq!(m.reference_point, Some(Vec3::new(3.0, 2.0, 3.0)));
+        // The plane x + y = 0 becomes x/2 + y = 0: its normal is (1/2, 1, 0), renormalised.
+        assert!((m.normals[0] - Vec3::new(0.5, 1.0, 0.0).normalize()).length() < 1e-6);
+        assert_eq!(m.indices, [0, 1, 2]);
+    }
+
+    #[test]
+    fn mirroring_flips_the_winding_and_singular_drops_the_normals() {
+        let mut m = triangle();
+        m.transform(Mat4::from_scale(Vec3::new(1.0, 1.0, -1.0)));
+        assert_eq!(m.indices, [0, 2, 1]);
+        assert_eq!(m.normals[0], Vec3::NEG_Z);
+        let mut m = triangle();
+        m.transform(Mat4::from_scale(Vec3::new(1.0, 1.0, 0.0)));
+        assert!(m.normals.is_empty(), "add_mesh computes them");
+    }
 }

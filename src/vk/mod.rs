@@ -12,7 +12,9 @@ pub use context::{
     process_validation_errors, required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry, ValidationLog,
     REQUIRED_DEVICE_EXTENSIONS,
 };
-pub use readback::{decode, read_image, record_copy_to_buffer, ImageData};
+pub use readback::{decode, read_image, record_copy_to_buffer};
+// ImageData moved to crate::image; the old path keeps working.
+pub use crate::image::ImageData;
 pub use recorder::{begin_rendering, OpenPass, PassTiming, Profiler, Recorder, Target};
 /// An owner of device objects whose `destroy` frees whatever exists, a partly built owner
 /// included (handles start null or as placeholders).

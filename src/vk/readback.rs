@@ -1,27 +1,10 @@
-//! Readback of images to the CPU as f32 texels.
+//! Readback of images to the CPU as f32 texels ([`ImageData`]).
 
 use ash::vk;
 
 use super::{Access, Buffer, Context, Image, MemoryLocation};
 use crate::error::{Error, Result};
-
-/// Texels of an image, layer after layer, row after row; `channels` per texel.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ImageData {
-    pub width: u32,
-    pub height: u32,
-    pub layers: u32,
-    pub channels: u32,
-    pub data: Vec<f32>,
-}
-
-impl ImageData {
-    pub fn texel(&self, layer: u32, x: u32, y: u32) -> &[f32] {
-        let c = self.channels as usize;
-        let i = ((layer * self.height + y) * self.width + x) as usize * c;
-        &self.data[i..i + c]
-    }
-}
+use crate::image::ImageData;
 
 /// Records a copy of every layer of `image` into `buffer` (which must hold `byte_size`).
 pub fn record_copy_to_buffer(ctx: &Context, cmd: vk::CommandBuffer, image: &Image, buffer: &Buffer) {

@@ -1,0 +1,205 @@
+//! What the subcommands share: the scene-and-knobs arguments, their parsers, the prepared
+//! job, image output by extension and the timed CPU reference.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use specula::image::ImageData;
+use specula::plan::{plan_with, Choices, Plan};
+use specula::scene::{self, Camera};
+use specula::vk::{Context, DeviceOptions, PassTiming};
+use specula::{Choice, Method, Quality, Scene};
+
+#[derive(clap::Args, Clone)]
+pub struct RenderArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
+    pub scene: PathBuf,
+    /// Rendering method of every specular object, or `auto`: the planner picks one per
+    /// object (`specula knobs` lists methods and knobs).
+    #[arg(long, default_value = "auto")]
+    pub method: String,
+    /// One object's method, NAME=METHOD (NAME: the glTF node or mesh name; repeatable);
+    /// overrides --method and the scene file's extras.specula.method.
+    #[arg(long = "object")]
+    pub objects: Vec<String>,
+    /// Output size WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512")]
+    pub size: String,
+    /// Accuracy knob key=value (repeatable).
+    #[arg(long = "quality", short = 'q')]
+    pub quality: Vec<String>,
+    /// Equirectangular environment map (.exr, .hdr, .png, .jpg).
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Camera position x,y,z (overrides the scene's camera; with --camera-target).
+    #[arg(long)]
+    pub camera_pos: Option<String>,
+    /// Camera target x,y,z.
+    #[arg(long)]
+    pub camera_target: Option<String>,
+    /// Vertical field of view in degrees (with --camera-pos).
+    #[arg(long, default_value_t = 60.0)]
+    pub fov: f32,
+    /// Enable the Khronos validation layer; any validation error fails the command.
+    #[arg(long)]
+    pub validate: bool,
+    /// Device name filter (substring, e.g. llvmpipe); default SPECULA_DEVICE or the first GPU.
+    #[arg(long)]
+    pub device: Option<String>,
+    /// Untimed frames before the timed ones.
+    #[arg(long, default_value_t = 1)]
+    pub warmup: u32,
+    /// Timed frames; the profile reports the median per pass.
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+}
+
+#[derive(clap::Args, Clone)]
+pub struct TradeoffArgs {
+    /// glTF 2.0 scene (.gltf or .glb).
+    pub scene: PathBuf,
+    /// Output size WIDTHxHEIGHT.
+    #[arg(long, default_value = "256x256")]
+    pub size: String,
+    /// Base accuracy knobs key=value (repeatable); spp and depth set the reference's.
+    #[arg(long = "quality", short = 'q')]
+    pub quality: Vec<String>,
+    /// Equirectangular environment map.
+    #[arg(long)]
+    pub env: Option<PathBuf>,
+    /// Untimed frames before the timed ones (at least 1: the first frame uploads the scene).
+    #[arg(long, default_value_t = 2)]
+    pub warmup: u32,
+    /// Timed frames per configuration; the median per pass is reported.
+    #[arg(long, default_value_t = 5)]
+    pub frames: u32,
+    /// Enable the Khronos validation layer.
+    #[arg(long)]
+    pub validate: bool,
+    /// Device name filter (substring).
+    #[arg(long)]
+    pub device: Option<String>,
+}
+
+pub fn parse_vec3(what: &str, s: &str) -> specula::Result<Vec3> {
+    let v: Vec<f32> = s
+        .split(',')
+        .map(|x| x.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| specula::Error::invalid(what, format!("'{s}' is not x,y,z")))?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|c| c.is_finite()) => Ok(Vec3::new(*x, *y, *z)),
+        _ => Err(specula::Error::invalid(what, format!("'{s}' is not three finite numbers x,y,z"))),
+    }
+}
+
+pub fn parse_size(s: &str) -> specula::Result<(u32, u32)> {
+    let bad = || specula::Error::invalid("--size", format!("'{s}' is not WIDTHxHEIGHT"));
+    let (w, h) = s.split_once('x').ok_or_else(bad)?;
+    let (w, h) = (w.parse::<u32>().map_err(|_| bad())?, h.parse::<u32>().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(specula::Error::invalid("--size", format!("{w}x{h} is outside 1..=16384")));
+    }
+    Ok((w, h))
+}
+
+/// A scene with its environment and camera overrides applied, the knobs, the methods and
+/// the output size.
+pub struct Job {
+    pub scene: Scene,
+    pub choices: Choices,
+    pub quality: Quality,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Job {
+    /// The CPU method, when the whole scene asks for one (the reference).
+    pub fn cpu_method(&self) -> Option<Method> {
+        match self.choices.method {
+            Choice::Method(m) if !m.is_gpu() => Some(m),
+            _ => None,
+        }
+    }
+
+    pub fn plan(&self, quality: &Quality) -> specula::Result<Plan> {
+        plan_with(&self.scene, &self.choices, quality)
+    }
+
+    /// What was asked for, for headings: the method or `auto`, plus the overrides.
+    pub fn label(&self) -> String {
+        let mut s = self.choices.method.name().to_string();
+        for (n, m) in &self.choices.objects {
+            s += &format!(" {n}={}", m.name());
+        }
+        s
+    }
+}
+
+/// `NAME=METHOD` of --object.
+pub fn parse_object(s: &str) -> specula::Result<(String, Method)> {
+    let (n, m) = s
+        .split_once('=')
+        .ok_or_else(|| specula::Error::invalid("--object", format!("'{}' is not NAME=METHOD", specula::error::clip(s))))?;
+    let m = Method::parse(m.trim())?;
+    if !m.is_gpu() {
+        return Err(specula::Error::invalid("--object", format!("'{}' renders on the CPU, not per object", m.name())));
+    }
+    Ok((n.trim().to_string(), m))
+}
+
+pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
+    let mut scene = scene::load(&a.scene)?;
+    if let Some(env) = &a.env {
+        scene.set_environment(scene::load_environment(env)?)?;
+    }
+    if let Some(pos) = &a.camera_pos {
+        let eye = parse_vec3("--camera-pos", pos)?;
+        let target = a.camera_target.as_deref().map(|t| parse_vec3("--camera-target", t)).transpose()?.unwrap_or(eye + Vec3::NEG_Z);
+        if !(a.fov > 0.0 && a.fov < 180.0) {
+            return Err(specula::Error::invalid("--fov", "must be in (0, 180) degrees"));
+        }
+        scene.camera = Some(Camera::look_at(eye, target, a.fov.to_radians()));
+    }
+    let mut quality = Quality::default();
+    for q in &a.quality {
+        quality.set_pair(q)?;
+    }
+    let (width, height) = parse_size(&a.size)?;
+    let objects = a.objects.iter().map(|o| parse_object(o)).collect::<specula::Result<Vec<_>>>()?;
+    let choices = Choices { method: Choice::parse(&a.method)?, objects };
+    Ok(Job { scene, choices, quality, width, height })
+}
+
+pub fn context(validate: bool, device: &Option<String>) -> specula::Result<Context> {
+    Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })
+}
+
+pub fn write_image(path: &Path, img: &ImageData) -> specula::Result<()> {
+    match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()).as_deref() {
+        Some("exr") => img.write_exr(path),
+        Some("png") => img.write_png_srgb(path),
+        _ => Err(specula::Error::invalid("--out", format!("{}: use .png or .exr", path.display()))),
+    }
+}
+
+/// The exact CPU reference, timed (wall-clock milliseconds).
+pub fn render_reference(scene: &Scene, quality: &Quality, size: (u32, u32)) -> specula::Result<(ImageData, f64)> {
+    let t = std::time::Instant::now();
+    let img = specula::reference::render_reference(scene, quality, size)?;
+    Ok((img, t.elapsed().as_secs_f64() * 1e3))
+}
+
+pub fn reference_timing(ms: f64) -> PassTiming {
+    PassTiming { name: specula::plan::REFERENCE_PASS.into(), gpu_ms: 0.0, cpu_ms: ms, gpu_start_ms: 0.0 }
+}
+
+pub fn reference_summary(q: &Quality, w: u32, h: u32, ms: f64) -> String {
+    format!(
+        "reference on the CPU ({} threads), {w}x{h}, {} spp, depth {}, fresnel {:?}: {ms:.1} ms",
+        rayon::current_num_threads(),
+        q.spp,
+        q.depth,
+        q.fresnel
+    )
+}

@@ -1,0 +1,122 @@
+//! The specula command line: render, info, plan, knobs, demo, bench, compare, tradeoff.
+//! One file per subcommand; `args` holds what they share (argument structs, parsers, the
+//! scene-and-knobs preparation, image output, the timed CPU reference).
+
+mod args;
+mod bench;
+mod compare;
+mod demo;
+mod info;
+mod knobs;
+mod plan;
+mod render;
+mod tradeoff;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use args::{RenderArgs, TradeoffArgs};
+
+#[derive(Parser)]
+#[command(name = "specula", version, about = "Specular effects on the GPU through raw Vulkan")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (.png: sRGB, clamped; .exr: linear radiance).
+    Render {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Output image.
+        #[arg(long)]
+        out: PathBuf,
+        /// Write the per-pass profile as Chrome trace-event JSON (opens in Perfetto).
+        #[arg(long)]
+        profile: Option<PathBuf>,
+    },
+    /// List meshes, materials with their classification, lights, camera and bounds.
+    Info { scene: PathBuf },
+    /// Print the plan a scene gets: per object its method and why, maps, passes, knobs.
+    Plan {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Print JSON instead of the table.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List methods and accuracy knobs with their ranges and defaults.
+    Knobs,
+    /// Time a method over several frames for each value of one knob, in one run, and print
+    /// per-pass medians with each variant's frame time relative to the first.
+    Bench {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// knob=v1,v2,... (e.g. cube_mode=six,multiview); without it, one variant.
+        #[arg(long)]
+        sweep: Option<String>,
+    },
+    /// Image errors of TEST against REFERENCE (.exr linear, .png/.jpg sRGB-decoded): RMSE,
+    /// PSNR, max and p99 absolute error, mean FLIP.
+    Compare {
+        test: PathBuf,
+        reference: PathBuf,
+        /// Write the FLIP error map in false colour (PNG).
+        #[arg(long)]
+        error_image: Option<PathBuf>,
+    },
+    /// The speed–accuracy trade-off: every GPU method (× every --sweep combination) timed
+    /// and compared with the exact reference; writes tradeoff.csv and tradeoff.svg to --out.
+    Tradeoff {
+        #[command(flatten)]
+        args: TradeoffArgs,
+        /// knob=v1,v2,... (repeatable: the combinations multiply); ref_point values split on ';'.
+        #[arg(long)]
+        sweep: Vec<String>,
+        /// Only these methods (repeatable); default every GPU method.
+        #[arg(long = "method")]
+        methods: Vec<String>,
+        /// Output directory.
+        #[arg(long, default_value = "tradeoff")]
+        out: PathBuf,
+    },
+    /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
+    Demo {
+        #[arg(default_value = "out")]
+        outdir: PathBuf,
+        #[arg(long, default_value = "512x512")]
+        size: String,
+        #[arg(long)]
+        validate: bool,
+        #[arg(long)]
+        device: Option<String>,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match run(cli.command) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("specula: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cmd: Command) -> specula::Result<()> {
+    match cmd {
+        Command::Render { args, out, profile } => render::run(&args, &out, profile.as_deref()),
+        Command::Info { scene } => info::run(&scene),
+        Command::Plan { args, json } => plan::run(&args, json),
+        Command::Knobs => knobs::run(),
+        Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),
+        Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
+        Command::Compare { test, reference, error_image } => compare::run(&test, &reference, error_image.as_deref()),
+        Command::Tradeoff { args, sweep, methods, out } => tradeoff::run(&args, &sweep, &methods, &out),
+    }
+}

@@ -1,0 +1,37 @@
+//! `specula render`: one image (GPU method, or the CPU reference) and its profile.
+
+use std::path::Path;
+
+use crate::args::{context, prepare, reference_summary, reference_timing, render_reference, write_image, RenderArgs};
+
+pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Result<()> {
+    let job = prepare(args)?;
+    if job.cpu_method().is_some() {
+        let (img, ms) = render_reference(&job.scene, &job.quality, (job.width, job.height))?;
+        write_image(out, &img)?;
+        println!("{}", reference_summary(&job.quality, job.width, job.height, ms));
+        if let Some(p) = profile {
+            let passes = [reference_timing(ms)];
+            std::fs::write(p, specula::profile::chrome_trace(&passes, &[], "CPU")).map_err(|e| specula::Error::io(p, e))?;
+        }
+        return Ok(());
+    }
+    let ctx = context(args.validate, &args.device)?;
+    let plan = job.plan(&job.quality)?;
+    let methods: Vec<String> = plan.objects.iter().map(|o| format!("{}: {}", o.name, o.method.name())).collect();
+    let frame = specula::render_plan(&ctx, &job.scene, plan, (job.width, job.height), (args.warmup, args.frames))?;
+    write_image(out, &frame.image)?;
+    println!("{} on {} ({}), {}x{}", job.label(), ctx.device_name, ctx.driver_info, job.width, job.height);
+    if !methods.is_empty() {
+        println!("objects: {}", methods.join(", "));
+    }
+    print!("{}", specula::profile::table(&frame.passes, &frame.memory));
+    if let Some(p) = profile {
+        let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);
+        std::fs::write(p, json).map_err(|e| specula::Error::io(p, e))?;
+    }
+    if args.validate {
+        println!("validation: {} error(s), {} warning(s)", ctx.validation.error_count(), ctx.validation.warning_count());
+    }
+    Ok(())
+}

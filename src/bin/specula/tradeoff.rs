@@ -1,0 +1,98 @@
+//! `specula tradeoff`: parses the arguments, runs `specula::tradeoff::run` with a progress
+//! bar and prints its table.
+
+use std::path::Path;
+
+use specula::tradeoff::{Config, Progress, Sweep};
+use specula::vk::DeviceOptions;
+use specula::Choice;
+
+use crate::args::{prepare, reference_summary, RenderArgs, TradeoffArgs};
+
+/// The reference once, then every GPU method × every sweep variant, timed and compared;
+/// CSV, SVG plot and the images into `out`.
+pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> specula::Result<()> {
+    let render_args = RenderArgs {
+        scene: a.scene.clone(),
+        method: "auto".into(),
+        objects: Vec::new(),
+        size: a.size.clone(),
+        quality: a.quality.clone(),
+        env: a.env.clone(),
+        camera_pos: None,
+        camera_target: None,
+        fov: 60.0,
+        validate: a.validate,
+        device: a.device.clone(),
+        warmup: a.warmup,
+        frames: a.frames,
+    };
+    let job = prepare(&render_args)?;
+    let sweeps: Vec<Sweep> = sweeps.iter().map(|s| Sweep::parse(s)).collect::<specula::Result<_>>()?;
+    let methods = only.iter().map(|n| Choice::parse(n)).collect::<specula::Result<Vec<_>>>()?;
+    let (w, h) = (job.width, job.height);
+    let quality = job.quality.clone();
+    let cfg = Config {
+        scene: job.scene,
+        scene_name: a.scene.file_name().unwrap_or_default().to_string_lossy().into_owned(),
+        quality: job.quality,
+        sweeps,
+        methods,
+        size: (w, h),
+        warmup: a.warmup,
+        frames: a.frames,
+        device: DeviceOptions { validation: a.validate, device_filter: a.device.clone() },
+        out: out.to_path_buf(),
+    };
+
+    let mut bar = None;
+    let report = specula::tradeoff::run(&cfg, &mut |p| match p {
+        Progress::Start { steps } => {
+            let b = indicatif::ProgressBar::new(steps);
+            b.set_style(
+                indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} [{elapsed_precise}] {msg}")
+                    .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            );
+            bar = Some(b);
+        }
+        Progress::Begin(msg) => {
+            if let Some(b) = &bar {
+                b.set_message(msg);
+            }
+        }
+        Progress::Done => {
+            if let Some(b) = &bar {
+                b.inc(1);
+            }
+        }
+        Progress::Finished => {
+            if let Some(b) = &bar {
+                b.finish_and_clear();
+            }
+        }
+    })?;
+
+    println!(
+        "{} on {} ({}), {w}x{h}, median of {} frames after {} warm-up",
+        a.scene.display(),
+        report.device_name,
+        report.driver_info,
+        a.frames.max(1),
+        a.warmup.max(1)
+    );
+    println!("{}", reference_summary(&quality, w, h, report.reference_ms));
+    println!("\n{:<10} {:<40} {:>10} {:>10} {:>9} {:>9} {:>9}", "method", "knobs", "frame ms", "RMSE", "PSNR dB", "FLIP", "p99");
+    for r in &report.rows {
+        let e = &r.errors;
+        println!(
+            "{:<10} {:<40} {:>10.3} {:>10.5} {:>9.2} {:>9.5} {:>9.5}",
+            r.method, r.knobs, r.frame_ms, e.rmse, e.psnr, e.flip, e.p99_abs
+        );
+    }
+    println!("\nwrote {} and {}", report.csv.display(), report.svg.display());
+    if a.validate {
+        let (errors, warnings) = report.validation;
+        println!("validation: {errors} error(s), {warnings} warning(s)");
+    }
+    Ok(())
+}

@@ -1,0 +1,204 @@
+//! Frames: knobs, configure (plan + renderer), standalone render, host-device record,
+//! per-pass timings and memory.
+
+use std::ffi::{c_char, c_void};
+
+use ash::vk::{self, Handle};
+
+use super::handle::{cstr, fail, header, with_ctx, FfiResult, SpeculaContext};
+use super::types::*;
+use crate::methods::registry::ABI_AUTO;
+use crate::methods::{Choice, Method};
+use crate::plan::{plan_with, Choices};
+use crate::renderer::Renderer;
+use crate::vk::Image;
+
+/// Sets an accuracy knob by name, as the CLI's `-q key=value` (see `specula knobs`).
+/// Takes effect at the next specula_context_configure.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_knob(ctx: *mut SpeculaContext, key: *const c_char, value: *const c_char) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        let (k, v) = (cstr(key, "key")?, cstr(value, "value")?);
+        c.quality.set(k, v)?;
+        Ok(SPECULA_SUCCESS)
+    })
+}
+
+/// Plans and creates everything a frame of the scene needs with the given method and size.
+/// Reconfiguring destroys the previous renderer: needs an idle GPU in host-device mode.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, desc: *const SpeculaRenderDesc) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
+        let choice = match d.method {
+            ABI_AUTO => Choice::Auto,
+            m => match Method::by_abi(m).filter(|m| m.is_gpu()) {
+                Some(m) => Choice::Method(m),
+                None => {
+                    let known: Vec<String> = Method::ALL.iter().filter(|m| m.is_gpu()).map(|m| format!("{} = {}", m.abi, m.name)).collect();
+                    return fail(
+                        SPECULA_ERROR_INVALID_ARGUMENT,
+                        format!("render desc.method: {m} is not a GPU method (known: {ABI_AUTO} = auto, {})", known.join(", ")),
+                    );
+                }
+            },
+        };
+        let choices = Choices { method: choice, objects: c.object_methods.clone() };
+        let p = plan_with(&c.scene, &choices, &c.quality)?;
+        c.destroy_renderer();
+        let r = Renderer::new(&c.vk, &c.scene, p, d.width, d.height)?;
+        c.choice = choice;
+        c.renderer = Some(r);
+        c.renderer_version = c.scene_version;
+        Ok(SPECULA_SUCCESS)
+    })
+}
+
+/// Standalone mode: renders one frame, waits for it, and writes width×height pixels of
+/// `pixel_format` row by row (no padding) into `dst` of `dst_size` bytes.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_render(
+    ctx: *mut SpeculaContext,
+    pixel_format: SpeculaPixelFormat,
+    dst: *mut c_void,
+    dst_size: usize,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if !c.vk.owns_device() {
+            return fail(SPECULA_ERROR_WRONG_ORDER, "host-device context: record frames with specula_context_record");
+        }
+        if dst.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "dst is NULL");
+        }
+        let bpp = match pixel_format {
+            SPECULA_PIXEL_RGBA8_SRGB => 4,
+            SPECULA_PIXEL_RGBA32F => 16,
+            f => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("pixel_format: unknown value {f}")),
+        };
+        let r = c.renderer()?;
+        let need = r.width as usize * r.height as usize * bpp;
+        if dst_size < need {
+            return fail(SPECULA_ERROR_BUFFER_TOO_SMALL, format!("dst holds {dst_size} bytes, the image needs {need}"));
+        }
+        let vkc = &c.vk;
+        let frame = c.renderer.as_mut().unwrap().render(vkc);
+        c.forward_validation_messages();
+        let frame = frame?;
+        let out = std::slice::from_raw_parts_mut(dst as *mut u8, need);
+        match pixel_format {
+            SPECULA_PIXEL_RGBA32F => out.copy_from_slice(bytemuck::cast_slice(&frame.image.data)),
+            _ => {
+                for (o, px) in out.chunks_exact_mut(4).zip(frame.image.data.chunks_exact(4)) {
+                    o[..3].iter_mut().zip(px).for_each(|(b, v)| *b = crate::scene::linear_to_srgb(*v));
+                    o[3] = 255;
+                }
+            }
+        }
+        Ok(SPECULA_SUCCESS)
+    })
+}
+
+/// Host-device mode: records one frame into the host's `command_buffer` (a VkCommandBuffer
+/// in the recording state, outside a render pass, from `queue_family`) and copies the
+/// result into `target`, leaving it in `target->final_layout`. The host submits. One frame
+/// in flight at a time: the host must have waited for the previous frame of this context.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_record(
+    ctx: *mut SpeculaContext,
+    command_buffer: *mut c_void,
+    target: *const SpeculaHostImage,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if c.vk.owns_device() {
+            return fail(SPECULA_ERROR_WRONG_ORDER, "standalone context: render frames with specula_context_render");
+        }
+        if command_buffer.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "command_buffer is NULL");
+        }
+        let t = header(target, SPECULA_STRUCT_HOST_IMAGE, "target")?;
+        if t.image == 0 {
+            return fail(SPECULA_ERROR_NULL_POINTER, "target.image is VK_NULL_HANDLE");
+        }
+        let name = if t.debug_name.is_null() { "host.target".to_string() } else { cstr(t.debug_name, "target.debug_name")?.to_string() };
+        let layout = |v: u32, what: &str| -> FfiResult<vk::ImageLayout> {
+            let l = vk::ImageLayout::from_raw(v as i32);
+            let known = [
+                vk::ImageLayout::UNDEFINED,
+                vk::ImageLayout::GENERAL,
+                vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                vk::ImageLayout::PRESENT_SRC_KHR,
+            ];
+            if known.contains(&l) {
+                Ok(l)
+            } else {
+                fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("{what}: unsupported VkImageLayout {v}"))
+            }
+        };
+        let current = layout(t.current_layout, "target.current_layout")?;
+        let final_layout = layout(t.final_layout, "target.final_layout")?;
+        if final_layout == vk::ImageLayout::UNDEFINED {
+            return fail(SPECULA_ERROR_INVALID_ARGUMENT, "target.final_layout must not be UNDEFINED");
+        }
+        let mut host =
+            Image::external(vk::Image::from_raw(t.image), vk::Format::from_raw(t.format as i32), t.width, t.height, current, &name);
+        c.vk.name(host.raw, &name);
+        c.renderer()?;
+        let vkc = &c.vk;
+        let cmd = vk::CommandBuffer::from_raw(command_buffer as u64);
+        c.renderer.as_mut().unwrap().record_into(vkc, cmd, &mut host, final_layout)?;
+        Ok(SPECULA_SUCCESS)
+    })
+}
+
+/// Copies the per-pass timings of the last frame the GPU completed into `out` (up to
+/// `capacity` entries) and the number of passes into `*count`. `out` may be NULL with
+/// capacity 0 to query the count. Returns SPECULA_WARNING_TRUNCATED when capacity was too
+/// small and SPECULA_WARNING_NOT_READY when no frame has completed yet.
+#[no_mangle]
+pub unsafe extern "C" fn specula_get_pass_timings(
+    ctx: *mut SpeculaContext,
+    out: *mut SpeculaPassTiming,
+    capacity: u32,
+    count: *mut u32,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if count.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
+        }
+        if out.is_null() && capacity > 0 {
+            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
+        }
+        let vkc = &c.vk;
+        let Some(r) = c.renderer.as_mut() else {
+            return fail(SPECULA_ERROR_WRONG_ORDER, "no renderer: call specula_context_configure first");
+        };
+        let timings = r.last_timings(vkc)?;
+        *count = timings.len() as u32;
+        if timings.is_empty() {
+            return Ok(SPECULA_WARNING_NOT_READY);
+        }
+        for (i, t) in timings.iter().take(capacity as usize).enumerate() {
+            let mut name = [0 as c_char; 48];
+            for (d, s) in name.iter_mut().zip(t.name.bytes().take(47)) {
+                *d = s as c_char;
+            }
+            *out.add(i) = SpeculaPassTiming { name, gpu_ms: t.gpu_ms, cpu_ms: t.cpu_ms };
+        }
+        Ok(if (capacity as usize) < timings.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+    })
+}
+
+/// Device memory the context's resources hold, in bytes, into `*out`.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_memory_bytes(ctx: *mut SpeculaContext, out: *mut u64) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if out.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL");
+        }
+        *out = c.vk.memory.total();
+        Ok(SPECULA_SUCCESS)
+    })
+}

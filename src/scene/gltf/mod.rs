@@ -1,0 +1,165 @@
+//! glTF 2.0 import (`.gltf` with external or embedded buffers, `.glb`) into a world-space
+//! [`Scene`].
+//!
+//! The `gltf` crate parses and validates the JSON; everything that touches binary data
+//! (buffers, buffer views, accessors, images) is read and bounds-checked here, so that a
+//! malformed file gives an [`Error::Scene`] naming the file and the offending field
+//! (`meshes[0].primitives[1].attributes.POSITION`, `images[2] (uri "wall.png")` …) and
+//! never a panic.
+//!
+//! Choices where glTF leaves room:
+//! - Primitive modes: triangles, triangle strips and triangle fans are imported (strips and
+//!   fans are converted to lists); points and lines are skipped without error, as are
+//!   primitives with no vertices or no triangles.
+//! - Materials are imported when a drawn primitive uses them (so `Scene::materials` is not
+//!   indexed like the glTF `materials` array), but every material's scalar parameters
+//!   (KHR_materials_ior, KHR_materials_emissive_strength) are validated up front.
+//!   Only images that an imported base-colour or emissive texture refers to are decoded.
+//! - Texture coordinates: the set the base-colour texture names (KHR_texture_transform's
+//!   `texCoord` override included; set 0 without a base-colour texture), with the base-colour
+//!   texture's KHR_texture_transform applied. The emissive texture shares these coordinates.
+//! - Only perspective cameras are considered; orthographic ones are ignored. The first one
+//!   in depth-first traversal order wins.
+//! - `extras.specula.reference_point` (on the node, else on the mesh) is given in the node's
+//!   local frame and transformed to world space.
+//! - `extras.specula.method` (on the node, else on the material): the method of that
+//!   specular object when the whole scene's method is `auto` (a registered GPU method's
+//!   name, or "auto"); an unknown name is an error naming the field.
+//! - Objects are named `<mesh name>/<primitive>`; the mesh name and the node name address
+//!   them too (`--object NAME=METHOD`, the C ABI).
+//! - Skins, morph targets and animations are ignored (the static node transforms are used).
+//! - A node hierarchy with a cycle is an error.
+//!
+//! Files: this one parses the document and holds the importer's state; `accessors` reads
+//! the binary data (buffers, buffer views, accessors, images), `translate` turns nodes,
+//! meshes, materials, lights and the camera into the scene.
+
+mod accessors;
+mod translate;
+
+use std::collections::HashMap;
+use std::panic::AssertUnwindSafe;
+use std::path::{Path, PathBuf};
+
+use gltf::json::validation::Checked;
+
+use super::Scene;
+use crate::error::{Error, Result};
+
+/// Loads a `.gltf` or `.glb` file into a world-space scene. See the module documentation.
+pub fn load(path: &Path) -> Result<Scene> {
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let file = path.display().to_string();
+    let base = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    // Everything below checks its input; the unwind guard is a last line of defence against
+    // a panic inside a dependency on input nobody anticipated.
+    match std::panic::catch_unwind(AssertUnwindSafe(|| import(&file, base, &bytes))) {
+        Ok(result) => result,
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            Err(Error::scene(file, "(document)", format!("internal error while importing: {what}")))
+        }
+    }
+}
+
+fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(file, e))?;
+    let (doc, blob) = (gltf.document, gltf.blob);
+    // gltf-json's validation indexes the POSITION accessor before checking the index.
+    precheck(file, doc.as_json())?;
+    let doc = gltf::Document::from_json(doc.into_json()).map_err(|e| gltf_error(file, e))?;
+
+    let mut imp = Importer {
+        file,
+        base,
+        doc: &doc,
+        buffers: Vec::new(),
+        scene: Scene::new(),
+        materials: HashMap::new(),
+        default_material: None,
+        textures: HashMap::new(),
+    };
+    imp.buffers = imp.load_buffers(blob)?;
+    for material in doc.materials() {
+        imp.check_material_scalars(&material)?;
+    }
+    imp.walk()?;
+    Ok(imp.scene)
+}
+
+/// gltf-json spells extension names in its paths as Rust fields ("khrLightsPunctual").
+fn extension_names(path: String) -> String {
+    const NAMES: &[(&str, &str)] = &[
+        ("khrLightsPunctual", "KHR_lights_punctual"),
+        ("khrMaterialsIor", "KHR_materials_ior"),
+        ("khrMaterialsTransmission", "KHR_materials_transmission"),
+        ("khrMaterialsVolume", "KHR_materials_volume"),
+        ("khrMaterialsSpecular", "KHR_materials_specular"),
+        ("khrMaterialsEmissiveStrength", "KHR_materials_emissive_strength"),
+        ("khrTextureTransform", "KHR_texture_transform"),
+        ("textureTransform", "KHR_texture_transform"),
+    ];
+    NAMES.iter().fold(path, |p, (from, to)| p.replace(from, to))
+}
+
+/// Wraps a `gltf` crate error; validation errors name the first offending path.
+fn gltf_error(file: &str, e: gltf::Error) -> Error {
+    match e {
+        gltf::Error::Validation(list) => {
+            let field = list.first().map(|(p, _)| extension_names(p.to_string())).unwrap_or_else(|| "(document)".into());
+            let message = list.iter().map(|(p, e)| format!("{}: {e}", extension_names(p.to_string()))).collect::<Vec<_>>().join("; ");
+            Error::scene(file, field, format!("invalid glTF: {message}"))
+        }
+        gltf::Error::Deserialize(e) => Error::scene(file, "(JSON)", format!("malformed glTF JSON: {e}")),
+        gltf::Error::Binary(e) => Error::scene(file, "(GLB container)", format!("malformed GLB: {e}")),
+        other => Error::scene(file, "(document)", other.to_string()),
+    }
+}
+
+/// Checks what gltf-json's validation would otherwise index out of range.
+fn precheck(file: &str, root: &gltf::json::Root) -> Result<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "?".into(),
+                    };
+                    return Err(Error::scene(
+                        file,
+                        format!("meshes[{m}].primitives[{p}].attributes.{name}"),
+                        format!("accessor index {} out of range ({} accessors)", index.value(), root.accessors.len()),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+struct Importer<'a> {
+    file: &'a str,
+    base: PathBuf,
+    doc: &'a gltf::Document,
+    buffers: Vec<Vec<u8>>,
+    scene: Scene,
+    /// glTF material index → scene material.
+    materials: HashMap<usize, usize>,
+    default_material: Option<usize>,
+    /// glTF image index → scene texture.
+    textures: HashMap<usize, usize>,
+}
+
+impl<'a> Importer<'a> {
+    fn err(&self, field: impl Into<String>, message: impl Into<String>) -> Error {
+        Error::scene(self.file, field, message)
+    }
+}
