@@ -5,13 +5,17 @@
 //! `glslang-tools` in seconds, while the crate builds glslang from C++ source for ~95 s
 //! per profile; CI pays that on every fresh clone. Shaders compile in parallel threads.
 
+#[path = "build/layout.rs"]
+#[allow(dead_code)]
+mod layout;
 #[path = "build/shaderc.rs"]
+#[allow(dead_code)]
 mod shaderc;
 
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use shaderc::{collect, compile};
+use shaderc::{collect, compile_with};
 
 fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
@@ -20,8 +24,32 @@ fn main() {
     // A directory makes cargo rerun when any file below it changes (or is added).
     println!("cargo:rerun-if-changed=glsl");
     println!("cargo:rerun-if-changed=build/shaderc.rs");
+    println!("cargo:rerun-if-changed=build/layout.rs");
+    println!("cargo:rerun-if-changed=src/frame/layout.in.rs");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=GLSLANG_VALIDATOR");
+
+    // The shared declaration's GLSL side (`#include "generated/layout.glsl"`), after checking
+    // that std430 and repr(C) agree on every field's offset.
+    let generated = out.join("glsl");
+    match layout::glsl(&layout::declared()) {
+        Ok(text) => {
+            std::fs::create_dir_all(generated.join("generated")).unwrap();
+            let path = generated.join("generated/layout.glsl");
+            // Rewritten only when it changes, so that its timestamp means something.
+            if std::fs::read_to_string(&path).ok().as_deref() != Some(text.as_str()) {
+                std::fs::write(&path, text).unwrap();
+            }
+        }
+        Err(e) => {
+            for line in e.lines() {
+                println!("cargo:warning={line}");
+            }
+            eprintln!("{e}");
+            eprintln!("src/frame/layout.in.rs: the shared layout is refused");
+            std::process::exit(1);
+        }
+    }
 
     let mut sources = Vec::new();
     collect(&glsl, &mut sources);
@@ -32,8 +60,8 @@ fn main() {
         let handles: Vec<_> = sources
             .iter()
             .map(|src| {
-                let (glsl, out, compiler) = (&glsl, &out, &compiler);
-                s.spawn(move || compile(compiler, glsl, out, src))
+                let (glsl, out, compiler, generated) = (&glsl, &out, &compiler, &generated);
+                s.spawn(move || compile_with(compiler, glsl, &[generated], out, src))
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()

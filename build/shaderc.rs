@@ -22,11 +22,18 @@ pub fn collect(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// Compiles one shader; on failure returns its diagnostics as `file:line: message`.
 pub fn compile(compiler: &str, glsl: &Path, out: &Path, src: &Path) -> Result<(String, PathBuf), String> {
+    compile_with(compiler, glsl, &[], out, src)
+}
+
+/// `compile`, with more include directories searched after `glsl` (build.rs: the generated
+/// headers in `$OUT_DIR/glsl`).
+pub fn compile_with(compiler: &str, glsl: &Path, includes: &[&Path], out: &Path, src: &Path) -> Result<(String, PathBuf), String> {
     let name = src.strip_prefix(glsl).unwrap().to_string_lossy().replace('\\', "/");
     let spv = out.join(format!("{}.spv", name.replace('/', "__")));
     let output = Command::new(compiler)
         .args(["-V", "--target-env", "vulkan1.3", "-Os"])
         .arg("-I".to_string() + &glsl.display().to_string())
+        .args(includes.iter().map(|i| "-I".to_string() + &i.display().to_string()))
         .arg("-o")
         .arg(&spv)
         .arg(src)

@@ -7,6 +7,8 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
 use crate::error::{Error, Result};
+pub use crate::frame::layout::{GpuLight, GpuMaterial, GpuObject, GpuView};
+use crate::frame::layout::{KIND_DIELECTRIC, KIND_DIFFUSE, KIND_MIRROR, LIGHT_DIRECTIONAL, LIGHT_POINT, LIGHT_SPOT};
 use crate::scene::{LightKind, Scene, SurfaceKind};
 use crate::vk::{Access, Buffer, Context, Image, ImageDesc, ImageKind, Recorder};
 
@@ -19,57 +21,6 @@ pub struct Vertex {
     pub position: [f32; 3],
     pub normal: [f32; 3],
     pub uv: [f32; 2],
-}
-
-/// std430 twin of `Material` in glsl/common/scene.glsl.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuMaterial {
-    pub base_color: [f32; 4],
-    pub emissive: [f32; 4],
-    pub nu: [f32; 4],
-    pub kappa: [f32; 4],
-    pub specular: [f32; 4],
-    pub kind: u32,
-    pub base_texture: i32,
-    pub emissive_texture: i32,
-    pub thin: u32,
-}
-
-/// std430 twin of `Object`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuObject {
-    pub material: u32,
-    pub envmap_layer: i32,
-    pub refractor_layer: i32,
-    /// `MapShading::code()` of its method.
-    pub map_shading: u32,
-    /// xyz; w: proxy sphere radius.
-    pub reference_point: [f32; 4],
-    pub proxy_min: [f32; 4],
-    pub proxy_max: [f32; 4],
-}
-
-/// std430 twin of `Light`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuLight {
-    pub position_range: [f32; 4],
-    pub direction_kind: [f32; 4],
-    pub intensity: [f32; 4],
-    pub cone: [f32; 4],
-    pub shadow_view_proj: [[f32; 4]; 4],
-}
-
-/// std430 twin of `View`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct GpuView {
-    pub view_proj: [[f32; 4]; 4],
-    pub inv_view_proj: [[f32; 4]; 4],
-    pub eye: [f32; 4],
-    pub dir: [f32; 4],
 }
 
 /// One mesh's draw call.
@@ -96,9 +47,9 @@ pub struct GpuScene {
 
 pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let (kind, nu, kappa, thin) = match m.kind {
-        SurfaceKind::Diffuse => (0, [1.0; 3], [0.0; 3], 0),
-        SurfaceKind::Mirror { nu, kappa } => (1, nu.to_array(), kappa.to_array(), 0),
-        SurfaceKind::Dielectric { ior, thin } => (2, [ior; 3], [0.0; 3], thin as u32),
+        SurfaceKind::Diffuse => (KIND_DIFFUSE, [1.0; 3], [0.0; 3], 0),
+        SurfaceKind::Mirror { nu, kappa } => (KIND_MIRROR, nu.to_array(), kappa.to_array(), 0),
+        SurfaceKind::Dielectric { ior, thin } => (KIND_DIELECTRIC, [ior; 3], [0.0; 3], thin as u32),
     };
     let v4 = |a: [f32; 3]| [a[0], a[1], a[2], 0.0];
     GpuMaterial {
@@ -114,12 +65,14 @@ pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     }
 }
 
+/// `LIGHT_*` of a light, as `GpuLight.direction_kind.w` holds it.
 pub fn light_kind_code(k: LightKind) -> f32 {
-    match k {
-        LightKind::Point => 0.0,
-        LightKind::Spot { .. } => 1.0,
-        LightKind::Directional => 2.0,
-    }
+    let code = match k {
+        LightKind::Point => LIGHT_POINT,
+        LightKind::Spot { .. } => LIGHT_SPOT,
+        LightKind::Directional => LIGHT_DIRECTIONAL,
+    };
+    code as f32
 }
 
 impl GpuScene {

@@ -11,6 +11,7 @@ use crate::cube::face_view_proj;
 use crate::error::{Error, Result};
 use crate::frame::camera::CameraShade;
 use crate::frame::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
+use crate::frame::layout::{binding, BINDINGS, MAP_BINDINGS, MAP_SHADING_SKY};
 use crate::frame::shadow::ShadowMaps;
 use crate::frame::stage::{FrameIo, LayerField, MapSets, Maps, Stage, StageInit, ViewLayout};
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, PUSH_BYTES};
@@ -18,33 +19,12 @@ use crate::gpu_scene::{light_kind_code, GpuLight, GpuObject, GpuScene, GpuView};
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::{Camera, LightKind, Scene};
-use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image, Binding};
+use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image};
 use crate::vk::{
     record_copy_to_buffer, Access, Buffer, Context, Image, ImageData, ImageDesc, ImageKind, MemoryLocation, PassTiming, Profiler, Recorder,
 };
 
 const MAX_PASSES: u32 = 32;
-
-/// The frame descriptor set's bindings (glsl/common/scene.glsl).
-const BINDINGS: &[Binding] = &[
-    (0, vk::DescriptorType::STORAGE_BUFFER, 1),
-    (1, vk::DescriptorType::STORAGE_BUFFER, 1),
-    (2, vk::DescriptorType::STORAGE_BUFFER, 1),
-    (3, vk::DescriptorType::STORAGE_BUFFER, 1),
-    (4, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (5, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (6, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (7, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (8, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-];
-
-/// The maps set's bindings (set 1 in glsl/common/scene.glsl and image_space/refract.vert).
-const MAP_BINDINGS: &[Binding] = &[
-    (0, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (1, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (2, vk::DescriptorType::COMBINED_IMAGE_SAMPLER, 1),
-    (3, vk::DescriptorType::STORAGE_BUFFER, 1),
-];
 
 /// A rendered frame: linear radiance RGBA32F, its per-pass profile and the device memory
 /// that the renderer's resources hold.
@@ -183,7 +163,7 @@ impl Renderer {
                 material: m.material as u32,
                 envmap_layer: -1,
                 refractor_layer: -1,
-                map_shading: 0,
+                map_shading: MAP_SHADING_SKY,
                 reference_point: [0.0; 4],
                 proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
                 proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
@@ -297,15 +277,15 @@ impl Renderer {
         let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
         let buffer = |b: Option<&Buffer>| b.map_or(vk::Buffer::null(), |b| b.raw);
         let view = |i: Option<&Image>| i.map_or(vk::ImageView::null(), |i| i.view);
-        write_buffer(ctx, self.set, 0, sb, self.view_buffer.raw);
-        write_buffer(ctx, self.set, 1, sb, self.scene.materials.raw);
-        write_buffer(ctx, self.set, 2, sb, self.objects.raw);
-        write_buffer(ctx, self.set, 3, sb, buffer(self.lights.as_ref()));
-        write_image(ctx, self.set, 4, 0, cis, view(self.scene.textures.as_ref()), self.linear_repeat, ro);
-        write_image(ctx, self.set, 5, 0, cis, view(self.scene.environment.as_ref()), self.linear_repeat, ro);
-        write_image(ctx, self.set, 6, 0, cis, view(self.maps.shadow_cubes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, 7, 0, cis, view(self.maps.shadow_planes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, 8, 0, cis, view(self.maps.radiance.as_ref()), self.linear_repeat, ro);
+        write_buffer(ctx, self.set, binding::VIEWS, sb, self.view_buffer.raw);
+        write_buffer(ctx, self.set, binding::MATERIALS, sb, self.scene.materials.raw);
+        write_buffer(ctx, self.set, binding::OBJECTS, sb, self.objects.raw);
+        write_buffer(ctx, self.set, binding::LIGHTS, sb, buffer(self.lights.as_ref()));
+        write_image(ctx, self.set, binding::TEXTURES, 0, cis, view(self.scene.textures.as_ref()), self.linear_repeat, ro);
+        write_image(ctx, self.set, binding::ENVIRONMENT_MAP, 0, cis, view(self.scene.environment.as_ref()), self.linear_repeat, ro);
+        write_image(ctx, self.set, binding::SHADOW_CUBES, 0, cis, view(self.maps.shadow_cubes.as_ref()), self.nearest_clamp, ro);
+        write_image(ctx, self.set, binding::SHADOW_PLANES, 0, cis, view(self.maps.shadow_planes.as_ref()), self.nearest_clamp, ro);
+        write_image(ctx, self.set, binding::ENVMAPS, 0, cis, view(self.maps.radiance.as_ref()), self.linear_repeat, ro);
         // Generation sets sample the refractor maps (made first) but no camera-space map;
         // camera sets sample everything; the empty set nothing.
         let refractor = view(self.maps.refractor.as_ref());
@@ -321,10 +301,10 @@ impl Renderer {
             all.push((self.sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
         }
         for (set, distance, refractor, backfaces, thickness) in all {
-            write_image(ctx, set, 0, 0, cis, distance, self.linear_repeat, ro);
-            write_image(ctx, set, 1, 0, cis, refractor, self.linear_repeat, ro);
-            write_image(ctx, set, 2, 0, cis, backfaces, self.nearest_clamp, ro);
-            write_buffer(ctx, set, 3, sb, thickness);
+            write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, self.linear_repeat, ro);
+            write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, self.linear_repeat, ro);
+            write_image(ctx, set, binding::BACKFACE_MAP, 0, cis, backfaces, self.nearest_clamp, ro);
+            write_buffer(ctx, set, binding::THICKNESS, sb, thickness);
         }
     }
 

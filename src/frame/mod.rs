@@ -6,39 +6,17 @@
 
 pub mod camera;
 pub mod direct;
+pub mod layout;
 pub mod shadow;
 pub mod stage;
+
+pub use layout::{Push, SearchKnobs, FLAG_FIRST_CYCLE, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_INTER_OBJECT, FLAG_PROXY_BOX};
 
 use ash::vk;
 
 use crate::gpu_scene::{Draw, GpuScene};
 use crate::quality::CubeMode;
 use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
-
-/// Push constants of every scene-drawing shader (`Push` in glsl/common/scene.glsl).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct Push {
-    pub view: u32,
-    pub object: u32,
-    pub flags: u32,
-    pub light_count: u32,
-    pub search: SearchKnobs,
-    pub tolerance: f32,
-    pub internal_bounces: u32,
-    pub pad: [u32; 2],
-}
-
-/// The distance-map search knobs (§4.1) as the shaders read them.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct SearchKnobs {
-    /// 0: parallax correction only.
-    pub linear_steps: u32,
-    pub secant_steps: u32,
-    pub binary_steps: u32,
-    pub parallax_iterations: u32,
-}
 
 impl SearchKnobs {
     pub fn of(q: &crate::quality::Quality) -> SearchKnobs {
@@ -52,11 +30,6 @@ impl SearchKnobs {
 }
 
 pub const PUSH_BYTES: u32 = std::mem::size_of::<Push>() as u32;
-pub const FLAG_FRESNEL_EXACT: u32 = 1;
-pub const FLAG_HAS_ENVIRONMENT: u32 = 2;
-pub const FLAG_INTER_OBJECT: u32 = 4;
-pub const FLAG_PROXY_BOX: u32 = 8;
-pub const FLAG_FIRST_CYCLE: u32 = 16;
 
 /// What every pass needs to draw the scene: geometry, the frame's descriptor set and
 /// pipeline layout, and the frame-wide push-constant fields.

@@ -36,9 +36,9 @@ pub trait Stage {
     fn destroy(&mut self, ctx: &Context);
 }
 
-/// The frame's shared maps, one per descriptor slot (glsl/common/scene.glsl). A map stage
-/// creates the images of its slot; the camera passes and later map stages sample them; the
-/// renderer writes the descriptors and frees the images.
+/// The frame's shared maps, one per descriptor slot (`binding::*`, src/frame/layout.in.rs).
+/// A map stage creates the images of its slot; the camera passes and later map stages sample
+/// them; the renderer writes the descriptors and frees the images.
 #[derive(Default)]
 pub struct Maps {
     /// Set 0, binding 6: shadow distance cubes of point and spot lights.
@@ -173,7 +173,7 @@ impl PartialEq for MapInfo {
     }
 }
 
-/// The fields of `Object` (glsl/common/scene.glsl) that index map arrays.
+/// The fields of `Object` (`GpuObject`, src/frame/layout.in.rs) that index map arrays.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum LayerField {
     /// `envmap_layer`: the radiance (set 0, binding 8) or distance (set 1, binding 0) cubes.

@@ -57,12 +57,13 @@ pub enum MapShading {
 }
 
 impl MapShading {
-    /// The code the shaders read (`MAP_SHADING_*` in glsl/common/scene.glsl).
+    /// The code the shaders read (`MAP_SHADING_*`, src/frame/layout.in.rs).
     pub fn code(self) -> u32 {
+        use crate::frame::layout::{MAP_SHADING_REFRACTOR, MAP_SHADING_SKY, MAP_SHADING_TRACED};
         match self {
-            MapShading::Sky => 0,
-            MapShading::Traced => 1,
-            MapShading::Refractor => 2,
+            MapShading::Sky => MAP_SHADING_SKY,
+            MapShading::Traced => MAP_SHADING_TRACED,
+            MapShading::Refractor => MAP_SHADING_REFRACTOR,
         }
     }
 }

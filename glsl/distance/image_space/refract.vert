@@ -2,14 +2,12 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_multiview : require
 // Wyman's second pass: the mesh with each vertex's precomputed distance through the object
-// along its inverted normal (d_N).
+// along its inverted normal (d_N): `thickness`, set 1 binding 3 (src/frame/layout.in.rs).
 #include "common/scene.glsl"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
 layout(location = 2) in vec2 in_uv;
-
-layout(set = 1, binding = 3) readonly buffer Thickness { float thickness[]; };
 
 layout(location = 0) out vec3 out_position;
 layout(location = 1) out vec3 out_normal;

@@ -1,0 +1,163 @@
+// The one declaration of what Rust and the shaders share: the std430 structs, the
+// push-constant block, the consts and the descriptor bindings. Two macros read it:
+// src/frame/layout.rs expands it into the crate's `#[repr(C)]` structs and consts, and
+// build/layout.rs into `$OUT_DIR/glsl/generated/layout.glsl` (included by
+// glsl/common/scene.glsl), after checking that std430 and `repr(C)` lay every field out at
+// the same offset. Field types are GLSL's (`[T; N]` is an array; a struct is named by its
+// Rust name); doc comments go to both sides.
+
+gpu_structs! {
+    /// std430 twin of `View`: one camera, cube face or shadow view.
+    struct GpuView => struct View {
+        /// world -> clip (reversed-Z, Vulkan y-down)
+        view_proj: mat4,
+        /// clip -> world, for the sky
+        inv_view_proj: mat4,
+        /// xyz: eye or reference point; w: 0 radial distance, 1 planar distance
+        eye: vec4,
+        /// xyz: direction for planar distance (directional shadow maps)
+        dir: vec4,
+    }
+
+    /// std430 twin of `Material`.
+    struct GpuMaterial => struct Material {
+        /// rgb linear albedo, a: unused
+        base_color: vec4,
+        /// rgb emitted radiance
+        emissive: vec4,
+        /// mirror: ν per rgb; dielectric: x = ior
+        nu: vec4,
+        /// mirror: κ per rgb
+        kappa: vec4,
+        /// rgb KHR_materials_specular colour, a factor
+        specular: vec4,
+        /// KIND_*
+        kind: uint,
+        /// -1: none
+        base_texture: int,
+        emissive_texture: int,
+        /// dielectric: thin-walled
+        thin: uint,
+    }
+
+    /// std430 twin of `Object`: one mesh as the passes see it.
+    struct GpuObject => struct Object {
+        material: uint,
+        /// cube index in the environment/distance-map arrays, -1: none
+        envmap_layer: int,
+        /// cube index in the refractor-map array, -1: none
+        refractor_layer: int,
+        /// how it looks in other objects' distance maps: MAP_SHADING_* (`MapShading::code()`
+        /// of its method)
+        map_shading: uint,
+        /// xyz; w: proxy sphere radius (§3.2)
+        reference_point: vec4,
+        /// proxy box (§3.2), world space
+        proxy_min: vec4,
+        proxy_max: vec4,
+    }
+
+    /// std430 twin of `Light`.
+    struct GpuLight => struct Light {
+        /// xyz position, w range (0: unbounded)
+        position_range: vec4,
+        /// xyz direction the light travels, w kind (LIGHT_*)
+        direction_kind: vec4,
+        /// rgb W/sr (point, spot) or W/m^2 (directional); w: directional shadow texel [m]
+        intensity: vec4,
+        /// x cos(outer), y cos(inner), z shadow layer (-1 none), w shadow map size
+        cone: vec4,
+        /// directional: world -> shadow clip
+        shadow_view_proj: mat4,
+    }
+
+    /// The distance-map search knobs (§4.1) as the shaders read them.
+    struct SearchKnobs => struct SearchKnobs {
+        /// 0: parallax correction only
+        linear_steps: uint,
+        secant_steps: uint,
+        binary_steps: uint,
+        parallax_iterations: uint,
+    }
+
+    /// Push constants of every scene-drawing shader.
+    struct Push => push_constant Push push {
+        /// first view of this draw (multiview adds gl_ViewIndex)
+        view: uint,
+        object: uint,
+        /// FLAG_*
+        flags: uint,
+        light_count: uint,
+        search: SearchKnobs,
+        /// early exit when | |l|/|l'| − 1 | ≤ tolerance
+        tolerance: float,
+        /// self refraction: total internal reflections followed (§4.4)
+        internal_bounces: uint,
+        pad: [uint; 2],
+    }
+}
+
+gpu_consts! {
+    /// `Material.kind`: diffuse.
+    KIND_DIFFUSE: uint = 0;
+    /// `Material.kind`: mirror (conductor Fresnel from ν, κ).
+    KIND_MIRROR: uint = 1;
+    /// `Material.kind`: dielectric (ior in ν.x).
+    KIND_DIELECTRIC: uint = 2;
+
+    /// `Light.direction_kind.w` (as a float): point, spot, directional.
+    LIGHT_POINT: uint = 0;
+    LIGHT_SPOT: uint = 1;
+    LIGHT_DIRECTIONAL: uint = 2;
+
+    /// How a specular object is drawn into the other objects' distance maps (§4.3), when the
+    /// frame runs inter-object cycles (FLAG_INTER_OBJECT): the environment only, its own
+    /// distance map of the previous cycle, or self refraction in its refractor map (§4.4).
+    MAP_SHADING_SKY: uint = 0;
+    MAP_SHADING_TRACED: uint = 1;
+    MAP_SHADING_REFRACTOR: uint = 2;
+
+    /// `Push.flags`: exact Fresnel (else Schlick's approximation).
+    FLAG_FRESNEL_EXACT: uint = 1;
+    /// `Push.flags`: the scene has an environment map.
+    FLAG_HAS_ENVIRONMENT: uint = 2;
+    /// Specular objects drawn into maps search their own (previous-cycle) distance maps (§4.3).
+    FLAG_INTER_OBJECT: uint = 4;
+    /// Proxy geometry of localised environment mapping (§3.2): box, else sphere.
+    FLAG_PROXY_BOX: uint = 8;
+    /// First inter-object cycle: no map holds anything yet, specular objects in maps are black
+    /// (paths longer than the requested depth end black, as in the reference).
+    FLAG_FIRST_CYCLE: uint = 16;
+}
+
+descriptor_sets! {
+    /// The frame's descriptor set (set 0), shared by every pass that draws the scene.
+    /// Bindings that a scene does not need (no lights, no textures, no specular objects) hold
+    /// null descriptors (VK_EXT_robustness2 nullDescriptor), so nothing is allocated for them.
+    BINDINGS = set 0 {
+        VIEWS = 0: STORAGE_BUFFER => "readonly buffer Views { View views[]; }";
+        MATERIALS = 1: STORAGE_BUFFER => "readonly buffer Materials { Material materials[]; }";
+        OBJECTS = 2: STORAGE_BUFFER => "readonly buffer Objects { Object objects[]; }";
+        LIGHTS = 3: STORAGE_BUFFER => "readonly buffer Lights { Light lights[]; }";
+        /// All base-colour and emissive textures as layers of one array: lavapipe has no
+        /// dynamic indexing of sampler arrays (shaderSampledImageArrayDynamicIndexing = false).
+        TEXTURES = 4: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray textures";
+        ENVIRONMENT_MAP = 5: COMBINED_IMAGE_SAMPLER => "uniform sampler2D environment_map";
+        SHADOW_CUBES = 6: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray shadow_cubes";
+        SHADOW_PLANES = 7: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray shadow_planes";
+        ENVMAPS = 8: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray envmaps";
+    }
+
+    /// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.
+    MAP_BINDINGS = set 1 {
+        /// rgb radiance, a distance
+        DISTANCE_MAPS = 0: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray distance_maps";
+        /// xyz normal, w distance
+        REFRACTOR_MAPS = 1: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray refractor_maps";
+        /// xyz normal, w distance from the eye
+        BACKFACE_MAP = 2: COMBINED_IMAGE_SAMPLER => "uniform sampler2D backface_map";
+        /// Per-vertex distance through the object along the inverted normal (d_N), read by
+        /// distance/image_space/refract.vert.
+        THICKNESS = 3: STORAGE_BUFFER => "readonly buffer Thickness { float thickness[]; }";
+    }
+}
