@@ -275,3 +275,45 @@ fn reference_point_inside_another_object_is_moved() {
     assert!(pm > pn + 3.0, "moved {pm} vs naive {pn}");
     common::assert_clean(&ctx);
 }
+
+/// `specula plan SCENE --method auto`: per object its method, reason, maps with sizes and
+/// memory, passes and knobs, as a table and as JSON; `--object` overrides one object.
+#[test]
+fn plan_command_prints_per_object_methods() {
+    let exe = env!("CARGO_BIN_EXE_specula");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(exe).args(args).output().unwrap();
+        assert!(o.status.success(), "{args:?}: {}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let table = run(&["plan", scene]);
+    for want in [
+        "method auto",
+        "mirror_sphere/0 (mirror",
+        "distance-multi",
+        "glass_sphere/0 (solid dielectric",
+        "refractor-map",
+        "reason",
+        "MiB",
+        "knobs",
+        "cycles=4",
+    ] {
+        assert!(table.contains(want), "plan table lacks {want}:\n{table}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&run(&["plan", scene, "--method", "auto", "--json"])).unwrap();
+    let objects = json["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 2);
+    for o in objects {
+        assert!(o["reason"].as_str().unwrap().starts_with("auto: "), "{o}");
+        assert!(o["maps"].as_array().is_some_and(|m| !m.is_empty() && m[0]["bytes"].as_u64().unwrap() > 0), "{o}");
+    }
+    let json: serde_json::Value = serde_json::from_str(&run(&["plan", scene, "--object", "mirror_sphere=proxy-box", "--json"])).unwrap();
+    let mirror = json["objects"].as_array().unwrap().iter().find(|o| o["name"] == "mirror_sphere/0").unwrap().clone();
+    assert_eq!(mirror["method"], "proxy-box");
+    // A bad --object is a one-line error naming the object.
+    let o = std::process::Command::new(exe).args(["plan", scene, "--object", "teapot=distance"]).output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!((o.status.code(), err.lines().count()), (Some(1), 1), "{err}");
+    assert!(err.contains("teapot"), "{err}");
+}

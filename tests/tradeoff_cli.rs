@@ -50,7 +50,7 @@ fn reference_renders_on_the_cpu_and_compare_reports_metrics() {
     assert!(out.contains("RMSE      0.000000") && out.contains("PSNR      inf dB"), "{out}");
 
     // The reference's plan is one CPU pass; bad knobs are one-line errors.
-    let plan = run(&["plan", SCENE, "--method", "reference"]);
+    let plan = run(&["plan", SCENE, "--method", "reference", "--json"]);
     let json: serde_json::Value = serde_json::from_str(&plan).unwrap();
     assert_eq!(json["passes"], serde_json::json!(["reference.trace"]));
     assert_eq!(json["envmaps"], serde_json::json!([]));

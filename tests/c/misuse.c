@@ -141,13 +141,45 @@ int main(int argc, char **argv) {
     const SpeculaMethod methods[] = {SPECULA_METHOD_ENVMAP,   SPECULA_METHOD_PROXY_SPHERE,   SPECULA_METHOD_PROXY_BOX,
                                      SPECULA_METHOD_DISTANCE, SPECULA_METHOD_DISTANCE_MULTI, SPECULA_METHOD_REFRACTOR_MAP,
                                      SPECULA_METHOD_IMAGE_SPACE_REFRACTION};
-    CASE("knob: depth=2", specula_context_set_knob(ctx, "depth", "2"), SPECULA_SUCCESS);
+    CASE("knob: cycles=2", specula_context_set_knob(ctx, "cycles", "2"), SPECULA_SUCCESS);
     for (unsigned i = 0; i < sizeof methods / sizeof methods[0]; ++i) {
         SpeculaRenderDesc each = render;
         each.method = methods[i];
         CASE("configure each method", specula_context_configure(ctx, &each), SPECULA_SUCCESS);
         CASE("render each method", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
     }
+    /* Per-object methods: auto, names, overrides, and every way to get them wrong. */
+    SpeculaRenderDesc auto_desc = render;
+    auto_desc.method = SPECULA_METHOD_AUTO;
+    CASE("configure: auto", specula_context_configure(ctx, &auto_desc), SPECULA_SUCCESS);
+    CASE("render: auto", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
+    uint32_t objects = 0;
+    CASE("object_count", specula_context_object_count(ctx, &objects), SPECULA_SUCCESS);
+    expect("the demo has objects", objects >= 8 ? 0 : -1, 0, "object count");
+    CASE("object_count: NULL out", specula_context_object_count(ctx, NULL), SPECULA_ERROR_NULL_POINTER);
+    char name[64];
+    CASE("object_name: 0", specula_context_object_name(ctx, 0, name, sizeof name), SPECULA_SUCCESS);
+    char tiny[3];
+    CASE("object_name: truncated", specula_context_object_name(ctx, 0, tiny, sizeof tiny), SPECULA_WARNING_TRUNCATED);
+    expect("truncated name is NUL-terminated", strlen(tiny) == 2 ? 0 : -1, 0, tiny);
+    CASE("object_name: index out of range", specula_context_object_name(ctx, objects, name, sizeof name), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("object_name: NULL buffer", specula_context_object_name(ctx, 0, NULL, 8), SPECULA_ERROR_NULL_POINTER);
+    CASE("set_object_method: mirror=distance", specula_context_set_object_method(ctx, "mirror_sphere", SPECULA_METHOD_DISTANCE), SPECULA_SUCCESS);
+    CASE("set_object_method: glass=refractor-map", specula_context_set_object_method(ctx, "glass_sphere", SPECULA_METHOD_REFRACTOR_MAP), SPECULA_SUCCESS);
+    CASE("configure: mixed methods", specula_context_configure(ctx, &auto_desc), SPECULA_SUCCESS);
+    CASE("render: mixed methods", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
+    CASE("set_object_method: unknown object", specula_context_set_object_method(ctx, "teapot", SPECULA_METHOD_DISTANCE), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the object", strstr(specula_context_last_error(ctx), "'teapot'") ? 0 : -1, 0, specula_context_last_error(ctx));
+    CASE("set_object_method: unknown method", specula_context_set_object_method(ctx, "mirror_sphere", 42), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("set_object_method: CPU method", specula_context_set_object_method(ctx, "mirror_sphere", SPECULA_METHOD_REFERENCE), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("set_object_method: cannot serve", specula_context_set_object_method(ctx, "mirror_sphere", SPECULA_METHOD_REFRACTOR_MAP), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message says why", strstr(specula_context_last_error(ctx), "cannot serve a mirror") ? 0 : -1, 0, specula_context_last_error(ctx));
+    CASE("set_object_method: diffuse object", specula_context_set_object_method(ctx, "wall_floor", SPECULA_METHOD_DISTANCE), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("set_object_method: NULL name", specula_context_set_object_method(ctx, NULL, SPECULA_METHOD_DISTANCE), SPECULA_ERROR_NULL_POINTER);
+    CASE("set_object_method_at: out of range", specula_context_set_object_method_at(ctx, 100000, SPECULA_METHOD_DISTANCE), SPECULA_ERROR_INVALID_ARGUMENT);
+    CASE("set_object_method: auto clears", specula_context_set_object_method(ctx, "glass_sphere", SPECULA_METHOD_AUTO), SPECULA_SUCCESS);
+    CASE("configure after the errors", specula_context_configure(ctx, &auto_desc), SPECULA_SUCCESS);
+    CASE("render after the errors", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
     SpeculaPassTiming one[1];
     CASE("timings: capacity 1", specula_get_pass_timings(ctx, one, 1, &count), SPECULA_WARNING_TRUNCATED);
     CASE("timings: NULL out with capacity", specula_get_pass_timings(ctx, NULL, 4, &count), SPECULA_ERROR_NULL_POINTER);

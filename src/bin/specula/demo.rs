@@ -1,11 +1,12 @@
-//! `specula demo`: every method on the bundled demo scene, images, traces, a timing table,
-//! errors against the reference and a contact sheet.
+//! `specula demo`: `auto` and every method of the registry on the bundled demo scene:
+//! images, traces, a timing table, errors against the reference and a labelled contact
+//! sheet.
 
 use std::path::Path;
 
-use specula::image::ImageData;
+use specula::demo::Tile;
 use specula::scene;
-use specula::{Method, Quality};
+use specula::{Choice, Method, Quality};
 
 use crate::args::{context, parse_size, reference_summary, reference_timing, render_reference, write_image};
 
@@ -16,44 +17,49 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     let (w, h) = parse_size(size)?;
     std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
     let ctx = context(validate, device)?;
+    let q = Quality::default();
     let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
-    let mut images: Vec<(&str, ImageData)> = Vec::new();
-    for &method in Method::ALL {
-        let png = outdir.join(format!("{}.png", method.name()));
-        let exr = outdir.join(format!("{}.exr", method.name()));
-        if !method.is_gpu() {
-            let q = Quality::default();
-            let (img, ms) = render_reference(&scene, &q, (w, h))?;
-            write_image(&png, &img)?;
-            write_image(&exr, &img)?;
-            let trace = outdir.join(format!("{}.trace.json", method.name()));
-            std::fs::write(&trace, specula::profile::chrome_trace(&[reference_timing(ms)], &[], "CPU"))
-                .map_err(|e| specula::Error::io(&trace, e))?;
-            report += &format!("== method {} -> {}\n{}\n\n", method.name(), png.display(), reference_summary(&q, w, h, ms));
-            images.push((method.name(), img));
-            continue;
-        }
-        let frame = specula::render(&ctx, &scene, method, &Quality::default(), (w, h), (2, 5))?;
+
+    // The exact reference first: every tile's label carries its error against it.
+    let reference_method = specula::methods::REFERENCE;
+    let (reference, ref_ms) = render_reference(&scene, &q, (w, h))?;
+    let stem = outdir.join(reference_method.name());
+    write_image(&stem.with_extension("png"), &reference)?;
+    write_image(&stem.with_extension("exr"), &reference)?;
+    let trace = stem.with_extension("trace.json");
+    std::fs::write(&trace, specula::profile::chrome_trace(&[reference_timing(ref_ms)], &[], "CPU"))
+        .map_err(|e| specula::Error::io(&trace, e))?;
+    report += &format!("== method reference -> {}\n{}\n\n", stem.with_extension("png").display(), reference_summary(&q, w, h, ref_ms));
+
+    let choices = std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method));
+    let mut tiles = Vec::new();
+    let mut errors = String::from("== error against the reference (PSNR, frame GPU ms, device memory)\n");
+    for choice in choices {
+        let name = choice.name();
+        let plan = specula::plan(&scene, choice, &q);
+        let methods: Vec<String> = plan.objects.iter().map(|o| format!("{}: {} ({})", o.name, o.method.name(), o.reason)).collect();
+        let frame = specula::render_plan(&ctx, &scene, plan, (w, h), (2, 5))?;
+        let png = outdir.join(format!("{name}.png"));
         write_image(&png, &frame.image)?;
-        write_image(&exr, &frame.image)?;
-        let trace = outdir.join(format!("{}.trace.json", method.name()));
+        write_image(&outdir.join(format!("{name}.exr")), &frame.image)?;
+        let trace = outdir.join(format!("{name}.trace.json"));
         std::fs::write(&trace, specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name))
             .map_err(|e| specula::Error::io(&trace, e))?;
-        report += &format!("== method {} -> {} (median of 5 frames)\n", method.name(), png.display());
+        report += &format!("== method {name} -> {} (median of 5 frames)\n", png.display());
+        for m in &methods {
+            report += &format!("   {m}\n");
+        }
         report += &specula::profile::table(&frame.passes, &frame.memory);
         report.push('\n');
-        images.push((method.name(), frame.image));
+        let e = specula::metrics::compare(&frame.image, &reference)?;
+        errors += &format!("{name:<24} {e}  {:.2} ms  {:.1} MiB\n", frame.gpu_ms(), frame.memory_bytes() as f64 / 1048576.0);
+        tiles.push(Tile { name: name.into(), label: format!("{name} {:.1}ms {:.1}dB", frame.gpu_ms(), e.psnr), image: frame.image });
     }
-    // Every method against the exact reference, and all of them side by side (the survey's
-    // Figures 20 and 24 in one sheet): methods.png, and methods.svg with labels.
-    if let Some((_, reference)) = images.iter().find(|(n, _)| *n == specula::methods::REFERENCE.name()) {
-        report += "== error against the reference\n";
-        for (name, img) in images.iter().filter(|(n, _)| *n != specula::methods::REFERENCE.name()) {
-            report += &format!("{name:<24} {}\n", specula::metrics::compare(img, reference)?);
-        }
-        report.push('\n');
-    }
-    specula::demo::write_composite(outdir, &images, w, h)?;
+    tiles.push(Tile { name: reference_method.name().into(), label: format!("reference {:.0}ms CPU", ref_ms), image: reference });
+    report += &errors;
+    report.push('\n');
+    // All of them side by side (the survey's Figures 20 and 24 in one sheet).
+    specula::demo::write_composite(outdir, &tiles, w, h)?;
     report += &format!("side by side: {}, {}\n", outdir.join("methods.png").display(), outdir.join("methods.svg").display());
     print!("{report}");
     let table = outdir.join("timings.txt");
