@@ -5,20 +5,20 @@
 //! methods' folders and `frame`.
 
 use ash::vk;
-use glam::{Mat4, Vec3, Vec4};
+use glam::Mat4;
 
-use crate::cube::face_view_proj;
 use crate::error::{Error, Result};
 use crate::frame::camera::CameraShade;
 use crate::frame::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{binding, BINDINGS, MAP_BINDINGS, MAP_SHADING_SKY};
 use crate::frame::shadow::ShadowMaps;
 use crate::frame::stage::{FrameIo, LayerField, MapSets, Maps, Stage, StageInit, ViewLayout};
+use crate::frame::{output, views};
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, PUSH_BYTES};
-use crate::gpu_scene::{light_kind_code, GpuLight, GpuObject, GpuScene, GpuView};
+use crate::gpu_scene::{GpuLight, GpuObject, GpuScene, GpuView};
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
-use crate::scene::{Camera, LightKind, Scene};
+use crate::scene::{Camera, Scene};
 use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image};
 use crate::vk::{
     record_copy_to_buffer, Access, Buffer, Context, Image, ImageData, ImageDesc, ImageKind, MemoryLocation, PassTiming, Profiler, Recorder,
@@ -133,21 +133,7 @@ impl Renderer {
 
     fn init(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
         let plan = &self.plan;
-        // The view table: camera, shadow cube faces, shadow planes, environment-map faces.
-        let mut v = ViewLayout { camera: 0, count: 1, ..Default::default() };
-        for _ in &plan.shadow_cubes {
-            v.shadow_cubes.push(v.count);
-            v.count += 6;
-        }
-        for _ in &plan.shadow_planes {
-            v.shadow_planes.push(v.count);
-            v.count += 1;
-        }
-        for _ in &plan.envmaps {
-            v.envmaps.push(v.count);
-            v.count += 6;
-        }
-        self.views = v;
+        self.views = ViewLayout::of(plan);
         self.view_buffer = Buffer::new(
             ctx,
             "frame.views",
@@ -184,7 +170,7 @@ impl Renderer {
         }
         self.objects = Buffer::with_data(ctx, "scene.objects", &objects, vk::BufferUsageFlags::STORAGE_BUFFER)?;
 
-        self.light_table = self.light_table(scene);
+        self.light_table = views::light_table(scene, &self.plan);
         self.light_count = self.light_table.len() as u32;
         if !self.light_table.is_empty() {
             self.lights = Some(Buffer::with_data(ctx, "scene.lights", &self.light_table, vk::BufferUsageFlags::STORAGE_BUFFER)?);
@@ -232,42 +218,6 @@ impl Renderer {
         self.profiler = Profiler::new(ctx, MAX_PASSES)?;
         self.write_descriptors(ctx);
         Ok(())
-    }
-
-    fn light_table(&self, scene: &Scene) -> Vec<GpuLight> {
-        let bounds = scene.bounds();
-        let (center, radius) = (bounds.center(), (bounds.diagonal() * 0.5).max(1e-6));
-        let size = self.plan.quality.shadow_size as f32;
-        scene
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| {
-                let mut cone = [-2.0, -1.0, -1.0, size];
-                let mut view_proj = Mat4::IDENTITY;
-                let mut texel = 0.0;
-                if let LightKind::Spot { inner_cone, outer_cone } = l.kind {
-                    cone[0] = outer_cone.cos();
-                    cone[1] = inner_cone.cos();
-                }
-                if let Some(k) = self.plan.shadow_cubes.iter().position(|&j| j == i) {
-                    cone[2] = k as f32;
-                }
-                if let Some(k) = self.plan.shadow_planes.iter().position(|&j| j == i) {
-                    cone[2] = k as f32;
-                    view_proj = directional_view_proj(l.direction, center, radius);
-                    texel = 2.0 * radius / size;
-                }
-                let position = if l.kind == LightKind::Directional { center - l.direction * radius } else { l.position };
-                GpuLight {
-                    position_range: position.extend(l.range.unwrap_or(0.0)).to_array(),
-                    direction_kind: l.direction.extend(light_kind_code(l.kind)).to_array(),
-                    intensity: l.intensity.extend(texel).to_array(),
-                    cone,
-                    shadow_view_proj: view_proj.to_cols_array_2d(),
-                }
-            })
-            .collect()
     }
 
     /// Writes every binding; what the scene does not need gets a null descriptor.
@@ -367,30 +317,7 @@ impl Renderer {
     }
 
     fn write_views(&mut self) -> Result<()> {
-        let scene_lights = &self.light_table;
-        let mut views = vec![GpuView::zeroed(); self.views.count as usize];
-        let vp = self.camera_view_proj();
-        views[self.views.camera as usize] = view(vp, self.camera.position.extend(0.0), Vec4::ZERO);
-        let near = self.plan.cube_near;
-        for (k, &li) in self.plan.shadow_cubes.iter().enumerate() {
-            let p = Vec3::from_slice(&scene_lights[li].position_range[..3]);
-            for f in 0..6 {
-                views[(self.views.shadow_cubes[k] + f) as usize] = view(face_view_proj(f as usize, p, near), p.extend(0.0), Vec4::ZERO);
-            }
-        }
-        for (k, &li) in self.plan.shadow_planes.iter().enumerate() {
-            let l = &scene_lights[li];
-            let m = Mat4::from_cols_array_2d(&l.shadow_view_proj);
-            let origin = Vec3::from_slice(&l.position_range[..3]);
-            let dir = Vec3::from_slice(&l.direction_kind[..3]);
-            views[self.views.shadow_planes[k] as usize] = view(m, origin.extend(1.0), dir.extend(0.0));
-        }
-        for (e, &base) in self.plan.envmaps.iter().zip(&self.views.envmaps) {
-            for f in 0..6 {
-                views[(base + f) as usize] =
-                    view(face_view_proj(f as usize, e.reference_point, near), e.reference_point.extend(0.0), Vec4::ZERO);
-            }
-        }
+        let views = views::view_table(&self.plan, &self.views, &self.light_table, self.camera_view_proj(), self.camera.position);
         self.view_buffer.write(bytemuck::cast_slice(&views))
     }
 
@@ -450,47 +377,7 @@ impl Renderer {
         }
         self.record(ctx, cmd)?;
         let mut rec = Recorder::resume(ctx, cmd, &mut self.profiler);
-        let open = rec.pass("frame.output").reads(&self.target, Access::TransferSrc).writes(host, Access::TransferDst).begin();
-        let layers = |aspect| vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 };
-        let c = vk::ImageAspectFlags::COLOR;
-        unsafe {
-            if host.format == self.target.format {
-                let region = vk::ImageCopy {
-                    src_subresource: layers(c),
-                    dst_subresource: layers(c),
-                    extent: vk::Extent3D { width: self.width, height: self.height, depth: 1 },
-                    ..Default::default()
-                };
-                ctx.device.cmd_copy_image(
-                    cmd,
-                    self.target.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    host.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[region],
-                );
-            } else {
-                let corner = vk::Offset3D { x: self.width as i32, y: self.height as i32, z: 1 };
-                let region = vk::ImageBlit {
-                    src_subresource: layers(c),
-                    src_offsets: [vk::Offset3D::default(), corner],
-                    dst_subresource: layers(c),
-                    dst_offsets: [vk::Offset3D::default(), corner],
-                };
-                ctx.device.cmd_blit_image(
-                    cmd,
-                    self.target.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    host.raw,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[region],
-                    vk::Filter::NEAREST,
-                );
-            }
-            let barriers = [host.release_to(final_layout)];
-            ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&barriers));
-        }
-        rec.end(open);
+        output::record_copy(&mut rec, &self.target, host, final_layout);
         Ok(())
     }
 
@@ -573,33 +460,6 @@ impl Renderer {
         self.linear_repeat = vk::Sampler::null();
         self.nearest_clamp = vk::Sampler::null();
     }
-}
-
-use bytemuck::Zeroable;
-
-fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
-    GpuView {
-        view_proj: view_proj.to_cols_array_2d(),
-        inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-        eye: eye.to_array(),
-        dir: dir.to_array(),
-    }
-}
-
-/// Orthographic world → clip for a directional light's planar distance map covering the
-/// sphere (center, radius); reversed depth.
-pub fn directional_view_proj(dir: Vec3, center: Vec3, radius: f32) -> Mat4 {
-    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-    let eye = center - dir * radius;
-    let view = Mat4::look_to_rh(eye, dir, up);
-    // x, y in [−r, r] → [−1, 1]; depth d along dir in [0, 2r] → z_ndc = 1 − d/2r.
-    let proj = Mat4::from_cols(
-        Vec4::new(1.0 / radius, 0.0, 0.0, 0.0),
-        Vec4::new(0.0, -1.0 / radius, 0.0, 0.0),
-        Vec4::new(0.0, 0.0, 1.0 / (2.0 * radius), 0.0),
-        Vec4::new(0.0, 0.0, 1.0, 1.0),
-    );
-    proj * view
 }
 
 impl crate::vk::Owner for Renderer {

@@ -7,8 +7,10 @@
 pub mod camera;
 pub mod direct;
 pub mod layout;
+pub mod output;
 pub mod shadow;
 pub mod stage;
+pub mod views;
 
 pub use layout::{Push, SearchKnobs, FLAG_FIRST_CYCLE, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_INTER_OBJECT, FLAG_PROXY_BOX};
 
