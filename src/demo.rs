@@ -40,7 +40,7 @@ pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<
     let mut svg =
         format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{sw}\" height=\"{}\" style=\"background:#111\">\n", rows * (h + label));
     for (i, (t, (name, _))) in tiles.iter().zip(&images).enumerate() {
-        let text = t.label.replace('&', "&amp;").replace('<', "&lt;");
+        let text = t.label.replace('&', "&amp;").replace('<', "&lt;").replace('\n', " · ");
         let (x, y) = ((i as u32 % cols) * w, (i as u32 / cols) * (h + label));
         svg += &format!(
             "<text x=\"{}\" y=\"{}\" fill=\"#eee\" font-family=\"sans-serif\" font-size=\"16\">{text}</text>\n<image x=\"{x}\" y=\"{}\" width=\"{w}\" height=\"{h}\" href=\"{name}.png\"/>\n",
@@ -54,9 +54,18 @@ pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<
     std::fs::write(&path, svg).map_err(|e| Error::io(&path, e))
 }
 
-/// Draws `text` into an RGBA32F linear image of `w`×`h` at (x, y): 8×8 glyphs (font8x8)
-/// scaled by `scale`, white on a black band, clipped to `max_w` pixels of width.
+/// Draws `text` (lines split at '\n') into an RGBA32F linear image of `w`×`h` at (x, y):
+/// 8×8 glyphs (font8x8) scaled by `scale`, white on a black band, clipped to `max_w` pixels
+/// of width.
+#[allow(clippy::too_many_arguments)]
 pub fn draw_label(pixels: &mut [f32], w: u32, h: u32, x: u32, y: u32, scale: u32, max_w: u32, text: &str) {
+    for (k, line) in text.lines().enumerate() {
+        draw_line(pixels, w, h, x, y + k as u32 * 9 * scale, scale, max_w, line);
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn draw_line(pixels: &mut [f32], w: u32, h: u32, x: u32, y: u32, scale: u32, max_w: u32, text: &str) {
     use font8x8::UnicodeFonts;
     let glyph = 8 * scale;
     let band_w = (text.chars().count() as u32 * glyph + 2 * scale).min(max_w);
@@ -66,7 +75,7 @@ pub fn draw_label(pixels: &mut [f32], w: u32, h: u32, x: u32, y: u32, scale: u32
             pixels[i..i + 4].copy_from_slice(&[v, v, v, 1.0]);
         }
     };
-    for py in y..y + glyph + 2 * scale {
+    for py in y..y + glyph + scale {
         for px in x..x + band_w {
             put(px, py, 0.0);
         }
@@ -98,7 +107,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let image = ImageData { width: 64, height: 32, layers: 1, channels: 4, data: vec![0.5; 64 * 32 * 4] };
         let tiles = vec![
-            Tile { name: "a".into(), label: "envmap 1.0 ms".into(), image: image.clone() },
+            Tile { name: "a".into(), label: "envmap\n1.0 ms".into(), image: image.clone() },
             Tile { name: "b".into(), label: "distance".into(), image },
         ];
         write_composite(&dir, &tiles, 64, 32).unwrap();
@@ -106,10 +115,15 @@ mod tests {
         assert_eq!(png.dimensions(), (128, 32));
         // The band is black, the glyphs white, the rest of the tile grey.
         let px = |x, y| png.get_pixel(x, y).0;
-        let white = (0..64).flat_map(|x| (0..10).map(move |y| (x, y))).filter(|&(x, y)| px(x, y) == [255, 255, 255]).count();
-        let black = (0..64).flat_map(|x| (0..10).map(move |y| (x, y))).filter(|&(x, y)| px(x, y) == [0, 0, 0]).count();
-        assert!(white > 40 && black > 100, "white {white}, black {black}");
-        assert!(px(10, 20)[0] > 150 && px(10, 20)[0] < 220, "grey below the label: {:?}", px(10, 20));
+        let count = |rows: std::ops::Range<u32>, c: [u8; 3]| {
+            (0..64).flat_map(|x| rows.clone().map(move |y| (x, y))).filter(|&(x, y)| px(x, y) == c).count()
+        };
+        // Two lines of glyphs, white on black.
+        for rows in [0..9, 9..18] {
+            let (white, black) = (count(rows.clone(), [255, 255, 255]), count(rows.clone(), [0, 0, 0]));
+            assert!(white > 30 && black > 100, "rows {rows:?}: white {white}, black {black}");
+        }
+        assert!(px(10, 25)[0] > 150 && px(10, 25)[0] < 220, "grey below the label: {:?}", px(10, 25));
         std::fs::remove_dir_all(&dir).ok();
     }
 }

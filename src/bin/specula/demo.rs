@@ -53,9 +53,9 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         report.push('\n');
         let e = specula::metrics::compare(&frame.image, &reference)?;
         errors += &format!("{name:<24} {e}  {:.2} ms  {:.1} MiB\n", frame.gpu_ms(), frame.memory_bytes() as f64 / 1048576.0);
-        tiles.push(Tile { name: name.into(), label: format!("{name} {:.1}ms {:.1}dB", frame.gpu_ms(), e.psnr), image: frame.image });
+        tiles.push(Tile { name: name.into(), label: format!("{name}\n{:.1} ms  {:.2} dB", frame.gpu_ms(), e.psnr), image: frame.image });
     }
-    tiles.push(Tile { name: reference_method.name().into(), label: format!("reference {:.0}ms CPU", ref_ms), image: reference });
+    tiles.push(Tile { name: reference_method.name().into(), label: format!("reference\n{ref_ms:.0} ms CPU"), image: reference });
     report += &errors;
     report.push('\n');
     // All of them side by side (the survey's Figures 20 and 24 in one sheet).
