@@ -188,17 +188,12 @@ impl Renderer {
         self.nearest_clamp = sampler(ctx, "sampler.nearest_clamp", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
 
         self.create_stages(ctx, scene)?;
-        // Set-1 sets over the distance images (none without distance maps): one for map
-        // generation and one for the camera passes per image, and an all-null one.
-        let images = self.maps.distance.len();
-        if images > 0 || self.maps.refractor.is_some() || self.maps.backfaces.is_some() {
-            for i in 0..2 * images + 1 {
-                let (pool, set) = allocate_set(ctx, &format!("maps.set{i}"), self.maps_layout, MAP_BINDINGS)?;
-                self.owned_sets.push(OwnedSet { pool, set });
-            }
-            let sets: Vec<vk::DescriptorSet> = self.owned_sets.iter().map(|s| s.set).collect();
-            self.sets = MapSets { generate: sets[..images].to_vec(), camera: sets[images..2 * images].to_vec(), empty: sets[2 * images] };
+        // The maps' set-1 descriptor sets, as many as the maps need.
+        for i in 0..self.maps.set_count() {
+            let (pool, set) = allocate_set(ctx, &format!("maps.set{i}"), self.maps_layout, MAP_BINDINGS)?;
+            self.owned_sets.push(OwnedSet { pool, set });
         }
+        self.sets = self.maps.sets(&self.owned_sets.iter().map(|s| s.set).collect::<Vec<_>>());
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED;
         self.target = Image::new(
             ctx,
@@ -233,29 +228,7 @@ impl Renderer {
         write_buffer(ctx, self.set, binding::LIGHTS, sb, buffer(self.lights.as_ref()));
         write_image(ctx, self.set, binding::TEXTURES, 0, cis, view(self.scene.textures.as_ref()), self.linear_repeat, ro);
         write_image(ctx, self.set, binding::ENVIRONMENT_MAP, 0, cis, view(self.scene.environment.as_ref()), self.linear_repeat, ro);
-        write_image(ctx, self.set, binding::SHADOW_CUBES, 0, cis, view(self.maps.shadow_cubes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, binding::SHADOW_PLANES, 0, cis, view(self.maps.shadow_planes.as_ref()), self.nearest_clamp, ro);
-        write_image(ctx, self.set, binding::ENVMAPS, 0, cis, view(self.maps.radiance.as_ref()), self.linear_repeat, ro);
-        // Generation sets sample the refractor maps (made first) but no camera-space map;
-        // camera sets sample everything; the empty set nothing.
-        let refractor = view(self.maps.refractor.as_ref());
-        let backfaces = view(self.maps.backfaces.as_ref());
-        let thickness = buffer(self.maps.thickness.as_ref());
-        let null_image = vk::ImageView::null();
-        let mut all: Vec<(vk::DescriptorSet, vk::ImageView, vk::ImageView, vk::ImageView, vk::Buffer)> = Vec::new();
-        for (i, d) in self.maps.distance.iter().enumerate() {
-            all.push((self.sets.generate[i], d.view, refractor, null_image, vk::Buffer::null()));
-            all.push((self.sets.camera[i], d.view, refractor, backfaces, thickness));
-        }
-        if self.sets.empty != vk::DescriptorSet::null() {
-            all.push((self.sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
-        }
-        for (set, distance, refractor, backfaces, thickness) in all {
-            write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, self.linear_repeat, ro);
-            write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, self.linear_repeat, ro);
-            write_image(ctx, set, binding::BACKFACE_MAP, 0, cis, backfaces, self.nearest_clamp, ro);
-            write_buffer(ctx, set, binding::THICKNESS, sb, thickness);
-        }
+        self.maps.write_descriptors(ctx, self.set, &self.sets, self.linear_repeat, self.nearest_clamp);
     }
 
     /// Creates the plan's stages in order; each map stage puts its images into `maps`.

@@ -71,6 +71,60 @@ impl Maps {
         v
     }
 
+    /// How many set-1 descriptor sets the maps need: per distance image one for map
+    /// generation and one for the camera passes, and an all-null one; none without set-1
+    /// maps.
+    pub fn set_count(&self) -> usize {
+        if self.distance.is_empty() && self.refractor.is_none() && self.backfaces.is_none() {
+            0
+        } else {
+            2 * self.distance.len() + 1
+        }
+    }
+
+    /// Assigns `set_count()` allocated sets to their roles.
+    pub fn sets(&self, sets: &[vk::DescriptorSet]) -> MapSets {
+        let n = self.distance.len();
+        if sets.len() < 2 * n + 1 {
+            return MapSets::default();
+        }
+        MapSets { generate: sets[..n].to_vec(), camera: sets[n..2 * n].to_vec(), empty: sets[2 * n] }
+    }
+
+    /// Writes every map slot's descriptors: set 0's shadow and radiance maps into `frame`,
+    /// and each set-1 set of `sets`. Generation sets sample the refractor maps (made first)
+    /// but no camera-space map; camera sets sample everything; the empty set nothing.
+    /// What the scene does not need gets a null descriptor.
+    pub fn write_descriptors(&self, ctx: &Context, frame: vk::DescriptorSet, sets: &MapSets, linear: vk::Sampler, nearest: vk::Sampler) {
+        use crate::frame::layout::binding;
+        use crate::vk::pipeline::{write_buffer, write_image};
+        let sb = vk::DescriptorType::STORAGE_BUFFER;
+        let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+        let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        let view = |i: Option<&Image>| i.map_or(vk::ImageView::null(), |i| i.view);
+        write_image(ctx, frame, binding::SHADOW_CUBES, 0, cis, view(self.shadow_cubes.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::SHADOW_PLANES, 0, cis, view(self.shadow_planes.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::ENVMAPS, 0, cis, view(self.radiance.as_ref()), linear, ro);
+        let refractor = view(self.refractor.as_ref());
+        let backfaces = view(self.backfaces.as_ref());
+        let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
+        let null_image = vk::ImageView::null();
+        let mut all = Vec::new();
+        for (i, d) in self.distance.iter().enumerate() {
+            all.push((sets.generate[i], d.view, refractor, null_image, vk::Buffer::null()));
+            all.push((sets.camera[i], d.view, refractor, backfaces, thickness));
+        }
+        if sets.empty != vk::DescriptorSet::null() {
+            all.push((sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
+        }
+        for (set, distance, refractor, backfaces, thickness) in all {
+            write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, linear, ro);
+            write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, linear, ro);
+            write_image(ctx, set, binding::BACKFACE_MAP, 0, cis, backfaces, nearest, ro);
+            write_buffer(ctx, set, binding::THICKNESS, sb, thickness);
+        }
+    }
+
     pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
         self.shadow_cubes.iter().chain(self.shadow_planes.iter())
     }

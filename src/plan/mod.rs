@@ -313,8 +313,10 @@ pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<
             ((half.x + half.y + half.z) / 3.0).max(1e-6)
         }
     });
-    let auto_needed = matches!(choices.method, Choice::Auto);
-    let scene_facts = facts::SceneFacts::new(scene, quality, auto_needed);
+    // Deep facts (convexity, mutual visibility) for the planner and for mixed choices,
+    // whose composition depends on who sees whom; a whole-scene method needs none.
+    let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();
+    let scene_facts = facts::SceneFacts::new(scene, quality, !whole_scene);
     let mut objects = Vec::new();
     for f in &scene_facts.objects {
         let (method, reason) = choose(scene, f, choices, quality)?;
@@ -355,14 +357,22 @@ pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<
         return Ok(p);
     }
     // A whole-scene method keeps its own behaviour (its fallbacks do not compose); mixed
-    // choices compose through inter-object cycles.
-    let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();
-    stages(scene, &mut p, !whole_scene);
+    // choices compose through inter-object cycles where an object's map sees a
+    // self-refracting one over at least `facts::MIN_COVERAGE` of its directions.
+    let composes = !whole_scene && {
+        let refracting =
+            |m: usize| p.objects.iter().any(|o| o.mesh == m && o.method.gpu.is_some_and(|g| g.map_shading == MapShading::Refractor));
+        scene_facts.objects.iter().any(|f| {
+            p.objects.iter().all(|o| o.mesh != f.mesh || o.method.gpu.is_some_and(|g| !g.maps.is_empty()))
+                && f.sees_specular.iter().any(|&(m, c)| c >= facts::MIN_COVERAGE && refracting(m))
+        })
+    };
+    stages(scene, &mut p, composes);
     Ok(p)
 }
 
 /// Derives the frame's stages from the objects' methods.
-fn stages(scene: &Scene, p: &mut Plan, compose: bool) {
+fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let q = p.quality.clone();
     let has_diffuse = scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular());
     let mut stages = Vec::new();
@@ -387,9 +397,7 @@ fn stages(scene: &Scene, p: &mut Plan, compose: bool) {
     // compose (a mirror's map shows the refractor-mapped glass refracting the room).
     let gpu = |m: Method| m.gpu.expect("GPU plan");
     let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
-    let mixed = methods.windows(2).any(|w| w[0] != w[1]);
     let asks = methods.iter().any(|&m| gpu(m).map_shading == MapShading::Traced);
-    let composes = compose && mixed && methods.iter().any(|&m| gpu(m).map_shading == MapShading::Refractor);
     p.inter_object = asks || composes;
     p.frame_latency = asks && q.frame_latency;
     p.cycles = methods.iter().map(|&m| (gpu(m).cycles)(&q)).max().unwrap_or(1).max(1);

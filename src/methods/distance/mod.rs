@@ -10,7 +10,7 @@ use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, Ma
 use crate::methods::envmap::generate::{CubeMaps, MapKind};
 use crate::methods::registry::{CameraPass, GpuSpec, MapShading, Method, MethodInfo, ObjectClass, Verdict};
 use crate::methods::EVERY_CLASS;
-use crate::plan::facts::ObjectFacts;
+use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::Plan;
 use crate::quality::Quality;
 use crate::Result;
@@ -119,14 +119,22 @@ fn distance_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
         _ if q.planner.speed() => {
             Some(Verdict { score: 3.0, reason: format!("{}: distance map, one search per ray (planner=speed){convex}", f.class.label()) })
         }
-        _ if !f.sees_specular.is_empty() => Some(Verdict {
+        _ if f.specular_coverage() >= MIN_COVERAGE => Some(Verdict {
             score: 2.0,
             reason: format!("{}: distance map; other specular objects in view want inter-object cycles{convex}", f.class.label()),
         }),
-        _ => Some(Verdict {
-            score: 3.0,
-            reason: format!("{}: distance map, the ray traced in the sampled geometry (§4.1){convex}", f.class.label()),
-        }),
+        _ => {
+            let few = f.specular_coverage();
+            let note = if few > 0.0 {
+                format!("; other specular objects cover only {:.1} % of its directions, not worth inter-object cycles", 100.0 * few)
+            } else {
+                String::new()
+            };
+            Some(Verdict {
+                score: 3.0,
+                reason: format!("{}: distance map, the ray traced in the sampled geometry (§4.1){convex}{note}", f.class.label()),
+            })
+        }
     }
 }
 
@@ -151,15 +159,17 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
 });
 
 fn multi_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    if f.class == ObjectClass::SolidDielectric || f.sees_specular.is_empty() || q.planner.speed() {
+    let coverage = f.specular_coverage();
+    if f.class == ObjectClass::SolidDielectric || coverage < MIN_COVERAGE || q.planner.speed() {
         return None;
     }
     Some(Verdict {
         score: 4.0,
         reason: format!(
-            "{} that sees {} other specular object(s): distance maps in inter-object cycles (§4.3)",
+            "{} that sees {} other specular object(s) over {:.1} % of its directions: distance maps in inter-object cycles (§4.3)",
             f.class.label(),
-            f.sees_specular.len()
+            f.sees_specular.iter().filter(|(_, c)| *c >= MIN_COVERAGE).count(),
+            100.0 * coverage
         ),
     })
 }
