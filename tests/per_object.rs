@@ -306,14 +306,13 @@ fn plan_command_prints_per_object_methods() {
     let table = run(&["plan", scene]);
     for want in [
         "method auto",
-        "mirror_sphere/0 (mirror",
-        "distance-multi",
-        "glass_sphere/0 (solid dielectric",
-        "refractor-map",
+        "mirror_sphere/0 (mirror, material 'mirror'): distance",
+        "cover only 1.",
+        "glass_sphere/0 (solid dielectric, material 'glass'): refractor-map",
         "reason",
         "MiB",
         "knobs",
-        "cycles=4",
+        "internal_bounces=2",
     ] {
         assert!(table.contains(want), "plan table lacks {want}:\n{table}");
     }
