@@ -68,6 +68,17 @@ impl MapShading {
     }
 }
 
+/// What an object's own cube maps leave out (survey §3.1: "the object itself left out";
+/// §4.5's layered maps keep the whole scene).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LeavesOut {
+    /// The object itself: its maps see the environment around it.
+    Itself,
+    /// Nothing: its maps see the whole scene, the object included.
+    Nothing,
+}
+
 /// A method's camera pass: its objects drawn over `scene.direct`'s colour and depth with
 /// its shaders. Methods that name the same pass share it (and must name the same shaders).
 #[derive(Clone, Copy, Debug)]
@@ -100,6 +111,8 @@ pub struct GpuSpec {
     pub camera: CameraPass,
     /// How the object looks in the other objects' distance maps.
     pub map_shading: MapShading,
+    /// What the object's own cube maps leave out.
+    pub leaves_out: LeavesOut,
     /// Distance-map cycles per frame this method asks for (§4.3).
     pub cycles: fn(&Quality) -> u32,
 }

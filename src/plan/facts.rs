@@ -48,6 +48,8 @@ struct MeshFacts {
 }
 
 static CACHE: Mutex<Option<HashMap<u64, Arc<MeshFacts>>>> = Mutex::new(None);
+/// Visible fractions by (mesh hash, reference point bits).
+static VISIBLE: Mutex<Option<HashMap<(u64, [u32; 3]), f32>>> = Mutex::new(None);
 
 fn mesh_hash(m: &Mesh) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
@@ -246,6 +248,23 @@ fn area_centroid(m: &Mesh) -> Vec3 {
     }
 }
 
+/// `visible_fraction`, cached per mesh and reference point.
+fn visible_fraction_cached(m: &Mesh, x: Vec3) -> f32 {
+    let key = (mesh_hash(m), [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]);
+    if let Some(f) = VISIBLE.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).copied())) {
+        return f;
+    }
+    let f = visible_fraction(m, x);
+    if let Ok(mut c) = VISIBLE.lock() {
+        let map = c.get_or_insert_with(HashMap::new);
+        if map.len() > 1024 {
+            map.clear();
+        }
+        map.insert(key, f);
+    }
+    f
+}
+
 /// Area fraction of mesh `m`'s triangles whose centroid is the first surface of the mesh
 /// along the ray from `x` (at most 4096 triangles, strided).
 fn visible_fraction(m: &Mesh, x: Vec3) -> f32 {
@@ -353,7 +372,7 @@ impl SceneFacts {
                 };
                 let mf = mesh_facts(m);
                 let (visible, sees) = match &bvh {
-                    Some(b) => (visible_fraction(m, reference_point), visible_specular(scene, b, i, reference_point)),
+                    Some(b) => (visible_fraction_cached(m, reference_point), visible_specular(scene, b, i, reference_point)),
                     None => (1.0, Vec::new()),
                 };
                 Some(ObjectFacts {

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use crate::error::{Error, Result};
 use crate::frame::stage::{order, MapInfo};
-pub use crate::methods::registry::{CameraPass, Choice, MapShading, Method, ObjectClass, Verdict};
+pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass, Verdict};
 use crate::quality::{Planner, Quality};
 use crate::scene::{LightKind, Scene};
 use facts::ObjectFacts;
@@ -51,6 +51,8 @@ pub struct ObjectPlan {
     pub reference_note: Option<String>,
     /// How the object appears in the other objects' distance maps.
     pub map_shading: MapShading,
+    /// What its own cube maps leave out.
+    pub leaves_out: LeavesOut,
     pub maps: Vec<ObjectMap>,
     /// The passes that draw or map this object.
     pub passes: Vec<&'static str>,
@@ -329,6 +331,7 @@ pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<
             reference_point: f.reference_point,
             reference_note: f.reference_note.clone(),
             map_shading: MapShading::Sky,
+            leaves_out: method.gpu.map_or(LeavesOut::Itself, |g| g.leaves_out),
             maps: Vec::new(),
             passes: Vec::new(),
             knobs: method.knobs.iter().map(|k| (*k, quality.get(k))).collect(),

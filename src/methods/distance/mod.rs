@@ -8,7 +8,7 @@ pub mod refractor;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
 use crate::methods::envmap::generate::{CubeMaps, MapKind};
-use crate::methods::registry::{CameraPass, GpuSpec, MapShading, Method, MethodInfo, ObjectClass, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::Plan;
@@ -100,7 +100,8 @@ pub const DISTANCE: Method = Method(&MethodInfo {
     summary: "distance maps (radiance + Euclidean distance from the reference point); reflected and refracted rays traced in them by linear search on the projected segment, secant and binary refinement, or parallax correction (eq. 4, 5)",
     serves: EVERY_CLASS,
     knobs: SEARCH_KNOBS,
-    gpu: Some(GpuSpec { maps: &[DISTANCE_CUBES], camera: SEARCH, map_shading: MapShading::Sky, cycles: one }),
+    gpu: Some(GpuSpec { maps: &[DISTANCE_CUBES], camera: SEARCH, map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: None,
     rule: distance_rule,
 });
@@ -152,6 +153,7 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
         maps: &[DISTANCE_CUBES],
         camera: SEARCH,
         map_shading: MapShading::Traced,
+        leaves_out: LeavesOut::Itself,
         cycles: |q| if q.frame_latency { 1 } else { q.cycles },
     }),
     fallback: None,
@@ -188,6 +190,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
         camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1 },
         map_shading: MapShading::Refractor,
+        leaves_out: LeavesOut::Itself,
         cycles: one,
     }),
     fallback: Some(DISTANCE),
@@ -233,6 +236,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
             order: order::CAMERA + 2,
         },
         map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Itself,
         cycles: one,
     }),
     fallback: Some(DISTANCE),

@@ -14,6 +14,7 @@ use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
 use crate::methods::distance::distance_images;
+use crate::methods::registry::LeavesOut;
 use crate::plan::Plan;
 use crate::quality::{CubeMode, Precision};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
@@ -208,6 +209,10 @@ impl Stage for CubeMaps {
             let clear = [0.0, 0.0, 0.0, if self.kind == MapKind::Distance { 1e30 } else { 0.0 }];
             for (layer, &mesh) in self.objects.iter().enumerate() {
                 let view = io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views");
+                let skip = match io.plan.object(mesh).map(|o| o.leaves_out) {
+                    Some(LeavesOut::Nothing) => None,
+                    _ => Some(mesh),
+                };
                 render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
                     f.bind(ctx, cmd, self.sky);
                     f.push_flags(ctx, cmd, v, 0, f.flags | flags);
@@ -216,7 +221,7 @@ impl Stage for CubeMaps {
                     if uses_maps {
                         f.bind_maps(ctx, cmd, read_set);
                     }
-                    for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh) {
+                    for d in f.scene.draws.iter().filter(|d| Some(d.mesh as usize) != skip) {
                         f.push_flags(ctx, cmd, v, d.mesh, f.flags | flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
                     }

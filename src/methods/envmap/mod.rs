@@ -9,7 +9,7 @@ pub use generate::{CubeMaps, MapKind};
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
-use crate::methods::registry::{CameraPass, GpuSpec, MapShading, Method, MethodInfo, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
@@ -38,7 +38,7 @@ const fn one(_: &Quality) -> u32 {
 }
 
 const fn spec(camera: CameraPass) -> GpuSpec {
-    GpuSpec { maps: &[RADIANCE_CUBES], camera, map_shading: MapShading::Sky, cycles: one }
+    GpuSpec { maps: &[RADIANCE_CUBES], camera, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }
 }
 
 const SHADE: CameraPass =
