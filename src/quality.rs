@@ -128,7 +128,10 @@ pub const KNOBS: &[Knob] = &[
         values: "16..=4096 texels",
         default: "256",
         doc: "edge of each face of an object's cube maps (environment, distance, refractor)",
-        set: |q, v| Ok(q.cube_size = count(v, 16, 4096)?),
+        set: |q, v| {
+            q.cube_size = count(v, 16, 4096)?;
+            Ok(())
+        },
         get: |q| q.cube_size.to_string(),
     },
     Knob {
@@ -136,7 +139,10 @@ pub const KNOBS: &[Knob] = &[
         values: "half|single",
         default: "half",
         doc: "cube-map storage (radiance and distance): RGBA16F or RGBA32F",
-        set: |q, v| Ok(q.cube_precision = one_of(v, PRECISIONS)?),
+        set: |q, v| {
+            q.cube_precision = one_of(v, PRECISIONS)?;
+            Ok(())
+        },
         get: |q| name_of(q.cube_precision, PRECISIONS),
     },
     Knob {
@@ -144,7 +150,10 @@ pub const KNOBS: &[Knob] = &[
         values: "six|multiview",
         default: "six",
         doc: "cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md)",
-        set: |q, v| Ok(q.cube_mode = one_of(v, CUBE_MODES)?),
+        set: |q, v| {
+            q.cube_mode = one_of(v, CUBE_MODES)?;
+            Ok(())
+        },
         get: |q| name_of(q.cube_mode, CUBE_MODES),
     },
     Knob {
@@ -152,7 +161,10 @@ pub const KNOBS: &[Knob] = &[
         values: "schlick|exact",
         default: "schlick",
         doc: "Schlick's approximation (survey eq. 2) or the exact Fresnel equations",
-        set: |q, v| Ok(q.fresnel = one_of(v, FRESNEL)?),
+        set: |q, v| {
+            q.fresnel = one_of(v, FRESNEL)?;
+            Ok(())
+        },
         get: |q| name_of(q.fresnel, FRESNEL),
     },
     Knob {
@@ -180,7 +192,10 @@ pub const KNOBS: &[Knob] = &[
         values: "16..=4096 texels",
         default: "512",
         doc: "edge of each shadow distance map face",
-        set: |q, v| Ok(q.shadow_size = count(v, 16, 4096)?),
+        set: |q, v| {
+            q.shadow_size = count(v, 16, 4096)?;
+            Ok(())
+        },
         get: |q| q.shadow_size.to_string(),
     },
     Knob {
@@ -188,7 +203,10 @@ pub const KNOBS: &[Knob] = &[
         values: "1..=64 bounces",
         default: "16",
         doc: "specular recursion depth R of the exact renderers (the reference): paths still specular after R bounces end black; the default is converged for glass",
-        set: |q, v| Ok(q.depth = count(v, 1, 64)?),
+        set: |q, v| {
+            q.depth = count(v, 1, 64)?;
+            Ok(())
+        },
         get: |q| q.depth.to_string(),
     },
     Knob {
@@ -196,7 +214,10 @@ pub const KNOBS: &[Knob] = &[
         values: "1..=16 cycles",
         default: "4",
         doc: "distance-multi: distance-map generation cycles per frame (§4.3); cycle k shows k specular bounces in the maps",
-        set: |q, v| Ok(q.cycles = count(v, 1, 16)?),
+        set: |q, v| {
+            q.cycles = count(v, 1, 16)?;
+            Ok(())
+        },
         get: |q| q.cycles.to_string(),
     },
     Knob {
@@ -219,7 +240,10 @@ pub const KNOBS: &[Knob] = &[
         values: "0..=256",
         default: "16",
         doc: "distance-map linear search steps (§4.1.2); 0: parallax correction only",
-        set: |q, v| Ok(q.linear_steps = count(v, 0, 256)?),
+        set: |q, v| {
+            q.linear_steps = count(v, 0, 256)?;
+            Ok(())
+        },
         get: |q| q.linear_steps.to_string(),
     },
     Knob {
@@ -227,7 +251,10 @@ pub const KNOBS: &[Knob] = &[
         values: "0..=64",
         default: "2",
         doc: "secant (false position) refinement steps after the linear search (survey eq. 5)",
-        set: |q, v| Ok(q.secant_steps = count(v, 0, 64)?),
+        set: |q, v| {
+            q.secant_steps = count(v, 0, 64)?;
+            Ok(())
+        },
         get: |q| q.secant_steps.to_string(),
     },
     Knob {
@@ -235,7 +262,10 @@ pub const KNOBS: &[Knob] = &[
         values: "0..=64",
         default: "0",
         doc: "binary refinement steps after the linear search (§4.1.4)",
-        set: |q, v| Ok(q.binary_steps = count(v, 0, 64)?),
+        set: |q, v| {
+            q.binary_steps = count(v, 0, 64)?;
+            Ok(())
+        },
         get: |q| q.binary_steps.to_string(),
     },
     Knob {
@@ -243,7 +273,10 @@ pub const KNOBS: &[Knob] = &[
         values: "1..=64",
         default: "1",
         doc: "parallax-correction iterations (survey eq. 4) when linear_steps = 0",
-        set: |q, v| Ok(q.parallax_iterations = count(v, 1, 64)?),
+        set: |q, v| {
+            q.parallax_iterations = count(v, 1, 64)?;
+            Ok(())
+        },
         get: |q| q.parallax_iterations.to_string(),
     },
     Knob {
@@ -251,7 +284,10 @@ pub const KNOBS: &[Knob] = &[
         values: "0..=1",
         default: "0.001",
         doc: "search stops once ‖l‖/‖l′‖ is within this of 1",
-        set: |q, v| Ok(q.search_tolerance = real(v, 0.0, 1.0)?),
+        set: |q, v| {
+            q.search_tolerance = real(v, 0.0, 1.0)?;
+            Ok(())
+        },
         get: |q| q.search_tolerance.to_string(),
     },
     Knob {
@@ -259,7 +295,10 @@ pub const KNOBS: &[Knob] = &[
         values: "0..=16",
         default: "2",
         doc: "refractor-map: total internal reflections followed inside a refractor (§4.4)",
-        set: |q, v| Ok(q.internal_bounces = count(v, 0, 16)?),
+        set: |q, v| {
+            q.internal_bounces = count(v, 0, 16)?;
+            Ok(())
+        },
         get: |q| q.internal_bounces.to_string(),
     },
     Knob {
@@ -267,7 +306,10 @@ pub const KNOBS: &[Knob] = &[
         values: "on|off",
         default: "off",
         doc: "distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)",
-        set: |q, v| Ok(q.frame_latency = one_of(v, ON_OFF)?),
+        set: |q, v| {
+            q.frame_latency = one_of(v, ON_OFF)?;
+            Ok(())
+        },
         get: |q| name_of(q.frame_latency, ON_OFF),
     },
     Knob {
@@ -292,7 +334,10 @@ pub const KNOBS: &[Knob] = &[
         values: "accuracy|speed",
         default: "accuracy",
         doc: "what --method auto optimises: the most accurate method per object, or a cheaper rung (single distance maps, image-space refraction)",
-        set: |q, v| Ok(q.planner = one_of(v, PLANNERS)?),
+        set: |q, v| {
+            q.planner = one_of(v, PLANNERS)?;
+            Ok(())
+        },
         get: |q| name_of(q.planner, PLANNERS),
     },
 ];

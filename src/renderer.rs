@@ -267,7 +267,7 @@ impl Renderer {
         self.maps.backfaces.as_ref()
     }
 
-    /// The refractor-map cube array (one cube per refractor), if planned.
+    /// The refractor maps' cube array (one cube per refractor), if planned.
     pub fn refractor_maps(&self) -> Option<&Image> {
         self.maps.refractor.as_ref()
     }

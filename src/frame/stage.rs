@@ -193,6 +193,9 @@ pub struct StageInit<'a> {
     pub height: u32,
 }
 
+/// A map pass's constructor: the pass for `objects` (mesh indices), its images into `maps`.
+pub type CreateStage = fn(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>>;
+
 /// A map kind some method needs for its objects (the radiance cubes of §3, the distance
 /// cubes of §4, refractor maps, back faces …): one pass for all the objects that need it,
 /// declared once in its family's folder.
@@ -208,7 +211,7 @@ pub struct MapInfo {
     pub layer_field: Option<LayerField>,
     /// Creates the pass for `objects` (mesh indices, layer = position) and its images in
     /// `maps`.
-    pub create: fn(&StageInit, &[usize], &mut Maps) -> Result<Box<dyn Stage>>,
+    pub create: CreateStage,
     /// Device memory of its images for `objects` objects at a `width`×`height` camera.
     pub bytes: fn(&Plan, u32, (u32, u32)) -> u64,
     /// What one object's map is, for `specula plan` (e.g. "cube 6×256² RGBA16F").

@@ -49,7 +49,8 @@ struct MeshFacts {
 
 static CACHE: Mutex<Option<HashMap<u64, Arc<MeshFacts>>>> = Mutex::new(None);
 /// Visible fractions by (mesh hash, reference point bits).
-static VISIBLE: Mutex<Option<HashMap<(u64, [u32; 3]), f32>>> = Mutex::new(None);
+type VisibleCache = HashMap<(u64, [u32; 3]), f32>;
+static VISIBLE: Mutex<Option<VisibleCache>> = Mutex::new(None);
 
 fn mesh_hash(m: &Mesh) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
