@@ -7,25 +7,10 @@
 
 mod common;
 
-use glam::Vec3;
-use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::{Method, Quality};
 
 fn fnv(bytes: &[u8]) -> u64 {
     bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
-}
-
-fn mirror_and_glass() -> Scene {
-    let mut s = Scene::new();
-    common::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
-    let glass = s
-        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })
-        .unwrap();
-    let mirror = s.add_material(common::mirror(0.9)).unwrap();
-    s.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.6, 1.5, 0.0), 0.5, 32, 16, glass)).unwrap();
-    s.add_mesh(shapes::uv_sphere("mirror", Vec3::new(-0.7, 1.5, -0.2), 0.5, 32, 16, mirror)).unwrap();
-    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
-    s
 }
 
 /// (label, method, knobs, frames): every GPU method at its defaults, and the knobs that
@@ -57,7 +42,7 @@ fn cases() -> Vec<(String, Method, Vec<&'static str>, u32)> {
 fn every_method_renders_the_recorded_bits() {
     let ctx = common::gpu();
     let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    let scenes = [("demo", demo), ("mirror_and_glass", mirror_and_glass())];
+    let scenes = [("demo", demo), ("mirror_and_glass", common::mirror_and_glass(32))];
     let mut lines = Vec::new();
     for (scene_name, scene) in &scenes {
         for (label, method, knobs, frames) in cases() {

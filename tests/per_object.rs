@@ -21,22 +21,11 @@ fn quality(pairs: &[&str]) -> Quality {
     q
 }
 
-const GLASS: Vec3 = Vec3::new(0.6, 1.5, 0.0);
-const MIRROR: Vec3 = Vec3::new(-0.7, 1.5, -0.2);
+use common::{GLASS, MIRROR};
 const R: f32 = 0.5;
 
-/// The emissive quadrant room with a mirror sphere and a solid glass sphere side by side.
 fn mirror_and_glass() -> Scene {
-    let mut s = Scene::new();
-    common::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
-    let glass = s
-        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })
-        .unwrap();
-    let mirror = s.add_material(common::mirror(0.9)).unwrap();
-    s.add_mesh(shapes::uv_sphere("glass", GLASS, R, 48, 24, glass)).unwrap();
-    s.add_mesh(shapes::uv_sphere("mirror", MIRROR, R, 48, 24, mirror)).unwrap();
-    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
-    s
+    common::mirror_and_glass(48)
 }
 
 fn render(ctx: &Context, scene: &Scene, choices: &Choices, q: &Quality, (w, h): (u32, u32)) -> ImageData {

@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use glam::Vec3;
-use specula::scene::{shapes, Material, Scene, SurfaceKind};
+use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::vk::{Context, DeviceOptions};
 
 /// A context with the Khronos validation layer on (every GPU test uses one).
@@ -106,4 +106,22 @@ pub fn run_cases<I: bytemuck::Pod, O: bytemuck::Pod>(ctx: &Context, shader: &str
     cases.destroy(ctx);
     results.destroy(ctx);
     out
+}
+
+/// The emissive quadrant room with a solid glass sphere (ν 1.5, centre `GLASS`) and a mirror
+/// sphere (F0 0.9, centre `MIRROR`), both of radius 0.5 and `segments`×`segments/2` quads,
+/// seen from inside the room.
+pub const GLASS: Vec3 = Vec3::new(0.6, 1.5, 0.0);
+pub const MIRROR: Vec3 = Vec3::new(-0.7, 1.5, -0.2);
+pub fn mirror_and_glass(segments: u32) -> Scene {
+    let mut s = Scene::new();
+    emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
+    let glass = s
+        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })
+        .unwrap();
+    let mirror = s.add_material(mirror(0.9)).unwrap();
+    s.add_mesh(shapes::uv_sphere("glass", GLASS, 0.5, segments, segments / 2, glass)).unwrap();
+    s.add_mesh(shapes::uv_sphere("mirror", MIRROR, 0.5, segments, segments / 2, mirror)).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
+    s
 }
