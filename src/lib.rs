@@ -40,7 +40,8 @@ pub fn render(
     size: (u32, u32),
     frames: (u32, u32),
 ) -> Result<Frame> {
-    render_plan(ctx, scene, plan(scene, method, quality), size, frames)
+    let choices = Choices::all(method);
+    render_plan(ctx, scene, plan_with(scene, &choices, quality)?, size, frames)
 }
 
 /// Renders a plan (per-object methods: `plan_with`), as `render`.

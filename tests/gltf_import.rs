@@ -939,3 +939,35 @@ fn srgb_helpers_round_trip() {
     assert_eq!(linear_to_srgb(7.0), 255);
     assert!((srgb_to_linear(188) - 0.5).abs() < 0.003);
 }
+
+/// `extras.specula.method` on the node or the material: the object's method when the whole
+/// scene asks for `auto`; the node's wins; the object answers to its mesh and node names.
+#[test]
+fn method_from_extras() {
+    let mirror = json!([{ "name": "m", "pbrMetallicRoughness": { "metallicFactor": 1.0, "roughnessFactor": 0.0 },
+                          "extras": { "specula": { "method": "proxy-box" } } }]);
+    let mut doc = quad_doc().with_materials(mirror.clone());
+    doc.json["nodes"][0]["name"] = json!("wall_mirror");
+    let s = load_doc("method_material", &doc);
+    assert_eq!(s.meshes[0].method.as_deref(), Some("proxy-box"));
+    assert!(
+        s.meshes[0].aliases.contains(&"quad".to_string()) && s.meshes[0].aliases.contains(&"wall_mirror".to_string()),
+        "{:?}",
+        s.meshes[0].aliases
+    );
+    let p = specula::plan(&s, specula::Choice::Auto, &specula::Quality::default());
+    assert_eq!(p.objects[0].method.name(), "proxy-box");
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "distance" } });
+    assert_eq!(load_doc("method_node", &doc).meshes[0].method.as_deref(), Some("distance"));
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "auto" } });
+    assert_eq!(load_doc("method_auto", &doc).meshes[0].method, None);
+    // Refused, naming the field and the value.
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "warp-drive" } });
+    expect_error("method_unknown", &doc, &["nodes[0].extras.specula.method", "warp-drive"]);
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": 3 } });
+    expect_error("method_number", &doc, &["nodes[0].extras.specula.method", "method name"]);
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "refractor-map" } });
+    expect_error("method_cannot_serve", &doc, &["nodes[0].extras.specula.method", "cannot serve this mirror"]);
+    doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "reference" } });
+    expect_error("method_cpu", &doc, &["nodes[0].extras.specula.method", "CPU"]);
+}

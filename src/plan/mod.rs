@@ -205,21 +205,42 @@ impl Default for Choices {
 /// The pass `reference` reports: one CPU pass, no maps.
 pub const REFERENCE_PASS: &str = "reference.trace";
 
-/// The plan of one method for the whole scene (objects it cannot serve get its fallback).
+/// The plan of one method for the whole scene (objects it cannot serve get its fallback),
+/// or of the planner (`Choice::Auto`, honouring the scene file's `extras.specula.method`
+/// where it can; `plan_with` reports a hint that cannot serve its object as an error).
 pub fn plan(scene: &Scene, method: impl Into<Choice>, quality: &Quality) -> Plan {
     let choices = Choices::all(method);
-    // A whole-scene method cannot fail: the registry checks that every method either
-    // serves every class or falls back to one that does.
-    plan_with(scene, &choices, quality).unwrap_or_else(|e| unreachable_plan(scene, quality, e))
+    // A whole-scene method cannot fail (the registry checks that every method serves every
+    // class or falls back to one that does), nor can the planner without the scene's hints.
+    plan_inner(scene, &choices, quality, true).or_else(|_| plan_inner(scene, &choices, quality, false)).unwrap_or_else(|e| {
+        // Unreachable by the registry's checks; a plan that renders nothing but says why.
+        let mut p = plan_inner(scene, &Choices::all(crate::methods::REFERENCE), quality, false).unwrap_or_else(|_| empty_plan(quality));
+        p.objects.iter_mut().for_each(|o| o.reason = format!("no GPU plan: {e}"));
+        p
+    })
 }
 
-fn unreachable_plan(scene: &Scene, quality: &Quality, e: Error) -> Plan {
-    debug_assert!(false, "whole-scene plan failed: {e}");
-    plan_with(scene, &Choices::all(crate::methods::REFERENCE), quality).expect("the reference serves every object")
+fn empty_plan(quality: &Quality) -> Plan {
+    Plan {
+        choice: Choice::Method(crate::methods::REFERENCE),
+        quality: quality.clone(),
+        shadow_cubes: Vec::new(),
+        shadow_planes: Vec::new(),
+        objects: Vec::new(),
+        envmaps: Vec::new(),
+        stages: Vec::new(),
+        passes: vec![REFERENCE_PASS],
+        cube_near: 1e-4,
+        cycles: 0,
+        inter_object: false,
+        frame_latency: false,
+        proxy_radius: 1.0,
+        proxy_box: (Vec3::ZERO, Vec3::ZERO),
+    }
 }
 
-/// Which method an object gets, and why.
-fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quality) -> Result<(Method, String)> {
+/// Which method an object gets, and why (`hints`: honour the scene file's methods).
+fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quality, hints: bool) -> Result<(Method, String)> {
     let mesh = &scene.meshes[facts.mesh];
     let class = facts.class;
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
@@ -245,7 +266,7 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
         }
         return check(m, "--method");
     }
-    if let Some(name) = &mesh.method {
+    if let Some(name) = mesh.method.as_ref().filter(|_| hints) {
         let m = Method::parse(name).map_err(|e| Error::invalid(format!("object '{}' extras.specula.method", mesh.name), e.to_string()))?;
         return check(m, "the scene file's extras.specula.method");
     }
@@ -303,6 +324,10 @@ fn check_names(scene: &Scene, choices: &Choices) -> Result<()> {
 
 /// The plan for per-object choices.
 pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<Plan> {
+    plan_inner(scene, choices, quality, true)
+}
+
+fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) -> Result<Plan> {
     check_names(scene, choices)?;
     let bounds = scene.bounds();
     let diag = bounds.diagonal();
@@ -321,7 +346,7 @@ pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<
     let scene_facts = facts::SceneFacts::new(scene, quality, !whole_scene);
     let mut objects = Vec::new();
     for f in &scene_facts.objects {
-        let (method, reason) = choose(scene, f, choices, quality)?;
+        let (method, reason) = choose(scene, f, choices, quality, hints)?;
         objects.push(ObjectPlan {
             mesh: f.mesh,
             name: scene.meshes[f.mesh].name.clone(),

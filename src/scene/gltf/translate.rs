@@ -246,6 +246,7 @@ impl Importer<'_> {
 
         // The method the file asks for: node extras first, then the material's.
         let mut method = None;
+        let mut method_field = String::new();
         let mfield = material.index().map_or("the default material".to_string(), |i| format!("materials[{i}]"));
         for (extras, field) in [(node.extras(), format!("nodes[{}]", node.index())), (material.extras(), mfield)] {
             if let Some(map) = specula_extras(extras, self.file, &field)? {
@@ -260,6 +261,7 @@ impl Importer<'_> {
                             return Err(Error::scene(self.file, &mf, format!("'{name}' renders on the CPU, not per object")));
                         }
                         method = Some(name.to_string());
+                        method_field = mf;
                     }
                     break;
                 }
@@ -267,6 +269,14 @@ impl Importer<'_> {
         }
 
         let material_index = self.material_index(&material)?;
+        if let Some(name) = &method {
+            let kind = &self.scene.materials[material_index].kind;
+            let serves =
+                crate::methods::Method::parse(name).ok().zip(crate::methods::ObjectClass::of(kind)).is_some_and(|(m, c)| m.can_serve(c));
+            if !serves {
+                return Err(Error::scene(self.file, &method_field, format!("'{name}' cannot serve this {} object", kind.label())));
+            }
+        }
         let mesh_name = mesh.name().map(str::to_string).unwrap_or_else(|| m.to_string());
         let name = format!("{mesh_name}/{p}");
         // `--object NAME=METHOD` and the C ABI address the object by its node or mesh name.
