@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use specula::methods::{DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP};
+use specula::methods::{DISTANCE, DISTANCE_MULTI, PROXY_BOX, REFRACTOR_MAP};
 use specula::metrics;
 use specula::plan::{plan_with, Choices};
 use specula::reference::{render_reference, CameraRays};
@@ -171,14 +171,21 @@ fn auto_plans_by_object_class() {
     let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     let p = plan_with(&demo, &Choices::default(), &q).unwrap();
     let names: Vec<_> = p.objects.iter().map(|o| o.method.name()).collect();
-    assert_eq!(names, ["distance", "refractor-map"], "{:?}", p.objects.iter().map(|o| &o.reason).collect::<Vec<_>>());
-    assert!(p.objects[0].reason.contains("cover only 1."), "{}", p.objects[0].reason);
+    // Its mirror sees the room's box in 98 % of its directions: the proxy box is exact there.
+    assert_eq!(names, ["proxy-box", "refractor-map"], "{:?}", p.objects.iter().map(|o| &o.reason).collect::<Vec<_>>());
+    assert!(p.objects[0].reason.contains("scene's bounding box"), "{}", p.objects[0].reason);
     assert!(!p.inter_object && p.cycles == 1);
-    // A lone mirror: a single distance map.
+    // A lone mirror in an empty box room: the proxy box; with a diffuse block beside it
+    // (the environment is no longer the box), a single distance map.
     let mut lone = mirror_and_glass();
     lone.meshes.retain(|m| m.name != "glass");
     let p = plan_with(&lone, &Choices::default(), &q).unwrap();
+    assert_eq!(p.objects[0].method, PROXY_BOX, "{}", p.objects[0].reason);
+    let grey = lone.add_material(Material { name: "grey".into(), base_color: Vec3::splat(0.5), ..Default::default() }).unwrap();
+    lone.add_mesh(shapes::uv_sphere("block", Vec3::new(0.4, 1.5, -0.2), 0.5, 24, 12, grey)).unwrap();
+    let p = plan_with(&lone, &Choices::default(), &q).unwrap();
     assert_eq!(p.objects[0].method, DISTANCE, "{}", p.objects[0].reason);
+    assert!(p.objects[0].reason.contains("distance map"), "{}", p.objects[0].reason);
     assert!(!p.inter_object && p.cycles == 1);
     // planner=speed: cheaper rungs.
     let fast = quality(&["planner=speed"]);
@@ -225,10 +232,11 @@ fn auto_is_as_good_as_the_best_single_method() {
         let best = singles.iter().cloned().fold(("", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
         let worst = singles.iter().map(|s| s.1).fold(f64::MAX, f64::min);
         eprintln!("{name}: auto {auto:.2} dB, best {} {:.2} dB, worst {worst:.2} dB; {singles:?}", best.0, best.1);
-        // Measured (72×48, cube_size 64): mirror 42.05 vs proxy-box 42.26; glass 41.31 =
-        // refractor-map; thin 40.34 vs proxy-box 40.83 (the proxy box is the room itself);
+        // Measured (72×48, cube_size 64): mirror 42.26 = proxy-box (the room is its own proxy
+        // box; distance 42.05); glass 41.31 = refractor-map; thin 40.83 = proxy-box;
         // mirror+glass 36.29 vs refractor-map 33.54 (mixed methods beat every single one);
-        // demo 31.31 = refractor-map (the mirror sees the glass over 1.1 % only: no cycles).
+        // demo 31.31 = refractor-map (mirror: proxy-box; it sees the glass over 1.1 % only:
+        // no cycles).
         assert!(auto >= best.1 - 0.5, "{name}: auto {auto} vs best {best:?}");
         assert!(auto >= worst, "{name}: auto {auto} vs worst {worst}");
         if *name == "mirror+glass" {
@@ -295,8 +303,8 @@ fn plan_command_prints_per_object_methods() {
     let table = run(&["plan", scene]);
     for want in [
         "method auto",
-        "mirror_sphere/0 (mirror, material 'mirror'): distance",
-        "cover only 1.",
+        "mirror_sphere/0 (mirror, material 'mirror'): proxy-box",
+        "bounding box",
         "glass_sphere/0 (solid dielectric, material 'glass'): refractor-map",
         "reason",
         "MiB",

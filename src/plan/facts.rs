@@ -30,6 +30,10 @@ pub struct ObjectFacts {
     /// Other specular objects visible from the reference point: (mesh, fraction of the
     /// sphere of directions they cover), largest first.
     pub sees_specular: Vec<(usize, f32)>,
+    /// Fraction of the directions from the reference point whose first surface lies on the
+    /// scene's bounding box (1: the environment is a box room with nothing in it, and the
+    /// proxy box of §3.2 is exact). 0 without deep facts.
+    pub box_fraction: f32,
     pub reference_point: Vec3,
     pub reference_note: Option<String>,
     pub triangles: usize,
@@ -304,13 +308,19 @@ fn visible_fraction(m: &Mesh, x: Vec3) -> f32 {
     }
 }
 
-/// Specular objects other than `mesh` that rays from `x` reach first, with the fraction of
-/// 2048 directions (a Fibonacci sphere) that reach each.
-fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> Vec<(usize, f32)> {
+/// What rays from `x` (2048 directions of a Fibonacci sphere, stepping through the object
+/// itself) reach first: the other specular objects with the fraction of directions that
+/// reach each, and the fraction of directions whose hit lies on the scene's bounding box
+/// (within 1 % of its diagonal: the environment is then its own proxy box, §3.2).
+fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usize, f32)>, f32) {
     let mut hits: HashMap<usize, u32> = HashMap::new();
+    let mut on_box = 0u32;
     let n = 2048;
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    let eps = 1e-6 * scene.bounds().diagonal().max(1e-30) as f64;
+    let bounds = scene.bounds();
+    let (lo, hi) = (bounds.min.as_dvec3(), bounds.max.as_dvec3());
+    let diag = bounds.diagonal().max(1e-30) as f64;
+    let eps = 1e-6 * diag;
     for i in 0..n {
         let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
         let r = (1.0 - z * z).sqrt();
@@ -328,12 +338,17 @@ fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> Vec<(usiz
             if scene.materials[scene.meshes[hit_mesh].material].kind.is_specular() {
                 *hits.entry(hit_mesh).or_insert(0) += 1;
             }
+            let p = o + d * h.t;
+            let to_face = (p - lo).abs().min_element().min((hi - p).abs().min_element());
+            if to_face <= 0.01 * diag {
+                on_box += 1;
+            }
             break;
         }
     }
     let mut out: Vec<(usize, f32)> = hits.into_iter().map(|(m, k)| (m, k as f32 / n as f32)).collect();
     out.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    out
+    (out, on_box as f32 / n as f32)
 }
 
 impl ObjectFacts {
@@ -372,9 +387,9 @@ impl SceneFacts {
                     (None, None) => reference_point(scene, i),
                 };
                 let mf = mesh_facts(m);
-                let (visible, sees) = match &bvh {
+                let (visible, (sees, box_fraction)) = match &bvh {
                     Some(b) => (visible_fraction_cached(m, reference_point), visible_specular(scene, b, i, reference_point)),
-                    None => (1.0, Vec::new()),
+                    None => (1.0, (Vec::new(), 0.0)),
                 };
                 Some(ObjectFacts {
                     mesh: i,
@@ -383,6 +398,7 @@ impl SceneFacts {
                     watertight: mf.watertight,
                     visible_fraction: visible,
                     sees_specular: sees,
+                    box_fraction,
                     reference_point,
                     reference_note,
                     triangles: m.triangle_count(),
