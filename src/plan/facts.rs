@@ -376,7 +376,8 @@ impl SceneFacts {
     /// Facts of every specular object. `deep`: also convexity and mutual visibility (ray
     /// casting; the planner needs them, a fixed method does not).
     pub fn new(scene: &Scene, quality: &Quality, deep: bool) -> SceneFacts {
-        let bvh = if deep && !scene.meshes.is_empty() { Some(Bvh::new(scene)) } else { None };
+        // The scene's BVH only where there is a specular object to ask about.
+        let bvh = if deep && scene.specular_meshes().next().is_some() { Some(Bvh::new(scene)) } else { None };
         let objects = scene
             .specular_meshes()
             .filter_map(|(i, m)| {
