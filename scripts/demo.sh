@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The main job: renders the bundled demo scene with every method into out/ (PNG + EXR
+# The main job: renders the bundled demo scene with auto and every method into out/ (PNG + EXR
 # per method, Chrome traces) and prints the per-pass timing table (also out/timings.txt).
 set -euo pipefail
 cd "$(dirname "$0")/.."

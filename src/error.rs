@@ -70,3 +70,13 @@ pub fn clip(s: &str) -> String {
         s.chars().take(MAX).collect::<String>() + "…"
     }
 }
+
+/// A whole message on one line, at most 300 characters.
+pub fn clip_long(s: &str) -> String {
+    let one: String = s.split_whitespace().collect::<Vec<_>>().join(" ");
+    if one.chars().count() <= 300 {
+        one
+    } else {
+        one.chars().take(300).collect::<String>() + "…"
+    }
+}

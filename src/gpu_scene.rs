@@ -77,9 +77,7 @@ pub fn light_kind_code(k: LightKind) -> f32 {
 
 impl GpuScene {
     pub fn new(ctx: &Context, scene: &Scene) -> Result<GpuScene> {
-        if scene.meshes.is_empty() || scene.triangle_count() == 0 {
-            return Err(Error::invalid("scene", "has no triangles to render"));
-        }
+        scene.check_renderable()?;
         scene.validate()?;
         if scene.textures.len() > MAX_TEXTURES {
             return Err(Error::invalid("scene", format!("{} textures exceed the limit of {MAX_TEXTURES}", scene.textures.len())));

@@ -651,9 +651,21 @@ fn nan_and_infinite_positions() {
     expect_error("inf_position", &doc, &["meshes[0].primitives[0].attributes.POSITION", "vertex 0"]);
 }
 
+/// KHR_materials_ior's schema admits 0 (its specular-glossiness compatibility mode: infinite
+/// IOR, Fresnel 1 at every angle) or values ≥ 1; 0 on a transmissive material imports as an
+/// ideal mirror of reflectance 1, anything in (0, 1) or below 0 is refused.
 #[test]
 fn ior_zero_or_negative() {
-    for ior in [0.0, -1.0] {
+    let doc = quad_doc().with_materials(json!([{
+        "name": "infinite", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+        "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 0.0 } }
+    }]));
+    let s = load_doc("ior_zero", &doc);
+    let SurfaceKind::Mirror { nu, kappa } = material(&s, "infinite").kind else { panic!("{:?}", material(&s, "infinite").kind) };
+    let f =
+        specula::optics::fresnel_conductor(1.0, nu.x as f64, kappa.x as f64).min(specula::optics::fresnel_f0(nu.x as f64, kappa.x as f64));
+    assert!(f > 1.0 - 1e-6, "reflectance {f}");
+    for ior in [0.5, -1.0] {
         let doc = quad_doc().with_materials(json!([{
             "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
             "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": ior } }
@@ -970,4 +982,70 @@ fn method_from_extras() {
     expect_error("method_cannot_serve", &doc, &["nodes[0].extras.specula.method", "cannot serve this mirror"]);
     doc.json["nodes"][0]["extras"] = json!({ "specula": { "method": "reference" } });
     expect_error("method_cpu", &doc, &["nodes[0].extras.specula.method", "CPU"]);
+}
+
+/// A scene with nothing to render (lines, points, a mesh without primitives): `info` lists
+/// it and `render` refuses it, both exit 1 with the same one line naming the file, the mesh,
+/// the primitive and its mode.
+#[test]
+fn info_and_render_agree_on_a_scene_without_triangles() {
+    let mut doc = quad_doc();
+    let mut lines = doc.json["meshes"][0]["primitives"][0].clone();
+    lines["mode"] = json!(1);
+    let mut points = lines.clone();
+    points["mode"] = json!(0);
+    doc.json["meshes"][0]["primitives"] = json!([lines, points]);
+    let dir = TempDir::new("no_triangles");
+    let path = write(&dir, "no_triangles", &doc, Form::Embedded);
+    let s = load(&path).unwrap();
+    assert_eq!(s.skipped.len(), 2, "{:?}", s.skipped);
+    let exe = env!("CARGO_BIN_EXE_specula");
+    let mut lines_of = Vec::new();
+    for args in [&["info", path.to_str().unwrap()][..], &["render", path.to_str().unwrap(), "--out", dir.join("x.png").to_str().unwrap()]] {
+        let o = std::process::Command::new(exe).args(args).output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr).to_string();
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        for want in ["no_triangles.gltf", "no triangles", "meshes[0].primitives[0]", "Lines", "meshes[0].primitives[1]", "Points"] {
+            assert!(err.contains(want), "{args:?}: {err} lacks {want}");
+        }
+        lines_of.push(err);
+    }
+    assert_eq!(lines_of[0], lines_of[1], "info and render say the same");
+}
+
+/// The schema's rules through the loader (the full table is in src/scene/gltf/schema.rs's
+/// unit tests): each refusal names the JSON path and the value.
+#[test]
+fn schema_rules_are_enforced() {
+    let mut doc = quad_doc();
+    doc.json["asset"]["version"] = json!("1.0");
+    expect_error("version_1", &doc, &["asset.version", "1.0"]);
+    let mut doc = quad_doc();
+    doc.json["asset"]["minVersion"] = json!("2.1");
+    expect_error("min_version", &doc, &["asset.minVersion", "2.1"]);
+    let mut doc = quad_doc();
+    doc.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+    doc.json["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+    expect_error("required", &doc, &["extensionsRequired[0]", "KHR_draco_mesh_compression"]);
+    let mut doc = quad_doc();
+    doc.json["bufferViews"][0]["byteStride"] = json!(8);
+    expect_error("stride", &doc, &["bufferViews[0].byteStride"]);
+    for (tag, m, needles) in [
+        (
+            "transmission_2",
+            json!({ "extensions": { "KHR_materials_transmission": { "transmissionFactor": 2.0 } } }),
+            ["transmissionFactor", "2"],
+        ),
+        ("thickness_neg", json!({ "extensions": { "KHR_materials_volume": { "thicknessFactor": -1.0 } } }), ["thicknessFactor", "-1"]),
+        ("emissive_neg", json!({ "emissiveFactor": [-1.0, 0.0, 0.0] }), ["emissiveFactor[0]", "-1"]),
+        ("albedo_2", json!({ "pbrMetallicRoughness": { "baseColorFactor": [2.0, 1.0, 1.0, 1.0] } }), ["baseColorFactor[0]", "2"]),
+        ("ior_half", json!({ "extensions": { "KHR_materials_ior": { "ior": 0.5 } } }), ["KHR_materials_ior.ior", "0.5"]),
+    ] {
+        let doc = quad_doc().with_materials(json!([m]));
+        expect_error(tag, &doc, &needles);
+    }
+    let mut doc = quad_doc();
+    doc.json["cameras"] = json!([{ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1, "aspectRatio": 0.0 } }]);
+    expect_error("aspect_0", &doc, &["cameras[0].perspective.aspectRatio"]);
 }

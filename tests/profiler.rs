@@ -103,6 +103,12 @@ fn cli_bad_input_is_one_line_and_nonzero() {
         &["render", scene, "--camera-pos", "1,nan,2", "--out", "/tmp/x.png"],
         &["render", scene, "--device", "no-such-gpu", "--out", "/tmp/x.png"],
         &["info", "/nonexistent.glb"],
+        // Argument-parser errors go through the same one-line reporter.
+        &["render", scene],
+        &["render", scene, "--out", "/tmp/x.png", "--frames", "abc"],
+        &["rendr", scene],
+        &["render", scene, "--out", "/tmp/x.png", "--no-such-flag"],
+        &[],
     ];
     for args in cases {
         let o = specula().args(*args).output().unwrap();
@@ -111,6 +117,26 @@ fn cli_bad_input_is_one_line_and_nonzero() {
         assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
         assert!(stderr.starts_with("specula: ") && stderr.trim_end().lines().count() == 1, "{args:?}: {stderr}");
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    }
+}
+
+/// Help and version still print as usual and exit 0; parser errors name what is wrong.
+#[test]
+fn cli_help_version_and_parser_messages() {
+    for args in [&["--help"][..], &["--version"], &["render", "--help"]] {
+        let o = specula().args(args).output().unwrap();
+        assert_eq!(o.status.code(), Some(0), "{args:?}");
+        assert!(!o.stdout.is_empty(), "{args:?}");
+    }
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    for (args, want) in [
+        (&["render", scene][..], "--out"),
+        (&["render", scene, "--out", "/tmp/x.png", "--frames", "abc"], "abc"),
+        (&["rendr", scene], "rendr"),
+    ] {
+        let o = specula().args(args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert!(stderr.contains(want), "{args:?}: {stderr}");
     }
 }
 

@@ -135,9 +135,7 @@ impl<'a> Tracer<'a> {
     /// Validates the scene and prepares it.
     pub fn new(scene: &'a Scene, quality: &Quality) -> Result<Tracer<'a>> {
         scene.validate()?;
-        if scene.triangle_count() == 0 {
-            return Err(Error::invalid("scene", "has no triangles to render"));
-        }
+        scene.check_renderable()?;
         if !(1..=64).contains(&quality.depth) {
             return Err(Error::invalid("knob depth", format!("{} is outside 1..=64", quality.depth)));
         }

@@ -279,6 +279,9 @@ pub struct Scene {
     pub camera: Option<Camera>,
     /// What rays that leave the scene see; `None` is black.
     pub environment: Option<EnvironmentMap>,
+    /// What the importer read but could not render (points, lines, empty primitives, meshes
+    /// without primitives), with its place in the file; says why a scene has no triangles.
+    pub skipped: Vec<String>,
 }
 
 impl Scene {
@@ -405,6 +408,21 @@ impl Scene {
 
     pub fn triangle_count(&self) -> usize {
         self.meshes.iter().map(Mesh::triangle_count).sum()
+    }
+
+    /// Fails with what the scene lacks and where when it has no triangle to render.
+    pub fn check_renderable(&self) -> Result<()> {
+        if self.triangle_count() > 0 {
+            return Ok(());
+        }
+        let why = if self.skipped.is_empty() {
+            "it has no meshes".to_string()
+        } else {
+            let n = self.skipped.len();
+            let shown: Vec<&str> = self.skipped.iter().take(4).map(String::as_str).collect();
+            format!("{}{}", shown.join("; "), if n > 4 { format!("; and {} more", n - 4) } else { String::new() })
+        };
+        Err(Error::invalid("scene", format!("has no triangles to render: {why}")))
     }
 
     /// A camera that frames the whole scene when none was given.

@@ -148,8 +148,23 @@ pub fn parse_object(s: &str) -> specula::Result<(String, Method)> {
     Ok((n.trim().to_string(), m))
 }
 
+/// Loads a scene that has something to render; otherwise says what it lacks and where.
+pub fn load_renderable(path: &Path) -> specula::Result<Scene> {
+    let scene = scene::load(path)?;
+    renderable(path, &scene)?;
+    Ok(scene)
+}
+
+/// `Scene::check_renderable`, naming the file.
+pub fn renderable(path: &Path, scene: &Scene) -> specula::Result<()> {
+    scene.check_renderable().map_err(|e| match e {
+        specula::Error::InvalidInput { message, .. } => specula::Error::scene(path.display().to_string(), "(scene)", message),
+        other => other,
+    })
+}
+
 pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
-    let mut scene = scene::load(&a.scene)?;
+    let mut scene = load_renderable(&a.scene)?;
     if let Some(env) = &a.env {
         scene.set_environment(scene::load_environment(env)?)?;
     }

@@ -5,10 +5,15 @@ use std::path::Path;
 use specula::scene;
 use specula::Scene;
 
+/// Prints what the scene holds; a scene with nothing to render is the same one-line error
+/// as `render` gives (after the listing), exit 1.
 pub fn run(path: &Path) -> specula::Result<()> {
     let s = scene::load(path)?;
     print!("{}", info(&s));
-    Ok(())
+    for note in &s.skipped {
+        println!("skipped: {note}");
+    }
+    crate::args::renderable(path, &s)
 }
 
 fn info(s: &Scene) -> String {

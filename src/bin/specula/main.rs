@@ -98,7 +98,10 @@ enum Command {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return parse_error(e),
+    };
     match run(cli.command) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -106,6 +109,45 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Help and version print as clap prints them (exit 0); every other argument error is one
+/// line on stderr, exit 1, as every other error.
+fn parse_error(e: clap::Error) -> ExitCode {
+    use clap::error::ErrorKind;
+    if matches!(e.kind(), ErrorKind::DisplayHelp | ErrorKind::DisplayVersion) {
+        let _ = e.print();
+        return ExitCode::SUCCESS;
+    }
+    if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand {
+        use clap::CommandFactory;
+        let names: Vec<String> = Cli::command().get_subcommands().map(|c| c.get_name().to_string()).collect();
+        eprintln!("specula: a subcommand is required ({}; see specula --help)", names.join(", "));
+        return ExitCode::FAILURE;
+    }
+    eprintln!("specula: {}", one_line(&e.render().to_string()));
+    ExitCode::FAILURE
+}
+
+/// clap's message without its usage block, on one line: "error: a\n  b\n\ntip: c" → "a b; tip: c".
+fn one_line(text: &str) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if line.is_empty() {
+            continue;
+        }
+        let line = line.strip_prefix("error: ").unwrap_or(line);
+        if line.starts_with("tip:") {
+            parts.push(format!("; {line}"));
+        } else {
+            parts.push(format!(" {line}"));
+        }
+    }
+    specula::error::clip_long(parts.concat().trim_start_matches([' ', ';']))
 }
 
 fn run(cmd: Command) -> specula::Result<()> {

@@ -30,11 +30,16 @@
 //! - Skins, morph targets and animations are ignored (the static node transforms are used).
 //! - A node hierarchy with a cycle is an error.
 //!
-//! Files: this one parses the document and holds the importer's state; `accessors` reads
+//! - The glTF schema's rules the `gltf` crate leaves unchecked (versions, required
+//!   extensions, strides, factor and camera/light ranges) are enforced first (`schema`).
+//!
+//! Files: this one parses the document and holds the importer's state; `schema` checks the
+//! JSON against the schema's rules; `accessors` reads
 //! the binary data (buffers, buffer views, accessors, images), `translate` turns nodes,
 //! meshes, materials, lights and the camera into the scene.
 
 mod accessors;
+pub mod schema;
 mod translate;
 
 use std::collections::HashMap;
@@ -75,6 +80,11 @@ fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
     // gltf-json's validation indexes the POSITION accessor before checking the index.
     precheck(file, doc.as_json())?;
     let doc = gltf::Document::from_json(doc.into_json()).map_err(|e| gltf_error(file, e))?;
+    // The schema's ranges and rules that the gltf crate leaves unchecked (on the validated
+    // document: every enum is valid, so it serialises back).
+    let json =
+        serde_json::to_value(doc.as_json()).map_err(|e| Error::scene(file, "(JSON)", format!("cannot re-read the document: {e}")))?;
+    schema::check(file, &json)?;
 
     let mut imp = Importer {
         file,

@@ -36,6 +36,18 @@ fn json_vec3(v: &Value, file: &str, field: &str) -> Result<Vec3> {
     }
 }
 
+fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::TriangleStrip => "triangle-strip",
+        Mode::TriangleFan => "triangle-fan",
+        _ => "triangle",
+    }
+}
+
+/// κ of the ideal reflector that KHR_materials_ior's ior = 0 stands for: with ν = 1 its
+/// reflectance is 1 − 4/(4 + κ²) ≥ 1 − 4·10⁻⁸ at normal incidence and closer to 1 elsewhere.
+const INFINITE_IOR_KAPPA: f32 = 1e4;
+
 /// ν of a conductor with κ = 0 whose normal-incidence reflectance is `f0`.
 fn nu_from_f0(f0: f32) -> f32 {
     let f0 = if f0.is_nan() { 0.0 } else { f0.clamp(0.0, 0.9999) };
@@ -107,6 +119,9 @@ impl Importer<'_> {
 
     fn visit(&mut self, node: &gltf::Node, world: Mat4) -> Result<()> {
         if let Some(mesh) = node.mesh() {
+            if mesh.primitives().len() == 0 {
+                self.scene.skipped.push(format!("meshes[{}] (node {}) has no primitives", mesh.index(), node.index()));
+            }
             for prim in mesh.primitives() {
                 self.import_primitive(node, &mesh, &prim, world)?;
             }
@@ -129,6 +144,7 @@ impl Importer<'_> {
         let pfield = format!("meshes[{m}].primitives[{p}]");
         let mode = prim.mode();
         if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
+            self.scene.skipped.push(format!("{pfield}: mode {mode:?} draws no triangles"));
             return Ok(());
         }
 
@@ -144,6 +160,7 @@ impl Importer<'_> {
         }
         let n = local_positions.len();
         if n == 0 {
+            self.scene.skipped.push(format!("{pfield}: {pos_field} has no vertices"));
             return Ok(());
         }
         if n > u32::MAX as usize {
@@ -218,6 +235,7 @@ impl Importer<'_> {
             }
         };
         if indices.is_empty() {
+            self.scene.skipped.push(format!("{pfield}: no complete triangle in its {} indices", mode_name(mode)));
             return Ok(());
         }
 
@@ -309,10 +327,11 @@ impl Importer<'_> {
     pub(super) fn check_material_scalars(&self, material: &gltf::Material) -> Result<()> {
         let i = material.index().unwrap_or(0);
         if let Some(ior) = material.ior() {
-            if !(ior > 0.0 && ior.is_finite()) {
+            // KHR_materials_ior admits 0 (infinite IOR, Fresnel 1) or ≥ 1 (see schema.rs).
+            if !(ior == 0.0 || (ior >= 1.0 && ior.is_finite())) {
                 return Err(self.err(
                     format!("materials[{i}].extensions.KHR_materials_ior.ior"),
-                    format!("index of refraction must be finite and > 0, got {ior}"),
+                    format!("index of refraction must be 0 or finite and ≥ 1, got {ior}"),
                 ));
             }
         }
@@ -373,6 +392,10 @@ impl Importer<'_> {
                 }
                 (None, None) => SurfaceKind::Mirror { nu: Vec3::new(nu_from_f0(r), nu_from_f0(g), nu_from_f0(b)), kappa: Vec3::ZERO },
             }
+        } else if transmission == 1.0 && roughness == 0.0 && material.ior() == Some(0.0) {
+            // KHR_materials_ior's ior = 0: infinite IOR, Fresnel 1 at every angle: nothing is
+            // transmitted, an ideal mirror of reflectance 1 (a conductor with a huge κ).
+            SurfaceKind::Mirror { nu: Vec3::ONE, kappa: Vec3::splat(INFINITE_IOR_KAPPA) }
         } else if transmission == 1.0 && roughness == 0.0 {
             let thin = material.volume().is_none_or(|v| v.thickness_factor() == 0.0);
             SurfaceKind::Dielectric { ior: material.ior().unwrap_or(1.5), thin }
