@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::image::ImageData;
 
 /// One tile of the contact sheet: the method's name (its PNG's stem), the label drawn on
@@ -51,7 +51,7 @@ pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<
     }
     svg += "</svg>\n";
     let path = outdir.join("methods.svg");
-    std::fs::write(&path, svg).map_err(|e| Error::io(&path, e))
+    crate::output::write_file(&path, svg.as_bytes())
 }
 
 /// Draws `text` (lines split at '\n') into an RGBA32F linear image of `w`×`h` at (x, y):

@@ -14,6 +14,7 @@ pub mod image;
 pub mod methods;
 pub mod metrics;
 pub mod optics;
+pub mod output;
 pub mod plan;
 pub mod profile;
 pub mod quality;

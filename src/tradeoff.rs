@@ -154,13 +154,26 @@ pub fn csv(rows: &[Row], device: &str) -> String {
 /// An SVG plot of mean FLIP against frame GPU time, one colour per method, each point
 /// labelled with its knobs, the Pareto front drawn as a line through its points.
 pub fn plot_svg(path: &Path, rows: &[Row], title: &str) -> Result<()> {
-    use plotters::prelude::*;
     let err = |e: &dyn std::fmt::Display| Error::Image(format!("{}: {e}", path.display()));
     let points: Vec<(f64, f64)> = rows.iter().map(|r| (r.frame_ms, plotted_error(&r.errors))).collect();
     let finite: Vec<&(f64, f64)> = points.iter().filter(|(t, e)| t.is_finite() && e.is_finite()).collect();
     let (t_max, e_max) = finite.iter().fold((0.0f64, 0.0f64), |(a, b), (t, e)| (a.max(*t), b.max(*e)));
     let (t_max, e_max) = ((t_max * 1.15).max(1e-3), (e_max * 1.15).max(1e-3));
-    let root = SVGBackend::new(path, (960, 640)).into_drawing_area();
+    let mut svg = String::new();
+    draw_plot(&mut svg, &points, rows, title, (t_max, e_max)).map_err(|e| err(&e))?;
+    crate::output::write_file(path, svg.as_bytes())
+}
+
+fn draw_plot(
+    svg: &mut String,
+    points: &[(f64, f64)],
+    rows: &[Row],
+    title: &str,
+    (t_max, e_max): (f64, f64),
+) -> std::result::Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let root = SVGBackend::with_string(svg, (960, 640)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 20))
@@ -170,7 +183,7 @@ pub fn plot_svg(path: &Path, rows: &[Row], title: &str) -> Result<()> {
         .build_cartesian_2d(0.0..t_max, 0.0..e_max)
         .map_err(|e| err(&e))?;
     chart.configure_mesh().x_desc("frame GPU time [ms] (median)").y_desc("mean FLIP vs reference").draw().map_err(|e| err(&e))?;
-    let front = pareto_front(&points);
+    let front = pareto_front(points);
     let mut front_pts: Vec<(f64, f64)> = points.iter().zip(&front).filter(|(_, f)| **f).map(|(p, _)| *p).collect();
     front_pts.sort_by(|a, b| a.0.total_cmp(&b.0));
     chart
@@ -188,7 +201,7 @@ pub fn plot_svg(path: &Path, rows: &[Row], title: &str) -> Result<()> {
         let color = Palette99::pick(k).to_rgba();
         let pts: Vec<((f64, f64), bool, &str)> = rows
             .iter()
-            .zip(&points)
+            .zip(points)
             .zip(&front)
             .filter(|((r, p), _)| r.method == *m && p.0.is_finite() && p.1.is_finite())
             .map(|((r, p), f)| (*p, *f, r.knobs.as_str()))
@@ -306,7 +319,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
 
     let csv_path = out.join("tradeoff.csv");
     let device = format!("{} ({})", ctx.device_name, ctx.driver_info);
-    std::fs::write(&csv_path, csv(&rows, &device)).map_err(|e| Error::io(&csv_path, e))?;
+    crate::output::write_file(&csv_path, csv(&rows, &device).as_bytes())?;
     let svg_path = out.join("tradeoff.svg");
     let title = format!("{} at {w}x{h} on {}: mean FLIP vs GPU time", cfg.scene_name, ctx.device_name);
     plot_svg(&svg_path, &rows, &title)?;

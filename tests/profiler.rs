@@ -149,3 +149,40 @@ fn cli_info_lists_classification() {
         assert!(s.contains(want), "info lacks {want}: {s}");
     }
 }
+
+/// A failed write is an error: a full device, a folder that cannot be created, a parent
+/// that is a file — exit 1, one line naming the path; no partial file under the final name.
+#[test]
+fn cli_failed_writes_exit_1_naming_the_path() {
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let dir = std::env::temp_dir().join(format!("specula-writes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("a-file");
+    std::fs::write(&file, b"x").unwrap();
+    let under_file = file.join("x.png");
+    let mut cases: Vec<(Vec<String>, String)> = vec![
+        (vec!["--out".into(), "/proc/specula-no/x.png".into()], "/proc/specula-no".into()),
+        (vec!["--out".into(), under_file.display().to_string()], "is not a folder".into()),
+        (
+            vec!["--out".into(), dir.join("ok.png").display().to_string(), "--profile".into(), "/proc/specula-no/t.json".into()],
+            "/proc/specula-no".into(),
+        ),
+    ];
+    if std::path::Path::new("/dev/full").exists() {
+        cases.push((vec!["--out".into(), "/dev/full".into(), "-q".into(), "cube_size=16".into()], "/dev/full".into()));
+    }
+    for (args, want) in cases {
+        let o = specula()
+            .args(["render", scene, "--method", "envmap", "--size", "16x16", "-q", "shadow_size=16", "-q", "cube_size=16"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.trim_end().lines().count() == 1 && stderr.contains(&want), "{args:?}: {stderr}");
+    }
+    let leftovers: Vec<_> =
+        std::fs::read_dir(&dir).unwrap().flatten().map(|e| e.file_name()).filter(|n| n.to_string_lossy().contains("partial")).collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -111,31 +111,28 @@ fn check_size(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<(
     Ok(())
 }
 
-fn create_parent(path: &Path) -> Result<()> {
-    match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e)),
-        _ => Ok(()),
-    }
-}
-
 /// Writes linear RGBA32F pixels (row-major, top row first) as an OpenEXR file.
 pub fn write_exr(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<()> {
     check_size(path, width, height, rgba32f)?;
-    create_parent(path)?;
+    use exr::prelude::{Image, SpecificChannels, Vec2, WritableImage};
     let w = width as usize;
-    exr::prelude::write_rgba_file(path, w, height as usize, |x, y| {
+    let channels = SpecificChannels::rgba(|Vec2(x, y): Vec2<usize>| {
         let i = (y * w + x) * 4;
         (rgba32f[i], rgba32f[i + 1], rgba32f[i + 2], rgba32f[i + 3])
-    })
-    .map_err(|e| exr_error(path, e))
+    });
+    let image = Image::from_channels((w, height as usize), channels);
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write().to_buffered(&mut bytes).map_err(|e| exr_error(path, e))?;
+    crate::output::write_file(path, bytes.get_ref())
 }
 
 /// Writes linear RGBA32F pixels as an 8-bit sRGB-encoded PNG (clamped; alpha 255).
 pub fn write_png_srgb(path: &Path, width: u32, height: u32, rgba32f: &[f32]) -> Result<()> {
     check_size(path, width, height, rgba32f)?;
-    create_parent(path)?;
     let bytes: Vec<u8> =
         rgba32f.chunks_exact(4).flat_map(|p| [linear_to_srgb(p[0]), linear_to_srgb(p[1]), linear_to_srgb(p[2]), 255]).collect();
-    image::save_buffer_with_format(path, &bytes, width, height, image::ExtendedColorType::Rgba8, image::ImageFormat::Png)
-        .map_err(|e| image_error(path, e))
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut png), &bytes, width, height, image::ExtendedColorType::Rgba8)
+        .map_err(|e| image_error(path, e))?;
+    crate::output::write_file(path, &png)
 }

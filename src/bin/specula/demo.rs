@@ -27,8 +27,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     write_image(&stem.with_extension("png"), &reference)?;
     write_image(&stem.with_extension("exr"), &reference)?;
     let trace = stem.with_extension("trace.json");
-    std::fs::write(&trace, specula::profile::chrome_trace(&[reference_timing(ref_ms)], &[], "CPU"))
-        .map_err(|e| specula::Error::io(&trace, e))?;
+    specula::output::write_file(&trace, specula::profile::chrome_trace(&[reference_timing(ref_ms)], &[], "CPU").as_bytes())?;
     report += &format!("== method reference -> {}\n{}\n\n", stem.with_extension("png").display(), reference_summary(&q, w, h, ref_ms));
 
     let choices = std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method));
@@ -43,8 +42,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         write_image(&png, &frame.image)?;
         write_image(&outdir.join(format!("{name}.exr")), &frame.image)?;
         let trace = outdir.join(format!("{name}.trace.json"));
-        std::fs::write(&trace, specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name))
-            .map_err(|e| specula::Error::io(&trace, e))?;
+        specula::output::write_file(&trace, specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name).as_bytes())?;
         report += &format!("== method {name} -> {} (median of 5 frames)\n", png.display());
         for m in &methods {
             report += &format!("   {m}\n");
@@ -63,6 +61,6 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     report += &format!("side by side: {}, {}\n", outdir.join("methods.png").display(), outdir.join("methods.svg").display());
     print!("{report}");
     let table = outdir.join("timings.txt");
-    std::fs::write(&table, &report).map_err(|e| specula::Error::io(&table, e))?;
+    specula::output::write_file(&table, report.as_bytes())?;
     Ok(())
 }

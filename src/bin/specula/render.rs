@@ -12,7 +12,7 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
         println!("{}", reference_summary(&job.quality, job.width, job.height, ms));
         if let Some(p) = profile {
             let passes = [reference_timing(ms)];
-            std::fs::write(p, specula::profile::chrome_trace(&passes, &[], "CPU")).map_err(|e| specula::Error::io(p, e))?;
+            specula::output::write_file(p, specula::profile::chrome_trace(&passes, &[], "CPU").as_bytes())?;
         }
         return Ok(());
     }
@@ -28,7 +28,7 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
     print!("{}", specula::profile::table(&frame.passes, &frame.memory));
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);
-        std::fs::write(p, json).map_err(|e| specula::Error::io(p, e))?;
+        specula::output::write_file(p, json.as_bytes())?;
     }
     if args.validate {
         println!("validation: {} error(s), {} warning(s)", ctx.validation.error_count(), ctx.validation.warning_count());
