@@ -1049,3 +1049,27 @@ fn schema_rules_are_enforced() {
     doc.json["cameras"] = json!([{ "type": "perspective", "perspective": { "yfov": 0.8, "znear": 0.1, "aspectRatio": 0.0 } }]);
     expect_error("aspect_0", &doc, &["cameras[0].perspective.aspectRatio"]);
 }
+
+/// A texture whose PNG header declares 65536×65536 pixels is refused before decoding,
+/// naming the image and the declared size.
+#[test]
+fn huge_declared_texture_is_refused() {
+    let mut png = png_bytes(&image::RgbaImage::from_pixel(1, 1, image::Rgba([1, 2, 3, 255])));
+    png[16..20].copy_from_slice(&65536u32.to_be_bytes());
+    png[20..24].copy_from_slice(&65536u32.to_be_bytes());
+    let crc = {
+        let mut c = 0xffff_ffffu32;
+        for &b in &png[12..29] {
+            c ^= b as u32;
+            for _ in 0..8 {
+                c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+            }
+        }
+        !c
+    };
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    let mut doc = quad_doc().with_materials(json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]));
+    doc.json["images"] = json!([{ "uri": format!("data:image/png;base64,{}", b64(&png)) }]);
+    doc.json["textures"] = json!([{ "source": 0 }]);
+    expect_error("huge_texture", &doc, &["images[0]", "declares 65536×65536"]);
+}

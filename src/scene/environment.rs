@@ -44,12 +44,62 @@ fn exr_error(path: &Path, e: exr::error::Error) -> Error {
     }
 }
 
-/// Loads an equirectangular environment map as linear RGBA32F radiance.
+/// How large an image a loader accepts, checked against the file's declared size before
+/// any pixel is allocated (a small file may declare a huge image).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LoadLimits {
+    /// Longest edge in pixels.
+    pub max_edge: u32,
+    /// Most pixels (width × height); decoded as RGBA32F, 16 bytes each.
+    pub max_pixels: u64,
+}
+
+impl Default for LoadLimits {
+    /// 16384 pixels an edge, 64 Mpixels (1 GiB of RGBA32F).
+    fn default() -> LoadLimits {
+        LoadLimits { max_edge: 16384, max_pixels: 64 << 20 }
+    }
+}
+
+impl LoadLimits {
+    /// Refuses a declared `width`×`height` beyond the limits, naming the file.
+    pub fn check(&self, what: &str, width: u64, height: u64) -> Result<()> {
+        if width > self.max_edge as u64 || height > self.max_edge as u64 || width.saturating_mul(height) > self.max_pixels {
+            return Err(Error::Image(format!(
+                "{what}: declares {width}×{height} pixels, beyond the loader's limits ({} pixels an edge, {} pixels)",
+                self.max_edge, self.max_pixels
+            )));
+        }
+        Ok(())
+    }
+
+    /// The `image` crate's limits for the same bounds.
+    pub fn image_limits(&self) -> image::Limits {
+        let mut l = image::Limits::default();
+        l.max_image_width = Some(self.max_edge);
+        l.max_image_height = Some(self.max_edge);
+        l.max_alloc = Some(self.max_pixels.saturating_mul(16));
+        l
+    }
+}
+
+/// Loads an equirectangular environment map as linear RGBA32F radiance, within the
+/// default `LoadLimits`.
 pub fn load_environment(path: &Path) -> Result<EnvironmentMap> {
+    load_environment_with(path, &LoadLimits::default())
+}
+
+/// `load_environment` within `limits`.
+pub fn load_environment_with(path: &Path, limits: &LoadLimits) -> Result<EnvironmentMap> {
     // Report a missing file as such, whatever the decoder would say.
     std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
     let (width, height, mut rgba32f) = if ext == "exr" {
+        // The header first: its data window is the size the pixels would take.
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| exr_error(path, e))?;
+        for h in meta.headers.iter() {
+            limits.check(&path.display().to_string(), h.layer_size.width() as u64, h.layer_size.height() as u64)?;
+        }
         let image = exr::prelude::read_first_rgba_layer_from_file(
             path,
             |resolution, _| (resolution.width(), vec![0f32; resolution.width() * resolution.height() * 4]),
@@ -63,12 +113,15 @@ pub fn load_environment(path: &Path) -> Result<EnvironmentMap> {
         let (_, pixels) = image.layer_data.channel_data.pixels;
         (size.width() as u32, size.height() as u32, pixels)
     } else {
-        let img = image::ImageReader::open(path)
-            .map_err(|e| Error::io(path, e))?
-            .with_guessed_format()
-            .map_err(|e| Error::io(path, e))?
-            .decode()
-            .map_err(|e| image_error(path, e))?;
+        let open = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
+            image::ImageReader::open(path).map_err(|e| Error::io(path, e))?.with_guessed_format().map_err(|e| Error::io(path, e))
+        };
+        // The header's declared size first, in the loader's words.
+        let (w, h) = open()?.into_dimensions().map_err(|e| image_error(path, e))?;
+        limits.check(&path.display().to_string(), w as u64, h as u64)?;
+        let mut reader = open()?;
+        reader.limits(limits.image_limits());
+        let img = reader.decode().map_err(|e| image_error(path, e))?;
         let (w, h) = (img.width(), img.height());
         let linear = matches!(img.color(), image::ColorType::Rgb32F | image::ColorType::Rgba32F);
         let mut data = img.into_rgba32f().into_raw();

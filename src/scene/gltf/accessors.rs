@@ -281,8 +281,19 @@ impl Importer<'_> {
             }
             (None, None) => return Err(self.err(format!("images[{image}]"), "has neither uri nor bufferView")),
         };
-        let decoded = image::load_from_memory(&bytes)
-            .map_err(|e| self.err(&field, format!("cannot decode image (used by {used_by}): {e}")))?
+        // Declared sizes are checked before decoding (a small file may declare a huge image).
+        let limits = crate::scene::LoadLimits::default();
+        let reader = || image::ImageReader::new(std::io::Cursor::new(&bytes[..])).with_guessed_format();
+        if let Ok((w, h)) = reader().map_err(image::ImageError::IoError).and_then(|r| r.into_dimensions()) {
+            limits.check(&field, w as u64, h as u64).map_err(|e| self.err(&field, format!("{e} (used by {used_by})")))?;
+        }
+        let decoded = image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+            .with_guessed_format()
+            .map_err(|e| self.err(&field, format!("cannot read image (used by {used_by}): {e}")))
+            .and_then(|mut r| {
+                r.limits(limits.image_limits());
+                r.decode().map_err(|e| self.err(&field, format!("cannot decode image (used by {used_by}): {e}")))
+            })?
             .to_rgba8();
         let name = json
             .name
