@@ -142,8 +142,8 @@ pub unsafe extern "C" fn specula_context_record(
         if final_layout == vk::ImageLayout::UNDEFINED {
             return fail(SPECULA_ERROR_INVALID_ARGUMENT, "target.final_layout must not be UNDEFINED");
         }
-        let mut host =
-            Image::external(vk::Image::from_raw(t.image), vk::Format::from_raw(t.format as i32), t.width, t.height, current, &name);
+        let format = host_format(c, t.format)?;
+        let mut host = Image::external(vk::Image::from_raw(t.image), format, t.width, t.height, current, &name);
         c.vk.name(host.raw, &name);
         c.renderer()?;
         let vkc = &c.vk;
@@ -151,6 +151,53 @@ pub unsafe extern "C" fn specula_context_record(
         c.renderer.as_mut().unwrap().record_into(vkc, cmd, &mut host, final_layout)?;
         Ok(SPECULA_SUCCESS)
     })
+}
+
+/// The host image's format, if the library can write it: RGBA32F is copied bit for bit;
+/// any other colour format must support `BLIT_DST` with optimal tiling on the device (the
+/// frame is blitted with conversion). UNDEFINED, depth/stencil formats, compressed ones and
+/// values that are no VkFormat are refused, naming the value.
+fn host_format(c: &SpeculaContext, raw: u32) -> FfiResult<vk::Format> {
+    let f = vk::Format::from_raw(raw as i32);
+    if f == vk::Format::R32G32B32A32_SFLOAT {
+        return Ok(f);
+    }
+    let depth = [
+        vk::Format::D16_UNORM,
+        vk::Format::X8_D24_UNORM_PACK32,
+        vk::Format::D32_SFLOAT,
+        vk::Format::S8_UINT,
+        vk::Format::D16_UNORM_S8_UINT,
+        vk::Format::D24_UNORM_S8_UINT,
+        vk::Format::D32_SFLOAT_S8_UINT,
+    ];
+    if f == vk::Format::UNDEFINED {
+        return fail(SPECULA_ERROR_INVALID_ARGUMENT, "target.format is VK_FORMAT_UNDEFINED");
+    }
+    if depth.contains(&f) {
+        return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("target.format {raw} ({f:?}) is a depth/stencil format: the frame is colour"));
+    }
+    // Only VkFormat values may be queried: Vulkan 1.0's 1..=184 and the ranges 1.1–1.3
+    // promoted to core (YCbCr, 4444, ASTC HDR, the 1.3 additions).
+    let core = [
+        1..=184,
+        1_000_066_000..=1_000_066_013,
+        1_000_156_000..=1_000_156_033,
+        1_000_330_000..=1_000_330_003,
+        1_000_340_000..=1_000_340_001,
+    ];
+    if !core.iter().any(|r| r.contains(&(raw as i32))) {
+        return fail(SPECULA_ERROR_UNSUPPORTED, format!("target.format {raw} is not a Vulkan 1.3 core VkFormat"));
+    }
+    let props = unsafe { c.vk.instance.get_physical_device_format_properties(c.vk.physical, f) };
+    if !props.optimal_tiling_features.contains(vk::FormatFeatureFlags::BLIT_DST) {
+        let what = format!("{f:?}");
+        return fail(
+            SPECULA_ERROR_UNSUPPORTED,
+            format!("target.format {raw} ({what}) cannot be blitted to on this device (no BLIT_DST with optimal tiling): use R32G32B32A32_SFLOAT or a colour format that supports blits"),
+        );
+    }
+    Ok(f)
 }
 
 /// Copies the per-pass timings of the last frame the GPU completed into `out` (up to
