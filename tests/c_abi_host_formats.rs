@@ -20,7 +20,12 @@ fn bad_host_target_formats_are_refused() {
         r#type: SPECULA_STRUCT_HOST_DESC,
         size: std::mem::size_of::<SpeculaHostDesc>() as u32,
         // The same function; the ABI spells the handle as a pointer.
-        get_instance_proc_addr: unsafe { std::mem::transmute::<_, SpeculaGetInstanceProcAddr>(Some(gipa)) },
+        get_instance_proc_addr: unsafe {
+            std::mem::transmute::<
+                Option<unsafe extern "system" fn(vk::Instance, *const std::ffi::c_char) -> vk::PFN_vkVoidFunction>,
+                SpeculaGetInstanceProcAddr,
+            >(Some(gipa))
+        },
         instance: own.instance.handle().as_raw() as *mut c_void,
         physical_device: own.physical.as_raw() as *mut c_void,
         device: own.device.handle().as_raw() as *mut c_void,
@@ -62,7 +67,7 @@ fn bad_host_target_formats_are_refused() {
                 final_layout: vk::ImageLayout::TRANSFER_SRC_OPTIMAL.as_raw() as u32,
                 debug_name: std::ptr::null(),
             };
-            let got = specula_context_record(ctx, 1 as *mut c_void, &target);
+            let got = specula_context_record(ctx, std::ptr::NonNull::<c_void>::dangling().as_ptr(), &target);
             let msg = CStr::from_ptr(specula_context_last_error(ctx)).to_string_lossy().into_owned();
             assert_eq!(got, want, "format {format}: {msg}");
             assert!(msg.contains(needle) && msg.contains("target.format"), "format {format}: {msg}");
