@@ -103,6 +103,11 @@ fn cli_bad_input_is_one_line_and_nonzero() {
         &["render", scene, "--camera-pos", "1,nan,2", "--out", "/tmp/x.png"],
         &["render", scene, "--device", "no-such-gpu", "--out", "/tmp/x.png"],
         &["info", "/nonexistent.glb"],
+        // One camera validation for every entry point.
+        &["render", scene, "--camera-pos", "1,1,1", "--camera-target", "1,1,1", "--out", "/tmp/x.png"],
+        &["render", scene, "--camera-target", "0,0,0", "--out", "/tmp/x.png"],
+        &["render", scene, "--fov", "40", "--out", "/tmp/x.png"],
+        &["render", scene, "--camera-pos", "0,1,3", "--fov", "180", "--out", "/tmp/x.png"],
         // Argument-parser errors go through the same one-line reporter.
         &["render", scene],
         &["render", scene, "--out", "/tmp/x.png", "--frames", "abc"],

@@ -129,13 +129,7 @@ pub unsafe extern "C" fn specula_context_add_light(ctx: *mut SpeculaContext, des
 pub unsafe extern "C" fn specula_context_set_camera(ctx: *mut SpeculaContext, desc: *const SpeculaCameraDesc) -> SpeculaResult {
     with_ctx(ctx, |c| {
         let d = header(desc, SPECULA_STRUCT_CAMERA_DESC, "camera")?;
-        let (eye, target) = (vec3(d.position), vec3(d.target));
-        if !eye.is_finite() || !target.is_finite() || eye == target {
-            return fail(SPECULA_ERROR_INVALID_ARGUMENT, "camera: position and target must be finite and distinct");
-        }
-        let mut cam = Camera::look_at(eye, target, d.yfov);
-        cam.znear = d.znear;
-        cam.validate()?;
+        let cam = Camera::checked(vec3(d.position), vec3(d.target), d.yfov, d.znear)?;
         c.scene.camera = Some(cam);
         if let Some(r) = c.renderer.as_mut() {
             r.set_camera(cam)?;

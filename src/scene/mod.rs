@@ -224,11 +224,40 @@ impl Camera {
         let world_from_camera = Mat4::look_to_rh(eye, dir, up).inverse();
         Camera { position: eye, world_from_camera, yfov, znear: 0.01, zfar: None }
     }
-    /// Finite transform, 0 < yfov < π, znear > 0.
+    /// The one camera validation of every entry point (glTF, CLI, C ABI, Rust API): a
+    /// camera at `eye` looking at `target` (finite, distinct) with `yfov` and `znear`.
+    pub fn checked(eye: Vec3, target: Vec3, yfov: f32, znear: f32) -> Result<Camera> {
+        if !eye.is_finite() {
+            return Err(Error::invalid("camera.position", format!("must be finite, got {eye}")));
+        }
+        if !target.is_finite() {
+            return Err(Error::invalid("camera.target", format!("must be finite, got {target}")));
+        }
+        if eye == target {
+            return Err(Error::invalid("camera.target", format!("equals camera.position {eye}: there is no view direction")));
+        }
+        let mut c = Camera::look_at(eye, target, yfov);
+        c.znear = znear;
+        c.validate()?;
+        Ok(c)
+    }
+
+    /// Finite transform, 0 < yfov < π, 0 < znear < ∞, zfar > znear: each refusal names the
+    /// field and the value.
     pub fn validate(&self) -> Result<()> {
-        let fov_ok = self.yfov > 0.0 && self.yfov < std::f32::consts::PI;
-        if !self.position.is_finite() || !self.world_from_camera.is_finite() || !fov_ok || self.znear.is_nan() || self.znear <= 0.0 {
-            return Err(Error::invalid("camera", "non-finite transform, yfov outside (0, π) or znear ≤ 0"));
+        if !self.position.is_finite() || !self.world_from_camera.is_finite() {
+            return Err(Error::invalid("camera.transform", format!("must be finite, got position {}", self.position)));
+        }
+        if !(self.yfov > 0.0 && self.yfov < std::f32::consts::PI) {
+            return Err(Error::invalid("camera.yfov", format!("must be in (0, π) radians, got {}", self.yfov)));
+        }
+        if !(self.znear > 0.0 && self.znear.is_finite()) {
+            return Err(Error::invalid("camera.znear", format!("must be finite and > 0, got {}", self.znear)));
+        }
+        if let Some(f) = self.zfar {
+            if !(f > self.znear) {
+                return Err(Error::invalid("camera.zfar", format!("must be > znear ({}), got {f}", self.znear)));
+            }
         }
         Ok(())
     }
@@ -389,9 +418,7 @@ impl Scene {
             e.validate()?;
         }
         if let Some(c) = &self.camera {
-            if !c.position.is_finite() || !c.world_from_camera.is_finite() {
-                return Err(Error::invalid("camera", "non-finite transform"));
-            }
+            c.validate()?;
         }
         Ok(())
     }

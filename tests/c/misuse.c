@@ -122,6 +122,15 @@ int main(int argc, char **argv) {
     cam.position[2] = 3.0f;
     cam.yfov = 0.0f;
     CASE("camera: zero field of view", specula_context_set_camera(ctx, &cam), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names yfov", strstr(specula_context_last_error(ctx), "camera.yfov") ? 0 : -1, 0, specula_context_last_error(ctx));
+    cam.yfov = 1.0f;
+    cam.znear = INFINITY;
+    CASE("camera: infinite znear", specula_context_set_camera(ctx, &cam), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names znear and the value", strstr(specula_context_last_error(ctx), "camera.znear") && strstr(specula_context_last_error(ctx), "inf") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    cam.znear = 0.01f;
+    cam.target[0] = cam.position[0], cam.target[1] = cam.position[1], cam.target[2] = cam.position[2];
+    CASE("camera: target equals position", specula_context_set_camera(ctx, &cam), SPECULA_ERROR_INVALID_ARGUMENT);
 
     /* A valid frame, then misuse around it. */
     CASE("load_gltf: demo", specula_context_load_gltf(ctx, scene), SPECULA_SUCCESS);

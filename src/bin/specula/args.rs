@@ -37,9 +37,9 @@ pub struct RenderArgs {
     /// Camera target x,y,z.
     #[arg(long)]
     pub camera_target: Option<String>,
-    /// Vertical field of view in degrees (with --camera-pos).
-    #[arg(long, default_value_t = 60.0)]
-    pub fov: f32,
+    /// Vertical field of view in degrees (with --camera-pos; default 60).
+    #[arg(long)]
+    pub fov: Option<f32>,
     /// Enable the Khronos validation layer; any validation error fails the command.
     #[arg(long)]
     pub validate: bool,
@@ -171,10 +171,21 @@ pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
     if let Some(pos) = &a.camera_pos {
         let eye = parse_vec3("--camera-pos", pos)?;
         let target = a.camera_target.as_deref().map(|t| parse_vec3("--camera-target", t)).transpose()?.unwrap_or(eye + Vec3::NEG_Z);
-        if !(a.fov > 0.0 && a.fov < 180.0) {
-            return Err(specula::Error::invalid("--fov", "must be in (0, 180) degrees"));
+        let fov = a.fov.unwrap_or(60.0);
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(specula::Error::invalid("--fov", format!("must be in (0, 180) degrees, got {fov}")));
         }
-        scene.camera = Some(Camera::look_at(eye, target, a.fov.to_radians()));
+        let znear = scene.camera.map_or(0.01, |c| c.znear);
+        scene.camera = Some(Camera::checked(eye, target, fov.to_radians(), znear).map_err(|e| match e {
+            specula::Error::InvalidInput { what, message } => specula::Error::invalid(
+                what.replace("camera.position", "--camera-pos").replace("camera.target", "--camera-target"),
+                message,
+            ),
+            other => other,
+        })?);
+    } else if a.camera_target.is_some() || a.fov.is_some() {
+        let which = if a.camera_target.is_some() { "--camera-target" } else { "--fov" };
+        return Err(specula::Error::invalid(which, "needs --camera-pos (the scene's own camera is used otherwise)"));
     }
     let mut quality = Quality::default();
     for q in &a.quality {

@@ -21,7 +21,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
         env: a.env.clone(),
         camera_pos: None,
         camera_target: None,
-        fov: 60.0,
+        fov: None,
         validate: a.validate,
         device: a.device.clone(),
         warmup: a.warmup,
