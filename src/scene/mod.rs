@@ -255,7 +255,7 @@ impl Camera {
             return Err(Error::invalid("camera.znear", format!("must be finite and > 0, got {}", self.znear)));
         }
         if let Some(f) = self.zfar {
-            if !(f > self.znear) {
+            if f.is_nan() || f <= self.znear {
                 return Err(Error::invalid("camera.zfar", format!("must be > znear ({}), got {f}", self.znear)));
             }
         }
