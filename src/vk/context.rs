@@ -15,6 +15,13 @@ use crate::error::{Error, Result, VkCall};
 
 const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
+/// Whether the validation layer provides instance extension `name`.
+fn layer_has_extension(entry: &ash::Entry, name: &CStr) -> bool {
+    unsafe { entry.enumerate_instance_extension_properties(Some(VALIDATION_LAYER)) }
+        .map(|v| v.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == name)))
+        .unwrap_or(false)
+}
+
 /// How to create a standalone context.
 #[derive(Clone, Debug, Default)]
 pub struct DeviceOptions {
@@ -195,7 +202,17 @@ impl Context {
         let app_name = c"specula";
         let app = vk::ApplicationInfo::default().application_name(app_name).engine_name(app_name).api_version(vk::API_VERSION_1_3);
         let layers: Vec<*const i8> = if opts.validation { vec![VALIDATION_LAYER.as_ptr()] } else { vec![] };
-        let exts: Vec<*const i8> = if has_debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+        let mut exts: Vec<*const i8> = if has_debug_utils { vec![ash::ext::debug_utils::NAME.as_ptr()] } else { vec![] };
+        // Synchronization validation (hazards between passes) with the validation layer,
+        // unless SPECULA_SYNC_VALIDATION=0.
+        let sync = opts.validation
+            && std::env::var("SPECULA_SYNC_VALIDATION").map_or(true, |v| v != "0")
+            && layer_has_extension(&entry, ash::ext::validation_features::NAME);
+        if sync {
+            exts.push(ash::ext::validation_features::NAME.as_ptr());
+        }
+        let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
         let validation = Arc::new(ValidationLog::default());
         let mut messenger_info = vk::DebugUtilsMessengerCreateInfoEXT::default()
             .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
@@ -209,6 +226,9 @@ impl Context {
         let mut ci = vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&exts);
         if has_debug_utils && opts.validation {
             ci = ci.push_next(&mut messenger_info); // also catches create/destroy-instance messages
+        }
+        if sync {
+            ci = ci.push_next(&mut features);
         }
         let instance = unsafe { entry.create_instance(&ci, None) }.call("vkCreateInstance")?;
         let mut ctx_guard = InstanceGuard { instance: Some(instance), debug: None, messenger: vk::DebugUtilsMessengerEXT::null() };
