@@ -415,6 +415,12 @@ SpeculaResult specula_context_add_light(SpeculaContext *ctx, const SpeculaLightD
 // Sets the camera. Takes effect on the next frame without reconfiguring.
 SpeculaResult specula_context_set_camera(SpeculaContext *ctx, const SpeculaCameraDesc *desc);
 
+// Caps the device memory this context's resources may hold, in bytes (0: no cap beyond the
+// device's heaps). A configuration that does not fit fails with SPECULA_ERROR_OUT_OF_MEMORY
+// naming the resource and its size, frees what it had allocated, and leaves the context
+// usable for a smaller one.
+SpeculaResult specula_context_set_memory_budget(SpeculaContext *ctx, uint64_t bytes);
+
 // Sets an accuracy knob by name, as the CLI's `-q key=value` (see `specula knobs`).
 // Takes effect at the next specula_context_configure.
 SpeculaResult specula_context_set_knob(SpeculaContext *ctx, const char *key, const char *value);

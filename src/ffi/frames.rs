@@ -13,6 +13,18 @@ use crate::plan::{plan_with, Choices};
 use crate::renderer::Renderer;
 use crate::vk::Image;
 
+/// Caps the device memory this context's resources may hold, in bytes (0: no cap beyond the
+/// device's heaps). A configuration that does not fit fails with SPECULA_ERROR_OUT_OF_MEMORY
+/// naming the resource and its size, frees what it had allocated, and leaves the context
+/// usable for a smaller one.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_memory_budget(ctx: *mut SpeculaContext, bytes: u64) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        c.vk.memory.set_budget(Some(bytes).filter(|&b| b > 0));
+        Ok(SPECULA_SUCCESS)
+    })
+}
+
 /// Sets an accuracy knob by name, as the CLI's `-q key=value` (see `specula knobs`).
 /// Takes effect at the next specula_context_configure.
 #[no_mangle]

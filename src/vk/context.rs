@@ -65,14 +65,42 @@ impl ValidationLog {
     }
 }
 
-/// Every live device allocation, by resource name: what the frame's resources hold.
+/// Every live device allocation, by resource name: what the frame's resources hold; and
+/// an optional budget (bytes) that allocations may not exceed.
 #[derive(Debug, Default)]
 pub struct MemoryRegistry {
     next: AtomicU64,
     live: Mutex<BTreeMap<u64, (String, u64)>>,
+    /// 0: no budget beyond the device's own.
+    budget: AtomicU64,
 }
 
 impl MemoryRegistry {
+    /// Caps the device memory this context's resources may hold (`None`: the device's
+    /// heaps alone). An allocation beyond it fails as out of device memory, naming the
+    /// resource and its size; what was allocated before stays usable.
+    pub fn set_budget(&self, bytes: Option<u64>) {
+        self.budget.store(bytes.unwrap_or(0), Ordering::Relaxed);
+    }
+
+    pub fn budget(&self) -> Option<u64> {
+        Some(self.budget.load(Ordering::Relaxed)).filter(|&b| b > 0)
+    }
+
+    /// Refuses `bytes` more for `name` beyond the budget.
+    pub(crate) fn check_budget(&self, name: &str, bytes: u64) -> crate::Result<()> {
+        if let Some(b) = self.budget() {
+            let used = self.total();
+            if used + bytes > b {
+                return Err(Error::OutOfMemory(format!(
+                    "device memory for '{name}': {bytes} bytes ({:.2} MiB) do not fit the budget of {b} bytes, {used} in use",
+                    bytes as f64 / 1048576.0
+                )));
+            }
+        }
+        Ok(())
+    }
+
     pub(crate) fn add(&self, name: &str, bytes: u64) -> u64 {
         let id = self.next.fetch_add(1, Ordering::Relaxed);
         if let Ok(mut l) = self.live.lock() {

@@ -12,19 +12,22 @@ pub use gpu_allocator::MemoryLocation;
 use super::Context;
 use crate::error::{Error, Result, VkCall};
 
-fn alloc_err(name: &str, e: gpu_allocator::AllocationError) -> Error {
+fn alloc_err(name: &str, bytes: u64, e: gpu_allocator::AllocationError) -> Error {
     match e {
-        gpu_allocator::AllocationError::OutOfMemory => Error::OutOfMemory(format!("allocating '{name}'")),
+        gpu_allocator::AllocationError::OutOfMemory => {
+            Error::OutOfMemory(format!("device memory for '{name}': {bytes} bytes ({:.2} MiB)", bytes as f64 / 1048576.0))
+        }
         e => Error::Unsupported(format!("allocating '{name}': {e}")),
     }
 }
 
 /// Sub-allocates device memory for one resource (gpu-allocator, explicit).
 fn allocate(ctx: &Context, name: &str, requirements: vk::MemoryRequirements, location: MemoryLocation, linear: bool) -> Result<Allocation> {
+    ctx.memory.check_budget(name, requirements.size)?;
     let mut guard = ctx.allocator();
     let allocator = guard.as_mut().ok_or_else(|| Error::invalid(name, "context is shutting down"))?;
     let desc = AllocationCreateDesc { name, requirements, location, linear, allocation_scheme: AllocationScheme::GpuAllocatorManaged };
-    allocator.allocate(&desc).map_err(|e| alloc_err(name, e))
+    allocator.allocate(&desc).map_err(|e| alloc_err(name, requirements.size, e))
 }
 
 pub struct Buffer {

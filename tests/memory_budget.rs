@@ -1,0 +1,72 @@
+//! Device-memory exhaustion, tested by capping the allocator rather than the machine: a
+//! configuration that does not fit the budget fails as out of device memory naming the
+//! resource and its size, frees everything it had allocated, and the context renders a
+//! smaller configuration afterwards — through the Rust API and the C ABI.
+
+mod common;
+
+use std::ffi::{CStr, CString};
+
+use specula::ffi::*;
+use specula::{Error, Quality};
+
+fn demo() -> specula::Scene {
+    specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
+}
+
+#[test]
+fn a_configuration_beyond_the_budget_fails_cleanly_and_a_smaller_one_renders() {
+    let ctx = common::gpu();
+    let scene = demo();
+    ctx.memory.set_budget(Some(24 << 20));
+    // Two 6×1024² RGBA16F distance cubes are 96 MiB.
+    let big = Quality { cube_size: 1024, ..Quality::default() };
+    let e = specula::render(&ctx, &scene, specula::methods::DISTANCE, &big, (64, 64), (0, 1)).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, Error::OutOfMemory(_)), "{msg}");
+    assert!(msg.contains("distance.cubes") && msg.contains("bytes") && msg.contains("budget"), "{msg}");
+    assert_eq!(ctx.memory.total(), 0, "everything allocated before the failure is freed: {:?}", ctx.memory.snapshot());
+    let small = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+    let f = specula::render(&ctx, &scene, specula::methods::DISTANCE, &small, (64, 64), (0, 1)).unwrap();
+    assert!(f.memory_bytes() <= 24 << 20);
+    ctx.memory.set_budget(None);
+    common::assert_clean(&ctx);
+}
+
+#[test]
+fn the_c_abi_reports_out_of_device_memory_and_stays_usable() {
+    unsafe {
+        let desc = SpeculaContextDesc {
+            r#type: SPECULA_STRUCT_CONTEXT_DESC,
+            size: std::mem::size_of::<SpeculaContextDesc>() as u32,
+            device_name: std::ptr::null(),
+            enable_validation: 1,
+        };
+        let mut ctx = std::ptr::null_mut();
+        assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS);
+        let scene = CString::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf")).unwrap();
+        assert_eq!(specula_context_load_gltf(ctx, scene.as_ptr()), SPECULA_SUCCESS);
+        assert_eq!(specula_context_set_memory_budget(ctx, 24 << 20), SPECULA_SUCCESS);
+        let knob = |k: &str, v: &str| {
+            let (k, v) = (CString::new(k).unwrap(), CString::new(v).unwrap());
+            assert_eq!(specula_context_set_knob(ctx, k.as_ptr(), v.as_ptr()), SPECULA_SUCCESS);
+        };
+        knob("cube_size", "1024");
+        let render = SpeculaRenderDesc {
+            r#type: SPECULA_STRUCT_RENDER_DESC,
+            size: std::mem::size_of::<SpeculaRenderDesc>() as u32,
+            method: specula::methods::DISTANCE.abi,
+            width: 32,
+            height: 32,
+        };
+        assert_eq!(specula_context_configure(ctx, &render), SPECULA_ERROR_OUT_OF_MEMORY);
+        let msg = CStr::from_ptr(specula_context_last_error(ctx)).to_string_lossy().into_owned();
+        assert!(msg.contains("distance.cubes") && msg.contains("budget"), "{msg}");
+        knob("cube_size", "32");
+        assert_eq!(specula_context_configure(ctx, &render), SPECULA_SUCCESS);
+        let mut px = vec![0u8; 32 * 32 * 4];
+        assert_eq!(specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, px.as_mut_ptr() as *mut _, px.len()), SPECULA_SUCCESS);
+        assert!(px.chunks_exact(4).any(|p| p[0] > 0), "the smaller configuration rendered");
+        assert_eq!(specula_context_destroy(ctx), SPECULA_SUCCESS);
+    }
+}
