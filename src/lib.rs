@@ -71,4 +71,5 @@ pub fn render_plan(
     result
 }
 pub mod ffi;
+pub mod fuzzing;
 pub mod search;

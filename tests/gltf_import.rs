@@ -1073,3 +1073,29 @@ fn huge_declared_texture_is_refused() {
     doc.json["textures"] = json!([{ "source": 0 }]);
     expect_error("huge_texture", &doc, &["images[0]", "declares 65536×65536"]);
 }
+
+/// GLB headers and chunk tables that lie about their lengths (one made the `gltf` crate
+/// subtract with overflow: found by tests/fuzz_replay.rs) are refused naming the field.
+#[test]
+fn glb_header_lengths_are_checked() {
+    let dir = TempDir::new("glb_header");
+    let doc = quad_doc();
+    let glb = glb_bytes(&doc.json, &doc.bin);
+    let cases: [(&str, Box<dyn Fn(&mut Vec<u8>)>, &[&str]); 4] = [
+        ("version", Box::new(|g: &mut Vec<u8>| g[4..8].copy_from_slice(&0x3f00_0002u32.to_le_bytes())), &["(GLB header)", "version"]),
+        ("zero_length", Box::new(|g: &mut Vec<u8>| g[8..12].copy_from_slice(&0u32.to_le_bytes())), &["(GLB header)", "declares 0 bytes"]),
+        ("long", Box::new(|g: &mut Vec<u8>| g[8..12].copy_from_slice(&1_000_000u32.to_le_bytes())), &["(GLB header)", "1000000"]),
+        (
+            "chunk",
+            Box::new(|g: &mut Vec<u8>| g[12..16].copy_from_slice(&0xffff_fff0u32.to_le_bytes())),
+            &["(GLB chunk 0)", "past the declared"],
+        ),
+    ];
+    for (tag, patch, needles) in cases {
+        let mut g = glb.clone();
+        patch(&mut g);
+        let path = dir.join(&format!("{tag}.glb"));
+        std::fs::write(&path, &g).unwrap();
+        assert_err(load(&path), &path, needles);
+    }
+}

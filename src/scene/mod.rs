@@ -8,7 +8,7 @@
 //! radiance.
 
 mod environment;
-mod gltf;
+pub mod gltf;
 pub mod shapes;
 
 pub use self::gltf::load;

@@ -54,14 +54,19 @@ use crate::error::{Error, Result};
 /// Loads a `.gltf` or `.glb` file into a world-space scene. See the module documentation.
 pub fn load(path: &Path) -> Result<Scene> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
-    let file = path.display().to_string();
     let base = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
     };
+    load_slice(&path.display().to_string(), &bytes, &base)
+}
+
+/// Loads a `.gltf` or `.glb` held in memory, named `file` in messages, with external URIs
+/// resolved against `base` (the fuzz targets' entry point).
+pub fn load_slice(file: &str, bytes: &[u8], base: &Path) -> Result<Scene> {
     // Everything below checks its input; the unwind guard is a last line of defence against
     // a panic inside a dependency on input nobody anticipated.
-    match std::panic::catch_unwind(AssertUnwindSafe(|| import(&file, base, &bytes))) {
+    match std::panic::catch_unwind(AssertUnwindSafe(|| import(file, base.to_path_buf(), bytes))) {
         Ok(result) => result,
         Err(payload) => {
             let what = payload
@@ -74,7 +79,48 @@ pub fn load(path: &Path) -> Result<Scene> {
     }
 }
 
+/// Checks a GLB container's header and chunk table against the bytes before the `gltf`
+/// crate reads it (it subtracts declared lengths unchecked: found by fuzzing).
+fn precheck_glb(file: &str, bytes: &[u8]) -> Result<()> {
+    if !bytes.starts_with(b"glTF") {
+        return Ok(());
+    }
+    let err = |field: &str, m: String| Error::scene(file, format!("(GLB {field})"), m);
+    let u32_at = |i: usize| bytes.get(i..i + 4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    let (Some(version), Some(length)) = (u32_at(4), u32_at(8)) else {
+        return Err(err("header", format!("{} bytes, shorter than the 12-byte header", bytes.len())));
+    };
+    if version != 2 {
+        return Err(err("header", format!("version {version}, expected 2")));
+    }
+    let length = length as usize;
+    if length < 12 || length > bytes.len() {
+        return Err(err("header", format!("declares {length} bytes; the file holds {} and the header alone is 12", bytes.len())));
+    }
+    let mut at = 12;
+    let mut index = 0;
+    while at < length {
+        let (Some(chunk_len), Some(kind)) = (u32_at(at), u32_at(at + 4)) else {
+            return Err(err(&format!("chunk {index}"), format!("header at byte {at} runs past the declared {length} bytes")));
+        };
+        let end = (at + 8).checked_add(chunk_len as usize).filter(|&e| e <= length);
+        let Some(end) = end else {
+            return Err(err(&format!("chunk {index}"), format!("declares {chunk_len} bytes at byte {at}, past the declared {length}")));
+        };
+        if index == 0 && kind != 0x4E4F_534A {
+            return Err(err("chunk 0", format!("type 0x{kind:08x}, expected JSON")));
+        }
+        at = end;
+        index += 1;
+    }
+    if index == 0 {
+        return Err(err("chunk 0", "missing: a GLB starts with a JSON chunk".into()));
+    }
+    Ok(())
+}
+
 fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
+    precheck_glb(file, bytes)?;
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| gltf_error(file, e))?;
     let (doc, blob) = (gltf.document, gltf.blob);
     // gltf-json's validation indexes the POSITION accessor before checking the index.
