@@ -1081,7 +1081,8 @@ fn glb_header_lengths_are_checked() {
     let dir = TempDir::new("glb_header");
     let doc = quad_doc();
     let glb = glb_bytes(&doc.json, &doc.bin);
-    let cases: [(&str, Box<dyn Fn(&mut Vec<u8>)>, &[&str]); 4] = [
+    type Patch = Box<dyn Fn(&mut Vec<u8>)>;
+    let cases: [(&str, Patch, &[&str]); 4] = [
         ("version", Box::new(|g: &mut Vec<u8>| g[4..8].copy_from_slice(&0x3f00_0002u32.to_le_bytes())), &["(GLB header)", "version"]),
         ("zero_length", Box::new(|g: &mut Vec<u8>| g[8..12].copy_from_slice(&0u32.to_le_bytes())), &["(GLB header)", "declares 0 bytes"]),
         ("long", Box::new(|g: &mut Vec<u8>| g[8..12].copy_from_slice(&1_000_000u32.to_le_bytes())), &["(GLB header)", "1000000"]),
