@@ -1100,3 +1100,14 @@ fn glb_header_lengths_are_checked() {
         assert_err(load(&path), &path, needles);
     }
 }
+
+/// A `.gltf` buffer without a uri is reported as that, not as a GLB chunk problem.
+#[test]
+fn gltf_buffer_without_uri() {
+    let doc = quad_doc();
+    let dir = TempDir::new("no_uri");
+    let path = dir.join("no_uri.gltf");
+    std::fs::write(&path, serde_json::to_vec(&doc.json).unwrap()).unwrap();
+    let msg = assert_err(load(&path), &path, &["buffers[0].uri", "missing"]);
+    assert!(!msg.contains("GLB"), "{msg}");
+}

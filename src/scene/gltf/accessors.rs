@@ -68,6 +68,10 @@ impl Importer<'_> {
                     let field = format!("buffers[{i}] (GLB BIN chunk)");
                     match blob.take() {
                         Some(b) => (field, b),
+                        // Only a .glb has a BIN chunk: in a .gltf a buffer without uri is the error.
+                        None if !self.glb => {
+                            return Err(self.err(format!("buffers[{i}].uri"), "is missing (only the first buffer of a .glb may omit it)"))
+                        }
                         None => return Err(self.err(field, "refers to the GLB BIN chunk, but the file has none (or it is already used)")),
                     }
                 }

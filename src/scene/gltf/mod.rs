@@ -134,6 +134,7 @@ fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
 
     let mut imp = Importer {
         file,
+        glb: bytes.starts_with(b"glTF"),
         base,
         doc: &doc,
         buffers: Vec::new(),
@@ -203,6 +204,8 @@ fn precheck(file: &str, root: &gltf::json::Root) -> Result<()> {
 
 struct Importer<'a> {
     file: &'a str,
+    /// The file is a GLB container (it may have a BIN chunk).
+    glb: bool,
     base: PathBuf,
     doc: &'a gltf::Document,
     buffers: Vec<Vec<u8>>,
