@@ -107,7 +107,7 @@ pub unsafe extern "C" fn specula_context_add_light(ctx: *mut SpeculaContext, des
             k => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.kind: unknown value {k}")),
         };
         if d.range.is_nan() || d.range < 0.0 {
-            return fail(SPECULA_ERROR_INVALID_ARGUMENT, "light.range must be ≥ 0 (0: unbounded)");
+            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.range: must be ≥ 0 (0: unbounded), got {}", d.range));
         }
         let range = (d.range > 0.0).then_some(d.range);
         let name = format!("light{}", c.scene.lights.len());

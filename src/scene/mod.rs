@@ -202,6 +202,37 @@ pub struct Light {
     pub range: Option<f32>,
 }
 
+impl Light {
+    /// The one light validation of every entry point: each refusal names the light, the
+    /// field and the value as given.
+    pub fn validate(&self) -> Result<()> {
+        let what = |field: &str| format!("light '{}': {field}", self.name);
+        if !self.position.is_finite() {
+            return Err(Error::invalid(what("position"), format!("must be finite, got {}", self.position)));
+        }
+        if !self.intensity.is_finite() || self.intensity.min_element() < 0.0 {
+            return Err(Error::invalid(what("intensity"), format!("must be finite and ≥ 0 per channel, got {}", self.intensity)));
+        }
+        if self.kind != LightKind::Point && (!self.direction.is_finite() || self.direction.length_squared() == 0.0) {
+            return Err(Error::invalid(what("direction"), format!("must be finite and non-zero, got {}", self.direction)));
+        }
+        if let Some(r) = self.range {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(Error::invalid(what("range"), format!("must be finite and > 0, got {r}")));
+            }
+        }
+        if let LightKind::Spot { inner_cone, outer_cone } = self.kind {
+            if !(0.0 <= inner_cone && inner_cone <= outer_cone && outer_cone <= std::f32::consts::FRAC_PI_2) {
+                return Err(Error::invalid(
+                    what("cone"),
+                    format!("needs 0 ≤ inner ≤ outer ≤ π/2, got inner {inner_cone}, outer {outer_cone}"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// A perspective pinhole camera. The output size's aspect ratio wins over any stored one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -362,19 +393,7 @@ impl Scene {
     }
 
     pub fn add_light(&mut self, l: Light) -> Result<usize> {
-        let bad = !l.position.is_finite() || !l.intensity.is_finite() || l.intensity.min_element() < 0.0;
-        let bad_dir = l.kind != LightKind::Point && (!l.direction.is_finite() || l.direction.length_squared() == 0.0);
-        if bad || bad_dir {
-            return Err(Error::invalid(format!("light '{}'", l.name), "non-finite or negative position, direction or intensity"));
-        }
-        if l.range.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
-            return Err(Error::invalid(format!("light '{}': range", l.name), "must be finite and > 0"));
-        }
-        if let LightKind::Spot { inner_cone, outer_cone } = l.kind {
-            if !(0.0 <= inner_cone && inner_cone <= outer_cone && outer_cone <= std::f32::consts::FRAC_PI_2) {
-                return Err(Error::invalid(format!("light '{}': cone", l.name), "needs 0 ≤ inner ≤ outer ≤ π/2"));
-            }
-        }
+        l.validate()?;
         self.lights.push(Light { direction: l.direction.normalize_or_zero(), ..l });
         Ok(self.lights.len() - 1)
     }
@@ -416,6 +435,9 @@ impl Scene {
         }
         if let Some(e) = &self.environment {
             e.validate()?;
+        }
+        for l in &self.lights {
+            l.validate()?;
         }
         if let Some(c) = &self.camera {
             c.validate()?;

@@ -112,6 +112,17 @@ int main(int argc, char **argv) {
     CASE("mesh: wrong struct tag", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_STRUCT_MISMATCH);
     SpeculaLightDesc light = {SPECULA_STRUCT_LIGHT_DESC, sizeof light, 9};
     CASE("light: unknown kind enum", specula_context_add_light(ctx, &light), SPECULA_ERROR_INVALID_ARGUMENT);
+    light.kind = SPECULA_LIGHT_POINT;
+    light.intensity[1] = -2.0f;
+    CASE("light: negative intensity", specula_context_add_light(ctx, &light), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the field and the value", strstr(specula_context_last_error(ctx), "intensity") && strstr(specula_context_last_error(ctx), "-2") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    light.intensity[1] = 1.0f;
+    light.range = -1.0f;
+    CASE("light: negative range", specula_context_add_light(ctx, &light), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names range and the value", strstr(specula_context_last_error(ctx), "range") && strstr(specula_context_last_error(ctx), "-1") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    light.range = 0.0f;
 
     /* Knobs and camera. */
     CASE("knob: out of range", specula_context_set_knob(ctx, "cube_size", "100000"), SPECULA_ERROR_INVALID_ARGUMENT);
