@@ -66,14 +66,23 @@ pub unsafe extern "C" fn specula_context_add_mesh(
         }
         const LIMIT: u32 = 1 << 28;
         if d.vertex_count == 0 || d.index_count == 0 || d.vertex_count > LIMIT || d.index_count > LIMIT {
-            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("mesh: {} vertices, {} indices", d.vertex_count, d.index_count));
+            return fail(
+                SPECULA_ERROR_INVALID_ARGUMENT,
+                format!(
+                    "mesh.vertex_count and mesh.index_count: each must be in 1..={LIMIT}, got {} and {}",
+                    d.vertex_count, d.index_count
+                ),
+            );
         }
         let n = d.vertex_count as usize;
         let pos = std::slice::from_raw_parts(d.positions, 3 * n);
         let transform =
             if d.transform.is_null() { Mat4::IDENTITY } else { Mat4::from_cols_slice(std::slice::from_raw_parts(d.transform, 16)) };
         if !transform.is_finite() || transform.determinant() == 0.0 {
-            return fail(SPECULA_ERROR_INVALID_ARGUMENT, "mesh.transform is not finite or not invertible");
+            return fail(
+                SPECULA_ERROR_INVALID_ARGUMENT,
+                format!("mesh.transform: must be finite and invertible, got determinant {}", transform.determinant()),
+            );
         }
         let mut mesh = Mesh {
             name: format!("mesh{}", c.scene.meshes.len()),
@@ -84,6 +93,13 @@ pub unsafe extern "C" fn specula_context_add_mesh(
         };
         if !d.normals.is_null() {
             mesh.normals = std::slice::from_raw_parts(d.normals, 3 * n).chunks_exact(3).map(Vec3::from_slice).collect();
+        }
+        // The values as given, before the transform moves them.
+        if let Some(k) = mesh.positions.iter().position(|p| !p.is_finite()) {
+            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("mesh.positions: vertex {k} is not finite, got {}", mesh.positions[k]));
+        }
+        if let Some((k, &i)) = mesh.indices.iter().enumerate().find(|(_, &i)| i >= d.vertex_count) {
+            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("mesh.indices[{k}]: {i} is out of range ({} vertices)", d.vertex_count));
         }
         mesh.transform(transform);
         let i = c.scene.add_mesh(mesh)?;

@@ -100,10 +100,12 @@ int main(int argc, char **argv) {
     m2 = mesh;
     m2.indices = bad_idx;
     CASE("mesh: index out of range", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the index and the value", strstr(specula_context_last_error(ctx), "mesh.indices[2]: 7") ? 0 : -1, 0, specula_context_last_error(ctx));
     float nan_pos[9] = {0, 0, 0, NAN, 0, 0, 0, 1, 0};
     m2 = mesh;
     m2.positions = nan_pos;
     CASE("mesh: NaN position", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the vertex as given", strstr(specula_context_last_error(ctx), "mesh.positions: vertex 1") ? 0 : -1, 0, specula_context_last_error(ctx));
     m2 = mesh;
     m2.material = 12345;
     CASE("mesh: material out of range", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
