@@ -39,13 +39,7 @@ fn bad_host_target_formats_are_refused() {
         assert_eq!(specula_context_load_gltf(ctx, scene.as_ptr()), SPECULA_SUCCESS);
         let knob = (CString::new("cube_size").unwrap(), CString::new("16").unwrap());
         assert_eq!(specula_context_set_knob(ctx, knob.0.as_ptr(), knob.1.as_ptr()), SPECULA_SUCCESS);
-        let render = SpeculaRenderDesc {
-            r#type: SPECULA_STRUCT_RENDER_DESC,
-            size: std::mem::size_of::<SpeculaRenderDesc>() as u32,
-            method: specula::methods::ENVMAP.abi,
-            width: 16,
-            height: 16,
-        };
+        let render = common::render_desc(specula::methods::ENVMAP, 16, 16);
         assert_eq!(specula_context_configure(ctx, &render), SPECULA_SUCCESS);
         let cases = [
             (vk::Format::UNDEFINED.as_raw() as u32, SPECULA_ERROR_INVALID_ARGUMENT, "UNDEFINED"),

@@ -205,14 +205,7 @@ fn environment_loaders_survive_mutations() {
 #[test]
 fn c_abi_struct_parsing_survives_random_calls() {
     use specula::ffi::*;
-    let desc = SpeculaContextDesc {
-        r#type: SPECULA_STRUCT_CONTEXT_DESC,
-        size: std::mem::size_of::<SpeculaContextDesc>() as u32,
-        device_name: std::ptr::null(),
-        enable_validation: 1,
-    };
-    let mut ctx = std::ptr::null_mut();
-    unsafe { assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS) };
+    let ctx = common::c_context();
     let mut rng = Rng(0xdead_beef_cafe_f00d);
     let mut findings = Vec::new();
     for i in 0..cases(300) {

@@ -36,14 +36,7 @@ fn a_configuration_beyond_the_budget_fails_cleanly_and_a_smaller_one_renders() {
 #[test]
 fn the_c_abi_reports_out_of_device_memory_and_stays_usable() {
     unsafe {
-        let desc = SpeculaContextDesc {
-            r#type: SPECULA_STRUCT_CONTEXT_DESC,
-            size: std::mem::size_of::<SpeculaContextDesc>() as u32,
-            device_name: std::ptr::null(),
-            enable_validation: 1,
-        };
-        let mut ctx = std::ptr::null_mut();
-        assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS);
+        let ctx = common::c_context();
         let scene = CString::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf")).unwrap();
         assert_eq!(specula_context_load_gltf(ctx, scene.as_ptr()), SPECULA_SUCCESS);
         assert_eq!(specula_context_set_memory_budget(ctx, 24 << 20), SPECULA_SUCCESS);
@@ -52,13 +45,7 @@ fn the_c_abi_reports_out_of_device_memory_and_stays_usable() {
             assert_eq!(specula_context_set_knob(ctx, k.as_ptr(), v.as_ptr()), SPECULA_SUCCESS);
         };
         knob("cube_size", "1024");
-        let render = SpeculaRenderDesc {
-            r#type: SPECULA_STRUCT_RENDER_DESC,
-            size: std::mem::size_of::<SpeculaRenderDesc>() as u32,
-            method: specula::methods::DISTANCE.abi,
-            width: 32,
-            height: 32,
-        };
+        let render = common::render_desc(specula::methods::DISTANCE, 32, 32);
         assert_eq!(specula_context_configure(ctx, &render), SPECULA_ERROR_OUT_OF_MEMORY);
         let msg = CStr::from_ptr(specula_context_last_error(ctx)).to_string_lossy().into_owned();
         assert!(msg.contains("distance.cubes") && msg.contains("budget"), "{msg}");

@@ -125,3 +125,29 @@ pub fn mirror_and_glass(segments: u32) -> Scene {
     s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 50f32.to_radians()));
     s
 }
+
+/// A standalone C ABI context with the validation layer on.
+pub fn c_context() -> *mut specula::ffi::SpeculaContext {
+    use specula::ffi::*;
+    let desc = SpeculaContextDesc {
+        r#type: SPECULA_STRUCT_CONTEXT_DESC,
+        size: std::mem::size_of::<SpeculaContextDesc>() as u32,
+        device_name: std::ptr::null(),
+        enable_validation: 1,
+    };
+    let mut ctx = std::ptr::null_mut();
+    unsafe { assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS) };
+    ctx
+}
+
+/// A render description for `method` at `width`×`height`.
+pub fn render_desc(method: specula::Method, width: u32, height: u32) -> specula::ffi::SpeculaRenderDesc {
+    use specula::ffi::*;
+    SpeculaRenderDesc {
+        r#type: SPECULA_STRUCT_RENDER_DESC,
+        size: std::mem::size_of::<SpeculaRenderDesc>() as u32,
+        method: method.abi,
+        width,
+        height,
+    }
+}
