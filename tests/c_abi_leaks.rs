@@ -9,6 +9,8 @@
 //!   the live heap must not grow over the next 90.
 //! - Handles: no live context remains.
 
+mod common;
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, Ordering};
 
@@ -44,14 +46,7 @@ fn ok(r: SpeculaResult, ctx: *mut SpeculaContext) {
 
 /// One context: a mirror, a glass triangle pair and a floor from arrays, one light.
 unsafe fn cycle() {
-    let desc = SpeculaContextDesc {
-        r#type: SPECULA_STRUCT_CONTEXT_DESC,
-        size: std::mem::size_of::<SpeculaContextDesc>() as u32,
-        device_name: std::ptr::null(),
-        enable_validation: 1,
-    };
-    let mut ctx = std::ptr::null_mut();
-    assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS);
+    let ctx = common::c_context();
     let mat = |surface, ior| {
         let m = SpeculaMaterialDesc {
             r#type: SPECULA_STRUCT_MATERIAL_DESC,

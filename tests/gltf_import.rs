@@ -1,6 +1,8 @@
 //! glTF import and environment-map I/O: every supported extension is read, and every kind
 //! of bad input is an `Err` naming the file and the field, never a panic. Pure CPU.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -1054,20 +1056,7 @@ fn schema_rules_are_enforced() {
 /// naming the image and the declared size.
 #[test]
 fn huge_declared_texture_is_refused() {
-    let mut png = png_bytes(&image::RgbaImage::from_pixel(1, 1, image::Rgba([1, 2, 3, 255])));
-    png[16..20].copy_from_slice(&65536u32.to_be_bytes());
-    png[20..24].copy_from_slice(&65536u32.to_be_bytes());
-    let crc = {
-        let mut c = 0xffff_ffffu32;
-        for &b in &png[12..29] {
-            c ^= b as u32;
-            for _ in 0..8 {
-                c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
-            }
-        }
-        !c
-    };
-    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    let png = common::huge_png_bytes();
     let mut doc = quad_doc().with_materials(json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0 } } }]));
     doc.json["images"] = json!([{ "uri": format!("data:image/png;base64,{}", b64(&png)) }]);
     doc.json["textures"] = json!([{ "source": 0 }]);

@@ -3,6 +3,8 @@
 //! (IHDR), Radiance HDR (resolution line) — through the library and through the CLI
 //! (`render --env`, `compare`), which exit 1 instead of aborting on a failed allocation.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use specula::scene::{load_environment, load_environment_with, LoadLimits};
@@ -11,17 +13,6 @@ fn dir() -> PathBuf {
     let d = std::env::temp_dir().join(format!("specula-limits-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut c = 0xffff_ffffu32;
-    for &b in bytes {
-        c ^= b as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
-        }
-    }
-    !c
 }
 
 /// A valid 8×8 EXR whose data window is then patched to 65536×65536.
@@ -37,17 +28,9 @@ fn huge_exr(d: &Path) -> PathBuf {
     path
 }
 
-/// A 1×1 PNG whose IHDR is patched to 65536×65536 (CRC fixed).
 fn huge_png(d: &Path) -> PathBuf {
     let path = d.join("huge.png");
-    specula::scene::write_png_srgb(&path, 1, 1, &[0.5; 4]).unwrap();
-    let mut bytes = std::fs::read(&path).unwrap();
-    // Signature (8), length (4), "IHDR" (4), width, height.
-    bytes[16..20].copy_from_slice(&65536u32.to_be_bytes());
-    bytes[20..24].copy_from_slice(&65536u32.to_be_bytes());
-    let crc = crc32(&bytes[12..29]);
-    bytes[29..33].copy_from_slice(&crc.to_be_bytes());
-    std::fs::write(&path, bytes).unwrap();
+    std::fs::write(&path, common::huge_png_bytes()).unwrap();
     path
 }
 

@@ -387,14 +387,9 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     // A whole-scene method keeps its own behaviour (its fallbacks do not compose); mixed
     // choices compose through inter-object cycles where an object's map sees a
     // self-refracting one over at least `facts::MIN_COVERAGE` of its directions.
-    let composes = !whole_scene && {
-        let refracting =
-            |m: usize| p.objects.iter().any(|o| o.mesh == m && o.method.gpu.is_some_and(|g| g.map_shading == MapShading::Refractor));
-        scene_facts.objects.iter().any(|f| {
-            p.objects.iter().all(|o| o.mesh != f.mesh || o.method.gpu.is_some_and(|g| !g.maps.is_empty()))
-                && f.sees_specular.iter().any(|&(m, c)| c >= facts::MIN_COVERAGE && refracting(m))
-        })
-    };
+    let self_refracting = |o: &ObjectPlan| o.method.gpu.is_some_and(|g| g.map_shading == MapShading::Refractor);
+    let composes =
+        !whole_scene && p.objects.iter().filter(|o| self_refracting(o)).any(|o| scene_facts.objects.iter().any(|f| f.sees(o.mesh)));
     stages(scene, &mut p, composes);
     Ok(p)
 }

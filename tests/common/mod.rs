@@ -151,3 +151,23 @@ pub fn render_desc(method: specula::Method, width: u32, height: u32) -> specula:
         height,
     }
 }
+
+/// A 1×1 PNG whose IHDR declares 65536×65536 pixels (CRC fixed): a few bytes that claim
+/// 16 GiB of RGBA.
+pub fn huge_png_bytes() -> Vec<u8> {
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(image::codecs::png::PngEncoder::new(&mut png), &[1, 2, 3, 255], 1, 1, image::ExtendedColorType::Rgba8)
+        .unwrap();
+    // Signature (8), length (4), "IHDR" (4), width, height; the CRC covers type and data.
+    png[16..20].copy_from_slice(&65536u32.to_be_bytes());
+    png[20..24].copy_from_slice(&65536u32.to_be_bytes());
+    let mut c = 0xffff_ffffu32;
+    for &b in &png[12..29] {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 { 0xedb8_8320 ^ (c >> 1) } else { c >> 1 };
+        }
+    }
+    png[29..33].copy_from_slice(&(!c).to_be_bytes());
+    png
+}
