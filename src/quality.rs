@@ -92,7 +92,7 @@ fn count(v: &str, lo: u32, hi: u32) -> std::result::Result<u32, String> {
     match v.trim().parse::<i64>() {
         Ok(n) if (lo as i64..=hi as i64).contains(&n) => Ok(n as u32),
         Ok(n) => Err(format!("{n} is outside {lo}..={hi}")),
-        Err(_) => Err(format!("'{}' is not a whole number (expected {lo}..={hi})", clip(v))),
+        Err(_) => Err(format!("'{}' is not a whole number", clip(v))),
     }
 }
 

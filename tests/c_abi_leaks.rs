@@ -1,13 +1,25 @@
-//! A create/render/destroy loop of 100 contexts leaks nothing. Valgrind and LeakSanitizer
+//! A create/render/destroy loop of contexts leaks nothing. Valgrind and LeakSanitizer
 //! are impractical with lavapipe (its LLVM JIT makes a valgrind run of this loop take hours
 //! and drowns LSan in the driver's deliberate process-lifetime caches), so the test counts
 //! instead, with the Khronos validation layer on:
 //! - Vulkan objects: at vkDestroyDevice the layer reports every child object still alive
 //!   as an error; the process-wide validation error count must stay 0.
 //! - Device memory: each context's allocation registry is empty before its device goes.
-//! - Host memory of the library: a counting global allocator; after 10 warm-up iterations
-//!   the live heap must not grow over the next 90.
+//! - Host memory of the library: a counting global allocator; after 10 warm-up cycles the
+//!   live Rust heap must not grow over the next 40.
+//! - Host memory of the whole process's C heap (the loader, the layer, lavapipe and the
+//!   library): glibc's `mallinfo2` live bytes, after `malloc_trim`, may grow by at most
+//!   1 KiB per cycle (measured: about 200 B per cycle from the driver after warm-up). The
+//!   33 KiB per cycle the hardening issue measured is the layer's synchronization
+//!   validation (Vulkan-ValidationLayers 1.3.239 keeps about 31 KiB per device it
+//!   tracks): this test turns it off (`SPECULA_SYNC_VALIDATION=0`) so that it measures the
+//!   library; tests/sync_validation.rs keeps the hazard checks.
 //! - Handles: no live context remains.
+//!
+//! Not counted: the resident size. Without the layer it still grows by 20–40 KiB per cycle
+//! while the C heap stays flat: the growth is in lavapipe's process-wide LLVM code memory
+//! (its rwx mappings grow by one every two cycles), which destroying the device does not
+//! release; a create/destroy loop of bare contexts (no pipelines) shows none.
 
 mod common;
 
@@ -127,23 +139,58 @@ unsafe fn cycle() {
     assert_eq!(specula_context_destroy(ctx), SPECULA_SUCCESS);
 }
 
-#[test]
-fn hundred_contexts_leak_nothing() {
+extern "C" {
+    fn mallinfo2() -> MallInfo2;
+    fn malloc_trim(pad: usize) -> i32;
+}
+
+/// glibc's `struct mallinfo2` (Debian 12: glibc 2.36).
+#[repr(C)]
+struct MallInfo2 {
+    arena: usize,
+    ordblks: usize,
+    smblks: usize,
+    hblks: usize,
+    hblkhd: usize,
+    usmblks: usize,
+    fsmblks: usize,
+    uordblks: usize,
+    fordblks: usize,
+    keepcost: usize,
+}
+
+/// Live bytes of the process's C heap: in-use ordinary blocks plus mmapped blocks.
+fn c_heap_live() -> isize {
     unsafe {
-        for _ in 0..10 {
+        malloc_trim(0);
+        let m = mallinfo2();
+        (m.uordblks + m.hblkhd) as isize
+    }
+}
+
+#[test]
+fn contexts_leak_nothing() {
+    const WARM_UP: usize = 10;
+    const CYCLES: isize = 40;
+    // Synchronization validation keeps state per device in the layer (see the top).
+    std::env::set_var("SPECULA_SYNC_VALIDATION", "0");
+    unsafe {
+        for _ in 0..WARM_UP {
             cycle();
         }
-        let heap_after_warmup = LIVE_BYTES.load(Ordering::Relaxed);
-        for _ in 10..100 {
+        let (heap0, c0) = (LIVE_BYTES.load(Ordering::Relaxed), c_heap_live());
+        for _ in 0..CYCLES {
             cycle();
         }
-        let growth = LIVE_BYTES.load(Ordering::Relaxed) - heap_after_warmup;
+        let growth = LIVE_BYTES.load(Ordering::Relaxed) - heap0;
+        let c_growth = c_heap_live() - c0;
         assert_eq!(specula_live_context_count(), 0);
         assert_eq!(
             specula::vk::process_validation_errors(),
             0,
             "the validation layer reported errors (e.g. objects alive at vkDestroyDevice)"
         );
-        assert!(growth.abs() < 64 * 1024, "library heap grew by {growth} bytes over 90 create/render/destroy cycles");
+        assert!(growth.abs() <= 4096, "library heap grew by {growth} bytes over {CYCLES} create/render/destroy cycles");
+        assert!(c_growth <= 1024 * CYCLES, "the process's C heap grew by {} bytes per create/render/destroy cycle", c_growth / CYCLES);
     }
 }

@@ -331,6 +331,22 @@ fn negative_determinant_flips_winding() {
 }
 
 #[test]
+fn zero_scale_node_is_skipped_with_a_note() {
+    // glTF hides nodes by scale 0; the C ABI refuses the same transform (tests/validation_paths.rs).
+    let mut doc = quad_doc();
+    doc.json["nodes"] = json!([{ "mesh": 0, "scale": [1.0, 0.0, 1.0] }, { "mesh": 0, "translation": [0.0, 0.0, 1.0] }]);
+    doc.json["scenes"][0]["nodes"] = json!([0, 1]);
+    let s = load_doc("zero_scale", &doc);
+    assert_eq!(s.meshes.len(), 1, "only the visible node's mesh");
+    assert!(s.skipped.iter().any(|n| n.contains("nodes[0]") && n.contains("determinant 0")), "{:?}", s.skipped);
+    // Every node hidden: the render error says why.
+    doc.json["scenes"][0]["nodes"] = json!([0]);
+    let s = load_doc("all_zero_scale", &doc);
+    let e = s.check_renderable().unwrap_err().to_string();
+    assert!(e.contains("nodes[0]") && e.contains("invertible"), "{e}");
+}
+
+#[test]
 fn reference_point_from_extras_in_world_space() {
     let mut doc = quad_doc();
     doc.json["nodes"][0]["translation"] = json!([0.0, 1.0, 0.0]);

@@ -78,11 +78,8 @@ pub unsafe extern "C" fn specula_context_add_mesh(
         let pos = std::slice::from_raw_parts(d.positions, 3 * n);
         let transform =
             if d.transform.is_null() { Mat4::IDENTITY } else { Mat4::from_cols_slice(std::slice::from_raw_parts(d.transform, 16)) };
-        if !transform.is_finite() || transform.determinant() == 0.0 {
-            return fail(
-                SPECULA_ERROR_INVALID_ARGUMENT,
-                format!("mesh.transform: must be finite and invertible, got determinant {}", transform.determinant()),
-            );
+        if let Err(crate::Error::InvalidInput { message, .. }) = crate::scene::validate_transform(&transform, "mesh") {
+            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("mesh.transform: {message}"));
         }
         let mut mesh = Mesh {
             name: format!("mesh{}", c.scene.meshes.len()),

@@ -351,7 +351,7 @@ impl Scene {
 
     pub fn add_material(&mut self, m: Material) -> Result<usize> {
         let what = format!("material '{}'", m.name);
-        validate_material(&m, &what)?;
+        m.validate()?;
         for (field, t) in [("base_color_texture", m.base_color_texture), ("emissive_texture", m.emissive_texture)] {
             if let Some(t) = t.filter(|&t| t >= self.textures.len()) {
                 return Err(Error::invalid(
@@ -407,7 +407,7 @@ impl Scene {
     pub fn validate(&self) -> Result<()> {
         for m in &self.materials {
             let what = format!("material '{}'", m.name);
-            validate_material(m, &what)?;
+            m.validate()?;
             if [m.base_color_texture, m.emissive_texture].into_iter().flatten().any(|t| t >= self.textures.len()) {
                 return Err(Error::invalid(what, "texture index out of range"));
             }
@@ -421,16 +421,22 @@ impl Scene {
             let what = format!("mesh '{}'", m.name);
             let n = m.positions.len();
             if m.material >= self.materials.len() {
-                return Err(Error::invalid(what, "material index out of range"));
+                return Err(Error::invalid(
+                    format!("{what}: material"),
+                    format!("index {} out of range ({} materials)", m.material, self.materials.len()),
+                ));
             }
             if m.normals.len() != n || m.uvs.len() != n || m.indices.len() % 3 != 0 || m.indices.iter().any(|&i| i as usize >= n) {
                 return Err(Error::invalid(what, "attribute lengths or indices inconsistent (add meshes with Scene::add_mesh)"));
             }
-            if !m.positions.iter().all(|p| p.is_finite())
-                || !m.normals.iter().all(|p| p.is_finite())
-                || !m.uvs.iter().all(|p| p.is_finite())
-            {
-                return Err(Error::invalid(what, "non-finite vertex attribute"));
+            if let Some(i) = m.positions.iter().position(|p| !p.is_finite()) {
+                return Err(Error::invalid(format!("{what}: positions"), format!("vertex {i} is not finite, got {}", m.positions[i])));
+            }
+            if let Some(i) = m.normals.iter().position(|p| !p.is_finite()) {
+                return Err(Error::invalid(format!("{what}: normals"), format!("vertex {i} is not finite, got {}", m.normals[i])));
+            }
+            if let Some(i) = m.uvs.iter().position(|p| !p.is_finite()) {
+                return Err(Error::invalid(format!("{what}: uvs"), format!("vertex {i} is not finite, got {}", m.uvs[i])));
             }
         }
         if let Some(e) = &self.environment {
@@ -484,22 +490,61 @@ impl Scene {
     }
 }
 
-pub(crate) fn validate_material(m: &Material, what: &str) -> Result<()> {
-    let finite = m.base_color.is_finite() && m.emissive.is_finite() && m.specular_color.is_finite() && m.specular_factor.is_finite();
-    if !finite {
-        return Err(Error::invalid(what, "non-finite colour or factor"));
-    }
-    match m.kind {
-        SurfaceKind::Dielectric { ior, .. } if !(ior > 0.0 && ior.is_finite()) => {
-            Err(Error::invalid(format!("{what}: ior"), format!("index of refraction must be finite and > 0, got {ior}")))
+impl Material {
+    /// The one material validation of every entry point (glTF, the C ABI, the Rust API,
+    /// [`Scene::validate`]): each refusal names the material, the field and the value as
+    /// given. The glTF importer maps the field onto its JSON path.
+    pub fn validate(&self) -> Result<()> {
+        let what = |field: &str| format!("material '{}': {field}", self.name);
+        let unit = |v: Vec3| v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0;
+        let non_negative = |v: Vec3| v.is_finite() && v.min_element() >= 0.0;
+        if !unit(self.base_color) {
+            return Err(Error::invalid(what("base_color"), format!("must be in 0..=1 per channel, got {}", self.base_color)));
         }
-        SurfaceKind::Mirror { nu, kappa }
-            if !(nu.min_element() > 0.0 && nu.is_finite() && kappa.min_element() >= 0.0 && kappa.is_finite()) =>
-        {
-            Err(Error::invalid(format!("{what}: nu/kappa"), "ν must be finite and > 0, κ finite and ≥ 0"))
+        if !non_negative(self.emissive) {
+            return Err(Error::invalid(what("emission"), format!("must be finite and ≥ 0 per channel, got {}", self.emissive)));
         }
-        _ => Ok(()),
+        if !non_negative(self.specular_color) {
+            return Err(Error::invalid(what("specular_color"), format!("must be finite and ≥ 0 per channel, got {}", self.specular_color)));
+        }
+        if !(0.0..=1.0).contains(&self.specular_factor) {
+            return Err(Error::invalid(what("specular_factor"), format!("must be in 0..=1, got {}", self.specular_factor)));
+        }
+        match self.kind {
+            SurfaceKind::Dielectric { ior, .. } if !(ior > 0.0 && ior.is_finite()) => {
+                Err(Error::invalid(what("ior"), format!("index of refraction must be finite and > 0, got {ior}")))
+            }
+            SurfaceKind::Mirror { nu, .. } if !(nu.is_finite() && nu.min_element() > 0.0) => {
+                Err(Error::invalid(what("nu"), format!("ν must be finite and > 0 per channel, got {nu}")))
+            }
+            SurfaceKind::Mirror { kappa, .. } if !non_negative(kappa) => {
+                Err(Error::invalid(what("kappa"), format!("κ must be finite and ≥ 0 per channel, got {kappa}")))
+            }
+            _ => Ok(()),
+        }
     }
+}
+
+/// The one object-to-world transform validation of every entry point: finite, and
+/// invertible (a zero scale flattens the object: its normals and its maps' reference
+/// point are undefined). The C ABI refuses such a transform; the glTF importer skips the
+/// node's meshes with a note in [`Scene::skipped`] (glTF uses scale 0 to hide a node).
+pub fn validate_transform(world: &Mat4, what: &str) -> Result<()> {
+    if !world.is_finite() {
+        let bad = world.to_cols_array().iter().position(|v| !v.is_finite()).unwrap_or(0);
+        return Err(Error::invalid(
+            format!("{what}: transform"),
+            format!("must be finite, got {} at column {} row {}", world.to_cols_array()[bad], bad / 4, bad % 4),
+        ));
+    }
+    let det = Mat3::from_mat4(*world).determinant();
+    if !(det.is_finite() && det != 0.0) {
+        return Err(Error::invalid(
+            format!("{what}: transform"),
+            format!("must be invertible (no zero scale), got a linear part of determinant {det}"),
+        ));
+    }
+    Ok(())
 }
 
 pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) -> Result<()> {
@@ -510,7 +555,7 @@ pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) 
         ));
     }
     if let Some(i) = mesh.positions.iter().position(|p| !p.is_finite()) {
-        return Err(Error::invalid(format!("{what}: positions"), format!("vertex {i} is not finite ({:?})", mesh.positions[i])));
+        return Err(Error::invalid(format!("{what}: positions"), format!("vertex {i} is not finite, got {}", mesh.positions[i])));
     }
     if mesh.positions.is_empty() || mesh.indices.is_empty() {
         return Err(Error::invalid(format!("{what}: indices"), "mesh has no vertices or no triangles"));
@@ -527,7 +572,7 @@ pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) 
     }
     if let Some(p) = mesh.reference_point {
         if !p.is_finite() {
-            return Err(Error::invalid(format!("{what}: reference_point"), "not finite"));
+            return Err(Error::invalid(format!("{what}: reference_point"), format!("must be finite, got {p}")));
         }
     }
     if mesh.normals.is_empty() {
@@ -546,7 +591,8 @@ pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) 
     } else if mesh.uvs.len() != n {
         return Err(Error::invalid(format!("{what}: uvs"), format!("{} uvs for {} vertices", mesh.uvs.len(), n)));
     } else if mesh.uvs.iter().any(|t| !t.is_finite()) {
-        return Err(Error::invalid(format!("{what}: uvs"), "non-finite texture coordinate"));
+        let i = mesh.uvs.iter().position(|t| !t.is_finite()).unwrap_or(0);
+        return Err(Error::invalid(format!("{what}: uvs"), format!("vertex {i} is not finite, got {}", mesh.uvs[i])));
     }
     Ok(())
 }

@@ -88,6 +88,16 @@ int main(int argc, char **argv) {
     glass.surface = 77;
     CASE("material: unknown surface enum", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
     glass.surface = SPECULA_SURFACE_DIELECTRIC;
+    glass.base_color[0] = 2.0f; /* refused by the glTF schema too: one material validation */
+    CASE("material: base colour above 1", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names base_color and the value", strstr(specula_context_last_error(ctx), "base_color") && strstr(specula_context_last_error(ctx), "[2, 1, 1]") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    glass.base_color[0] = 1.0f;
+    glass.emission[2] = -1.0f;
+    CASE("material: negative emission", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names emission and the value", strstr(specula_context_last_error(ctx), "emission") && strstr(specula_context_last_error(ctx), "-1") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    glass.emission[2] = 0.0f;
     uint32_t mat = 99;
     CASE("material: valid", specula_context_add_material(ctx, &glass, &mat), SPECULA_SUCCESS);
     float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
@@ -106,6 +116,17 @@ int main(int argc, char **argv) {
     m2.positions = nan_pos;
     CASE("mesh: NaN position", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
     expect("message names the vertex as given", strstr(specula_context_last_error(ctx), "mesh.positions: vertex 1") ? 0 : -1, 0, specula_context_last_error(ctx));
+    float flat[16] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; /* scale y = 0 */
+    m2 = mesh;
+    m2.transform = flat;
+    CASE("mesh: zero-scale transform", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the transform and its determinant", strstr(specula_context_last_error(ctx), "mesh.transform") && strstr(specula_context_last_error(ctx), "determinant 0") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    flat[5] = 1.0f;
+    flat[13] = NAN;
+    CASE("mesh: NaN transform", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names the transform entry", strstr(specula_context_last_error(ctx), "mesh.transform") && strstr(specula_context_last_error(ctx), "NaN at column 3 row 1") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
     m2 = mesh;
     m2.material = 12345;
     CASE("mesh: material out of range", specula_context_add_mesh(ctx, &m2, NULL), SPECULA_ERROR_INVALID_ARGUMENT);

@@ -119,6 +119,15 @@ impl Importer<'_> {
 
     fn visit(&mut self, node: &gltf::Node, world: Mat4) -> Result<()> {
         if let Some(mesh) = node.mesh() {
+            if let Err(Error::InvalidInput { message, .. }) = crate::scene::validate_transform(&world, "node") {
+                let field = format!("nodes[{}]", node.index());
+                if !world.is_finite() {
+                    return Err(self.err(field, format!("the node's world transform {message}")));
+                }
+                // glTF hides nodes by scale 0: skipped, with a note saying why.
+                self.scene.skipped.push(format!("{field} (meshes[{}]): the world transform {message}", mesh.index()));
+                return Ok(());
+            }
             if mesh.primitives().len() == 0 {
                 self.scene.skipped.push(format!("meshes[{}] (node {}) has no primitives", mesh.index(), node.index()));
             }
@@ -432,7 +441,11 @@ impl Importer<'_> {
         self.scene.add_material(m).map_err(|e| {
             map_invalid(file, e, |suffix| match suffix {
                 Some("ior") => format!("{field}.extensions.KHR_materials_ior.ior"),
-                Some("nu/kappa") => format!("{field}.extras.specula"),
+                Some("nu" | "kappa") => format!("{field}.extras.specula"),
+                Some("base_color") => format!("{field}.pbrMetallicRoughness.baseColorFactor"),
+                Some("emission") => format!("{field}.emissiveFactor"),
+                Some("specular_color") => format!("{field}.extensions.KHR_materials_specular.specularColorFactor"),
+                Some("specular_factor") => format!("{field}.extensions.KHR_materials_specular.specularFactor"),
                 _ => field.clone(),
             })
         })
