@@ -80,6 +80,56 @@ gpu_structs! {
         parallax_iterations: uint,
     }
 
+    /// One ray of the ray-tracing pipeline's intersection query (survey §2.3.1: the rays
+    /// live in GPU memory; every acceleration scheme answers the same query).
+    struct GpuRayQuery => struct RayQuery {
+        /// xyz origin, w t_min
+        origin: vec4,
+        /// xyz direction (any length), w t_max (+inf: unbounded)
+        direction: vec4,
+        /// the triangle the ray leaves (RAY_NO_TRIANGLE: none)
+        skip: uint,
+        /// RAY_ANY_HIT: the first hit found will do (shadow rays)
+        flags: uint,
+        pad: [uint; 2],
+    }
+
+    /// The answer to one `RayQuery`: the nearest hit, or `triangle` = RAY_NO_TRIANGLE.
+    struct GpuRayHit => struct RayHit {
+        t: float,
+        /// barycentric of v1
+        u: float,
+        /// barycentric of v2
+        v: float,
+        /// index into the triangle list (scene order: mesh by mesh, index by index)
+        triangle: uint,
+    }
+
+    /// One scene triangle in world space, as the intersection kernels read it.
+    struct GpuTriangle => struct Triangle {
+        /// xyz; w: unused
+        v0: vec4,
+        v1: vec4,
+        v2: vec4,
+    }
+
+    /// What an acceleration scheme's kernel needs besides its node and reference buffers.
+    struct GpuAccel => struct Accel {
+        /// uniform grid: world-space minimum corner (xyz)
+        grid_min: vec4,
+        /// uniform grid: cells per world unit along each axis (xyz)
+        grid_inv_cell: vec4,
+        /// uniform grid: cells per axis (xyz); w: 1 with empty-cell skipping (KL04)
+        grid_res: uvec4,
+        /// rays in the query buffer
+        ray_count: uint,
+        /// triangles in the triangle list
+        triangle_count: uint,
+        /// nodes of the tree (BVH, kd-tree); 0 for the grid and brute force
+        node_count: uint,
+        pad: uint,
+    }
+
     /// Push constants of every scene-drawing shader.
     struct Push => push_constant Push push {
         /// first view of this draw (multiview adds gl_ViewIndex)
@@ -128,6 +178,11 @@ gpu_consts! {
     /// First inter-object cycle: no map holds anything yet, specular objects in maps are black
     /// (paths longer than the requested depth end black, as in the reference).
     FLAG_FIRST_CYCLE: uint = 16;
+
+    /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
+    RAY_NO_TRIANGLE: uint = 4294967295;
+    /// `RayQuery.flags`: any hit will do (shadow rays).
+    RAY_ANY_HIT: uint = 1;
 }
 
 descriptor_sets! {
@@ -159,5 +214,20 @@ descriptor_sets! {
         /// Per-vertex distance through the object along the inverted normal (d_N), read by
         /// distance/image_space/refract.vert.
         THICKNESS = 3: STORAGE_BUFFER => "readonly buffer Thickness { float thickness[]; }";
+    }
+
+    /// Ray tracing in the original geometry (survey §2), set 2: the ray queries and their
+    /// hits, the triangle list, and the acceleration scheme's buffers. Nodes are 16-byte
+    /// words whose meaning is the scheme's (src/methods/raytrace/: BVH nodes, grid cells,
+    /// kd-tree nodes); references index the triangle list.
+    RAY_BINDINGS = set 2 {
+        RAY_QUERIES = 0: STORAGE_BUFFER => "readonly buffer RayQueries { RayQuery queries[]; }";
+        RAY_HITS = 1: STORAGE_BUFFER => "writeonly buffer RayHits { RayHit hits[]; }";
+        RAY_TRIANGLES = 2: STORAGE_BUFFER => "readonly buffer Triangles { Triangle triangles[]; }";
+        ACCEL_NODES = 3: STORAGE_BUFFER => "readonly buffer AccelNodes { uvec4 accel_nodes[]; }";
+        ACCEL_REFS = 4: STORAGE_BUFFER => "readonly buffer AccelRefs { uint accel_refs[]; }";
+        /// BVH: the miss link of each node (stackless traversal); grid: unused
+        ACCEL_AUX = 5: STORAGE_BUFFER => "readonly buffer AccelAux { uint accel_aux[]; }";
+        ACCEL_PARAMS = 6: STORAGE_BUFFER => "readonly buffer AccelParams { Accel accel; }";
     }
 }

@@ -8,6 +8,7 @@
 
 pub mod distance;
 pub mod envmap;
+pub mod raytrace;
 pub mod registry;
 
 pub use crate::reference::REFERENCE;

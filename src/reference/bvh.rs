@@ -85,27 +85,27 @@ impl Bounds {
 impl Bvh {
     /// Builds the hierarchy over every triangle of every mesh.
     pub fn new(scene: &Scene) -> Bvh {
-        let mut triangles = Vec::with_capacity(scene.triangle_count());
-        let mut boxes = Vec::with_capacity(scene.triangle_count());
-        for (m, mesh) in scene.meshes.iter().enumerate() {
-            for (k, idx) in mesh.indices.chunks_exact(3).enumerate() {
+        let soup = scene.meshes.iter().enumerate().flat_map(|(m, mesh)| {
+            mesh.indices.chunks_exact(3).enumerate().map(move |(k, idx)| {
                 let p = |i: u32| mesh.positions[i as usize].as_dvec3();
-                let (a, b, c) = (p(idx[0]), p(idx[1]), p(idx[2]));
-                let (e1, e2) = (b - a, c - a);
-                triangles.push(Triangle {
-                    v0: a,
-                    e1,
-                    e2,
-                    det_scale: RAY_TRIANGLE_PARALLEL * e1.length() * e2.length(),
-                    mesh: m as u32,
-                    tri: k as u32,
-                });
-                let mut bb = Bounds::EMPTY;
-                for q in [a, b, c] {
-                    bb.grow(q);
-                }
-                boxes.push(bb);
+                ([p(idx[0]), p(idx[1]), p(idx[2])], m as u32, k as u32)
+            })
+        });
+        Bvh::build(soup)
+    }
+
+    /// Builds the hierarchy over a triangle soup: (corners, mesh, index within the mesh).
+    pub fn build(soup: impl Iterator<Item = ([DVec3; 3], u32, u32)>) -> Bvh {
+        let mut triangles = Vec::new();
+        let mut boxes = Vec::new();
+        for ([a, b, c], m, k) in soup {
+            let (e1, e2) = (b - a, c - a);
+            triangles.push(Triangle { v0: a, e1, e2, det_scale: RAY_TRIANGLE_PARALLEL * e1.length() * e2.length(), mesh: m, tri: k });
+            let mut bb = Bounds::EMPTY;
+            for q in [a, b, c] {
+                bb.grow(q);
             }
+            boxes.push(bb);
         }
         let mut order: Vec<u32> = (0..triangles.len() as u32).collect();
         let centroids: Vec<DVec3> = boxes.iter().map(|b| (b.min + b.max) * 0.5).collect();
@@ -176,6 +176,13 @@ impl Bvh {
 
     pub fn node_count(&self) -> usize {
         self.nodes.len()
+    }
+
+    /// The nodes in their stored order (the root first; an interior node's children are
+    /// adjacent, the left one at `first`): (min, max, first, count), count 0 for interior
+    /// nodes, else the leaf's triangles `triangles[first..first + count]`.
+    pub fn nodes(&self) -> impl Iterator<Item = (DVec3, DVec3, u32, u32)> + '_ {
+        self.nodes.iter().map(|n| (n.min, n.max, n.first, n.count))
     }
 
     /// The nearest hit with t_min < t < t_max, skipping triangle `skip` (the surface a

@@ -1,0 +1,46 @@
+// The intersection query of ray tracing in the original geometry (survey §2.3.1): every
+// scheme's kernel answers RayQuery → RayHit (set 2 of src/frame/layout.in.rs) with the
+// same triangle test, so they agree hit for hit up to ties at shared edges.
+#ifndef RAYTRACE_RAYS_GLSL
+#define RAYTRACE_RAYS_GLSL
+#include "common/scene.glsl"
+#include "common/ray_triangle.glsl"
+
+// lavapipe gives each invocation one budget of 65535 loop iterations shared by all its
+// loops (gallivm's loop limiter: the loop that exhausts it stops). Traversals stay far
+// below it (a ray visits hundreds of nodes or cells); brute force unrolls its loop.
+
+RayHit no_hit(RayQuery q) {
+    return RayHit(q.direction.w, 0.0, 0.0, RAY_NO_TRIANGLE);
+}
+
+// Tests triangle `id` (never the one the ray leaves); a hit nearer than best.t replaces it.
+bool test_triangle(uint id, RayQuery q, inout RayHit best) {
+    if (id == q.skip) return false;
+    Triangle tr = triangles[id];
+    vec3 tuv;
+    if (!ray_triangle(q.origin.xyz, q.direction.xyz, tr.v0.xyz, tr.v1.xyz, tr.v2.xyz, q.origin.w, best.t, tuv)) return false;
+    best = RayHit(tuv.x, tuv.y, tuv.z, id);
+    return true;
+}
+
+// 1 / d with zero components replaced by ±1e-30 (so that slab products never form 0 · ∞).
+vec3 safe_inverse(vec3 d) {
+    vec3 s = mix(vec3(1.0), vec3(-1.0), lessThan(d, vec3(0.0)));
+    return 1.0 / mix(d, s * 1e-30, lessThan(abs(d), vec3(1e-30)));
+}
+
+// Slab test of the box [lo, hi] on t_min ≤ t ≤ t_max; `t_near` is where the ray enters.
+// The far bound is widened by 1 + 2γ₃ (PBRT's robust bounds) so that rounding never
+// rejects a box that a hit on its face lies in.
+bool ray_box(vec3 lo, vec3 hi, vec3 o, vec3 inv_d, float t_min, float t_max, out float t_near) {
+    vec3 t0 = (lo - o) * inv_d;
+    vec3 t1 = (hi - o) * inv_d;
+    vec3 a = min(t0, t1);
+    vec3 b = max(t0, t1);
+    t_near = max(max(a.x, a.y), max(a.z, t_min));
+    float t_far = min(min(b.x, b.y), min(b.z, t_max)) * 1.0000004;
+    return t_near <= t_far;
+}
+
+#endif

@@ -1,0 +1,174 @@
+//! One acceleration scheme on the GPU: its buffers (triangles, nodes, references,
+//! auxiliary words, parameters, each named `raytrace.<scheme>.<part>` in the memory
+//! registry), its intersection kernel, and the descriptor set (set 2) that binds them
+//! with a query and a hit buffer.
+
+use ash::vk;
+
+use super::{Packed, Scheme, TriangleList};
+use crate::error::{Error, Result};
+use crate::frame::layout::{binding, GpuAccel, GpuRayHit, GpuRayQuery, RAY_BINDINGS};
+use crate::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
+use crate::vk::{Buffer, Context, MemoryLocation, Profiler, Recorder};
+
+pub struct Intersector {
+    pub scheme: Scheme,
+    pub accel: GpuAccel,
+    triangles: Buffer,
+    nodes: Buffer,
+    refs: Buffer,
+    aux: Buffer,
+    params: Buffer,
+    /// Empty layouts for sets 0 and 1, then set 2.
+    set_layouts: [vk::DescriptorSetLayout; 3],
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+    structure_bytes: u64,
+}
+
+const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
+
+impl Intersector {
+    /// Uploads `list` and the scheme's structure `packed` (built from `list`).
+    pub fn new(ctx: &Context, scheme: Scheme, list: &TriangleList, packed: &Packed) -> Result<Intersector> {
+        let mut me = Intersector {
+            scheme,
+            accel: packed.accel,
+            triangles: Buffer::placeholder(),
+            nodes: Buffer::placeholder(),
+            refs: Buffer::placeholder(),
+            aux: Buffer::placeholder(),
+            params: Buffer::placeholder(),
+            set_layouts: [vk::DescriptorSetLayout::null(); 3],
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+            structure_bytes: packed.bytes(),
+        };
+        // On any failure `me` is dropped through `destroy`, which frees what exists.
+        match me.init(ctx, list, packed) {
+            Ok(()) => Ok(me),
+            Err(e) => {
+                me.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn init(&mut self, ctx: &Context, list: &TriangleList, packed: &Packed) -> Result<()> {
+        let name = |part: &str| format!("raytrace.{}.{part}", self.scheme.pass_name().trim_start_matches("raytrace.intersect."));
+        self.triangles = Buffer::with_data(ctx, &name("triangles"), &list.gpu(), STORAGE)?;
+        // Zero-length parts get one word: robustness2 would allow null descriptors, but a
+        // kernel never reads them then, and one word keeps the binding valid everywhere.
+        let or_one = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
+        let nodes: Vec<u32> = packed.nodes.iter().flatten().copied().collect();
+        self.nodes = Buffer::with_data(ctx, &name("nodes"), &or_one(&nodes), STORAGE)?;
+        self.refs = Buffer::with_data(ctx, &name("refs"), &or_one(&packed.refs), STORAGE)?;
+        self.aux = Buffer::with_data(ctx, &name("aux"), &or_one(&packed.aux), STORAGE)?;
+        self.params = Buffer::with_data(ctx, &name("params"), &[packed.accel], STORAGE)?;
+        let stage = vk::ShaderStageFlags::COMPUTE;
+        self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.set0", &[], stage)?;
+        self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.set1", &[], stage)?;
+        self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stage)?;
+        self.layout = pipeline_layout(ctx, "raytrace.intersect", &self.set_layouts, 0, stage)?;
+        self.pipeline = compute_pipeline(ctx, self.layout, packed.shader)?;
+        let (pool, set) = allocate_set(ctx, "raytrace.rays", self.set_layouts[2], RAY_BINDINGS)?;
+        self.pool = pool;
+        self.set = set;
+        let ty = vk::DescriptorType::STORAGE_BUFFER;
+        write_buffer(ctx, set, binding::RAY_TRIANGLES, ty, self.triangles.raw);
+        write_buffer(ctx, set, binding::ACCEL_NODES, ty, self.nodes.raw);
+        write_buffer(ctx, set, binding::ACCEL_REFS, ty, self.refs.raw);
+        write_buffer(ctx, set, binding::ACCEL_AUX, ty, self.aux.raw);
+        write_buffer(ctx, set, binding::ACCEL_PARAMS, ty, self.params.raw);
+        Ok(())
+    }
+
+    /// Device bytes of the structure (nodes, references, auxiliary words), without the
+    /// triangle list that every scheme shares.
+    pub fn structure_bytes(&self) -> u64 {
+        self.structure_bytes
+    }
+
+    /// Records the intersection of `count` queries into `hits` under the pass name
+    /// `raytrace.intersect.<scheme>`. The queries must be written before (host writes are
+    /// visible at submission; GPU writes need their own barrier).
+    pub fn record(&mut self, ctx: &Context, rec: &mut Recorder, queries: &Buffer, hits: &Buffer, count: u32) -> Result<()> {
+        if (queries.size as usize) < count as usize * std::mem::size_of::<GpuRayQuery>()
+            || (hits.size as usize) < count as usize * std::mem::size_of::<GpuRayHit>()
+        {
+            return Err(Error::invalid("raytrace.intersect", format!("buffers too small for {count} rays")));
+        }
+        self.accel.ray_count = count;
+        self.params.write(bytemuck::bytes_of(&self.accel))?;
+        let ty = vk::DescriptorType::STORAGE_BUFFER;
+        write_buffer(ctx, self.set, binding::RAY_QUERIES, ty, queries.raw);
+        write_buffer(ctx, self.set, binding::RAY_HITS, ty, hits.raw);
+        let cmd = rec.cmd;
+        let open = rec.pass(self.scheme.pass_name()).begin();
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 2, &[self.set], &[]);
+            ctx.device.cmd_dispatch(cmd, count.div_ceil(64), 1, 1);
+        }
+        rec.end(open);
+        Ok(())
+    }
+
+    /// Intersects `queries` in one submission and reads the hits back (tests, tools).
+    pub fn intersect(&mut self, ctx: &Context, queries: &[GpuRayQuery]) -> Result<(Vec<GpuRayHit>, f64)> {
+        let n = queries.len().max(1);
+        let mut q = Buffer::with_data(ctx, "raytrace.queries", queries, STORAGE)?;
+        let mut h =
+            match Buffer::new(ctx, "raytrace.hits", (n * std::mem::size_of::<GpuRayHit>()) as u64, STORAGE, MemoryLocation::GpuToCpu) {
+                Ok(h) => h,
+                Err(e) => {
+                    q.destroy(ctx);
+                    return Err(e);
+                }
+            };
+        let result = (|| {
+            let mut profiler = Profiler::new(ctx, 2)?;
+            let r = ctx.one_shot(|cmd| {
+                let mut rec = Recorder::new(ctx, cmd, &mut profiler);
+                self.record(ctx, &mut rec, &q, &h, queries.len() as u32)?;
+                let barrier = [vk::MemoryBarrier2::default()
+                    .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+                    .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                    .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                    .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+                unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
+                Ok(())
+            });
+            let ms = r.and_then(|_| profiler.results(ctx)).map(|p| p.iter().map(|p| p.gpu_ms).sum::<f64>());
+            profiler.destroy(ctx);
+            let ms = ms?;
+            let hits: Vec<GpuRayHit> = bytemuck::pod_collect_to_vec(&h.read()?[..queries.len() * std::mem::size_of::<GpuRayHit>()]);
+            Ok((hits, ms))
+        })();
+        q.destroy(ctx);
+        h.destroy(ctx);
+        result
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            for l in self.set_layouts {
+                ctx.device.destroy_descriptor_set_layout(l, None);
+            }
+        }
+        self.pipeline = vk::Pipeline::null();
+        self.layout = vk::PipelineLayout::null();
+        self.pool = vk::DescriptorPool::null();
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 3];
+        for b in [&mut self.triangles, &mut self.nodes, &mut self.refs, &mut self.aux, &mut self.params] {
+            b.destroy(ctx);
+        }
+    }
+}

@@ -1,0 +1,134 @@
+//! Ray tracing in the original geometry on the GPU (survey §2): the triangle list, the
+//! acceleration schemes and the intersection kernels that answer "the nearest hit of each
+//! ray" for a buffer of ray queries (`GpuRayQuery` → `GpuRayHit`, set 2 of
+//! src/frame/layout.in.rs), in the spirit of Purcell's decomposition (§2.3.1): every
+//! scheme reads the same query buffer and writes the same hit buffer, so traversal is a
+//! pluggable step between the passes that make rays and the passes that shade them.
+//!
+//! Each scheme is built on the CPU (the survey's 2008 state) into one uniform GPU form,
+//! [`Packed`]: 16-byte node words whose meaning is the scheme's, a reference list into the
+//! triangle list, an auxiliary word list, the kernel's parameters and its shader:
+//! - [`Scheme::Brute`]: every triangle for every ray (the baseline the tests compare with);
+//! - [`Scheme::Bvh`]: the CPU reference's SAH BVH (`reference::bvh`), traversed nearest
+//!   child first with a short stack, or stackless along hit/miss links (CHCH06);
+//! - [`Scheme::Grid`]: a uniform grid with 3D-DDA traversal (Amanatides–Woo), optionally
+//!   skipping empty space by each empty cell's Chebyshev distance to the nearest
+//!   non-empty cell (KL04).
+//!
+//! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
+//! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
+
+pub mod bvh;
+pub mod gpu;
+pub mod grid;
+
+use glam::Vec3;
+
+use crate::error::{Error, Result};
+use crate::frame::layout::{GpuAccel, GpuTriangle};
+use crate::scene::Scene;
+
+/// The scene's triangles in world space in scene order (mesh by mesh, index by index):
+/// the ids that every scheme's hits refer to.
+#[derive(Clone, Debug, Default)]
+pub struct TriangleList {
+    pub triangles: Vec<[Vec3; 3]>,
+    /// The first triangle id of each mesh.
+    pub mesh_offsets: Vec<u32>,
+}
+
+impl TriangleList {
+    pub fn from_scene(scene: &Scene) -> TriangleList {
+        let mut list = TriangleList::default();
+        for mesh in &scene.meshes {
+            list.mesh_offsets.push(list.triangles.len() as u32);
+            for t in mesh.indices.chunks_exact(3) {
+                list.triangles.push([0, 1, 2].map(|k| mesh.positions[t[k] as usize]));
+            }
+        }
+        list
+    }
+
+    /// A triangle soup; non-finite corners are refused with the triangle's index.
+    pub fn from_soup(triangles: Vec<[Vec3; 3]>) -> Result<TriangleList> {
+        if let Some(i) = triangles.iter().position(|t| t.iter().any(|v| !v.is_finite())) {
+            return Err(Error::invalid(format!("triangles[{i}]"), format!("corners must be finite, got {:?}", triangles[i])));
+        }
+        Ok(TriangleList { triangles, mesh_offsets: vec![0] })
+    }
+
+    pub fn len(&self) -> usize {
+        self.triangles.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
+    /// The world-space bounds (min, max) of every corner.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.triangles.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
+    }
+
+    pub fn gpu(&self) -> Vec<GpuTriangle> {
+        self.triangles
+            .iter()
+            .map(|t| GpuTriangle { v0: t[0].extend(0.0).to_array(), v1: t[1].extend(0.0).to_array(), v2: t[2].extend(0.0).to_array() })
+            .collect()
+    }
+}
+
+/// An acceleration scheme and its knobs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Scheme {
+    /// Every triangle for every ray.
+    Brute,
+    /// SAH BVH; `stackless`: the threaded traversal along hit/miss links (CHCH06).
+    Bvh { stackless: bool },
+    /// Uniform grid of about `density` × N cells; `skip_empty`: KL04 empty-space skipping.
+    Grid { density: f32, skip_empty: bool },
+}
+
+impl Scheme {
+    /// The profiler's name of its intersection pass: `raytrace.intersect.<scheme>`.
+    pub fn pass_name(&self) -> &'static str {
+        match self {
+            Scheme::Brute => "raytrace.intersect.brute",
+            Scheme::Bvh { .. } => "raytrace.intersect.bvh",
+            Scheme::Grid { .. } => "raytrace.intersect.grid",
+        }
+    }
+
+    /// Builds the scheme over `list` (CPU) into its GPU form.
+    pub fn build(&self, list: &TriangleList) -> Result<Packed> {
+        match *self {
+            Scheme::Brute => Ok(Packed {
+                nodes: Vec::new(),
+                refs: Vec::new(),
+                aux: Vec::new(),
+                accel: GpuAccel { triangle_count: list.len() as u32, ..bytemuck::Zeroable::zeroed() },
+                shader: "raytrace/intersect_brute.comp",
+            }),
+            Scheme::Bvh { stackless } => bvh::pack(list, stackless),
+            Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),
+        }
+    }
+}
+
+/// A scheme in its GPU form (see the module documentation).
+#[derive(Clone, Debug)]
+pub struct Packed {
+    pub nodes: Vec<[u32; 4]>,
+    pub refs: Vec<u32>,
+    pub aux: Vec<u32>,
+    /// The kernel's parameters; `ray_count` is filled per dispatch.
+    pub accel: GpuAccel,
+    pub shader: &'static str,
+}
+
+impl Packed {
+    /// Device bytes of the structure itself (nodes, references, auxiliary words).
+    pub fn bytes(&self) -> u64 {
+        (self.nodes.len() * 16 + self.refs.len() * 4 + self.aux.len() * 4) as u64
+    }
+}
