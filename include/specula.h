@@ -53,6 +53,10 @@
 #define SPECULA_METHOD_REFRACTOR_MAP 5
 /* image-space-refraction (§4.4) */
 #define SPECULA_METHOD_IMAGE_SPACE_REFRACTION 6
+/* bvh (§2.3.5) */
+#define SPECULA_METHOD_BVH 7
+/* grid (§2.3.1) */
+#define SPECULA_METHOD_GRID 8
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

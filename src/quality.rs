@@ -73,6 +73,14 @@ pub struct Quality {
     pub proxy_radius: Option<f32>,
     /// What `--method auto` optimises.
     pub planner: Planner,
+    /// Ray tracing in the original geometry (§2): rays per pixel each bounce's queue holds.
+    pub ray_budget: u32,
+    /// `bvh`: traversal with a short stack, else stackless along hit/miss links (CHCH06).
+    pub bvh_stackless: bool,
+    /// `grid`: about this many cells per triangle.
+    pub grid_density: f32,
+    /// `grid`: empty-space skipping by distance to the nearest non-empty cell (KL04).
+    pub grid_skip: bool,
 }
 
 /// One knob, declared once.
@@ -120,6 +128,7 @@ const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single",
 const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
 const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
 const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
+const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
 
 pub const KNOBS: &[Knob] = &[
@@ -313,6 +322,50 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.frame_latency, ON_OFF),
     },
     Knob {
+        name: "ray_budget",
+        values: "1..=64 rays per pixel",
+        default: "4",
+        doc: "ray tracing (§2): capacity of each bounce's ray queue; rays beyond it are dropped (and counted)",
+        set: |q, v| {
+            q.ray_budget = count(v, 1, 64)?;
+            Ok(())
+        },
+        get: |q| q.ray_budget.to_string(),
+    },
+    Knob {
+        name: "bvh_traversal",
+        values: "stack|stackless",
+        default: "stack",
+        doc: "bvh (§2.3.5): nearest child first with a short stack, or stackless along hit/miss links (CHCH06)",
+        set: |q, v| {
+            q.bvh_stackless = one_of(v, BVH_TRAVERSALS)?;
+            Ok(())
+        },
+        get: |q| name_of(q.bvh_stackless, BVH_TRAVERSALS),
+    },
+    Knob {
+        name: "grid_density",
+        values: "0.01..=64 cells per triangle",
+        default: "2",
+        doc: "grid (§2.3.1): cells of the uniform grid per triangle of the scene",
+        set: |q, v| {
+            q.grid_density = real(v, 0.01, 64.0)?;
+            Ok(())
+        },
+        get: |q| q.grid_density.to_string(),
+    },
+    Knob {
+        name: "grid_skip",
+        values: "on|off",
+        default: "on",
+        doc: "grid: skip empty space by each empty cell's distance to the nearest non-empty cell (KL04)",
+        set: |q, v| {
+            q.grid_skip = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.grid_skip, ON_OFF),
+    },
+    Knob {
         name: "proxy_radius",
         values: "auto|metres",
         default: "auto",
@@ -363,6 +416,10 @@ impl Default for Quality {
             frame_latency: false,
             proxy_radius: None,
             planner: Planner::Accuracy,
+            ray_budget: 4,
+            bvh_stackless: false,
+            grid_density: 2.0,
+            grid_skip: true,
         }
     }
 }

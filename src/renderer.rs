@@ -24,7 +24,8 @@ use crate::vk::{
     record_copy_to_buffer, Access, Buffer, Context, Image, ImageData, ImageDesc, ImageKind, MemoryLocation, PassTiming, Profiler, Recorder,
 };
 
-const MAX_PASSES: u32 = 32;
+/// Profiled passes a frame may record (ray tracing records about 7 per bounce).
+const MAX_PASSES: u32 = 512;
 
 /// A rendered frame: linear radiance RGBA32F, its per-pass profile and the device memory
 /// that the renderer's resources hold.
@@ -179,10 +180,12 @@ impl Renderer {
             | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 };
 
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        self.set_layout = descriptor_set_layout(ctx, "frame.set_layout", BINDINGS, stages)?;
+        // The sets are visible to compute too: the ray pipeline's kernels shade with them.
+        let set_stages = stages | vk::ShaderStageFlags::COMPUTE;
+        self.set_layout = descriptor_set_layout(ctx, "frame.set_layout", BINDINGS, set_stages)?;
         let (pool, set) = allocate_set(ctx, "frame.set", self.set_layout, BINDINGS)?;
         (self.pool, self.set) = (pool, set);
-        self.maps_layout = descriptor_set_layout(ctx, "maps.set_layout", MAP_BINDINGS, stages)?;
+        self.maps_layout = descriptor_set_layout(ctx, "maps.set_layout", MAP_BINDINGS, set_stages)?;
         self.layout = pipeline_layout(ctx, "frame.layout", &[self.set_layout, self.maps_layout], PUSH_BYTES, stages)?;
         self.linear_repeat = sampler(ctx, "sampler.linear_repeat", vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)?;
         self.nearest_clamp = sampler(ctx, "sampler.nearest_clamp", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
@@ -233,8 +236,16 @@ impl Renderer {
 
     /// Creates the plan's stages in order; each map stage puts its images into `maps`.
     fn create_stages(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
-        let init =
-            StageInit { ctx, scene, gpu: &self.scene, plan: &self.plan, layout: self.layout, width: self.width, height: self.height };
+        let init = StageInit {
+            ctx,
+            scene,
+            gpu: &self.scene,
+            plan: &self.plan,
+            layout: self.layout,
+            set_layouts: [self.set_layout, self.maps_layout],
+            width: self.width,
+            height: self.height,
+        };
         for spec in &self.plan.stages {
             let stage: Box<dyn Stage> = match spec {
                 // The scene records its own upload (first frame only).
@@ -242,7 +253,10 @@ impl Renderer {
                 StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
                 StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout)?),
                 StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
-                StageSpec::Camera(c) => Box::new(CameraShade::new(ctx, self.layout, c)?),
+                StageSpec::Camera(c) => match c.pass.create {
+                    Some(create) => create(&init, c)?,
+                    None => Box::new(CameraShade::new(ctx, self.layout, c)?),
+                },
             };
             self.stages.push(stage);
         }

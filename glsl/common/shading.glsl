@@ -6,15 +6,23 @@
 #include "common/optics.glsl"
 #include "common/sky.glsl"
 
+// Compute shaders have no derivatives: they define SHADING_LOD0 and sample level 0 (the
+// only level: textures have no mip chain, so the result is the same).
+#ifdef SHADING_LOD0
+#define MATERIAL_TEXTURE(uv, layer) textureLod(textures, vec3(uv, float(layer)), 0.0)
+#else
+#define MATERIAL_TEXTURE(uv, layer) texture(textures, vec3(uv, float(layer)))
+#endif
+
 vec3 material_base_color(Material m, vec2 uv) {
     vec3 c = m.base_color.rgb;
-    if (m.base_texture >= 0) c *= texture(textures, vec3(uv, float(m.base_texture))).rgb;
+    if (m.base_texture >= 0) c *= MATERIAL_TEXTURE(uv, m.base_texture).rgb;
     return c;
 }
 
 vec3 material_emission(Material m, vec2 uv) {
     vec3 e = m.emissive.rgb;
-    if (m.emissive_texture >= 0) e *= texture(textures, vec3(uv, float(m.emissive_texture))).rgb;
+    if (m.emissive_texture >= 0) e *= MATERIAL_TEXTURE(uv, m.emissive_texture).rgb;
     return e;
 }
 
@@ -40,6 +48,32 @@ float light_visibility(Light l, vec3 p, vec3 n) {
     return length(dq) <= stored * (1.0 + 2.0 * texel) + 1e-4 ? 1.0 : 0.0;
 }
 
+// Irradiance E of light l at p on a surface facing it (range window, spot cone), the unit
+// direction wi towards it and its distance (+∞ for directional lights).
+vec3 light_irradiance(Light l, vec3 p, out vec3 wi, out float dist) {
+    uint kind = uint(l.direction_kind.w);
+    if (kind == LIGHT_DIRECTIONAL) {
+        wi = -l.direction_kind.xyz;
+        dist = 1.0 / 0.0;
+        return l.intensity.rgb;
+    }
+    vec3 d = l.position_range.xyz - p;
+    float d2 = max(dot(d, d), 1e-12);
+    dist = sqrt(d2);
+    wi = d / dist;
+    vec3 e = l.intensity.rgb / d2;
+    float range = l.position_range.w;
+    if (range > 0.0) {  // glTF's recommended smooth window
+        float r = dist / range;
+        e *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
+    }
+    if (kind == LIGHT_SPOT) {
+        float cd = dot(l.direction_kind.xyz, -wi);
+        e *= clamp((cd - l.cone.x) / max(l.cone.y - l.cone.x, 1e-4), 0.0, 1.0);
+    }
+    return e;
+}
+
 // Emission + Σ albedo/π · E_i · visibility (radiance towards any direction).
 vec3 shade_diffuse(Material m, vec3 p, vec3 n, vec3 eye, vec2 uv) {
     vec3 albedo = material_base_color(m, uv);
@@ -48,28 +82,9 @@ vec3 shade_diffuse(Material m, vec3 p, vec3 n, vec3 eye, vec2 uv) {
     vec3 l_sum = vec3(0.0);
     for (uint i = 0u; i < push.light_count; ++i) {
         Light l = lights[i];
-        uint kind = uint(l.direction_kind.w);
         vec3 wi;
-        vec3 e;
-        if (kind == LIGHT_DIRECTIONAL) {
-            wi = -l.direction_kind.xyz;
-            e = l.intensity.rgb;
-        } else {
-            vec3 d = l.position_range.xyz - p;
-            float d2 = max(dot(d, d), 1e-12);
-            float dist = sqrt(d2);
-            wi = d / dist;
-            e = l.intensity.rgb / d2;
-            float range = l.position_range.w;
-            if (range > 0.0) {  // glTF's recommended smooth window
-                float r = dist / range;
-                e *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
-            }
-            if (kind == LIGHT_SPOT) {
-                float cd = dot(l.direction_kind.xyz, -wi);
-                e *= clamp((cd - l.cone.x) / max(l.cone.y - l.cone.x, 1e-4), 0.0, 1.0);
-            }
-        }
+        float dist;
+        vec3 e = light_irradiance(l, p, wi, dist);
         float cos_t = dot(n, wi);
         if (cos_t <= 0.0) continue;
         l_sum += e * cos_t * light_visibility(l, p, n);

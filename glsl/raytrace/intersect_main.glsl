@@ -4,6 +4,6 @@ layout(local_size_x = 64) in;
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
-    if (i >= accel.ray_count) return;
+    if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) return;
     hits[i] = INTERSECT(queries[i]);
 }

@@ -25,6 +25,10 @@ pub mod order {
     /// Camera-space maps (image-space refraction's back faces).
     pub const CAMERA_MAPS: u32 = 40;
     pub const CAMERA: u32 = 50;
+    /// Ray tracing in the original geometry: last, since it replaces its objects' pixels
+    /// by what its own visibility pass found nearest (other camera passes draw over
+    /// depth it does not write).
+    pub const RAYTRACE: u32 = 60;
 }
 
 /// One recorded pass with its resources (`new` creates everything, `destroy` frees it).
@@ -189,6 +193,8 @@ pub struct StageInit<'a> {
     pub gpu: &'a GpuScene,
     pub plan: &'a Plan,
     pub layout: vk::PipelineLayout,
+    /// The frame's descriptor set layouts (set 0, set 1), for stages with layouts of their own.
+    pub set_layouts: [vk::DescriptorSetLayout; 2],
     pub width: u32,
     pub height: u32,
 }

@@ -91,7 +91,14 @@ pub struct CameraPass {
     pub flags: u32,
     /// Position among the frame's passes (`frame::stage::order`).
     pub order: u32,
+    /// A stage of the method's own instead of the one fragment pass that draws its objects
+    /// with `vertex` and `fragment` (ray tracing in the original geometry: a pipeline of
+    /// passes).
+    pub create: Option<CreateCamera>,
 }
+
+/// Creates a method's own camera stage for the plan's objects.
+pub type CreateCamera = fn(&crate::frame::stage::StageInit, &crate::plan::CameraPlan) -> crate::Result<Box<dyn crate::frame::stage::Stage>>;
 
 /// What the planner's rule says about one object: a score (higher wins) and why.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]

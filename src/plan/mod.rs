@@ -402,8 +402,10 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     if !scene.textures.is_empty() || scene.environment.is_some() {
         stages.push(StageSpec::Upload);
     }
-    // Shadows matter only where a diffuse surface receives light.
-    if has_diffuse {
+    // Shadows matter only where a diffuse surface receives light, and not at all where a
+    // whole-scene ray tracer shades every pixel with exact shadow rays (survey §2).
+    let traced_everywhere = matches!(p.choice, Choice::Method(m) if m.family == "raytrace");
+    if has_diffuse && !traced_everywhere {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),

@@ -87,8 +87,14 @@ const fn one(_: &Quality) -> u32 {
     1
 }
 
-const SEARCH: CameraPass =
-    CameraPass { name: "distance.search", vertex: "scene/mesh.vert", fragment: "distance/search.frag", flags: 0, order: order::CAMERA };
+const SEARCH: CameraPass = CameraPass {
+    name: "distance.search",
+    vertex: "scene/mesh.vert",
+    fragment: "distance/search.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+};
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 
@@ -188,7 +194,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
-        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1 },
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None },
         map_shading: MapShading::Refractor,
         leaves_out: LeavesOut::Itself,
         cycles: one,
@@ -234,6 +240,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
             fragment: "distance/image_space/refract.frag",
             flags: 0,
             order: order::CAMERA + 2,
+            create: None,
         },
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,

@@ -41,11 +41,17 @@ const fn spec(camera: CameraPass) -> GpuSpec {
     GpuSpec { maps: &[RADIANCE_CUBES], camera, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }
 }
 
-const SHADE: CameraPass =
-    CameraPass { name: "envmap.shade", vertex: "scene/mesh.vert", fragment: "envmap/shade.frag", flags: 0, order: order::CAMERA };
+const SHADE: CameraPass = CameraPass {
+    name: "envmap.shade",
+    vertex: "scene/mesh.vert",
+    fragment: "envmap/shade.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+};
 
 const fn proxy(flags: u32) -> CameraPass {
-    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA }
+    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA, create: None }
 }
 
 pub const ENVMAP: Method = Method(&MethodInfo {

@@ -1,7 +1,7 @@
-//! One acceleration scheme on the GPU: its buffers (triangles, nodes, references,
+//! One acceleration scheme on the GPU: its buffers (the triangle list, nodes, references,
 //! auxiliary words, parameters, each named `raytrace.<scheme>.<part>` in the memory
-//! registry), its intersection kernel, and the descriptor set (set 2) that binds them
-//! with a query and a hit buffer.
+//! registry), which set 2's scheme bindings point at, and the one-shot intersection of a
+//! query buffer (tests, tools) with its own pipeline.
 
 use ash::vk;
 
@@ -11,45 +11,37 @@ use crate::frame::layout::{binding, GpuAccel, GpuRayHit, GpuRayQuery, RAY_BINDIN
 use crate::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
 use crate::vk::{Buffer, Context, MemoryLocation, Profiler, Recorder};
 
-pub struct Intersector {
+const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
+
+/// A scheme's structure and the triangle list on the device.
+pub struct Structure {
     pub scheme: Scheme,
     pub accel: GpuAccel,
+    /// The scheme's intersection kernel.
+    pub shader: &'static str,
     triangles: Buffer,
     nodes: Buffer,
     refs: Buffer,
     aux: Buffer,
     params: Buffer,
-    /// Empty layouts for sets 0 and 1, then set 2.
-    set_layouts: [vk::DescriptorSetLayout; 3],
-    layout: vk::PipelineLayout,
-    pipeline: vk::Pipeline,
-    pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
     structure_bytes: u64,
 }
 
-const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
-
-impl Intersector {
+impl Structure {
     /// Uploads `list` and the scheme's structure `packed` (built from `list`).
-    pub fn new(ctx: &Context, scheme: Scheme, list: &TriangleList, packed: &Packed) -> Result<Intersector> {
-        let mut me = Intersector {
+    pub fn new(ctx: &Context, scheme: Scheme, list: &TriangleList, packed: &Packed) -> Result<Structure> {
+        let mut me = Structure {
             scheme,
             accel: packed.accel,
+            shader: packed.shader,
             triangles: Buffer::placeholder(),
             nodes: Buffer::placeholder(),
             refs: Buffer::placeholder(),
             aux: Buffer::placeholder(),
             params: Buffer::placeholder(),
-            set_layouts: [vk::DescriptorSetLayout::null(); 3],
-            layout: vk::PipelineLayout::null(),
-            pipeline: vk::Pipeline::null(),
-            pool: vk::DescriptorPool::null(),
-            set: vk::DescriptorSet::null(),
             structure_bytes: packed.bytes(),
         };
-        // On any failure `me` is dropped through `destroy`, which frees what exists.
-        match me.init(ctx, list, packed) {
+        match me.upload(ctx, list, packed) {
             Ok(()) => Ok(me),
             Err(e) => {
                 me.destroy(ctx);
@@ -58,33 +50,28 @@ impl Intersector {
         }
     }
 
-    fn init(&mut self, ctx: &Context, list: &TriangleList, packed: &Packed) -> Result<()> {
-        let name = |part: &str| format!("raytrace.{}.{part}", self.scheme.pass_name().trim_start_matches("raytrace.intersect."));
+    fn upload(&mut self, ctx: &Context, list: &TriangleList, packed: &Packed) -> Result<()> {
+        let scheme = self.scheme.pass_name().trim_start_matches("raytrace.intersect.");
+        let name = |part: &str| format!("raytrace.{scheme}.{part}");
         self.triangles = Buffer::with_data(ctx, &name("triangles"), &list.gpu(), STORAGE)?;
-        // Zero-length parts get one word: robustness2 would allow null descriptors, but a
-        // kernel never reads them then, and one word keeps the binding valid everywhere.
+        // Empty parts get one word, so that every binding holds a valid buffer.
         let or_one = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
         let nodes: Vec<u32> = packed.nodes.iter().flatten().copied().collect();
         self.nodes = Buffer::with_data(ctx, &name("nodes"), &or_one(&nodes), STORAGE)?;
         self.refs = Buffer::with_data(ctx, &name("refs"), &or_one(&packed.refs), STORAGE)?;
         self.aux = Buffer::with_data(ctx, &name("aux"), &or_one(&packed.aux), STORAGE)?;
         self.params = Buffer::with_data(ctx, &name("params"), &[packed.accel], STORAGE)?;
-        let stage = vk::ShaderStageFlags::COMPUTE;
-        self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.set0", &[], stage)?;
-        self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.set1", &[], stage)?;
-        self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stage)?;
-        self.layout = pipeline_layout(ctx, "raytrace.intersect", &self.set_layouts, 0, stage)?;
-        self.pipeline = compute_pipeline(ctx, self.layout, packed.shader)?;
-        let (pool, set) = allocate_set(ctx, "raytrace.rays", self.set_layouts[2], RAY_BINDINGS)?;
-        self.pool = pool;
-        self.set = set;
+        Ok(())
+    }
+
+    /// Writes the triangle list and the structure into a set-2 descriptor set.
+    pub fn write(&self, ctx: &Context, set: vk::DescriptorSet) {
         let ty = vk::DescriptorType::STORAGE_BUFFER;
         write_buffer(ctx, set, binding::RAY_TRIANGLES, ty, self.triangles.raw);
         write_buffer(ctx, set, binding::ACCEL_NODES, ty, self.nodes.raw);
         write_buffer(ctx, set, binding::ACCEL_REFS, ty, self.refs.raw);
         write_buffer(ctx, set, binding::ACCEL_AUX, ty, self.aux.raw);
         write_buffer(ctx, set, binding::ACCEL_PARAMS, ty, self.params.raw);
-        Ok(())
     }
 
     /// Device bytes of the structure (nodes, references, auxiliary words), without the
@@ -93,22 +80,80 @@ impl Intersector {
         self.structure_bytes
     }
 
+    pub fn destroy(&mut self, ctx: &Context) {
+        for b in [&mut self.triangles, &mut self.nodes, &mut self.refs, &mut self.aux, &mut self.params] {
+            b.destroy(ctx);
+        }
+    }
+}
+
+/// A structure with its own intersection pipeline and descriptor set.
+pub struct Intersector {
+    pub structure: Structure,
+    count: Buffer,
+    /// Empty layouts for sets 0 and 1, then set 2.
+    set_layouts: [vk::DescriptorSetLayout; 3],
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+}
+
+impl Intersector {
+    /// Uploads `list` and the scheme's structure `packed` (built from `list`).
+    pub fn new(ctx: &Context, scheme: Scheme, list: &TriangleList, packed: &Packed) -> Result<Intersector> {
+        let structure = Structure::new(ctx, scheme, list, packed)?;
+        let mut me = Intersector {
+            structure,
+            count: Buffer::placeholder(),
+            set_layouts: [vk::DescriptorSetLayout::null(); 3],
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+        };
+        match me.init(ctx) {
+            Ok(()) => Ok(me),
+            Err(e) => {
+                me.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn init(&mut self, ctx: &Context) -> Result<()> {
+        self.count = Buffer::with_data(ctx, "raytrace.count", &[0u32], STORAGE)?;
+        let stage = vk::ShaderStageFlags::COMPUTE;
+        self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.set0", &[], stage)?;
+        self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.set1", &[], stage)?;
+        self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stage)?;
+        self.layout = pipeline_layout(ctx, "raytrace.intersect", &self.set_layouts, 0, stage)?;
+        self.pipeline = compute_pipeline(ctx, self.layout, self.structure.shader)?;
+        let (pool, set) = allocate_set(ctx, "raytrace.rays", self.set_layouts[2], RAY_BINDINGS)?;
+        self.pool = pool;
+        self.set = set;
+        self.structure.write(ctx, set);
+        let ty = vk::DescriptorType::STORAGE_BUFFER;
+        write_buffer(ctx, set, binding::RAY_COUNT, ty, self.count.raw);
+        write_buffer(ctx, set, binding::RAY_PAYLOADS, ty, vk::Buffer::null());
+        Ok(())
+    }
+
     /// Records the intersection of `count` queries into `hits` under the pass name
-    /// `raytrace.intersect.<scheme>`. The queries must be written before (host writes are
-    /// visible at submission; GPU writes need their own barrier).
+    /// `raytrace.intersect.<scheme>`; one recording per submission (the count and the
+    /// query and hit descriptors are rewritten).
     pub fn record(&mut self, ctx: &Context, rec: &mut Recorder, queries: &Buffer, hits: &Buffer, count: u32) -> Result<()> {
         if (queries.size as usize) < count as usize * std::mem::size_of::<GpuRayQuery>()
             || (hits.size as usize) < count as usize * std::mem::size_of::<GpuRayHit>()
         {
             return Err(Error::invalid("raytrace.intersect", format!("buffers too small for {count} rays")));
         }
-        self.accel.ray_count = count;
-        self.params.write(bytemuck::bytes_of(&self.accel))?;
+        self.count.write(bytemuck::bytes_of(&count))?;
         let ty = vk::DescriptorType::STORAGE_BUFFER;
         write_buffer(ctx, self.set, binding::RAY_QUERIES, ty, queries.raw);
         write_buffer(ctx, self.set, binding::RAY_HITS, ty, hits.raw);
         let cmd = rec.cmd;
-        let open = rec.pass(self.scheme.pass_name()).begin();
+        let open = rec.pass(self.structure.scheme.pass_name()).begin();
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 2, &[self.set], &[]);
@@ -118,7 +163,7 @@ impl Intersector {
         Ok(())
     }
 
-    /// Intersects `queries` in one submission and reads the hits back (tests, tools).
+    /// Intersects `queries` in one submission and reads the hits back, with the GPU time.
     pub fn intersect(&mut self, ctx: &Context, queries: &[GpuRayQuery]) -> Result<(Vec<GpuRayHit>, f64)> {
         let n = queries.len().max(1);
         let mut q = Buffer::with_data(ctx, "raytrace.queries", queries, STORAGE)?;
@@ -167,8 +212,7 @@ impl Intersector {
         self.layout = vk::PipelineLayout::null();
         self.pool = vk::DescriptorPool::null();
         self.set_layouts = [vk::DescriptorSetLayout::null(); 3];
-        for b in [&mut self.triangles, &mut self.nodes, &mut self.refs, &mut self.aux, &mut self.params] {
-            b.destroy(ctx);
-        }
+        self.count.destroy(ctx);
+        self.structure.destroy(ctx);
     }
 }

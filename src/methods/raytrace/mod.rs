@@ -21,12 +21,82 @@
 pub mod bvh;
 pub mod gpu;
 pub mod grid;
+pub mod stage;
 
 use glam::Vec3;
 
 use crate::error::{Error, Result};
 use crate::frame::layout::{GpuAccel, GpuTriangle};
+use crate::frame::stage::{order, Stage, StageInit};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo};
+use crate::methods::EVERY_CLASS;
+use crate::plan::CameraPlan;
+use crate::quality::Quality;
 use crate::scene::Scene;
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+/// The camera pass of a ray-tracing method: its own stage (`stage::RayTrace`); the
+/// shaders named are its visibility pass.
+const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Result<Box<dyn Stage>>) -> CameraPass {
+    CameraPass {
+        name,
+        vertex: "raytrace/primary.vert",
+        fragment: "raytrace/primary.frag",
+        flags: 0,
+        order: order::RAYTRACE,
+        create: Some(create),
+    }
+}
+
+const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
+const RAY_KNOBS_GRID: &[&str] = &["depth", "fresnel", "ray_budget", "grid_density", "grid_skip"];
+
+pub const BVH: Method = Method(&MethodInfo {
+    name: "bvh",
+    abi: 7,
+    section: "§2.3.5",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry: primary hits by rasterisation, then per bounce intersect → shade (exact shadow rays) → spawn both Fresnel-weighted branches on the GPU, through the CPU reference's SAH BVH (short-stack or stackless traversal)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_BVH,
+    gpu: Some(GpuSpec {
+        maps: &[],
+        camera: camera("raytrace.bvh", |init, plan| {
+            let q = &init.plan.quality;
+            stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
+        }),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+    }),
+    fallback: None,
+    rule: |_, _| None,
+});
+
+pub const GRID: Method = Method(&MethodInfo {
+    name: "grid",
+    abi: 8,
+    section: "§2.3.1",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through a uniform grid traversed by 3D-DDA, with optional empty-space skipping (KL04)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_GRID,
+    gpu: Some(GpuSpec {
+        maps: &[],
+        camera: camera("raytrace.grid", |init, plan| {
+            let q = &init.plan.quality;
+            stage::create(init, plan, Scheme::Grid { density: q.grid_density, skip_empty: q.grid_skip })
+        }),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+    }),
+    fallback: None,
+    rule: |_, _| None,
+});
 
 /// The scene's triangles in world space in scene order (mesh by mesh, index by index):
 /// the ids that every scheme's hits refer to.

@@ -1,0 +1,39 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Shading of one bounce's hits (survey §2.3.1): a ray that left the scene adds the
+// environment, a diffuse hit its emission and, per light, one shadow query carrying the
+// unshadowed Lambertian contribution (added by shadow.comp when nothing occludes it), all
+// weighted by the ray's path weight. Specular hits are spawn.comp's.
+layout(local_size_x = 64) in;
+#include "raytrace/trace.glsl"
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= min(ray_count, trace.capacity)) return;
+    RayQuery q = queries[i];
+    RayHit h = hits[i];
+    RayPayload pl = payloads[i];
+    vec3 w = pl.weight.rgb;
+    vec3 d = normalize(q.direction.xyz);
+    if (h.triangle == RAY_NO_TRIANGLE) {
+        accumulate(pl.pixel, w * sky_radiance(d));
+        return;
+    }
+    Surface s = hit_surface(h);
+    Material m = materials[s.material];
+    if (m.kind != KIND_DIFFUSE) return;
+    accumulate(pl.pixel, w * material_emission(m, s.uv));
+    vec3 albedo = material_base_color(m, s.uv);
+    vec3 n = dot(s.n, -d) < 0.0 ? -s.n : s.n;  // two-sided
+    for (uint k = 0u; k < push.light_count; ++k) {
+        vec3 wi;
+        float dist;
+        vec3 e = light_irradiance(lights[k], s.p, wi, dist);
+        float cos_t = dot(n, wi);
+        vec3 c = w * albedo / PI * e * cos_t;
+        if (cos_t <= 0.0 || all(equal(c, vec3(0.0)))) continue;
+        // Up to the light, short of it by the offset the ray starts with.
+        float t_max = isinf(dist) ? dist : dist - trace.t_min;
+        push_shadow(make_query(s.p, wi, trace.t_min, t_max, h.triangle, RAY_ANY_HIT), make_payload(c, pl.pixel));
+    }
+}

@@ -1,0 +1,598 @@
+//! The ray pipeline of ray tracing in the original geometry (survey §2.3.1, Purcell's
+//! decomposition): rays live in GPU buffers, and each bounce is a sequence of kernels
+//! with no readback between them, their sizes from GPU counters (indirect dispatch):
+//!
+//! 1. `raytrace.primary`: the whole triangle list rasterised from the camera into a
+//!    visibility image (each pixel's nearest triangle id); `primary.comp` turns the pixels
+//!    of this stage's objects into the first queue's rays with their hits.
+//! 2. per bounce k = 0 … R: `raytrace.intersect.<scheme>` answers the queue's nearest-hit
+//!    queries (at k = 0 only those of pixels whose raster triangle failed the exact test); `raytrace.shade` adds the environment for rays that left the
+//!    scene and, at diffuse hits, the emission and one shadow query per light;
+//!    `raytrace.spawn` (k < R) appends the reflected and refracted children of specular
+//!    hits, Fresnel-weighted, to the next queue; the shadow queries go through the same
+//!    `raytrace.intersect.<scheme>` (any hit), and those that meet nothing add their light.
+//! 3. `raytrace.resolve`: the accumulated radiance of this stage's pixels replaces what
+//!    the frame's earlier passes drew there.
+//!
+//! Radiance accumulates per pixel in 64-bit fixed point through integer atomics
+//! (`glsl/raytrace/trace.glsl`), so the image does not depend on the order in which the
+//! GPU processes rays, and a host-device frame equals a standalone one bit for bit.
+
+use ash::vk;
+
+use super::gpu::Structure;
+use super::{Scheme, TriangleList};
+use crate::error::{Error, Result, VkCall};
+use crate::frame::layout::{
+    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, TRACE_BINDINGS,
+};
+use crate::frame::stage::{FrameIo, Stage, StageInit};
+use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, Push, PUSH_BYTES};
+use crate::methods::Choice;
+use crate::plan::CameraPlan;
+use crate::vk::pipeline::{
+    compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, GraphicsDesc, VertexInput,
+};
+use crate::vk::{begin_rendering, Access, Buffer, Context, Image, ImageDesc, ImageKind, MemoryLocation, Recorder, Target};
+
+const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
+const VIS_FORMAT: vk::Format = vk::Format::R32_UINT;
+const VIS_DEPTH: vk::Format = vk::Format::D32_SFLOAT;
+
+/// One ray queue: queries, their hits and payloads.
+struct Queue {
+    queries: Buffer,
+    hits: Buffer,
+    payloads: Buffer,
+}
+
+impl Queue {
+    fn new(ctx: &Context, name: &str, capacity: u64) -> Result<Queue> {
+        let mut q = Queue { queries: Buffer::placeholder(), hits: Buffer::placeholder(), payloads: Buffer::placeholder() };
+        let r = (|| {
+            let size = |n: usize| capacity.max(1) * n as u64;
+            q.queries =
+                Buffer::new(ctx, &format!("{name}.queries"), size(std::mem::size_of::<GpuRayQuery>()), STORAGE, MemoryLocation::GpuOnly)?;
+            q.hits = Buffer::new(ctx, &format!("{name}.hits"), size(std::mem::size_of::<GpuRayHit>()), STORAGE, MemoryLocation::GpuOnly)?;
+            q.payloads = Buffer::new(
+                ctx,
+                &format!("{name}.payloads"),
+                size(std::mem::size_of::<GpuRayPayload>()),
+                STORAGE,
+                MemoryLocation::GpuOnly,
+            )?;
+            Ok(())
+        })();
+        match r {
+            Ok(()) => Ok(q),
+            Err(e) => {
+                q.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.queries.destroy(ctx);
+        self.hits.destroy(ctx);
+        self.payloads.destroy(ctx);
+    }
+}
+
+#[derive(Default)]
+struct Pipelines {
+    primary_raster: vk::Pipeline,
+    primary: vk::Pipeline,
+    intersect: vk::Pipeline,
+    shade: vk::Pipeline,
+    spawn: vk::Pipeline,
+    shadow: vk::Pipeline,
+    args: vk::Pipeline,
+    resolve: vk::Pipeline,
+}
+
+pub struct RayTrace {
+    name: &'static str,
+    scheme: Scheme,
+    depth: u32,
+    width: u32,
+    height: u32,
+    triangle_count: u32,
+    structure: Option<Structure>,
+    shading: Buffer,
+    handled: Buffer,
+    queues: Vec<Queue>,
+    shadow: Option<Queue>,
+    /// Per queue k = 0 … R + 1 a counter, then per bounce a shadow counter, `stride` apart.
+    counters: Buffer,
+    /// One `TraceParams` per bounce, `stride` apart.
+    params: Buffer,
+    /// 8 words per bounce: the rays' and the shadow queries' dispatch arguments.
+    dispatch: Buffer,
+    accum: Buffer,
+    vis: Option<Image>,
+    vis_depth: Option<Image>,
+    stride: u64,
+    set_layouts: [vk::DescriptorSetLayout; 2],
+    layout: vk::PipelineLayout,
+    p: Pipelines,
+    pool: vk::DescriptorPool,
+    /// Set 2 over queue k (k = 0 … R), then over the shadow queue of bounce k.
+    ray_sets: Vec<vk::DescriptorSet>,
+    shadow_sets: Vec<vk::DescriptorSet>,
+    /// Set 3 of bounce k (next queue k + 1, shadow counter k); `primary_set`: next queue 0.
+    trace_sets: Vec<vk::DescriptorSet>,
+    primary_set: vk::DescriptorSet,
+    /// The structure's CPU build time (`raytrace.build`), milliseconds.
+    pub build_ms: f64,
+}
+
+/// Creates the stage of a ray-tracing method for the plan's objects.
+pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box<dyn Stage>> {
+    let ctx = init.ctx;
+    let q = &init.plan.quality;
+    let mut me = RayTrace {
+        name: plan.name,
+        scheme,
+        depth: q.depth,
+        width: init.width,
+        height: init.height,
+        triangle_count: 0,
+        structure: None,
+        shading: Buffer::placeholder(),
+        handled: Buffer::placeholder(),
+        queues: Vec::new(),
+        shadow: None,
+        counters: Buffer::placeholder(),
+        params: Buffer::placeholder(),
+        dispatch: Buffer::placeholder(),
+        accum: Buffer::placeholder(),
+        vis: None,
+        vis_depth: None,
+        stride: 64,
+        set_layouts: [vk::DescriptorSetLayout::null(); 2],
+        layout: vk::PipelineLayout::null(),
+        p: Pipelines::default(),
+        pool: vk::DescriptorPool::null(),
+        ray_sets: Vec::new(),
+        shadow_sets: Vec::new(),
+        trace_sets: Vec::new(),
+        primary_set: vk::DescriptorSet::null(),
+        build_ms: 0.0,
+    };
+    match me.init(init, plan) {
+        Ok(()) => Ok(Box::new(me)),
+        Err(e) => {
+            me.destroy(ctx);
+            Err(e)
+        }
+    }
+}
+
+/// The shading attributes of every triangle of the list, in its order.
+fn triangle_shading(scene: &crate::scene::Scene) -> Vec<GpuTriangleShading> {
+    let mut out = Vec::with_capacity(scene.triangle_count());
+    for (m, mesh) in scene.meshes.iter().enumerate() {
+        for t in mesh.indices.chunks_exact(3) {
+            let n = |k: usize| mesh.normals[t[k] as usize].extend(0.0).to_array();
+            let uv = |k: usize| mesh.uvs[t[k] as usize];
+            let mut n0 = n(0);
+            n0[3] = f32::from_bits(mesh.material as u32);
+            let (a, b, c) = (uv(0), uv(1), uv(2));
+            out.push(GpuTriangleShading {
+                n0,
+                n1: n(1),
+                n2: n(2),
+                uv01: [a.x, a.y, b.x, b.y],
+                uv2: [c.x, c.y, f32::from_bits(m as u32), 0.0],
+            });
+        }
+    }
+    out
+}
+
+impl RayTrace {
+    fn init(&mut self, init: &StageInit, plan: &CameraPlan) -> Result<()> {
+        let ctx = init.ctx;
+        let scene = init.scene;
+        let q = &init.plan.quality;
+        let list = TriangleList::from_scene(scene);
+        self.triangle_count = list.len() as u32;
+        let start = std::time::Instant::now();
+        let packed = self.scheme.build(&list)?;
+        self.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        self.structure = Some(Structure::new(ctx, self.scheme, &list, &packed)?);
+        self.shading = Buffer::with_data(ctx, "raytrace.shading", &triangle_shading(scene), STORAGE)?;
+        // Its objects' pixels; every pixel when the whole scene is ray traced (the plan then
+        // makes no shadow maps: diffuse surfaces seen directly get exact shadow rays too).
+        let whole_scene = matches!(init.plan.choice, Choice::Method(m) if m.gpu.is_some_and(|g| g.camera.name == plan.name));
+        let mut handled = vec![whole_scene as u32; scene.meshes.len().max(1)];
+        for &(m, _) in &plan.objects {
+            handled[m] = 1;
+        }
+        self.handled = Buffer::with_data(ctx, "raytrace.handled", &handled, STORAGE)?;
+
+        let pixels = self.width as u64 * self.height as u64;
+        let capacity = pixels * q.ray_budget as u64;
+        let lights = scene.lights.len().max(1) as u64;
+        if capacity > u32::MAX as u64 / 2 || capacity * lights > u32::MAX as u64 / 2 {
+            return Err(Error::invalid(
+                "knob ray_budget",
+                format!("{} rays per bounce exceed the queues' 32-bit indices", capacity * lights),
+            ));
+        }
+        for i in 0..2 {
+            self.queues.push(Queue::new(ctx, &format!("raytrace.queue{i}"), capacity)?);
+        }
+        self.shadow = Some(Queue::new(ctx, "raytrace.shadow", capacity * lights)?);
+        let align = ctx.properties.limits.min_storage_buffer_offset_alignment.max(4);
+        self.stride = 64u64.div_ceil(align) * align;
+        let bounces = self.depth as u64 + 1;
+        let counter_usage = STORAGE | vk::BufferUsageFlags::TRANSFER_DST;
+        self.counters = Buffer::new(ctx, "raytrace.counters", self.stride * (2 * bounces + 1), counter_usage, MemoryLocation::GpuOnly)?;
+        let mut params = vec![0u8; (self.stride * bounces) as usize];
+        for k in 0..bounces {
+            let p = GpuTraceParams {
+                width: self.width,
+                height: self.height,
+                bounce: k as u32,
+                last: (k + 1 == bounces) as u32,
+                capacity: capacity as u32,
+                shadow_capacity: (capacity * lights) as u32,
+                t_min: list_offset(&list),
+                pad: 0,
+            };
+            let at = (k * self.stride) as usize;
+            params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        self.params = Buffer::with_data(ctx, "raytrace.params", &params, STORAGE)?;
+        self.dispatch =
+            Buffer::new(ctx, "raytrace.dispatch", 32 * bounces, STORAGE | vk::BufferUsageFlags::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
+        self.accum = Buffer::new(ctx, "raytrace.accum", pixels * 24, counter_usage, MemoryLocation::GpuOnly)?;
+        let image = |name: &'static str, format, usage| {
+            Image::new(ctx, &ImageDesc { name, format, width: self.width, height: self.height, kind: ImageKind::D2, usage })
+        };
+        self.vis = Some(image("raytrace.visibility", VIS_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE)?);
+        self.vis_depth = Some(image("raytrace.visibility_depth", VIS_DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?);
+
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+        self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stages)?;
+        self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.trace", TRACE_BINDINGS, stages)?;
+        let layouts = [init.set_layouts[0], init.set_layouts[1], self.set_layouts[0], self.set_layouts[1]];
+        self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
+        self.create_pipelines(ctx)?;
+        self.create_sets(ctx)
+    }
+
+    fn create_pipelines(&mut self, ctx: &Context) -> Result<()> {
+        let raster = |name, vertex, fragment, formats: &'static [vk::Format], depth: Option<vk::Format>| GraphicsDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input: VertexInput::None,
+            color_formats: formats,
+            depth_format: depth,
+            depth_test: depth.is_some(),
+            depth_write: depth.is_some(),
+            view_mask: 0,
+            cull: vk::CullModeFlags::NONE,
+        };
+        self.p.primary_raster = graphics_pipeline(
+            ctx,
+            self.layout,
+            &raster("raytrace.primary", "raytrace/primary.vert", "raytrace/primary.frag", &[VIS_FORMAT], Some(VIS_DEPTH)),
+        )?;
+        // The resolve pass draws into the frame's target and depth, testing nothing.
+        let mut resolve = raster(
+            "raytrace.resolve",
+            "raytrace/resolve.vert",
+            "raytrace/resolve.frag",
+            &[crate::frame::direct::TARGET_FORMAT],
+            Some(crate::frame::direct::DEPTH_FORMAT),
+        );
+        resolve.depth_test = false;
+        resolve.depth_write = false;
+        self.p.resolve = graphics_pipeline(ctx, self.layout, &resolve)?;
+        let shader = self.structure.as_ref().map_or("raytrace/intersect_brute.comp", |s| s.shader);
+        self.p.intersect = compute_pipeline(ctx, self.layout, shader)?;
+        self.p.primary = compute_pipeline(ctx, self.layout, "raytrace/primary.comp")?;
+        self.p.shade = compute_pipeline(ctx, self.layout, "raytrace/shade.comp")?;
+        self.p.spawn = compute_pipeline(ctx, self.layout, "raytrace/spawn.comp")?;
+        self.p.shadow = compute_pipeline(ctx, self.layout, "raytrace/shadow.comp")?;
+        self.p.args = compute_pipeline(ctx, self.layout, "raytrace/args.comp")?;
+        Ok(())
+    }
+
+    fn create_sets(&mut self, ctx: &Context) -> Result<()> {
+        let bounces = self.depth as usize + 1;
+        let ray_sets = 2 * bounces;
+        let trace_sets = bounces + 1;
+        let count = |bindings: &[crate::vk::pipeline::Binding], ty: vk::DescriptorType, sets: usize| {
+            bindings.iter().filter(|b| b.1 == ty).count() as u32 * sets as u32
+        };
+        let sizes = [
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_BUFFER,
+                descriptor_count: count(RAY_BINDINGS, vk::DescriptorType::STORAGE_BUFFER, ray_sets)
+                    + count(TRACE_BINDINGS, vk::DescriptorType::STORAGE_BUFFER, trace_sets),
+            },
+            vk::DescriptorPoolSize {
+                ty: vk::DescriptorType::STORAGE_IMAGE,
+                descriptor_count: count(TRACE_BINDINGS, vk::DescriptorType::STORAGE_IMAGE, trace_sets),
+            },
+        ];
+        let info = vk::DescriptorPoolCreateInfo::default().max_sets((ray_sets + trace_sets) as u32).pool_sizes(&sizes);
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
+        let mut layouts = vec![self.set_layouts[0]; ray_sets];
+        layouts.extend(std::iter::repeat_n(self.set_layouts[1], trace_sets));
+        let sets = unsafe {
+            ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts))
+        }
+        .call("vkAllocateDescriptorSets")?;
+        self.ray_sets = sets[..bounces].to_vec();
+        self.shadow_sets = sets[bounces..ray_sets].to_vec();
+        self.primary_set = sets[ray_sets];
+        self.trace_sets = sets[ray_sets + 1..].to_vec();
+
+        let sb = vk::DescriptorType::STORAGE_BUFFER;
+        let structure = self.structure.as_ref().expect("created before the sets");
+        let at = |set, b, buf: &Buffer, offset: u64, range: u64| {
+            let info = [vk::DescriptorBufferInfo { buffer: buf.raw, offset, range }];
+            let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(b).descriptor_type(sb).buffer_info(&info);
+            unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+        };
+        let whole = vk::WHOLE_SIZE;
+        let stride = self.stride;
+        let counter = |k: usize| k as u64 * stride;
+        let shadow_counter = |k: usize| (bounces + 1 + k) as u64 * stride;
+        let shadow = self.shadow.as_ref().expect("created before the sets");
+        for k in 0..bounces {
+            for (set, queue, count_at) in
+                [(self.ray_sets[k], &self.queues[k % 2], counter(k)), (self.shadow_sets[k], shadow, shadow_counter(k))]
+            {
+                structure.write(ctx, set);
+                write_buffer(ctx, set, binding::RAY_QUERIES, sb, queue.queries.raw);
+                write_buffer(ctx, set, binding::RAY_HITS, sb, queue.hits.raw);
+                write_buffer(ctx, set, binding::RAY_PAYLOADS, sb, queue.payloads.raw);
+                at(set, binding::RAY_COUNT, &self.counters, count_at, 4);
+            }
+        }
+        // Set 3 of the primary step (next: queue 0) and of each bounce k (next: queue k+1).
+        let mut trace: Vec<(vk::DescriptorSet, usize, usize)> = vec![(self.primary_set, 0, 0)];
+        trace.extend((0..bounces).map(|k| (self.trace_sets[k], k + 1, k)));
+        let vis = self.vis.as_ref().expect("created before the sets");
+        for (set, next, k) in trace {
+            let queue = &self.queues[next % 2];
+            write_buffer(ctx, set, binding::NEXT_QUERIES, sb, queue.queries.raw);
+            write_buffer(ctx, set, binding::NEXT_PAYLOADS, sb, queue.payloads.raw);
+            write_buffer(ctx, set, binding::NEXT_HITS, sb, queue.hits.raw);
+            at(set, binding::NEXT_COUNT, &self.counters, counter(next), 4);
+            write_buffer(ctx, set, binding::SHADOW_QUERIES, sb, shadow.queries.raw);
+            write_buffer(ctx, set, binding::SHADOW_PAYLOADS, sb, shadow.payloads.raw);
+            at(set, binding::SHADOW_COUNT, &self.counters, shadow_counter(k), 4);
+            write_buffer(ctx, set, binding::ACCUM, sb, self.accum.raw);
+            write_buffer(ctx, set, binding::SHADING, sb, self.shading.raw);
+            write_buffer(ctx, set, binding::HANDLED, sb, self.handled.raw);
+            at(set, binding::TRACE, &self.params, k as u64 * stride, std::mem::size_of::<GpuTraceParams>() as u64);
+            at(set, binding::DISPATCH, &self.dispatch, 0, whole);
+            let img =
+                [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: vis.view, image_layout: vk::ImageLayout::GENERAL }];
+            let w = vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(binding::VISIBILITY)
+                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                .image_info(&img);
+            unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+        }
+        Ok(())
+    }
+
+    fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32) {
+        let p = Push {
+            view,
+            object: 0,
+            flags: f.flags,
+            light_count: f.light_count,
+            search: f.search,
+            tolerance: f.tolerance,
+            internal_bounces: f.internal_bounces,
+            pad: [0; 2],
+        };
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+        unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
+    }
+
+    fn bind(
+        &self,
+        ctx: &Context,
+        cmd: vk::CommandBuffer,
+        point: vk::PipelineBindPoint,
+        pipeline: vk::Pipeline,
+        f: &FrameInputs,
+        sets: [vk::DescriptorSet; 2],
+    ) {
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, point, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[f.set], &[]);
+            ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 2, &sets, &[]);
+        }
+    }
+
+    /// Compute writes before the next dispatch's reads (and its indirect arguments).
+    fn barrier(ctx: &Context, cmd: vk::CommandBuffer) {
+        let b = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+            .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::SHADER_STORAGE_READ)
+            .dst_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::DRAW_INDIRECT)
+            .dst_access_mask(
+                vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE | vk::AccessFlags2::INDIRECT_COMMAND_READ,
+            )];
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
+    }
+
+    fn dispatch_indirect(
+        &self,
+        (ctx, cmd): (&Context, vk::CommandBuffer),
+        pipeline: vk::Pipeline,
+        f: &FrameInputs,
+        sets: [vk::DescriptorSet; 2],
+        offset: u64,
+        view: u32,
+    ) {
+        self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, pipeline, f, sets);
+        self.push(ctx, cmd, f, view);
+        unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, offset) };
+    }
+}
+
+/// Secondary and shadow rays start this far from the surface they leave (besides skipping
+/// its triangle): 10⁻⁵ of the scene's diagonal, far above f32 rounding of positions of
+/// the scene's size at any scale (1 mm or 1 km scenes alike).
+fn list_offset(list: &TriangleList) -> f32 {
+    let (lo, hi) = list.bounds();
+    let diag = (hi - lo).length();
+    if diag.is_finite() && diag > 0.0 {
+        diag * 1e-6
+    } else {
+        1e-6
+    }
+}
+
+impl Stage for RayTrace {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let view = io.views.camera;
+        let compute = vk::PipelineBindPoint::COMPUTE;
+        let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
+
+        // 1. Primary hits by rasterisation, then the first queue.
+        let open = rec
+            .pass("raytrace.primary")
+            .after_buffer_writes()
+            .writes(vis, Access::ColorAttachment)
+            .writes(vis_depth, Access::DepthAttachment)
+            .begin();
+        unsafe {
+            ctx.device.cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0);
+            ctx.device.cmd_fill_buffer(cmd, self.accum.raw, 0, vk::WHOLE_SIZE, 0);
+        }
+        let none = f32::from_bits(u32::MAX); // clears the R32_UINT ids to RAY_NO_TRIANGLE
+        begin_rendering(
+            ctx,
+            cmd,
+            &Target {
+                color: &[vis.view],
+                depth: Some(vis_depth.view),
+                width: self.width,
+                height: self.height,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [none; 4],
+                clear: true,
+            },
+        );
+        self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.primary_raster, f, [self.ray_sets[0], self.primary_set]);
+        self.push(ctx, cmd, f, view);
+        unsafe {
+            ctx.device.cmd_draw(cmd, 3 * self.triangle_count, 1, 0, 0);
+            ctx.device.cmd_end_rendering(cmd);
+        }
+        rec.end(open);
+        let vis = self.vis.as_mut().expect("checked above");
+        let open = rec.pass("raytrace.primary").after_buffer_writes().writes(vis, Access::ComputeStorage).begin();
+        self.bind(ctx, cmd, compute, self.p.primary, f, [self.ray_sets[0], self.primary_set]);
+        self.push(ctx, cmd, f, view);
+        unsafe { ctx.device.cmd_dispatch(cmd, self.width.div_ceil(8), self.height.div_ceil(8), 1) };
+        rec.end(open);
+
+        // 2. The bounces.
+        let intersect_name = self.scheme.pass_name();
+        for k in 0..=self.depth as usize {
+            let sets = [self.ray_sets[k], self.trace_sets[k]];
+            let shadow_sets = [self.shadow_sets[k], self.trace_sets[k]];
+            let rays_at = 32 * k as u64;
+            let shadows_at = rays_at + 16;
+            let open = rec.pass("raytrace.spawn").after_buffer_writes().begin();
+            self.bind(ctx, cmd, compute, self.p.args, f, sets);
+            self.push(ctx, cmd, f, view);
+            unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
+            rec.end(open);
+            // Bounce 0's hits come from rasterisation; the intersection kernel only answers
+            // the pixels whose raster triangle failed the exact test (RAY_HIT_KNOWN unset).
+            let open = rec.pass(intersect_name).after_buffer_writes().begin();
+            self.dispatch_indirect((ctx, cmd), self.p.intersect, f, sets, rays_at, view);
+            rec.end(open);
+            let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
+            self.dispatch_indirect((ctx, cmd), self.p.shade, f, sets, rays_at, view);
+            rec.end(open);
+            let open = rec.pass("raytrace.spawn").after_buffer_writes().begin();
+            if k < self.depth as usize {
+                self.dispatch_indirect((ctx, cmd), self.p.spawn, f, sets, rays_at, view);
+                Self::barrier(ctx, cmd);
+            }
+            // The shadow queries' count is known now.
+            self.bind(ctx, cmd, compute, self.p.args, f, sets);
+            unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
+            rec.end(open);
+            let open = rec.pass(intersect_name).after_buffer_writes().begin();
+            self.dispatch_indirect((ctx, cmd), self.p.intersect, f, shadow_sets, shadows_at, view);
+            rec.end(open);
+            let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
+            self.dispatch_indirect((ctx, cmd), self.p.shadow, f, shadow_sets, shadows_at, view);
+            rec.end(open);
+        }
+
+        // 3. This stage's pixels into the frame's target.
+        let open = rec
+            .pass("raytrace.resolve")
+            .after_buffer_writes()
+            .writes(io.target, Access::ColorAttachment)
+            .writes(io.depth, Access::DepthAttachment)
+            .begin();
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, false);
+        self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.resolve, f, [self.ray_sets[0], self.trace_sets[0]]);
+        self.push(ctx, cmd, f, view);
+        unsafe {
+            ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+            ctx.device.cmd_end_rendering(cmd);
+        }
+        rec.end(open);
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        let p = &mut self.p;
+        destroy_pipelines(ctx, &mut [p.primary_raster, p.primary, p.intersect, p.shade, p.spawn, p.shadow, p.args, p.resolve]);
+        self.p = Pipelines::default();
+        unsafe {
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            for l in self.set_layouts {
+                ctx.device.destroy_descriptor_set_layout(l, None);
+            }
+        }
+        self.layout = vk::PipelineLayout::null();
+        self.pool = vk::DescriptorPool::null();
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 2];
+        if let Some(s) = self.structure.as_mut() {
+            s.destroy(ctx);
+        }
+        self.structure = None;
+        for q in self.queues.iter_mut().chain(self.shadow.iter_mut()) {
+            q.destroy(ctx);
+        }
+        self.queues.clear();
+        self.shadow = None;
+        for b in [&mut self.shading, &mut self.handled, &mut self.counters, &mut self.params, &mut self.dispatch, &mut self.accum] {
+            b.destroy(ctx);
+        }
+        for i in self.vis.iter_mut().chain(self.vis_depth.iter_mut()) {
+            i.destroy(ctx);
+        }
+        self.vis = None;
+        self.vis_depth = None;
+    }
+}
