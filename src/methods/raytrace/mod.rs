@@ -14,6 +14,9 @@
 //! - [`Scheme::Grid`]: a uniform grid with 3D-DDA traversal (Amanatides–Woo), optionally
 //!   skipping empty space by each empty cell's Chebyshev distance to the nearest
 //!   non-empty cell (KL04).
+//! - [`Scheme::KdTree`]: an SAH kd-tree over clipped triangle boxes, traversed front to
+//!   back with a short stack that falls back to kd-restart (HSHH07), or by pure kd-restart
+//!   (FS05).
 //!
 //! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
 //! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
@@ -21,6 +24,7 @@
 pub mod bvh;
 pub mod gpu;
 pub mod grid;
+pub mod kdtree;
 
 use glam::Vec3;
 
@@ -87,6 +91,11 @@ pub enum Scheme {
     Bvh { stackless: bool },
     /// Uniform grid of about `density` × N cells; `skip_empty`: KL04 empty-space skipping.
     Grid { density: f32, skip_empty: bool },
+    /// SAH kd-tree of at most `max_depth` levels (0: 8 + 1.3 log₂ N, at most
+    /// `kdtree::MAX_DEPTH`), nodes of at most `leaf_size` (≥ 1) references left unsplit;
+    /// `restart`: pure kd-restart (FS05) instead of the short stack with restart fallback
+    /// and push-down (HSHH07).
+    KdTree { max_depth: u32, leaf_size: u32, restart: bool },
 }
 
 impl Scheme {
@@ -96,6 +105,7 @@ impl Scheme {
             Scheme::Brute => "raytrace.intersect.brute",
             Scheme::Bvh { .. } => "raytrace.intersect.bvh",
             Scheme::Grid { .. } => "raytrace.intersect.grid",
+            Scheme::KdTree { .. } => "raytrace.intersect.kdtree",
         }
     }
 
@@ -111,6 +121,7 @@ impl Scheme {
             }),
             Scheme::Bvh { stackless } => bvh::pack(list, stackless),
             Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),
+            Scheme::KdTree { max_depth, leaf_size, restart } => kdtree::pack(list, max_depth, leaf_size, restart),
         }
     }
 }
