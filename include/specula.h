@@ -55,6 +55,8 @@
 #define SPECULA_METHOD_IMAGE_SPACE_REFRACTION 6
 /* bvh (§2.3.5) */
 #define SPECULA_METHOD_BVH 7
+/* kd-tree (§2.3.3) */
+#define SPECULA_METHOD_KD_TREE 9
 /* grid (§2.3.1) */
 #define SPECULA_METHOD_GRID 8
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */

@@ -81,6 +81,13 @@ pub struct Quality {
     pub grid_density: f32,
     /// `grid`: empty-space skipping by distance to the nearest non-empty cell (KL04).
     pub grid_skip: bool,
+    /// `kd-tree`: the deepest level (0: 8 + 1.3 log₂ N, at most 64).
+    pub kd_max_depth: u32,
+    /// `kd-tree`: nodes of at most this many triangles stay leaves.
+    pub kd_leaf_size: u32,
+    /// `kd-tree`: kd-restart from the root at each leaf's exit (FS05), else a short stack
+    /// with push-down (HSHH07).
+    pub kd_restart: bool,
 }
 
 /// One knob, declared once.
@@ -128,6 +135,7 @@ const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single",
 const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
 const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
 const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
+const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
 
@@ -366,6 +374,39 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.grid_skip, ON_OFF),
     },
     Knob {
+        name: "kd_max_depth",
+        values: "0..=64 levels",
+        default: "0",
+        doc: "kd-tree (§2.3.3): the deepest level; 0: 8 + 1.3 log₂ N",
+        set: |q, v| {
+            q.kd_max_depth = count(v, 0, 64)?;
+            Ok(())
+        },
+        get: |q| q.kd_max_depth.to_string(),
+    },
+    Knob {
+        name: "kd_leaf_size",
+        values: "1..=64 triangles",
+        default: "4",
+        doc: "kd-tree: nodes of at most this many triangles are not split",
+        set: |q, v| {
+            q.kd_leaf_size = count(v, 1, 64)?;
+            Ok(())
+        },
+        get: |q| q.kd_leaf_size.to_string(),
+    },
+    Knob {
+        name: "kd_traversal",
+        values: "short-stack|restart",
+        default: "short-stack",
+        doc: "kd-tree: a short stack with push-down (HSHH07), or kd-restart from the root (FS05)",
+        set: |q, v| {
+            q.kd_restart = one_of(v, KD_TRAVERSALS)?;
+            Ok(())
+        },
+        get: |q| name_of(q.kd_restart, KD_TRAVERSALS),
+    },
+    Knob {
         name: "proxy_radius",
         values: "auto|metres",
         default: "auto",
@@ -420,6 +461,9 @@ impl Default for Quality {
             bvh_stackless: false,
             grid_density: 2.0,
             grid_skip: true,
+            kd_max_depth: 0,
+            kd_leaf_size: 4,
+            kd_restart: false,
         }
     }
 }

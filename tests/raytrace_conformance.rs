@@ -137,6 +137,8 @@ fn schemes() -> Vec<Scheme> {
         Scheme::Grid { density: 2.0, skip_empty: false },
         Scheme::Grid { density: 2.0, skip_empty: true },
         Scheme::Grid { density: 0.25, skip_empty: true },
+        Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: false },
+        Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: true },
     ]
 }
 
@@ -213,10 +215,13 @@ fn empty_list_and_rays_that_miss_everything() {
     common::assert_clean(&ctx);
 }
 
+/// A kd-tree `leaf_size` that keeps every list here in one leaf (the root).
+const ONE_LEAF: u32 = 1 << 20;
+
 /// lavapipe gives an invocation one budget of 65535 loop iterations for all its loops:
-/// brute force and the grid unroll their triangle loops so that the 65536th triangle (and
-/// the 131073rd) is still tested; the BVH visits few nodes. A grid cell holding every
-/// triangle is the grid's worst case.
+/// brute force, the grid and the kd-tree unroll their triangle loops so that the 65536th
+/// triangle (and the 131073rd) is still tested; the BVH and a split kd-tree visit few
+/// nodes. A grid cell or a kd-tree leaf holding every triangle is their worst case.
 #[test]
 fn triangles_beyond_the_loop_budget_are_tested() {
     let ctx = common::gpu();
@@ -225,7 +230,13 @@ fn triangles_beyond_the_loop_budget_are_tested() {
         let mut tris = vec![far; n];
         tris[n - 1] = [Vec3::new(-1.0, -1.0, 1.0), Vec3::new(1.0, -1.0, 1.0), Vec3::new(0.0, 1.0, 1.0)];
         let list = TriangleList::from_soup(tris).unwrap();
-        for scheme in [Scheme::Brute, Scheme::Bvh { stackless: false }, Scheme::Bvh { stackless: true }] {
+        for scheme in [
+            Scheme::Brute,
+            Scheme::Bvh { stackless: false },
+            Scheme::Bvh { stackless: true },
+            Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: false },
+            Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, restart: true },
+        ] {
             let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
             let (hits, _) = x.intersect(&ctx, &[query(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)]).unwrap();
             x.destroy(&ctx);
@@ -236,10 +247,12 @@ fn triangles_beyond_the_loop_budget_are_tested() {
     let mut tris = vec![[Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.1, 0.0, 5.0), Vec3::new(0.0, 0.1, 5.0)]; 100_000];
     tris[99_999] = [Vec3::new(-1.0, -1.0, 4.0), Vec3::new(1.0, -1.0, 4.0), Vec3::new(0.0, 1.0, 4.0)];
     let list = TriangleList::from_soup(tris).unwrap();
-    let scheme = Scheme::Grid { density: 1e-3, skip_empty: false };
-    let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
-    let (hits, _) = x.intersect(&ctx, &[query(Vec3::new(0.01, 0.01, 0.0), Vec3::Z, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)]).unwrap();
-    x.destroy(&ctx);
-    assert_eq!(hits[0].triangle, 99_999, "{:?}", hits[0]);
+    for scheme in [Scheme::Grid { density: 1e-3, skip_empty: false }, Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, restart: false }]
+    {
+        let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
+        let (hits, _) = x.intersect(&ctx, &[query(Vec3::new(0.01, 0.01, 0.0), Vec3::Z, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)]).unwrap();
+        x.destroy(&ctx);
+        assert_eq!(hits[0].triangle, 99_999, "{scheme:?}: {:?}", hits[0]);
+    }
     common::assert_clean(&ctx);
 }

@@ -158,6 +158,10 @@ gpu_structs! {
         grid_inv_cell: vec4,
         /// uniform grid: cells per axis (xyz); w: 1 with empty-cell skipping (KL04)
         grid_res: uvec4,
+        /// kd-tree: the root node's box, minimum corner (xyz; f32 values the builder split)
+        bounds_min: vec4,
+        /// kd-tree: the root node's box, maximum corner (xyz)
+        bounds_max: vec4,
         /// unused (the query count is `RAY_COUNT`'s)
         unused: uint,
         /// triangles in the triangle list
@@ -266,7 +270,7 @@ descriptor_sets! {
         RAY_TRIANGLES = 2: STORAGE_BUFFER => "readonly buffer Triangles { Triangle triangles[]; }";
         ACCEL_NODES = 3: STORAGE_BUFFER => "readonly buffer AccelNodes { uvec4 accel_nodes[]; }";
         ACCEL_REFS = 4: STORAGE_BUFFER => "readonly buffer AccelRefs { uint accel_refs[]; }";
-        /// BVH: the miss link of each node (stackless traversal); grid: unused
+        /// BVH: the miss link of each node (stackless traversal); grid, kd-tree: unused
         ACCEL_AUX = 5: STORAGE_BUFFER => "readonly buffer AccelAux { uint accel_aux[]; }";
         ACCEL_PARAMS = 6: STORAGE_BUFFER => "readonly buffer AccelParams { Accel accel; }";
         /// The payload of each query (the ray pipeline; unused by the intersection kernels)

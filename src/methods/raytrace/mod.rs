@@ -14,6 +14,9 @@
 //! - [`Scheme::Grid`]: a uniform grid with 3D-DDA traversal (Amanatides–Woo), optionally
 //!   skipping empty space by each empty cell's Chebyshev distance to the nearest
 //!   non-empty cell (KL04).
+//! - [`Scheme::KdTree`]: an SAH kd-tree over clipped triangle boxes, traversed front to
+//!   back with a short stack that falls back to kd-restart (HSHH07), or by pure kd-restart
+//!   (FS05).
 //!
 //! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
 //! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
@@ -21,6 +24,7 @@
 pub mod bvh;
 pub mod gpu;
 pub mod grid;
+pub mod kdtree;
 pub mod stage;
 
 use glam::Vec3;
@@ -52,6 +56,7 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
 }
 
 const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
+const RAY_KNOBS_KD: &[&str] = &["depth", "fresnel", "ray_budget", "kd_max_depth", "kd_leaf_size", "kd_traversal"];
 const RAY_KNOBS_GRID: &[&str] = &["depth", "fresnel", "ray_budget", "grid_density", "grid_skip"];
 
 pub const BVH: Method = Method(&MethodInfo {
@@ -67,6 +72,28 @@ pub const BVH: Method = Method(&MethodInfo {
         camera: camera("raytrace.bvh", |init, plan| {
             let q = &init.plan.quality;
             stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
+        }),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+    }),
+    fallback: None,
+    rule: |_, _| None,
+});
+
+pub const KD_TREE: Method = Method(&MethodInfo {
+    name: "kd-tree",
+    abi: 9,
+    section: "§2.3.3",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through an SAH kd-tree over clipped triangle boxes, traversed with a short stack and push-down (HSHH07) or by kd-restart (FS05)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_KD,
+    gpu: Some(GpuSpec {
+        maps: &[],
+        camera: camera("raytrace.kd-tree", |init, plan| {
+            let q = &init.plan.quality;
+            stage::create(init, plan, Scheme::KdTree { max_depth: q.kd_max_depth, leaf_size: q.kd_leaf_size, restart: q.kd_restart })
         }),
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Nothing,
@@ -157,6 +184,11 @@ pub enum Scheme {
     Bvh { stackless: bool },
     /// Uniform grid of about `density` × N cells; `skip_empty`: KL04 empty-space skipping.
     Grid { density: f32, skip_empty: bool },
+    /// SAH kd-tree of at most `max_depth` levels (0: 8 + 1.3 log₂ N, at most
+    /// `kdtree::MAX_DEPTH`), nodes of at most `leaf_size` (≥ 1) references left unsplit;
+    /// `restart`: pure kd-restart (FS05) instead of the short stack with restart fallback
+    /// and push-down (HSHH07).
+    KdTree { max_depth: u32, leaf_size: u32, restart: bool },
 }
 
 impl Scheme {
@@ -166,6 +198,7 @@ impl Scheme {
             Scheme::Brute => "raytrace.intersect.brute",
             Scheme::Bvh { .. } => "raytrace.intersect.bvh",
             Scheme::Grid { .. } => "raytrace.intersect.grid",
+            Scheme::KdTree { .. } => "raytrace.intersect.kdtree",
         }
     }
 
@@ -181,6 +214,7 @@ impl Scheme {
             }),
             Scheme::Bvh { stackless } => bvh::pack(list, stackless),
             Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),
+            Scheme::KdTree { max_depth, leaf_size, restart } => kdtree::pack(list, max_depth, leaf_size, restart),
         }
     }
 }
@@ -191,7 +225,7 @@ pub struct Packed {
     pub nodes: Vec<[u32; 4]>,
     pub refs: Vec<u32>,
     pub aux: Vec<u32>,
-    /// The kernel's parameters; `ray_count` is filled per dispatch.
+    /// The kernel's parameters (the query count is bound separately: `RAY_COUNT`).
     pub accel: GpuAccel,
     pub shader: &'static str,
 }
