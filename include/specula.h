@@ -59,6 +59,10 @@
 #define SPECULA_METHOD_KD_TREE 9
 /* grid (§2.3.1) */
 #define SPECULA_METHOD_GRID 8
+/* ray-engine (§2.2) */
+#define SPECULA_METHOD_RAY_ENGINE 10
+/* ray-hierarchy (§2.2.1) */
+#define SPECULA_METHOD_RAY_HIERARCHY 11
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

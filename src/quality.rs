@@ -88,6 +88,8 @@ pub struct Quality {
     /// `kd-tree`: kd-restart from the root at each leaf's exit (FS05), else a short stack
     /// with push-down (HSHH07).
     pub kd_restart: bool,
+    /// `ray-hierarchy`: edge of the ray-texture tiles whose cones are tested (§2.2.1).
+    pub tile_size: u32,
 }
 
 /// One knob, declared once.
@@ -407,6 +409,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.kd_restart, KD_TRAVERSALS),
     },
     Knob {
+        name: "tile_size",
+        values: "8|16|32 rays",
+        default: "16",
+        doc: "ray-hierarchy (§2.2.1): edge of the ray-texture tiles bounded by one cone each",
+        set: |q, v| {
+            q.tile_size = one_of(v, &[("8", 8), ("16", 16), ("32", 32)])?;
+            Ok(())
+        },
+        get: |q| q.tile_size.to_string(),
+    },
+    Knob {
         name: "proxy_radius",
         values: "auto|metres",
         default: "auto",
@@ -464,6 +477,7 @@ impl Default for Quality {
             kd_max_depth: 0,
             kd_leaf_size: 4,
             kd_restart: false,
+            tile_size: 16,
         }
     }
 }

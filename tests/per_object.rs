@@ -202,9 +202,9 @@ fn auto_plans_by_object_class() {
     assert!(p.objects.iter().all(|o| o.method == DISTANCE));
 }
 
-/// `auto` is within 0.5 dB (PSNR against the reference) of the best single method on each
-/// scene and never worse than the worst: a mirror alone, a glass alone, a thin dielectric,
-/// the mirror-and-glass pair.
+/// `auto` is within 0.5 dB (PSNR against the reference) of the best single approximate
+/// method on each scene and never worse than the worst: a mirror alone, a glass alone, a
+/// thin dielectric, the mirror-and-glass pair.
 #[test]
 fn auto_is_as_good_as_the_best_single_method() {
     let ctx = common::gpu();
@@ -227,8 +227,13 @@ fn auto_is_as_good_as_the_best_single_method() {
         let reference = render_reference(scene, &quality(&["spp=1"]), (w, h)).unwrap();
         let psnr = |img: &ImageData| metrics::compare(img, &reference).unwrap().psnr;
         let auto = psnr(&render(&ctx, scene, &Choices::default(), &q, (w, h)));
-        let singles: Vec<(&str, f64)> =
-            Method::ALL.iter().filter(|m| m.is_gpu()).map(|&m| (m.name(), psnr(&render(&ctx, scene, &whole(m), &q, (w, h))))).collect();
+        // The approximate methods: the exact ray tracers (survey §2) beat them all, and the
+        // planner chooses them only where its rule says (tests/raytrace.rs).
+        let singles: Vec<(&str, f64)> = Method::ALL
+            .iter()
+            .filter(|m| m.is_gpu() && m.family != "raytrace")
+            .map(|&m| (m.name(), psnr(&render(&ctx, scene, &whole(m), &q, (w, h)))))
+            .collect();
         let best = singles.iter().cloned().fold(("", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });
         let worst = singles.iter().map(|s| s.1).fold(f64::MAX, f64::min);
         eprintln!("{name}: auto {auto:.2} dB, best {} {:.2} dB, worst {worst:.2} dB; {singles:?}", best.0, best.1);

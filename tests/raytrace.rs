@@ -189,3 +189,37 @@ fn degenerate_triangles_change_nothing() {
     }
     common::assert_clean(&ctx);
 }
+
+/// The planner's rule (`planner=accuracy`): an object that sees two or more other specular
+/// objects is ray traced (`bvh`); the mirror-and-glass pair (one other each) and the demo
+/// (the mirror sees the glass over 1.1 % of its directions) keep their sampled-geometry
+/// methods; `planner=speed` never ray traces.
+#[test]
+fn planner_ray_traces_objects_in_mutual_view() {
+    let mut s = Scene::new();
+    common::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0);
+    let m = s.add_material(common::mirror(0.9)).unwrap();
+    for (i, c) in [Vec3::new(-0.6, 1.5, 0.0), Vec3::new(0.6, 1.5, 0.0), Vec3::new(0.0, 1.5, -0.9)].into_iter().enumerate() {
+        s.add_mesh(shapes::uv_sphere(&format!("ball{i}"), c, 0.45, 24, 12, m)).unwrap();
+    }
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 2.2, 2.0), Vec3::new(0.0, 1.5, -0.3), 60f32.to_radians()));
+    let choices = specula::Choices::default();
+    let p = specula::plan_with(&s, &choices, &Quality::default()).unwrap();
+    for o in &p.objects {
+        assert_eq!(o.method, BVH, "{}: {}", o.mesh, o.reason);
+        assert!(o.reason.contains("other specular objects"), "{}", o.reason);
+    }
+    let speed = specula::plan_with(&s, &choices, &quality(&["planner=speed"])).unwrap();
+    assert!(speed.objects.iter().all(|o| o.method.family != "raytrace"));
+    for scene in [common::mirror_and_glass(24), demo()] {
+        let p = specula::plan_with(&scene, &choices, &Quality::default()).unwrap();
+        assert!(p.objects.iter().all(|o| o.method.family != "raytrace"), "{:?}", p.objects.iter().map(|o| &o.reason).collect::<Vec<_>>());
+    }
+    // Rendered: exact against the reference.
+    let ctx = common::gpu();
+    let q = quality(&["depth=4"]);
+    let img = specula::render_plan(&ctx, &s, specula::plan_with(&s, &choices, &q).unwrap(), (48, 48), (0, 1)).unwrap().image;
+    let p = psnr(&img, &render_reference(&s, &q, (48, 48)).unwrap());
+    assert!(p >= 45.0, "auto on three mirrors in mutual view: {p:.2} dB");
+    common::assert_clean(&ctx);
+}

@@ -147,7 +147,12 @@ gpu_structs! {
         shadow_capacity: uint,
         /// secondary and shadow rays start this far from the surface they leave
         t_min: float,
-        pad: uint,
+        /// the ray engine's ray texture (§2.2): width; its height is capacity / width
+        ray_texture_width: uint,
+        /// the ray hierarchy (§2.2.1): edge of a tile of the ray texture, and tiles per row
+        tile_size: uint,
+        tiles_per_row: uint,
+        pad: [uint; 2],
     }
 
     /// What an acceleration scheme's kernel needs besides its node and reference buffers.
@@ -302,5 +307,10 @@ descriptor_sets! {
         DISPATCH = 11: STORAGE_BUFFER => "buffer Dispatch { uint dispatch[]; }";
         /// The first queue's hits (primary.comp writes them from the visibility image)
         NEXT_HITS = 12: STORAGE_BUFFER => "writeonly buffer NextHits { RayHit next_hits[]; }";
+        /// The ray engine's hit records (t, u, v bits, triangle) per texel of the ray texture
+        ENGINE_HITS = 13: STORAGE_IMAGE => "layout(rgba32ui) uniform readonly uimage2D engine_hits";
+        /// The ray hierarchy's cone per tile: apex (xyz), cos of the half angle (w; 2: no
+        /// cone, test every triangle; 3: empty tile) and axis (xyz), sin of the half angle (w)
+        TILE_CONES = 14: STORAGE_BUFFER => "buffer TileCones { vec4 tile_cones[]; }";
     }
 }

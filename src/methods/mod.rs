@@ -14,13 +14,26 @@ pub mod registry;
 pub use crate::reference::REFERENCE;
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
 pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
-pub use raytrace::{BVH, GRID, KD_TREE};
+pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{Choice, Method, MethodInfo, ObjectClass};
 
 /// Every registered method, GPU methods first: the CLI's list, `specula knobs`, the C
 /// header's constants, the README tables, `tradeoff` and the demo read this.
-pub const ALL: &[Method] =
-    &[ENVMAP, PROXY_SPHERE, PROXY_BOX, DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP, IMAGE_SPACE_REFRACTION, BVH, KD_TREE, GRID, REFERENCE];
+pub const ALL: &[Method] = &[
+    ENVMAP,
+    PROXY_SPHERE,
+    PROXY_BOX,
+    DISTANCE,
+    DISTANCE_MULTI,
+    REFRACTOR_MAP,
+    IMAGE_SPACE_REFRACTION,
+    BVH,
+    KD_TREE,
+    GRID,
+    RAY_ENGINE,
+    RAY_HIERARCHY,
+    REFERENCE,
+];
 
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];

@@ -32,8 +32,9 @@ use glam::Vec3;
 use crate::error::{Error, Result};
 use crate::frame::layout::{GpuAccel, GpuTriangle};
 use crate::frame::stage::{order, Stage, StageInit};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
 use crate::methods::EVERY_CLASS;
+use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::CameraPlan;
 use crate::quality::Quality;
 use crate::scene::Scene;
@@ -55,8 +56,47 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
     }
 }
 
+/// How many other specular objects in view (each covering at least `MIN_COVERAGE` of an
+/// object's directions) make ray tracing the planner's choice for it.
+pub const MUTUAL_VIEW_OBJECTS: usize = 2;
+
+/// The planner's rule for `bvh` (with `planner=accuracy`): exact ray tracing for an object
+/// that sees `MUTUAL_VIEW_OBJECTS` or more other specular objects (survey Table 1: the
+/// sampled-geometry methods then need inter-object map cycles whose cost grows with the
+/// square of the object count and whose depth is capped by the cycles, while the ray
+/// pipeline's cost does not grow with the object count and follows every path to the
+/// depth R), and for a solid dielectric whose surface is not all visible from its
+/// reference point (single-layer refractor maps miss what they cannot see).
+fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
+    if q.planner.speed() {
+        return None;
+    }
+    let others = f.sees_specular.iter().filter(|(_, c)| *c >= MIN_COVERAGE).count();
+    if others >= MUTUAL_VIEW_OBJECTS {
+        return Some(Verdict {
+            score: 4.5, // above distance-multi's 4.0 for objects in mutual view
+            reason: format!(
+                "sees {others} other specular objects: exact ray tracing through a BVH (inter-object paths to depth {})",
+                q.depth
+            ),
+        });
+    }
+    if f.class == ObjectClass::SolidDielectric && f.visible_fraction < 0.9 {
+        return Some(Verdict {
+            score: 4.5,
+            reason: format!(
+                "solid dielectric only {:.0} % visible from its reference point: exact ray tracing through a BVH",
+                100.0 * f.visible_fraction
+            ),
+        });
+    }
+    None
+}
+
 const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
 const RAY_KNOBS_KD: &[&str] = &["depth", "fresnel", "ray_budget", "kd_max_depth", "kd_leaf_size", "kd_traversal"];
+const RAY_KNOBS_ENGINE: &[&str] = &["depth", "fresnel", "ray_budget"];
+const RAY_KNOBS_HIERARCHY: &[&str] = &["depth", "fresnel", "ray_budget", "tile_size"];
 const RAY_KNOBS_GRID: &[&str] = &["depth", "fresnel", "ray_budget", "grid_density", "grid_skip"];
 
 pub const BVH: Method = Method(&MethodInfo {
@@ -72,6 +112,46 @@ pub const BVH: Method = Method(&MethodInfo {
         camera: camera("raytrace.bvh", |init, plan| {
             let q = &init.plan.quality;
             stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
+        }),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+    }),
+    fallback: None,
+    rule: bvh_rule,
+});
+
+pub const RAY_ENGINE: Method = Method(&MethodInfo {
+    name: "ray-engine",
+    abi: 10,
+    section: "§2.2",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) with the ray engine as the intersection step: the rays as a texture, one quad over it per triangle, Möller–Trumbore in the fragment shader writing the hit distance as depth, the z-test keeping the nearest (O(N) per ray)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_ENGINE,
+    gpu: Some(GpuSpec {
+        maps: &[],
+        camera: camera("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine)),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+    }),
+    fallback: None,
+    rule: |_, _| None,
+});
+
+pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
+    name: "ray-hierarchy",
+    abi: 11,
+    section: "§2.2.1",
+    family: "raytrace",
+    summary: "the ray engine over tiles of the ray texture, each bounded by a cone built on the GPU from its rays; a tile is rasterised for a triangle only where the cone meets the triangle's bounding sphere (tested in the vertex shader)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_HIERARCHY,
+    gpu: Some(GpuSpec {
+        maps: &[],
+        camera: camera("raytrace.ray-hierarchy", |init, plan| {
+            stage::create(init, plan, Scheme::RayHierarchy { tile: init.plan.quality.tile_size })
         }),
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Nothing,
@@ -189,6 +269,13 @@ pub enum Scheme {
     /// `restart`: pure kd-restart (FS05) instead of the short stack with restart fallback
     /// and push-down (HSHH07).
     KdTree { max_depth: u32, leaf_size: u32, restart: bool },
+    /// The ray engine (§2.2, CHH02): the rays as a texture, every triangle rasterised over
+    /// it as a quad, Möller–Trumbore in the fragment shader, the z-test keeping the nearest.
+    RayEngine,
+    /// The ray hierarchy (§2.2.1): the ray engine over `tile`×`tile` tiles of the ray
+    /// texture, each tile drawn for a triangle only if its rays' cone meets the triangle's
+    /// bounding sphere.
+    RayHierarchy { tile: u32 },
 }
 
 impl Scheme {
@@ -196,6 +283,8 @@ impl Scheme {
     pub fn pass_name(&self) -> &'static str {
         match self {
             Scheme::Brute => "raytrace.intersect.brute",
+            Scheme::RayEngine => "raytrace.intersect.ray-engine",
+            Scheme::RayHierarchy { .. } => "raytrace.intersect.ray-hierarchy",
             Scheme::Bvh { .. } => "raytrace.intersect.bvh",
             Scheme::Grid { .. } => "raytrace.intersect.grid",
             Scheme::KdTree { .. } => "raytrace.intersect.kdtree",
@@ -205,7 +294,8 @@ impl Scheme {
     /// Builds the scheme over `list` (CPU) into its GPU form.
     pub fn build(&self, list: &TriangleList) -> Result<Packed> {
         match *self {
-            Scheme::Brute => Ok(Packed {
+            // The rasterising schemes keep nothing but the triangle list.
+            Scheme::Brute | Scheme::RayEngine | Scheme::RayHierarchy { .. } => Ok(Packed {
                 nodes: Vec::new(),
                 refs: Vec::new(),
                 aux: Vec::new(),

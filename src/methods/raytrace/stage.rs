@@ -89,6 +89,11 @@ struct Pipelines {
     shadow: vk::Pipeline,
     args: vk::Pipeline,
     resolve: vk::Pipeline,
+    /// The ray engine's raster pass (or the ray hierarchy's), its copy into the hit buffer,
+    /// and the hierarchy's cone kernel.
+    engine: vk::Pipeline,
+    engine_copy: vk::Pipeline,
+    cones: vk::Pipeline,
 }
 
 pub struct RayTrace {
@@ -112,6 +117,13 @@ pub struct RayTrace {
     accum: Buffer,
     vis: Option<Image>,
     vis_depth: Option<Image>,
+    /// The ray engine's (and ray hierarchy's) ray texture: hit records and depth.
+    engine: Option<Image>,
+    engine_depth: Option<Image>,
+    /// The ray hierarchy's cone per tile.
+    cones: Buffer,
+    ray_texture: (u32, u32),
+    tiles: u32,
     stride: u64,
     set_layouts: [vk::DescriptorSetLayout; 2],
     layout: vk::PipelineLayout,
@@ -149,6 +161,11 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         accum: Buffer::placeholder(),
         vis: None,
         vis_depth: None,
+        engine: None,
+        engine_depth: None,
+        cones: Buffer::placeholder(),
+        ray_texture: (0, 0),
+        tiles: 0,
         stride: 64,
         set_layouts: [vk::DescriptorSetLayout::null(); 2],
         layout: vk::PipelineLayout::null(),
@@ -230,6 +247,33 @@ impl RayTrace {
         let bounces = self.depth as u64 + 1;
         let counter_usage = STORAGE | vk::BufferUsageFlags::TRANSFER_DST;
         self.counters = Buffer::new(ctx, "raytrace.counters", self.stride * (2 * bounces + 1), counter_usage, MemoryLocation::GpuOnly)?;
+        // The ray texture of the rasterising schemes: every queue's rays, row by row.
+        let most = capacity.max(capacity * lights);
+        let width = ((most as f64).sqrt().ceil() as u32).div_ceil(32).max(1) * 32;
+        let height = most.div_ceil(width as u64) as u32;
+        let limit = ctx.properties.limits.max_image_dimension2_d;
+        let tile = match self.scheme {
+            Scheme::RayHierarchy { tile } => tile,
+            _ => 0,
+        };
+        if matches!(self.scheme, Scheme::RayEngine | Scheme::RayHierarchy { .. }) {
+            if width > limit || height > limit {
+                return Err(Error::invalid(
+                    "knob ray_budget",
+                    format!("the ray texture of {most} rays ({width}×{height}) exceeds the device's {limit}² image limit"),
+                ));
+            }
+            self.ray_texture = (width, height);
+            let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE;
+            let desc = |name, format, usage| ImageDesc { name, format, width, height, kind: ImageKind::D2, usage };
+            self.engine = Some(Image::new(ctx, &desc("raytrace.ray_texture", vk::Format::R32G32B32A32_UINT, usage))?);
+            self.engine_depth =
+                Some(Image::new(ctx, &desc("raytrace.ray_texture_depth", VIS_DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT))?);
+        }
+        if tile > 0 {
+            self.tiles = (width / tile) * height.div_ceil(tile);
+            self.cones = Buffer::new(ctx, "raytrace.tile_cones", 32 * self.tiles.max(1) as u64, STORAGE, MemoryLocation::GpuOnly)?;
+        }
         let mut params = vec![0u8; (self.stride * bounces) as usize];
         for k in 0..bounces {
             let p = GpuTraceParams {
@@ -240,7 +284,10 @@ impl RayTrace {
                 capacity: capacity as u32,
                 shadow_capacity: (capacity * lights) as u32,
                 t_min: list_offset(&list),
-                pad: 0,
+                ray_texture_width: width,
+                tile_size: tile.max(1),
+                tiles_per_row: if tile > 0 { width / tile } else { 0 },
+                pad: [0; 2],
             };
             let at = (k * self.stride) as usize;
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
@@ -293,8 +340,23 @@ impl RayTrace {
         resolve.depth_test = false;
         resolve.depth_write = false;
         self.p.resolve = graphics_pipeline(ctx, self.layout, &resolve)?;
-        let shader = self.structure.as_ref().map_or("raytrace/intersect_brute.comp", |s| s.shader);
-        self.p.intersect = compute_pipeline(ctx, self.layout, shader)?;
+        match self.scheme {
+            Scheme::RayEngine | Scheme::RayHierarchy { .. } => {
+                let vertex = if matches!(self.scheme, Scheme::RayEngine) { "raytrace/engine.vert" } else { "raytrace/hierarchy.vert" };
+                let mut engine =
+                    raster("raytrace.engine", vertex, "raytrace/engine.frag", &[vk::Format::R32G32B32A32_UINT], Some(VIS_DEPTH));
+                engine.name = self.scheme.pass_name();
+                self.p.engine = graphics_pipeline(ctx, self.layout, &engine)?;
+                self.p.engine_copy = compute_pipeline(ctx, self.layout, "raytrace/engine_copy.comp")?;
+                if matches!(self.scheme, Scheme::RayHierarchy { .. }) {
+                    self.p.cones = compute_pipeline(ctx, self.layout, "raytrace/cones.comp")?;
+                }
+            }
+            _ => {
+                let shader = self.structure.as_ref().map_or("raytrace/intersect_brute.comp", |s| s.shader);
+                self.p.intersect = compute_pipeline(ctx, self.layout, shader)?;
+            }
+        }
         self.p.primary = compute_pipeline(ctx, self.layout, "raytrace/primary.comp")?;
         self.p.shade = compute_pipeline(ctx, self.layout, "raytrace/shade.comp")?;
         self.p.spawn = compute_pipeline(ctx, self.layout, "raytrace/spawn.comp")?;
@@ -375,14 +437,18 @@ impl RayTrace {
             write_buffer(ctx, set, binding::HANDLED, sb, self.handled.raw);
             at(set, binding::TRACE, &self.params, k as u64 * stride, std::mem::size_of::<GpuTraceParams>() as u64);
             at(set, binding::DISPATCH, &self.dispatch, 0, whole);
-            let img =
-                [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: vis.view, image_layout: vk::ImageLayout::GENERAL }];
-            let w = vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(binding::VISIBILITY)
-                .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
-                .image_info(&img);
-            unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+            let engine = self.engine.as_ref().map_or(vk::ImageView::null(), |e| e.view);
+            for (b, view) in [(binding::VISIBILITY, vis.view), (binding::ENGINE_HITS, engine)] {
+                let img =
+                    [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: view, image_layout: vk::ImageLayout::GENERAL }];
+                let w = vk::WriteDescriptorSet::default()
+                    .dst_set(set)
+                    .dst_binding(b)
+                    .descriptor_type(vk::DescriptorType::STORAGE_IMAGE)
+                    .image_info(&img);
+                unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+            }
+            write_buffer(ctx, set, binding::TILE_CONES, sb, if self.tiles > 0 { self.cones.raw } else { vk::Buffer::null() });
         }
         Ok(())
     }
@@ -416,6 +482,61 @@ impl RayTrace {
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[f.set], &[]);
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 2, &sets, &[]);
         }
+    }
+
+    /// The nearest hits of the queue bound in `sets`: the scheme's kernel (indirect, from the
+    /// queue's counter), or the ray engine's raster pass over the ray texture and its copy
+    /// into the hit buffer (the ray hierarchy first builds its tiles' cones).
+    fn intersect(&mut self, rec: &mut Recorder, f: &FrameInputs, sets: [vk::DescriptorSet; 2], at: u64, view: u32) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let name = self.scheme.pass_name();
+        let (Some(engine), Some(depth)) = (self.engine.as_mut(), self.engine_depth.as_mut()) else {
+            let open = rec.pass(name).after_buffer_writes().begin();
+            self.dispatch_indirect((ctx, cmd), self.p.intersect, f, sets, at, view);
+            rec.end(open);
+            return;
+        };
+        let open =
+            rec.pass(name).after_buffer_writes().writes(engine, Access::ColorAttachment).writes(depth, Access::DepthAttachment).begin();
+        if self.tiles > 0 {
+            self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.p.cones, f, sets);
+            self.push(ctx, cmd, f, view);
+            unsafe { ctx.device.cmd_dispatch(cmd, self.tiles.div_ceil(64), 1, 1) };
+            let b = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+                .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_SHADER)
+                .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ)];
+            unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
+        }
+        let (engine, depth) = (self.engine.as_ref().expect("checked"), self.engine_depth.as_ref().expect("checked"));
+        let none = f32::from_bits(u32::MAX); // RAY_NO_TRIANGLE in every channel
+        begin_rendering(
+            ctx,
+            cmd,
+            &Target {
+                color: &[engine.view],
+                depth: Some(depth.view),
+                width: self.ray_texture.0,
+                height: self.ray_texture.1,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [none; 4],
+                clear: true,
+            },
+        );
+        self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.engine, f, sets);
+        self.push(ctx, cmd, f, view);
+        let vertices = 6 * self.tiles.max(1);
+        unsafe {
+            ctx.device.cmd_draw(cmd, vertices, self.triangle_count, 0, 0);
+            ctx.device.cmd_end_rendering(cmd);
+        }
+        rec.end(open);
+        let engine = self.engine.as_mut().expect("checked");
+        let open = rec.pass(name).after_buffer_writes().writes(engine, Access::ComputeStorage).begin();
+        self.dispatch_indirect((ctx, cmd), self.p.engine_copy, f, sets, at, view);
+        rec.end(open);
     }
 
     /// Compute writes before the next dispatch's reads (and its indirect arguments).
@@ -510,7 +631,6 @@ impl Stage for RayTrace {
         rec.end(open);
 
         // 2. The bounces.
-        let intersect_name = self.scheme.pass_name();
         for k in 0..=self.depth as usize {
             let sets = [self.ray_sets[k], self.trace_sets[k]];
             let shadow_sets = [self.shadow_sets[k], self.trace_sets[k]];
@@ -523,9 +643,7 @@ impl Stage for RayTrace {
             rec.end(open);
             // Bounce 0's hits come from rasterisation; the intersection kernel only answers
             // the pixels whose raster triangle failed the exact test (RAY_HIT_KNOWN unset).
-            let open = rec.pass(intersect_name).after_buffer_writes().begin();
-            self.dispatch_indirect((ctx, cmd), self.p.intersect, f, sets, rays_at, view);
-            rec.end(open);
+            self.intersect(rec, f, sets, rays_at, view);
             let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
             self.dispatch_indirect((ctx, cmd), self.p.shade, f, sets, rays_at, view);
             rec.end(open);
@@ -538,9 +656,7 @@ impl Stage for RayTrace {
             self.bind(ctx, cmd, compute, self.p.args, f, sets);
             unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
             rec.end(open);
-            let open = rec.pass(intersect_name).after_buffer_writes().begin();
-            self.dispatch_indirect((ctx, cmd), self.p.intersect, f, shadow_sets, shadows_at, view);
-            rec.end(open);
+            self.intersect(rec, f, shadow_sets, shadows_at, view);
             let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
             self.dispatch_indirect((ctx, cmd), self.p.shadow, f, shadow_sets, shadows_at, view);
             rec.end(open);
@@ -565,7 +681,22 @@ impl Stage for RayTrace {
 
     fn destroy(&mut self, ctx: &Context) {
         let p = &mut self.p;
-        destroy_pipelines(ctx, &mut [p.primary_raster, p.primary, p.intersect, p.shade, p.spawn, p.shadow, p.args, p.resolve]);
+        destroy_pipelines(
+            ctx,
+            &mut [
+                p.primary_raster,
+                p.primary,
+                p.intersect,
+                p.shade,
+                p.spawn,
+                p.shadow,
+                p.args,
+                p.resolve,
+                p.engine,
+                p.engine_copy,
+                p.cones,
+            ],
+        );
         self.p = Pipelines::default();
         unsafe {
             ctx.device.destroy_pipeline_layout(self.layout, None);
@@ -586,13 +717,23 @@ impl Stage for RayTrace {
         }
         self.queues.clear();
         self.shadow = None;
-        for b in [&mut self.shading, &mut self.handled, &mut self.counters, &mut self.params, &mut self.dispatch, &mut self.accum] {
+        for b in [
+            &mut self.shading,
+            &mut self.handled,
+            &mut self.counters,
+            &mut self.params,
+            &mut self.dispatch,
+            &mut self.accum,
+            &mut self.cones,
+        ] {
             b.destroy(ctx);
         }
-        for i in self.vis.iter_mut().chain(self.vis_depth.iter_mut()) {
+        for i in self.vis.iter_mut().chain(self.vis_depth.iter_mut()).chain(self.engine.iter_mut()).chain(self.engine_depth.iter_mut()) {
             i.destroy(ctx);
         }
         self.vis = None;
         self.vis_depth = None;
+        self.engine = None;
+        self.engine_depth = None;
     }
 }
