@@ -270,8 +270,9 @@ impl RayTrace {
             self.engine_depth =
                 Some(Image::new(ctx, &desc("raytrace.ray_texture_depth", VIS_DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT))?);
         }
+        let tiles_per_row = width.checked_div(tile).unwrap_or(0);
         if tile > 0 {
-            self.tiles = (width / tile) * height.div_ceil(tile);
+            self.tiles = tiles_per_row * height.div_ceil(tile);
             self.cones = Buffer::new(ctx, "raytrace.tile_cones", 32 * self.tiles.max(1) as u64, STORAGE, MemoryLocation::GpuOnly)?;
         }
         let mut params = vec![0u8; (self.stride * bounces) as usize];
@@ -286,7 +287,7 @@ impl RayTrace {
                 t_min: list_offset(&list),
                 ray_texture_width: width,
                 tile_size: tile.max(1),
-                tiles_per_row: if tile > 0 { width / tile } else { 0 },
+                tiles_per_row,
                 pad: [0; 2],
             };
             let at = (k * self.stride) as usize;
