@@ -90,6 +90,8 @@ pub struct Quality {
     pub kd_restart: bool,
     /// `ray-hierarchy`: edge of the ray-texture tiles whose cones are tested (§2.2.1).
     pub tile_size: u32,
+    /// Ray tracing: count rays per bounce and the ray hierarchy's culling (costs a pass).
+    pub ray_stats: bool,
 }
 
 /// One knob, declared once.
@@ -420,6 +422,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| q.tile_size.to_string(),
     },
     Knob {
+        name: "ray_stats",
+        values: "on|off",
+        default: "off",
+        doc: "ray tracing: report rays per bounce, dropped rays and the ray hierarchy's culling rate (an extra pass)",
+        set: |q, v| {
+            q.ray_stats = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.ray_stats, ON_OFF),
+    },
+    Knob {
         name: "proxy_radius",
         values: "auto|metres",
         default: "auto",
@@ -478,6 +491,7 @@ impl Default for Quality {
             kd_leaf_size: 4,
             kd_restart: false,
             tile_size: 16,
+            ray_stats: false,
         }
     }
 }

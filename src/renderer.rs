@@ -34,6 +34,8 @@ pub struct Frame {
     pub image: ImageData,
     pub passes: Vec<PassTiming>,
     pub memory: Vec<(String, u64)>,
+    /// What the stages counted in this frame (`Stage::stats`).
+    pub stats: Vec<(String, f64)>,
 }
 
 impl Frame {
@@ -398,7 +400,8 @@ impl Renderer {
         if errors > 0 {
             return Err(Error::Validation(errors));
         }
-        Ok(Frame { image, passes, memory: ctx.memory.snapshot() })
+        let stats = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
+        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats })
     }
 
     /// Frees everything. The GPU must be idle with respect to this renderer's frames.

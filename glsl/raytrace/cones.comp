@@ -39,6 +39,38 @@ void main() {
         cos_t = min(cos_t, dot(normalize(queries[i].direction.xyz), axis));
         r = max(r, length(queries[i].origin.xyz - c));
     }
+    // Rays that all end near one point (shadow rays towards a point light) are segments
+    // inside the cone from that point back over the origins' ball, which is far narrower.
+    bool bounded = true;
+    vec3 sum_e = vec3(0.0);
+    for (uint j = 0u; j < ts * ts && bounded; ++j) {
+        uint i = (t0.y + j / ts) * w + t0.x + j % ts;
+        if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+        float t_max = queries[i].direction.w;
+        bounded = !isinf(t_max);
+        sum_e += queries[i].origin.xyz + queries[i].direction.xyz * t_max;
+    }
+    if (bounded) {
+        vec3 e = sum_e / float(n);
+        float re = 0.0;
+        for (uint j = 0u; j < ts * ts; ++j) {
+            uint i = (t0.y + j / ts) * w + t0.x + j % ts;
+            if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+            re = max(re, length(queries[i].origin.xyz + queries[i].direction.xyz * queries[i].direction.w - e));
+        }
+        float dist = length(c - e);
+        float s = (r + re) * 1.0001 / max(dist, 1e-30);
+        if (s < 0.98 && is_finite(e)) {
+            vec3 ax = (c - e) / dist;
+            float sin_b = s;
+            float cos_b = sqrt(1.0 - s * s);
+            // Apex behind e so that the ball around the end points lies inside too.
+            vec3 apex = e - ax * (re * 1.0001 / sin_b);
+            tile_cones[2u * k] = vec4(apex, cos_b - 1e-5);
+            tile_cones[2u * k + 1u] = vec4(ax, sqrt(max(1.0 - (cos_b - 1e-5) * (cos_b - 1e-5), 0.0)));
+            return;
+        }
+    }
     // Rounding margin on the angle, then the apex behind the origins' ball.
     cos_t = cos_t - 1e-5;
     float sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));

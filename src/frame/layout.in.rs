@@ -312,5 +312,8 @@ descriptor_sets! {
         /// The ray hierarchy's cone per tile: apex (xyz), cos of the half angle (w; 2: no
         /// cone, test every triangle; 3: empty tile) and axis (xyz), sin of the half angle (w)
         TILE_CONES = 14: STORAGE_BUFFER => "buffer TileCones { vec4 tile_cones[]; }";
+        /// The ray hierarchy's culling counts (with the ray_stats knob): per bounce and
+        /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
+        CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
     }
 }

@@ -38,6 +38,11 @@ pub trait Stage {
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo);
     /// Frees everything; the GPU must be idle with respect to the renderer's frames.
     fn destroy(&mut self, ctx: &Context);
+    /// What the last frame counted (rays per bounce, culling rates …), read after the frame
+    /// finished: (name, value), names stable like pass names.
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        Vec::new()
+    }
 }
 
 /// The frame's shared maps, one per descriptor slot (`binding::*`, src/frame/layout.in.rs).

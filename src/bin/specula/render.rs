@@ -26,6 +26,9 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
         println!("objects: {}", methods.join(", "));
     }
     print!("{}", specula::profile::table(&frame.passes, &frame.memory));
+    for (name, value) in &frame.stats {
+        println!("{name:<40} {value:>12.4}");
+    }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);
         specula::output::write_file(p, json.as_bytes())?;

@@ -94,6 +94,7 @@ struct Pipelines {
     engine: vk::Pipeline,
     engine_copy: vk::Pipeline,
     cones: vk::Pipeline,
+    cull_stats: vk::Pipeline,
 }
 
 pub struct RayTrace {
@@ -122,6 +123,11 @@ pub struct RayTrace {
     engine_depth: Option<Image>,
     /// The ray hierarchy's cone per tile.
     cones: Buffer,
+    /// With the ray_stats knob: the hierarchy's culling counts (`cull_stats.comp`).
+    cull_stats: Buffer,
+    stats: bool,
+    capacity: u64,
+    lights: u64,
     ray_texture: (u32, u32),
     tiles: u32,
     stride: u64,
@@ -164,6 +170,10 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         engine: None,
         engine_depth: None,
         cones: Buffer::placeholder(),
+        cull_stats: Buffer::placeholder(),
+        stats: q.ray_stats,
+        capacity: 0,
+        lights: 1,
         ray_texture: (0, 0),
         tiles: 0,
         stride: 64,
@@ -242,11 +252,14 @@ impl RayTrace {
             self.queues.push(Queue::new(ctx, &format!("raytrace.queue{i}"), capacity)?);
         }
         self.shadow = Some(Queue::new(ctx, "raytrace.shadow", capacity * lights)?);
+        self.lights = lights;
         let align = ctx.properties.limits.min_storage_buffer_offset_alignment.max(4);
         self.stride = 64u64.div_ceil(align) * align;
         let bounces = self.depth as u64 + 1;
         let counter_usage = STORAGE | vk::BufferUsageFlags::TRANSFER_DST;
-        self.counters = Buffer::new(ctx, "raytrace.counters", self.stride * (2 * bounces + 1), counter_usage, MemoryLocation::GpuOnly)?;
+        // Host-visible: `stats` reads the rays each bounce made after the frame.
+        self.counters = Buffer::new(ctx, "raytrace.counters", self.stride * (2 * bounces + 1), counter_usage, MemoryLocation::GpuToCpu)?;
+        self.capacity = capacity;
         // The ray texture of the rasterising schemes: every queue's rays, row by row.
         let most = capacity.max(capacity * lights);
         let width = ((most as f64).sqrt().ceil() as u32).div_ceil(32).max(1) * 32;
@@ -274,6 +287,10 @@ impl RayTrace {
         if tile > 0 {
             self.tiles = tiles_per_row * height.div_ceil(tile);
             self.cones = Buffer::new(ctx, "raytrace.tile_cones", 32 * self.tiles.max(1) as u64, STORAGE, MemoryLocation::GpuOnly)?;
+            if self.stats {
+                let usage = STORAGE | vk::BufferUsageFlags::TRANSFER_DST;
+                self.cull_stats = Buffer::new(ctx, "raytrace.cull_stats", 16 * bounces, usage, MemoryLocation::GpuToCpu)?;
+            }
         }
         let mut params = vec![0u8; (self.stride * bounces) as usize];
         for k in 0..bounces {
@@ -351,6 +368,9 @@ impl RayTrace {
                 self.p.engine_copy = compute_pipeline(ctx, self.layout, "raytrace/engine_copy.comp")?;
                 if matches!(self.scheme, Scheme::RayHierarchy { .. }) {
                     self.p.cones = compute_pipeline(ctx, self.layout, "raytrace/cones.comp")?;
+                    if self.stats {
+                        self.p.cull_stats = compute_pipeline(ctx, self.layout, "raytrace/cull_stats.comp")?;
+                    }
                 }
             }
             _ => {
@@ -450,14 +470,26 @@ impl RayTrace {
                 unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
             }
             write_buffer(ctx, set, binding::TILE_CONES, sb, if self.tiles > 0 { self.cones.raw } else { vk::Buffer::null() });
+            write_buffer(
+                ctx,
+                set,
+                binding::CULL_STATS,
+                sb,
+                if self.cull_stats.size > 0 { self.cull_stats.raw } else { vk::Buffer::null() },
+            );
         }
         Ok(())
     }
 
     fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32) {
+        self.push_object(ctx, cmd, f, view, 0);
+    }
+
+    /// `push` with `Push.object` set (cull_stats.comp: which queue it counts).
+    fn push_object(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32, object: u32) {
         let p = Push {
             view,
-            object: 0,
+            object,
             flags: f.flags,
             light_count: f.light_count,
             search: f.search,
@@ -488,7 +520,7 @@ impl RayTrace {
     /// The nearest hits of the queue bound in `sets`: the scheme's kernel (indirect, from the
     /// queue's counter), or the ray engine's raster pass over the ray texture and its copy
     /// into the hit buffer (the ray hierarchy first builds its tiles' cones).
-    fn intersect(&mut self, rec: &mut Recorder, f: &FrameInputs, sets: [vk::DescriptorSet; 2], at: u64, view: u32) {
+    fn intersect(&mut self, rec: &mut Recorder, f: &FrameInputs, sets: [vk::DescriptorSet; 2], at: u64, view: u32, queue: u32) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let name = self.scheme.pass_name();
         let (Some(engine), Some(depth)) = (self.engine.as_mut(), self.engine_depth.as_mut()) else {
@@ -509,6 +541,13 @@ impl RayTrace {
                 .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_SHADER)
                 .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ)];
             unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
+            if self.p.cull_stats != vk::Pipeline::null() {
+                // The culling rate: the same test over every tile × triangle pair, counted.
+                Self::barrier(ctx, cmd);
+                self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.p.cull_stats, f, sets);
+                self.push_object(ctx, cmd, f, view, queue);
+                unsafe { ctx.device.cmd_dispatch(cmd, self.triangle_count.div_ceil(64), self.tiles, 1) };
+            }
         }
         let (engine, depth) = (self.engine.as_ref().expect("checked"), self.engine_depth.as_ref().expect("checked"));
         let none = f32::from_bits(u32::MAX); // RAY_NO_TRIANGLE in every channel
@@ -601,6 +640,9 @@ impl Stage for RayTrace {
         unsafe {
             ctx.device.cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0);
             ctx.device.cmd_fill_buffer(cmd, self.accum.raw, 0, vk::WHOLE_SIZE, 0);
+            if self.cull_stats.size > 0 {
+                ctx.device.cmd_fill_buffer(cmd, self.cull_stats.raw, 0, vk::WHOLE_SIZE, 0);
+            }
         }
         let none = f32::from_bits(u32::MAX); // clears the R32_UINT ids to RAY_NO_TRIANGLE
         begin_rendering(
@@ -644,7 +686,7 @@ impl Stage for RayTrace {
             rec.end(open);
             // Bounce 0's hits come from rasterisation; the intersection kernel only answers
             // the pixels whose raster triangle failed the exact test (RAY_HIT_KNOWN unset).
-            self.intersect(rec, f, sets, rays_at, view);
+            self.intersect(rec, f, sets, rays_at, view, 0);
             let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
             self.dispatch_indirect((ctx, cmd), self.p.shade, f, sets, rays_at, view);
             rec.end(open);
@@ -657,7 +699,7 @@ impl Stage for RayTrace {
             self.bind(ctx, cmd, compute, self.p.args, f, sets);
             unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
             rec.end(open);
-            self.intersect(rec, f, shadow_sets, shadows_at, view);
+            self.intersect(rec, f, shadow_sets, shadows_at, view, 1);
             let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
             self.dispatch_indirect((ctx, cmd), self.p.shadow, f, shadow_sets, shadows_at, view);
             rec.end(open);
@@ -680,6 +722,37 @@ impl Stage for RayTrace {
         rec.end(open);
     }
 
+    /// Rays each bounce's queue received (`raytrace.rays.bounceK`, with the shadow rays), the
+    /// rays the budget dropped, and with `ray_stats=on` the ray hierarchy's culling rate per
+    /// bounce (the fraction of tile × triangle pairs its cone test rejected).
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        let mut out = Vec::new();
+        let Ok(words) = self.counters.read() else { return out };
+        let word = |at: u64| words.get(at as usize..at as usize + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64;
+        let bounces = self.depth as u64 + 1;
+        let mut dropped = 0;
+        for k in 0..bounces {
+            let rays = word(k * self.stride);
+            let shadows = word((bounces + 1 + k) * self.stride);
+            dropped += rays.saturating_sub(self.capacity) + shadows.saturating_sub(self.capacity * self.lights);
+            out.push((format!("raytrace.rays.bounce{k}"), rays as f64));
+            out.push((format!("raytrace.shadow_rays.bounce{k}"), shadows as f64));
+        }
+        out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
+        if let Ok(c) = self.cull_stats.read() {
+            let w = |i: usize| c.get(4 * i..4 * i + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as f64;
+            for k in 0..bounces as usize {
+                for (q, label) in [(0, "rays"), (1, "shadow_rays")] {
+                    let (tested, kept) = (w(4 * k + 2 * q), w(4 * k + 2 * q + 1));
+                    if tested > 0.0 {
+                        out.push((format!("raytrace.cull_rate.bounce{k}.{label}"), 1.0 - kept / tested));
+                    }
+                }
+            }
+        }
+        out
+    }
+
     fn destroy(&mut self, ctx: &Context) {
         let p = &mut self.p;
         destroy_pipelines(
@@ -696,6 +769,7 @@ impl Stage for RayTrace {
                 p.engine,
                 p.engine_copy,
                 p.cones,
+                p.cull_stats,
             ],
         );
         self.p = Pipelines::default();
@@ -726,6 +800,7 @@ impl Stage for RayTrace {
             &mut self.dispatch,
             &mut self.accum,
             &mut self.cones,
+            &mut self.cull_stats,
         ] {
             b.destroy(ctx);
         }
