@@ -9,6 +9,7 @@ mod demo;
 mod info;
 mod knobs;
 mod plan;
+mod raytrace;
 mod render;
 mod tradeoff;
 
@@ -84,6 +85,31 @@ enum Command {
         #[arg(long, default_value = "tradeoff")]
         out: PathBuf,
     },
+    /// Survey Table 1 measured for ray tracing in the original geometry: per scheme and
+    /// scene size the CPU build, the GPU frame and the structure's memory (table1.csv,
+    /// table1.svg in --out, log–log), the ray hierarchy's culling rate per tile size, and
+    /// the default distance-map method's frame against bvh's on the demo scene.
+    RaytraceBench {
+        /// Triangles of the two specular spheres together (comma-separated).
+        #[arg(long, default_value = "1000,10000,100000,1000000")]
+        triangles: String,
+        #[arg(long, default_value = "256x256")]
+        size: String,
+        #[arg(long, default_value_t = 4)]
+        depth: u32,
+        /// Seconds a scheme's frame may take before larger scenes are skipped for it.
+        #[arg(long, default_value_t = 60.0)]
+        budget_s: f64,
+        #[arg(long, default_value_t = 3)]
+        frames: u32,
+        /// Image size of the distance-vs-bvh comparison.
+        #[arg(long, default_value = "512x512")]
+        headline_size: String,
+        #[arg(long, default_value = "raytrace-bench")]
+        out: PathBuf,
+        #[arg(long)]
+        device: Option<String>,
+    },
     /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
     Demo {
         #[arg(default_value = "out")]
@@ -157,6 +183,9 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Plan { args, json } => plan::run(&args, json),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),
+        Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, out, device } => {
+            raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &out, &device)
+        }
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image } => compare::run(&test, &reference, error_image.as_deref()),
         Command::Tradeoff { args, sweep, methods, out } => tradeoff::run(&args, &sweep, &methods, &out),

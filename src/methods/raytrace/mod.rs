@@ -21,6 +21,7 @@
 //! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
 //! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
 
+pub mod bench;
 pub mod bvh;
 pub mod gpu;
 pub mod grid;

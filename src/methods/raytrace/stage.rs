@@ -739,6 +739,7 @@ impl Stage for RayTrace {
             out.push((format!("raytrace.shadow_rays.bounce{k}"), shadows as f64));
         }
         out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
+        out.push(("raytrace.build_ms".to_string(), self.build_ms));
         if let Ok(c) = self.cull_stats.read() {
             let w = |i: usize| c.get(4 * i..4 * i + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as f64;
             for k in 0..bounces as usize {

@@ -1,0 +1,257 @@
+//! `specula raytrace-bench`: survey Table 1's rows for ray tracing in the original geometry
+//! measured — per scheme and scene size N the structure's CPU build time, the frame's GPU
+//! time and the structure's device memory, on a procedural scene (the demo room with a
+//! tessellated mirror sphere and glass sphere of N triangles together), plotted log–log;
+//! the ray hierarchy's culling rate against its tile size; and the survey's headline
+//! ratio, the default distance-map method's frame against `bvh`'s on the demo scene with
+//! both methods' PSNR against the reference.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use crate::error::{Error, Result};
+use crate::methods::{Method, BVH, DISTANCE, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
+use crate::quality::Quality;
+use crate::scene::{shapes, Scene};
+use crate::vk::Context;
+
+/// The survey's asymptotic class of each scheme's cost per ray (Table 1 and §2).
+pub fn complexity(m: Method) -> &'static str {
+    match m.name() {
+        "ray-engine" => "O(N) per ray",
+        "ray-hierarchy" => "O(N) per tile, culled",
+        "grid" => "O(N^(1/3)) cells per ray",
+        _ => "O(log N) per ray",
+    }
+}
+
+/// The demo room with its two spheres replaced by tessellations of `n` triangles in all.
+pub fn scene_with(demo: &Scene, n: usize) -> Result<Scene> {
+    let mut s = demo.clone();
+    let spheres: Vec<usize> = s.specular_meshes().map(|(i, _)| i).collect();
+    if spheres.len() != 2 {
+        return Err(Error::invalid("raytrace-bench", "the demo scene should have two specular spheres"));
+    }
+    // A uv sphere of `seg` segments and seg/2 rings has seg · (seg − 2) triangles.
+    let per = (n / 2).max(8) as f64;
+    let seg = ((1.0 + (1.0 + per).sqrt()).round() as u32).max(4);
+    for &i in spheres.iter().rev() {
+        let m = s.meshes.remove(i);
+        let b = m.bounds();
+        let c = b.center();
+        let r = (b.max - b.min).max_element() * 0.5;
+        let mut sphere = shapes::uv_sphere(&m.name, c, r, seg, seg / 2, m.material);
+        sphere.aliases = m.aliases.clone();
+        s.meshes.insert(i, sphere);
+    }
+    for m in &mut s.meshes {
+        if m.normals.len() != m.positions.len() {
+            m.normals = crate::scene::compute_normals(&m.positions, &m.indices);
+        }
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+/// One measured cell of Table 1.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub method: &'static str,
+    pub objects_triangles: usize,
+    pub scene_triangles: usize,
+    pub build_ms: f64,
+    pub frame_ms: f64,
+    pub structure_bytes: u64,
+}
+
+fn structure_bytes(frame: &crate::Frame, scheme: &str) -> u64 {
+    let prefix = format!("raytrace.{scheme}.");
+    frame.memory.iter().filter(|(n, _)| n.starts_with(&prefix) && !n.ends_with(".triangles")).map(|(_, b)| b).sum()
+}
+
+/// Renders `scene` with `m` (median of `frames` after one warm-up) and returns the row.
+fn measure(ctx: &Context, scene: &Scene, m: Method, q: &Quality, size: (u32, u32), frames: u32, n: usize) -> Result<Row> {
+    let f = crate::render(ctx, scene, m, q, size, (1, frames))?;
+    let stat = |name: &str| f.stats.iter().find(|(k, _)| k == name).map_or(0.0, |(_, v)| *v);
+    let scheme = match m.name() {
+        "kd-tree" => "kdtree",
+        other => other,
+    };
+    Ok(Row {
+        method: m.name(),
+        objects_triangles: n,
+        scene_triangles: scene.triangle_count(),
+        build_ms: stat("raytrace.build_ms"),
+        frame_ms: f.gpu_ms(),
+        structure_bytes: structure_bytes(&f, scheme),
+    })
+}
+
+/// What [`run`] measures.
+pub struct Config {
+    pub demo: Scene,
+    pub sizes: Vec<usize>,
+    pub size: (u32, u32),
+    pub depth: u32,
+    /// A scheme whose frame exceeds this is not measured at larger N.
+    pub budget_ms: f64,
+    pub frames: u32,
+    /// The headline comparison's image size.
+    pub headline_size: (u32, u32),
+}
+
+/// Runs the benchmark; prints its tables and returns them as Markdown, writing the plot
+/// (`table1.svg`) and the rows (`table1.csv`) into `out`.
+pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
+    let methods = [BVH, KD_TREE, GRID, RAY_HIERARCHY, RAY_ENGINE];
+    let q = Quality { depth: c.depth, ..Quality::default() };
+    let mut rows: Vec<Row> = Vec::new();
+    let mut stopped: Vec<String> = Vec::new();
+    let mut md = String::new();
+    let _ = writeln!(md, "### Table 1 measured: {}×{}, depth {}, median of {} frames\n", c.size.0, c.size.1, c.depth, c.frames);
+    let _ = writeln!(md, "| scheme | class | N (objects) | scene triangles | build ms (CPU) | frame ms (GPU) | structure memory |");
+    let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|");
+    for &n in &c.sizes {
+        let scene = scene_with(&c.demo, n)?;
+        for &m in &methods {
+            if stopped.iter().any(|s| s.starts_with(m.name())) {
+                continue;
+            }
+            let row = measure(ctx, &scene, m, &q, c.size, c.frames, n)?;
+            let line = format!(
+                "| {} | {} | {} | {} | {:.1} | {:.1} | {:.2} MiB |",
+                row.method,
+                complexity(m),
+                n,
+                row.scene_triangles,
+                row.build_ms,
+                row.frame_ms,
+                row.structure_bytes as f64 / (1 << 20) as f64
+            );
+            println!("{line}");
+            let _ = writeln!(md, "{line}");
+            if row.frame_ms > c.budget_ms {
+                stopped.push(format!(
+                    "{} stopped after N = {n}: its frame took {:.0} ms > the budget of {:.0} ms",
+                    m.name(),
+                    row.frame_ms,
+                    c.budget_ms
+                ));
+            }
+            rows.push(row);
+        }
+    }
+    for s in &stopped {
+        println!("{s}");
+        let _ = writeln!(md, "\n{s}.");
+    }
+
+    // The ray hierarchy's culling against its tile size (demo scene).
+    let _ = writeln!(md, "\n### Ray-hierarchy culling rate (tile × triangle pairs rejected by the cone test), demo scene\n");
+    let _ = writeln!(md, "| tile | frame ms | culling per bounce: rays / shadow rays |");
+    let _ = writeln!(md, "|---:|---:|---|");
+    for tile in [8u32, 16, 32] {
+        let qt = Quality { tile_size: tile, ray_stats: true, ..q.clone() };
+        let f = crate::render(ctx, &c.demo, RAY_HIERARCHY, &qt, c.size, (0, 1))?;
+        let mut per = Vec::new();
+        for k in 0..=c.depth {
+            let get = |label: &str| f.stats.iter().find(|(n, _)| *n == format!("raytrace.cull_rate.bounce{k}.{label}")).map(|(_, v)| *v);
+            let fmt = |v: Option<f64>| v.map_or("–".to_string(), |v| format!("{:.0} %", 100.0 * v));
+            per.push(format!("{}: {} / {}", k, fmt(get("rays")), fmt(get("shadow_rays"))));
+        }
+        let line = format!("| {tile} | {:.1} | {} |", f.gpu_ms(), per.join("; "));
+        println!("{line}");
+        let _ = writeln!(md, "{line}");
+    }
+
+    // The headline: sampled geometry against ray tracing in the original geometry.
+    let (w, h) = c.headline_size;
+    let reference = crate::reference::render_reference(&c.demo, &Quality { spp: 1, ..q.clone() }, (w, h))?;
+    let mut head = Vec::new();
+    for m in [DISTANCE, BVH] {
+        let f = crate::render(ctx, &c.demo, m, &q, (w, h), (1, c.frames))?;
+        let psnr = crate::metrics::compare(&f.image, &reference)?.psnr;
+        head.push((m.name(), f.gpu_ms(), psnr));
+    }
+    let _ = writeln!(md, "\n### Sampled geometry against the original geometry: demo scene, {w}×{h}, depth {}\n", c.depth);
+    let _ = writeln!(md, "| method | frame ms (GPU) | PSNR vs reference (1 spp, same depth) |");
+    let _ = writeln!(md, "|---|---:|---:|");
+    for (name, ms, psnr) in &head {
+        let line = format!("| {name} | {ms:.1} | {psnr:.2} dB |");
+        println!("{line}");
+        let _ = writeln!(md, "{line}");
+    }
+    let ratio = head[1].1 / head[0].1;
+    let line = format!("bvh's frame / distance's frame = {ratio:.2}× (the survey's claim: sampled geometry at least 10× faster; the compass goal ≥ 20× at ≥ 35 dB)");
+    println!("{line}");
+    let _ = writeln!(md, "\n{line}.");
+
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let mut csv = String::from("method,objects_triangles,scene_triangles,build_ms,frame_ms,structure_bytes\n");
+    for r in &rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:.3},{:.3},{}",
+            r.method, r.objects_triangles, r.scene_triangles, r.build_ms, r.frame_ms, r.structure_bytes
+        );
+    }
+    crate::output::write_file(&out.join("table1.csv"), csv.as_bytes())?;
+    let mut svg = String::new();
+    plot(&mut svg, &rows, c).map_err(|e| Error::invalid("table1.svg", e))?;
+    crate::output::write_file(&out.join("table1.svg"), svg.as_bytes())?;
+    Ok(md)
+}
+
+/// Frame time against N, log–log, one line per scheme.
+fn plot(svg: &mut String, rows: &[Row], c: &Config) -> std::result::Result<(), String> {
+    use plotters::prelude::*;
+    let err = |e: &dyn std::fmt::Display| e.to_string();
+    let root = SVGBackend::with_string(svg, (960, 640)).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| err(&e))?;
+    let n_max = rows.iter().map(|r| r.objects_triangles as f64).fold(10.0, f64::max) * 2.0;
+    let t_max = rows.iter().map(|r| r.frame_ms.max(r.build_ms)).fold(10.0, f64::max) * 2.0;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            format!("Table 1 measured: ray tracing in the original geometry, {}×{}, depth {}", c.size.0, c.size.1, c.depth),
+            ("sans-serif", 20),
+        )
+        .margin(20)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
+        .build_cartesian_2d((500.0..n_max).log_scale(), (1.0..t_max).log_scale())
+        .map_err(|e| err(&e))?;
+    chart
+        .configure_mesh()
+        .x_desc("N: triangles of the specular objects")
+        .y_desc("ms (solid: GPU frame, dashed: CPU build)")
+        .draw()
+        .map_err(|e| err(&e))?;
+    let mut names: Vec<&str> = Vec::new();
+    for r in rows {
+        if !names.contains(&r.method) {
+            names.push(r.method);
+        }
+    }
+    for (k, name) in names.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let pts: Vec<(f64, f64)> =
+            rows.iter().filter(|r| r.method == *name).map(|r| (r.objects_triangles as f64, r.frame_ms.max(1.0))).collect();
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), ShapeStyle::from(&color).stroke_width(2)))
+            .map_err(|e| err(&e))?
+            .label(*name)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color));
+        chart.draw_series(pts.iter().map(|p| Circle::new(*p, 4, color.filled()))).map_err(|e| err(&e))?;
+        let build: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.method == *name && r.build_ms > 0.0)
+            .map(|r| (r.objects_triangles as f64, r.build_ms.max(1.0)))
+            .collect();
+        if !build.is_empty() {
+            chart.draw_series(DashedLineSeries::new(build, 6, 4, ShapeStyle::from(&color).stroke_width(1))).map_err(|e| err(&e))?;
+        }
+    }
+    chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
+    root.present().map_err(|e| err(&e))?;
+    Ok(())
+}
