@@ -25,7 +25,7 @@ void main() {
     uint slot = atomicAdd(next_count, 1u);
     if (slot >= trace.capacity) return;
     uint pixel = xy.y * trace.width + xy.x;
-    next_queries[slot] = make_query(o, d, 0.0, 1.0 / 0.0, RAY_NO_TRIANGLE, known ? RAY_HIT_KNOWN : 0u);
+    next_queries[slot] = make_query(o, d, near_plane_t(d), 1.0 / 0.0, RAY_NO_TRIANGLE, known ? RAY_HIT_KNOWN : 0u);
     next_payloads[slot] = make_payload(vec3(1.0), pixel);
     next_hits[slot] = known ? RayHit(tuv.x, tuv.y, tuv.z, id) : RayHit(1.0 / 0.0, 0.0, 0.0, RAY_NO_TRIANGLE);
 }

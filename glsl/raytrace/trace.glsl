@@ -87,4 +87,15 @@ void camera_ray(uint x, uint y, out vec3 o, out vec3 d) {
     d = normalize(far_point.xyz / far_point.w - o);
 }
 
+// The ray parameter of the camera's near plane along the unit camera ray d (reversed-Z:
+// NDC depth 1 is the near plane), so that traced primary rays clip where rasterisation does.
+float near_plane_t(vec3 d) {
+    View v = views[push.view];
+    vec4 c = v.inv_view_proj * vec4(0.0, 0.0, 1.0, 1.0);
+    vec3 to_near = c.xyz / c.w - v.eye.xyz;
+    float znear = length(to_near);
+    float cos_a = dot(d, to_near / max(znear, 1e-30));
+    return cos_a > 0.0 ? znear / cos_a : 0.0;
+}
+
 #endif

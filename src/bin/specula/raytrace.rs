@@ -2,7 +2,7 @@
 //! geometry (`specula::methods::raytrace::bench`); writes `table1.md`, `table1.csv` and
 //! `table1.svg` into `out`.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use specula::methods::raytrace::bench::{self, Config};
 
@@ -16,7 +16,7 @@ pub fn run(
     budget_s: f64,
     frames: u32,
     headline_size: &str,
-    out: &PathBuf,
+    out: &Path,
     device: &Option<String>,
 ) -> specula::Result<()> {
     let sizes = triangles

@@ -29,6 +29,11 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
     for (name, value) in &frame.stats {
         println!("{name:<40} {value:>12.4}");
     }
+    if let Some((_, n)) = frame.stats.iter().find(|(k, _)| k == "raytrace.dropped_rays").filter(|(_, n)| *n > 0.0) {
+        eprintln!(
+            "specula: warning: {n} rays did not fit in their queues and were dropped (their light is missing); raise the ray_budget knob"
+        );
+    }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);
         specula::output::write_file(p, json.as_bytes())?;
