@@ -7,6 +7,8 @@
 layout(local_size_x = 64) in;
 #include "raytrace/hierarchy.glsl"
 
+const bool RAY_HIERARCHY_END_POINT_CONES = false;
+
 void main() {
     uint k = gl_GlobalInvocationID.x;
     uint w = trace.ray_texture_width;
@@ -41,7 +43,10 @@ void main() {
     }
     // Rays that all end near one point (shadow rays towards a point light) are segments
     // inside the cone from that point back over the origins' ball, which is far narrower.
-    bool bounded = true;
+    // Disabled: in 1 of 12 runs (ray order differs between runs) a tile's end-point cone
+    // rejected a triangle one of its shadow rays hits; until that is understood, shadow-ray
+    // tiles use the direction cone like every other tile.
+    bool bounded = RAY_HIERARCHY_END_POINT_CONES;
     vec3 sum_e = vec3(0.0);
     for (uint j = 0u; j < ts * ts && bounded; ++j) {
         uint i = (t0.y + j / ts) * w + t0.x + j % ts;
