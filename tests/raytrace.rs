@@ -223,3 +223,33 @@ fn planner_ray_traces_objects_in_mutual_view() {
     assert!(p >= 45.0, "auto on three mirrors in mutual view: {p:.2} dB");
     common::assert_clean(&ctx);
 }
+
+/// The frame's ray statistics: bounce 0 holds one ray per pixel (the whole scene is traced),
+/// shadow rays follow the diffuse hits, nothing is dropped at the default budget; with a
+/// budget of one ray per pixel and a glass sphere filling the view (two children per
+/// pixel) the overflow is counted; the ray hierarchy reports its culling rate with
+/// `ray_stats=on`.
+#[test]
+fn ray_statistics_count_rays_and_overflow() {
+    let ctx = common::gpu();
+    let stat = |f: &specula::Frame, name: &str| f.stats.iter().find(|(k, _)| k == name).map(|(_, v)| *v);
+    let q = quality(&["depth=2"]);
+    let f = specula::render(&ctx, &demo(), BVH, &q, (32, 32), (0, 1)).unwrap();
+    assert_eq!(stat(&f, "raytrace.rays.bounce0"), Some(1024.0), "{:?}", f.stats);
+    assert!(stat(&f, "raytrace.shadow_rays.bounce0").unwrap() > 500.0, "{:?}", f.stats);
+    assert_eq!(stat(&f, "raytrace.dropped_rays"), Some(0.0));
+    assert!(stat(&f, "raytrace.build_ms").unwrap() > 0.0);
+
+    let mut s = common::mirror_and_glass(24);
+    s.camera = Some(Camera::look_at(common::GLASS + Vec3::new(0.0, 0.0, 0.8), common::GLASS, 50f32.to_radians()));
+    let tight = quality(&["depth=2", "ray_budget=1"]);
+    let f = specula::render(&ctx, &s, BVH, &tight, (32, 32), (0, 1)).unwrap();
+    assert!(stat(&f, "raytrace.rays.bounce1").unwrap() > 1024.0, "{:?}", f.stats);
+    assert!(stat(&f, "raytrace.dropped_rays").unwrap() > 0.0, "{:?}", f.stats);
+
+    let h = quality(&["depth=1", "ray_stats=on", "tile_size=8"]);
+    let f = specula::render(&ctx, &demo(), specula::methods::RAY_HIERARCHY, &h, (16, 16), (0, 1)).unwrap();
+    let rates: Vec<f64> = f.stats.iter().filter(|(k, _)| k.starts_with("raytrace.cull_rate")).map(|(_, v)| *v).collect();
+    assert!(!rates.is_empty() && rates.iter().all(|r| (0.0..=1.0).contains(r)), "{:?}", f.stats);
+    common::assert_clean(&ctx);
+}

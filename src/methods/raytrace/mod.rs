@@ -94,6 +94,12 @@ fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
     None
 }
 
+/// Every ray tracer's GPU side: no maps, its own stage, seen in other objects' maps as the
+/// environment only.
+const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Result<Box<dyn Stage>>) -> GpuSpec {
+    GpuSpec { maps: &[], camera: camera(name, create), map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one }
+}
+
 const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
 const RAY_KNOBS_KD: &[&str] = &["depth", "fresnel", "ray_budget", "kd_max_depth", "kd_leaf_size", "kd_traversal"];
 const RAY_KNOBS_ENGINE: &[&str] = &["depth", "fresnel", "ray_budget"];
@@ -108,16 +114,10 @@ pub const BVH: Method = Method(&MethodInfo {
     summary: "exact ray tracing in the original geometry: primary hits by rasterisation, then per bounce intersect → shade (exact shadow rays) → spawn both Fresnel-weighted branches on the GPU, through the CPU reference's SAH BVH (short-stack or stackless traversal)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_BVH,
-    gpu: Some(GpuSpec {
-        maps: &[],
-        camera: camera("raytrace.bvh", |init, plan| {
+    gpu: Some(ray_tracer("raytrace.bvh", |init, plan| {
             let q = &init.plan.quality;
             stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
-        }),
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Nothing,
-        cycles: one,
-    }),
+        })),
     fallback: None,
     rule: bvh_rule,
 });
@@ -130,13 +130,7 @@ pub const RAY_ENGINE: Method = Method(&MethodInfo {
     summary: "exact ray tracing in the original geometry (the `bvh` pipeline) with the ray engine as the intersection step: the rays as a texture, one quad over it per triangle, Möller–Trumbore in the fragment shader writing the hit distance as depth, the z-test keeping the nearest (O(N) per ray)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_ENGINE,
-    gpu: Some(GpuSpec {
-        maps: &[],
-        camera: camera("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine)),
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Nothing,
-        cycles: one,
-    }),
+    gpu: Some(ray_tracer("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine))),
     fallback: None,
     rule: |_, _| None,
 });
@@ -149,15 +143,9 @@ pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
     summary: "the ray engine over tiles of the ray texture, each bounded by a cone built on the GPU from its rays; a tile is rasterised for a triangle only where the cone meets the triangle's bounding sphere (tested in the vertex shader)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_HIERARCHY,
-    gpu: Some(GpuSpec {
-        maps: &[],
-        camera: camera("raytrace.ray-hierarchy", |init, plan| {
+    gpu: Some(ray_tracer("raytrace.ray-hierarchy", |init, plan| {
             stage::create(init, plan, Scheme::RayHierarchy { tile: init.plan.quality.tile_size })
-        }),
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Nothing,
-        cycles: one,
-    }),
+        })),
     fallback: None,
     rule: |_, _| None,
 });
@@ -170,16 +158,10 @@ pub const KD_TREE: Method = Method(&MethodInfo {
     summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through an SAH kd-tree over clipped triangle boxes, traversed with a short stack and push-down (HSHH07) or by kd-restart (FS05)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_KD,
-    gpu: Some(GpuSpec {
-        maps: &[],
-        camera: camera("raytrace.kd-tree", |init, plan| {
+    gpu: Some(ray_tracer("raytrace.kd-tree", |init, plan| {
             let q = &init.plan.quality;
             stage::create(init, plan, Scheme::KdTree { max_depth: q.kd_max_depth, leaf_size: q.kd_leaf_size, restart: q.kd_restart })
-        }),
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Nothing,
-        cycles: one,
-    }),
+        })),
     fallback: None,
     rule: |_, _| None,
 });
@@ -192,16 +174,10 @@ pub const GRID: Method = Method(&MethodInfo {
     summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through a uniform grid traversed by 3D-DDA, with optional empty-space skipping (KL04)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_GRID,
-    gpu: Some(GpuSpec {
-        maps: &[],
-        camera: camera("raytrace.grid", |init, plan| {
+    gpu: Some(ray_tracer("raytrace.grid", |init, plan| {
             let q = &init.plan.quality;
             stage::create(init, plan, Scheme::Grid { density: q.grid_density, skip_empty: q.grid_skip })
-        }),
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Nothing,
-        cycles: one,
-    }),
+        })),
     fallback: None,
     rule: |_, _| None,
 });
