@@ -126,9 +126,10 @@ fn examples_render_the_same_image_through_every_link_mode() {
     }
     // The methods with the most moving parts, through the host's command buffers too:
     // inter-object cycles (ping-pong maps, 4 cycles), self refraction, and the ray pipeline
-    // of each acceleration scheme (GPU counters, indirect dispatch, integer accumulation).
+    // of each acceleration scheme (GPU counters, indirect dispatch, integer accumulation),
+    // the ray engine and the ray hierarchy (raster passes over the ray texture) included.
     let (standalone, host) = (dir.join("standalone_shared"), dir.join("host_shared"));
-    for method in ["4", "5", "6", "7", "8", "9"] {
+    for method in ["4", "5", "6", "7", "8", "9", "10", "11"] {
         let (a, b) = (dir.join(format!("m{method}_standalone.f32")), dir.join(format!("m{method}_host.f32")));
         run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new(method)]);
         run(&host, &[&scene, &b, Path::new(method)]);

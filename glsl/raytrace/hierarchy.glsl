@@ -27,12 +27,19 @@ bool cone_meets_sphere(uint k, vec3 s, float rho) {
     return dot(v, b.xyz) >= len * cos_limit - 1e-6 * len;
 }
 
-// The bounding sphere of triangle t: the centre of its box and the farthest corner.
+// The bounding sphere of what the intersection test accepts of triangle t: the centre of
+// its box, the farthest corner, and a margin for the test's widening (RAY_EDGE_EPS of the
+// barycentric extent moves a corner out by up to 3 ε times the longest edge ≤ 6 ε r) and
+// for f32 rounding of the centre (a few ulps of its largest coordinate). Without the margin
+// a ray through a corner of the widened triangle lay outside the sphere and its tile was
+// culled (seen with the tight end-point cones of shadow-ray tiles, 1 run in 12).
 void triangle_sphere(Triangle t, out vec3 c, out float r) {
     vec3 lo = min(min(t.v0.xyz, t.v1.xyz), t.v2.xyz);
     vec3 hi = max(max(t.v0.xyz, t.v1.xyz), t.v2.xyz);
     c = 0.5 * (lo + hi);
-    r = max(max(length(t.v0.xyz - c), length(t.v1.xyz - c)), length(t.v2.xyz - c)) * 1.000001;
+    float corner = max(max(length(t.v0.xyz - c), length(t.v1.xyz - c)), length(t.v2.xyz - c));
+    vec3 m = max(abs(lo), abs(hi));
+    r = corner * (1.0 + 8.0 * RAY_EDGE_EPS + 1e-6) + 4.8e-7 * max(max(m.x, m.y), m.z);
 }
 
 #endif

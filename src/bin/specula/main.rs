@@ -105,6 +105,9 @@ enum Command {
         /// Image size of the distance-vs-bvh comparison.
         #[arg(long, default_value = "512x512")]
         headline_size: String,
+        /// Parts to run (comma-separated): table1, culling, headline, mutual.
+        #[arg(long, default_value = "table1,culling,headline,mutual")]
+        parts: String,
         #[arg(long, default_value = "raytrace-bench")]
         out: PathBuf,
         #[arg(long)]
@@ -183,8 +186,8 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Plan { args, json } => plan::run(&args, json),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),
-        Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, out, device } => {
-            raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &out, &device)
+        Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, parts, out, device } => {
+            raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image } => compare::run(&test, &reference, error_image.as_deref()),

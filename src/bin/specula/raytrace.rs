@@ -16,6 +16,7 @@ pub fn run(
     budget_s: f64,
     frames: u32,
     headline_size: &str,
+    parts: &str,
     out: &Path,
     device: &Option<String>,
 ) -> specula::Result<()> {
@@ -33,6 +34,14 @@ pub fn run(
     if !(budget_s > 0.0 && budget_s.is_finite()) {
         return Err(specula::Error::invalid("--budget-s", format!("must be a positive number of seconds, got {budget_s}")));
     }
+    let parts = parts
+        .split(',')
+        .map(|p| {
+            bench::Part::parse(p.trim()).ok_or_else(|| {
+                specula::Error::invalid("--parts", format!("'{}' is not one of table1, culling, headline, mutual", specula::error::clip(p)))
+            })
+        })
+        .collect::<specula::Result<Vec<_>>>()?;
     let demo = specula::scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/demo.gltf"))?;
     let ctx = context(false, device)?;
     println!("raytrace-bench on {} ({})", ctx.device_name, ctx.driver_info);
@@ -44,6 +53,7 @@ pub fn run(
         budget_ms: budget_s * 1e3,
         frames: frames.max(1),
         headline_size: parse_size(headline_size)?,
+        parts,
     };
     let md = bench::run(&ctx, &config, out)?;
     let header = format!("Device: {} ({})\n\n", ctx.device_name, ctx.driver_info);

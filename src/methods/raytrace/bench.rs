@@ -4,13 +4,14 @@
 //! tessellated mirror sphere and glass sphere of N triangles together), plotted log–log;
 //! the ray hierarchy's culling rate against its tile size; and the survey's headline
 //! ratio, the default distance-map method's frame against `bvh`'s on the demo scene with
-//! both methods' PSNR against the reference.
+//! both methods' PSNR against the reference; and the planner's mutual-view rule measured:
+//! k mirror spheres that see each other, the sampled-geometry methods against `bvh`.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::methods::{Method, BVH, DISTANCE, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
+use crate::methods::{Method, BVH, DISTANCE, DISTANCE_MULTI, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 use crate::quality::Quality;
 use crate::scene::{shapes, Scene};
 use crate::vk::Context;
@@ -51,6 +52,50 @@ pub fn scene_with(demo: &Scene, n: usize) -> Result<Scene> {
     }
     s.validate()?;
     Ok(s)
+}
+
+/// The demo room with its two spheres replaced by `k` mirror spheres on a ring, each
+/// seeing the others (the planner's mutual-view case); the box stays.
+pub fn mutual_scene(demo: &Scene, k: usize) -> Result<Scene> {
+    let mut s = demo.clone();
+    let spheres: Vec<usize> = s.specular_meshes().map(|(i, _)| i).collect();
+    let mirror =
+        spheres.iter().map(|&i| s.meshes[i].material).find(|&m| matches!(s.materials[m].kind, crate::scene::SurfaceKind::Mirror { .. }));
+    let Some(mirror) = mirror else {
+        return Err(Error::invalid("raytrace-bench", "the demo scene should have a mirror sphere"));
+    };
+    for &i in spheres.iter().rev() {
+        s.meshes.remove(i);
+    }
+    let centre = glam::Vec3::new(-0.45, 0.4, -0.55);
+    for j in 0..k {
+        let a = std::f32::consts::TAU * j as f32 / k.max(1) as f32 + 0.4;
+        let c = centre + if k > 1 { 0.8 * glam::Vec3::new(a.cos(), 0.0, a.sin()) } else { glam::Vec3::ZERO };
+        s.meshes.push(shapes::uv_sphere(&format!("mirror_{j}"), c, 0.38, 48, 24, mirror));
+    }
+    s.validate()?;
+    Ok(s)
+}
+
+/// Which parts [`run`] measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Part {
+    Table1,
+    Culling,
+    Headline,
+    Mutual,
+}
+
+impl Part {
+    pub fn parse(s: &str) -> Option<Part> {
+        Some(match s {
+            "table1" => Part::Table1,
+            "culling" => Part::Culling,
+            "headline" => Part::Headline,
+            "mutual" => Part::Mutual,
+            _ => return None,
+        })
+    }
 }
 
 /// One measured cell of Table 1.
@@ -98,6 +143,7 @@ pub struct Config {
     pub frames: u32,
     /// The headline comparison's image size.
     pub headline_size: (u32, u32),
+    pub parts: Vec<Part>,
 }
 
 /// Runs the benchmark; prints its tables and returns them as Markdown, writing the plot
@@ -106,18 +152,37 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     let methods = [BVH, KD_TREE, GRID, RAY_HIERARCHY, RAY_ENGINE];
     let q = Quality { depth: c.depth, ..Quality::default() };
     let mut rows: Vec<Row> = Vec::new();
-    let mut stopped: Vec<String> = Vec::new();
     let mut md = String::new();
+    if c.parts.contains(&Part::Table1) {
+        table1(ctx, c, &q, &methods, &mut md, &mut rows)?;
+    }
+    if c.parts.contains(&Part::Culling) {
+        culling(ctx, c, &q, &mut md)?;
+    }
+    if c.parts.contains(&Part::Headline) {
+        headline(ctx, c, &q, &mut md)?;
+    }
+    if c.parts.contains(&Part::Mutual) {
+        mutual(ctx, c, &q, &mut md)?;
+    }
+    if !rows.is_empty() {
+        write_table1(&rows, c, out)?;
+    }
+    Ok(md)
+}
+
+fn table1(ctx: &Context, c: &Config, q: &Quality, methods: &[Method], md: &mut String, rows: &mut Vec<Row>) -> Result<()> {
+    let mut stopped: Vec<String> = Vec::new();
     let _ = writeln!(md, "### Table 1 measured: {}×{}, depth {}, median of {} frames\n", c.size.0, c.size.1, c.depth, c.frames);
     let _ = writeln!(md, "| scheme | class | N (objects) | scene triangles | build ms (CPU) | frame ms (GPU) | structure memory |");
     let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|");
     for &n in &c.sizes {
         let scene = scene_with(&c.demo, n)?;
-        for &m in &methods {
+        for &m in methods {
             if stopped.iter().any(|s| s.starts_with(m.name())) {
                 continue;
             }
-            let row = measure(ctx, &scene, m, &q, c.size, c.frames, n)?;
+            let row = measure(ctx, &scene, m, q, c.size, c.frames, n)?;
             let line = format!(
                 "| {} | {} | {} | {} | {:.1} | {:.1} | {:.2} MiB |",
                 row.method,
@@ -145,7 +210,10 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
         println!("{s}");
         let _ = writeln!(md, "\n{s}.");
     }
+    Ok(())
+}
 
+fn culling(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()> {
     // The ray hierarchy's culling against its tile size (demo scene).
     let _ = writeln!(md, "\n### Ray-hierarchy culling rate (tile × triangle pairs rejected by the cone test), demo scene\n");
     let _ = writeln!(md, "| tile | frame ms | culling per bounce: rays / shadow rays |");
@@ -163,13 +231,16 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
         println!("{line}");
         let _ = writeln!(md, "{line}");
     }
+    Ok(())
+}
 
+fn headline(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()> {
     // The headline: sampled geometry against ray tracing in the original geometry.
     let (w, h) = c.headline_size;
     let reference = crate::reference::render_reference(&c.demo, &Quality { spp: 1, ..q.clone() }, (w, h))?;
     let mut head = Vec::new();
     for m in [DISTANCE, BVH] {
-        let f = crate::render(ctx, &c.demo, m, &q, (w, h), (1, c.frames))?;
+        let f = crate::render(ctx, &c.demo, m, q, (w, h), (1, c.frames))?;
         let psnr = crate::metrics::compare(&f.image, &reference)?.psnr;
         head.push((m.name(), f.gpu_ms(), psnr));
     }
@@ -185,10 +256,39 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     let line = format!("bvh's frame / distance's frame = {ratio:.2}× (the survey's claim: sampled geometry at least 10× faster; the compass goal ≥ 20× at ≥ 35 dB)");
     println!("{line}");
     let _ = writeln!(md, "\n{line}.");
+    Ok(())
+}
 
+/// The planner's mutual-view rule measured: k = 1 … 5 mirror spheres that see each other,
+/// `distance` (single-bounce maps), `distance-multi` (inter-object cycles) and `bvh`, each
+/// frame against its PSNR.
+fn mutual(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()> {
+    let (w, h) = c.size;
+    let _ = writeln!(md, "\n### Mutual view: k mirror spheres on a ring in the demo room, {w}×{h}, depth {}\n", c.depth);
+    let _ = writeln!(md, "| k | method | frame ms (GPU) | PSNR vs reference | bvh's frame / this frame |");
+    let _ = writeln!(md, "|---:|---|---:|---:|---:|");
+    for k in 1..=5usize {
+        let scene = mutual_scene(&c.demo, k)?;
+        let reference = crate::reference::render_reference(&scene, &Quality { spp: 1, ..q.clone() }, (w, h))?;
+        let mut got = Vec::new();
+        for m in [DISTANCE, DISTANCE_MULTI, BVH] {
+            let f = crate::render(ctx, &scene, m, q, (w, h), (1, c.frames))?;
+            got.push((m.name(), f.gpu_ms(), crate::metrics::compare(&f.image, &reference)?.psnr));
+        }
+        let bvh_ms = got[2].1;
+        for (name, ms, psnr) in &got {
+            let line = format!("| {k} | {name} | {ms:.1} | {psnr:.2} dB | {:.2} |", bvh_ms / ms);
+            println!("{line}");
+            let _ = writeln!(md, "{line}");
+        }
+    }
+    Ok(())
+}
+
+fn write_table1(rows: &[Row], c: &Config, out: &Path) -> Result<()> {
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let mut csv = String::from("method,objects_triangles,scene_triangles,build_ms,frame_ms,structure_bytes\n");
-    for r in &rows {
+    for r in rows {
         let _ = writeln!(
             csv,
             "{},{},{},{:.3},{:.3},{}",
@@ -197,9 +297,8 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     }
     crate::output::write_file(&out.join("table1.csv"), csv.as_bytes())?;
     let mut svg = String::new();
-    plot(&mut svg, &rows, c).map_err(|e| Error::invalid("table1.svg", e))?;
-    crate::output::write_file(&out.join("table1.svg"), svg.as_bytes())?;
-    Ok(md)
+    plot(&mut svg, rows, c).map_err(|e| Error::invalid("table1.svg", e))?;
+    crate::output::write_file(&out.join("table1.svg"), svg.as_bytes())
 }
 
 /// Frame time against N, log–log, one line per scheme.
@@ -254,4 +353,27 @@ fn plot(svg: &mut String, rows: &[Row], c: &Config) -> std::result::Result<(), S
     chart.configure_series_labels().background_style(WHITE.mix(0.8)).border_style(BLACK).draw().map_err(|e| err(&e))?;
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mutual_scene_puts_k_mirror_spheres_apart_in_the_room() {
+        let demo = crate::scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/demo/demo.gltf")).unwrap();
+        for k in 1..=5 {
+            let s = mutual_scene(&demo, k).unwrap();
+            let spheres: Vec<_> = s.specular_meshes().map(|(_, m)| m.bounds()).collect();
+            assert_eq!(spheres.len(), k);
+            for (i, a) in spheres.iter().enumerate() {
+                assert!(a.min.cmpge(glam::Vec3::new(-2.0, 0.0, -2.0)).all() && a.max.cmple(glam::Vec3::new(2.0, 3.0, 2.0)).all());
+                for b in &spheres[i + 1..] {
+                    assert!((a.center() - b.center()).length() > 0.8, "spheres {k} overlap");
+                }
+            }
+        }
+        assert_eq!(Part::parse("mutual"), Some(Part::Mutual));
+        assert_eq!(Part::parse("tabel1"), None);
+    }
 }

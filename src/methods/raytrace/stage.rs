@@ -607,7 +607,7 @@ impl RayTrace {
 }
 
 /// Secondary and shadow rays start this far from the surface they leave (besides skipping
-/// its triangle): 10⁻⁵ of the scene's diagonal, far above f32 rounding of positions of
+/// its triangle): 10⁻⁶ of the scene's diagonal, far above f32 rounding of positions of
 /// the scene's size at any scale (1 mm or 1 km scenes alike).
 fn list_offset(list: &TriangleList) -> f32 {
     let (lo, hi) = list.bounds();
