@@ -65,6 +65,15 @@ pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     }
 }
 
+/// A mesh's interleaved vertices, as `scene.vertices` holds them.
+pub fn vertices_of(m: &crate::scene::Mesh) -> impl Iterator<Item = Vertex> + '_ {
+    m.positions.iter().zip(&m.normals).zip(&m.uvs).map(|((p, n), t)| Vertex {
+        position: p.to_array(),
+        normal: n.to_array(),
+        uv: t.to_array(),
+    })
+}
+
 /// `LIGHT_*` of a light, as `GpuLight.direction_kind.w` holds it.
 pub fn light_kind_code(k: LightKind) -> f32 {
     let code = match k {
@@ -93,11 +102,7 @@ impl GpuScene {
                 mesh: i as u32,
                 specular: scene.materials[m.material].kind.is_specular(),
             });
-            vertices.extend(m.positions.iter().zip(&m.normals).zip(&m.uvs).map(|((p, n), t)| Vertex {
-                position: p.to_array(),
-                normal: n.to_array(),
-                uv: t.to_array(),
-            }));
+            vertices.extend(vertices_of(m));
             indices.extend_from_slice(&m.indices);
         }
         let materials: Vec<GpuMaterial> = scene.materials.iter().map(gpu_material).collect();

@@ -27,7 +27,7 @@ pub mod vk;
 pub use methods::{Choice, Method};
 pub use plan::{plan, plan_with, Choices, Plan};
 pub use quality::Quality;
-pub use renderer::{Frame, Renderer};
+pub use renderer::{Frame, MapUpdate, Renderer};
 pub use scene::Scene;
 
 /// Renders `scene` with `method` (or `Choice::Auto`) at `(width, height)`: `warmup` frames

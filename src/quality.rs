@@ -92,6 +92,9 @@ pub struct Quality {
     pub tile_size: u32,
     /// Ray tracing: count rays per bounce and the ray hierarchy's culling (costs a pass).
     pub ray_stats: bool,
+    /// Maps (shadow, environment, distance, refractor) regenerated every frame, else only
+    /// when what they depend on changed (frames over time).
+    pub map_updates_always: bool,
 }
 
 /// One knob, declared once.
@@ -139,6 +142,7 @@ const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single",
 const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
 const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
 const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
+const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
@@ -450,6 +454,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| q.proxy_radius.map_or("auto".into(), |r| r.to_string()),
     },
     Knob {
+        name: "map_updates",
+        values: "on_change|always",
+        default: "on_change",
+        doc: "frames over time: regenerate a map only when the objects, materials or lights it depends on changed, or every frame (benchmarks)",
+        set: |q, v| {
+            q.map_updates_always = one_of(v, MAP_UPDATES)?;
+            Ok(())
+        },
+        get: |q| name_of(q.map_updates_always, MAP_UPDATES),
+    },
+    Knob {
         name: "planner",
         values: "accuracy|speed",
         default: "accuracy",
@@ -492,6 +507,7 @@ impl Default for Quality {
             kd_restart: false,
             tile_size: 16,
             ray_stats: false,
+            map_updates_always: false,
         }
     }
 }

@@ -12,12 +12,13 @@ use crate::frame::camera::CameraShade;
 use crate::frame::direct::{SceneDirect, DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{binding, BINDINGS, MAP_BINDINGS, MAP_SHADING_SKY};
 use crate::frame::shadow::ShadowMaps;
-use crate::frame::stage::{FrameIo, LayerField, MapSets, Maps, Stage, StageInit, ViewLayout};
+use crate::frame::stage::{order, FrameIo, LayerField, MapSets, Maps, Stage, StageInit, ViewLayout};
 use crate::frame::{output, views};
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, PUSH_BYTES};
 use crate::gpu_scene::{GpuLight, GpuObject, GpuScene, GpuView};
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
+use crate::scene::update::Changes;
 use crate::scene::{Camera, Scene};
 use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image};
 use crate::vk::{
@@ -36,6 +37,30 @@ pub struct Frame {
     pub memory: Vec<(String, u64)>,
     /// What the stages counted in this frame (`Stage::stats`).
     pub stats: Vec<(String, f64)>,
+    /// The maps this frame regenerated, and why (a map not listed was kept).
+    pub map_updates: Vec<MapUpdate>,
+}
+
+/// A map stage the frame recorded, and why: its first frame, `map_updates=always`, or what
+/// it depends on that changed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MapUpdate {
+    pub stage: &'static str,
+    pub reason: String,
+}
+
+/// What a stage's output depends on, so that a frame records it only when that changed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Deps {
+    /// The camera's view (direct light, camera passes, ray tracing): every frame.
+    EveryFrame,
+    /// Shadow maps: the geometry and the lights (not materials, not the camera).
+    Shadows,
+    /// Maps around objects (environment, distance, refractor): everything they see, which
+    /// is the whole scene's geometry, materials and lights, but not the camera.
+    World,
+    /// Maps from the camera (image-space refraction's back faces): camera and geometry.
+    CameraMap,
 }
 
 impl Frame {
@@ -85,6 +110,21 @@ pub struct Renderer {
     light_count: u32,
     light_table: Vec<GpuLight>,
     last_timings: Vec<PassTiming>,
+    /// The scene the GPU holds (meshes, materials, lights, camera; no texels): what
+    /// `update` compares a new state with.
+    cpu: Scene,
+    texture_count: usize,
+    has_environment: bool,
+    /// Changes taken by `update`, uploaded when the next frame is recorded.
+    pending: Changes,
+    /// Per stage, in `stages` order.
+    deps: Vec<Deps>,
+    /// Per stage: frames it still records after a change (inter-object cycles spread over
+    /// frames by `frame_latency`).
+    latency_left: Vec<u32>,
+    first_frame: bool,
+    /// The map stages the last recorded frame regenerated.
+    map_updates: Vec<MapUpdate>,
 }
 
 impl Renderer {
@@ -130,6 +170,14 @@ impl Renderer {
             light_count: 0,
             light_table: Vec::new(),
             last_timings: Vec::new(),
+            cpu: geometry_of(scene),
+            texture_count: scene.textures.len(),
+            has_environment: scene.environment.is_some(),
+            pending: Changes::default(),
+            deps: Vec::new(),
+            latency_left: Vec::new(),
+            first_frame: true,
+            map_updates: Vec::new(),
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -145,33 +193,7 @@ impl Renderer {
             MemoryLocation::CpuToGpu,
         )?;
 
-        let mut objects: Vec<GpuObject> = scene
-            .meshes
-            .iter()
-            .map(|m| GpuObject {
-                material: m.material as u32,
-                envmap_layer: -1,
-                refractor_layer: -1,
-                map_shading: MAP_SHADING_SKY,
-                reference_point: [0.0; 4],
-                proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
-                proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
-            })
-            .collect();
-        for o in &plan.objects {
-            let g = &mut objects[o.mesh];
-            g.reference_point = o.reference_point.extend(plan.proxy_radius).to_array();
-            g.map_shading = o.map_shading.code();
-            // The object's layer in each map array, by the slot the map fills.
-            for m in &o.maps {
-                match m.layer_field {
-                    Some(LayerField::Envmap) => g.envmap_layer = m.layer as i32,
-                    Some(LayerField::Refractor) => g.refractor_layer = m.layer as i32,
-                    None => {}
-                }
-            }
-        }
-        self.objects = Buffer::with_data(ctx, "scene.objects", &objects, vk::BufferUsageFlags::STORAGE_BUFFER)?;
+        self.objects = Buffer::with_data(ctx, "scene.objects", &object_table(scene, plan), vk::BufferUsageFlags::STORAGE_BUFFER)?;
 
         self.light_table = views::light_table(scene, &self.plan);
         self.light_count = self.light_table.len() as u32;
@@ -249,9 +271,18 @@ impl Renderer {
             height: self.height,
         };
         for spec in &self.plan.stages {
+            self.deps.push(match spec {
+                StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
+                StageSpec::Shadows => Deps::Shadows,
+                StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
+                StageSpec::Map(_) => Deps::World,
+            });
             let stage: Box<dyn Stage> = match spec {
                 // The scene records its own upload (first frame only).
-                StageSpec::Upload => continue,
+                StageSpec::Upload => {
+                    self.deps.pop();
+                    continue;
+                }
                 StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
                 StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout)?),
                 StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
@@ -262,13 +293,150 @@ impl Renderer {
             };
             self.stages.push(stage);
         }
+        self.latency_left = vec![0; self.stages.len()];
+        Ok(())
+    }
+
+    /// Takes the scene's new state for the next recorded frame: moved objects, changed
+    /// materials, lights and camera (the scene's own setters validate each change:
+    /// `Scene::set_object_transform`, `set_material`, `set_light`). The topology must be
+    /// the renderer's (same objects, triangles, textures, material and light kinds), and the
+    /// plan's structure must survive (each object keeps its method and maps; reference
+    /// points and proxies follow the objects). Touches no GPU memory: the next `record`
+    /// uploads the change in place, so a frame may still be in flight. On error nothing
+    /// changes. Returns what changed.
+    pub fn update(&mut self, scene: &Scene) -> Result<Changes> {
+        scene.validate()?;
+        if scene.textures.len() != self.texture_count || scene.environment.is_some() != self.has_environment {
+            return Err(Error::invalid("scene update", "other textures or environment: make a new renderer"));
+        }
+        let new = geometry_of(scene);
+        let c = Changes::between(&self.cpu, &new)?;
+        if c.is_empty() {
+            return Ok(c);
+        }
+        let mut plan = self.plan.clone();
+        if !c.moved.is_empty() {
+            plan.refresh_geometry(scene)?;
+        }
+        let camera = if c.camera { Some(scene.camera_or_default()) } else { None };
+        if let Some(cam) = &camera {
+            cam.validate()?;
+        }
+        self.plan = plan;
+        self.cpu = new;
+        if let Some(cam) = camera {
+            self.camera = cam;
+        }
+        self.pending.merge(&c);
+        Ok(c)
+    }
+
+    /// The map stages the last recorded frame regenerated, and why.
+    pub fn map_updates(&self) -> &[MapUpdate] {
+        &self.map_updates
+    }
+
+    /// Uploads the pending changes in place and decides which map stages this frame
+    /// records. Called by `record`: every earlier frame has completed (the one-frame-in-
+    /// flight rule), so the host-visible buffers are free to write.
+    fn apply_updates(&mut self, ctx: &Context) -> Result<()> {
+        let c = std::mem::take(&mut self.pending);
+        if !c.moved.is_empty() {
+            for &i in &c.moved {
+                let d = self.scene.draws[i];
+                let v: Vec<crate::gpu_scene::Vertex> = crate::gpu_scene::vertices_of(&self.cpu.meshes[i]).collect();
+                let at = d.vertex_offset as usize * std::mem::size_of::<crate::gpu_scene::Vertex>();
+                self.scene.vertices.write_at(at, bytemuck::cast_slice(&v))?;
+            }
+            self.objects.write(bytemuck::cast_slice(&object_table(&self.cpu, &self.plan)))?;
+        }
+        if !c.materials.is_empty() {
+            let m: Vec<_> = self.cpu.materials.iter().map(crate::gpu_scene::gpu_material).collect();
+            self.scene.materials.write(bytemuck::cast_slice(&m))?;
+        }
+        if !c.moved.is_empty() || !c.lights.is_empty() {
+            // A directional light's shadow projection covers the scene's bounds.
+            self.light_table = views::light_table(&self.cpu, &self.plan);
+            if let Some(l) = &mut self.lights {
+                l.write(bytemuck::cast_slice(&self.light_table))?;
+            }
+        }
+        if !c.is_empty() {
+            let init = StageInit {
+                ctx,
+                scene: &self.cpu,
+                gpu: &self.scene,
+                plan: &self.plan,
+                layout: self.layout,
+                set_layouts: [self.set_layout, self.maps_layout],
+                width: self.width,
+                height: self.height,
+            };
+            for s in &mut self.stages {
+                s.update(&init, &c, &mut self.maps)?;
+            }
+        }
+        self.map_updates.clear();
+        let names = |ids: &[usize], name: &dyn Fn(usize) -> String| ids.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ");
+        let moved = names(&c.moved, &|i| format!("'{}'", self.cpu.meshes[i].name));
+        let materials = names(&c.materials, &|i| format!("'{}'", self.cpu.materials[i].name));
+        let lights = names(&c.lights, &|i| format!("'{}'", self.cpu.lights[i].name));
+        let q = &self.plan.quality;
+        for (i, deps) in self.deps.iter().enumerate() {
+            let mut why = Vec::new();
+            if self.first_frame {
+                why.push("first frame".to_string());
+            } else if q.map_updates_always {
+                why.push("map_updates=always".to_string());
+            } else {
+                let geometry = !c.moved.is_empty();
+                let (g, m, l, cam) = match deps {
+                    Deps::EveryFrame => continue,
+                    Deps::Shadows => (geometry, false, !c.lights.is_empty(), false),
+                    Deps::World => (geometry, !c.materials.is_empty(), !c.lights.is_empty(), false),
+                    Deps::CameraMap => (geometry, false, false, c.camera),
+                };
+                if g {
+                    why.push(format!("moved {moved}"));
+                }
+                if m {
+                    why.push(format!("material {materials}"));
+                }
+                if l {
+                    why.push(format!("light {lights}"));
+                }
+                if cam {
+                    why.push("camera".to_string());
+                }
+            }
+            if *deps == Deps::EveryFrame {
+                continue;
+            }
+            if !why.is_empty() && self.plan.frame_latency && *deps == Deps::World {
+                // One inter-object cycle per frame: the change needs `cycles` frames.
+                self.latency_left[i] = q.cycles.max(1);
+            }
+            if why.is_empty() && self.latency_left[i] > 0 {
+                why.push(format!("frame latency: {} more cycle(s)", self.latency_left[i]));
+            }
+            self.latency_left[i] = self.latency_left[i].saturating_sub(1);
+            if !why.is_empty() {
+                self.map_updates.push(MapUpdate { stage: self.stages[i].name(), reason: why.join("; ") });
+            }
+        }
+        self.first_frame = false;
         Ok(())
     }
 
     /// Replaces the camera (the output size's aspect ratio still wins).
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         camera.validate()?;
+        if camera != self.camera {
+            self.pending.camera = true;
+        }
         self.camera = camera;
+        self.cpu.camera = Some(camera);
         Ok(())
     }
 
@@ -315,6 +483,7 @@ impl Renderer {
     /// layout. The view table is written by the host now, so only one frame may be in
     /// flight at a time.
     pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
+        self.apply_updates(ctx)?;
         self.write_views()?;
         let mut rec = Recorder::new(ctx, cmd, &mut self.profiler);
         self.scene.record_upload(&mut rec);
@@ -338,7 +507,10 @@ impl Renderer {
             sets: &self.sets,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
         };
-        for stage in &mut self.stages {
+        for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
+            if *deps != Deps::EveryFrame && !self.map_updates.iter().any(|u| u.stage == stage.name()) {
+                continue; // its maps still hold what this frame would draw
+            }
             stage.record(&mut rec, &f, &mut io);
         }
         if let Some(rb) = &self.readback {
@@ -401,7 +573,7 @@ impl Renderer {
             return Err(Error::Validation(errors));
         }
         let stats = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
-        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats })
+        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates: self.map_updates.clone() })
     }
 
     /// Frees everything. The GPU must be idle with respect to this renderer's frames.
@@ -456,4 +628,50 @@ impl crate::vk::Owner for Renderer {
     fn destroy(&mut self, ctx: &Context) {
         Renderer::destroy(self, ctx)
     }
+}
+
+/// The scene without its texels and environment: what the renderer keeps to compare
+/// updates with and to hand its stages.
+fn geometry_of(scene: &Scene) -> Scene {
+    Scene {
+        meshes: scene.meshes.clone(),
+        materials: scene.materials.clone(),
+        lights: scene.lights.clone(),
+        camera: scene.camera,
+        textures: Vec::new(),
+        environment: None,
+        skipped: Vec::new(),
+    }
+}
+
+/// The object table (`scene.objects`): per mesh its material, reference point and proxy,
+/// how it shows in maps, and its layer in each map array.
+fn object_table(scene: &Scene, plan: &Plan) -> Vec<GpuObject> {
+    let mut objects: Vec<GpuObject> = scene
+        .meshes
+        .iter()
+        .map(|m| GpuObject {
+            material: m.material as u32,
+            envmap_layer: -1,
+            refractor_layer: -1,
+            map_shading: MAP_SHADING_SKY,
+            reference_point: [0.0; 4],
+            proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
+            proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
+        })
+        .collect();
+    for o in &plan.objects {
+        let g = &mut objects[o.mesh];
+        g.reference_point = o.reference_point.extend(plan.proxy_radius).to_array();
+        g.map_shading = o.map_shading.code();
+        // The object's layer in each map array, by the slot the map fills.
+        for m in &o.maps {
+            match m.layer_field {
+                Some(LayerField::Envmap) => g.envmap_layer = m.layer as i32,
+                Some(LayerField::Refractor) => g.refractor_layer = m.layer as i32,
+                None => {}
+            }
+        }
+    }
+    objects
 }

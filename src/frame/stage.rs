@@ -43,6 +43,13 @@ pub trait Stage {
     fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
         Vec::new()
     }
+    /// Takes a change of the scene (`init.scene` is the new state) before the frame that
+    /// shows it is recorded: a stage that holds data derived from the geometry or the
+    /// materials (an acceleration structure, per-vertex thickness) refreshes it here. The
+    /// GPU has completed every earlier frame of this renderer.
+    fn update(&mut self, _init: &StageInit, _changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// The frame's shared maps, one per descriptor slot (`binding::*`, src/frame/layout.in.rs).

@@ -176,6 +176,52 @@ impl Plan {
         self.objects.iter().all(|o| o.method.is_gpu()) && !matches!(self.choice, Choice::Method(m) if !m.is_gpu())
     }
 
+    /// After objects moved: the geometry-dependent parts of the plan (reference points,
+    /// proxies, the cube maps' near plane) as the planner computes them for `scene` with
+    /// every object kept on its method. Refused, with the plan unchanged, when that plan
+    /// would have another structure (other stages, maps or shadow maps).
+    pub fn refresh_geometry(&mut self, scene: &Scene) -> Result<()> {
+        let methods = |p: &Plan| p.objects.iter().map(|o| (o.mesh, o.method.name())).collect::<Vec<_>>();
+        let same = |fresh: &Plan| {
+            fresh.stages == self.stages
+                && fresh.shadow_cubes == self.shadow_cubes
+                && fresh.shadow_planes == self.shadow_planes
+                && methods(fresh) == methods(self)
+                && fresh.envmaps.iter().map(|e| e.mesh).eq(self.envmaps.iter().map(|e| e.mesh))
+        };
+        // The plan a fresh renderer would get; if the planner would now choose otherwise for
+        // some object, the same plan with every object kept on its method.
+        let mut fresh = plan(scene, self.choice, &self.quality);
+        if !same(&fresh) {
+            let choices = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
+            if let Ok(kept) = plan_with(scene, &choices, &self.quality) {
+                fresh = kept;
+            }
+        }
+        if !same(&fresh) {
+            let what = match fresh.stages.iter().zip(&self.stages).find(|(a, b)| a != b) {
+                Some((a, b)) => format!("{} was {b:?}, now {a:?}", a.name()),
+                None => format!(
+                    "passes now {}, maps of {:?}",
+                    fresh.passes.join(", "),
+                    fresh.envmaps.iter().map(|e| e.mesh).collect::<Vec<_>>()
+                ),
+            };
+            return Err(Error::invalid("scene update", format!("the plan changes ({what}): make a new renderer")));
+        }
+        for (o, f) in self.objects.iter_mut().zip(&fresh.objects) {
+            o.reference_point = f.reference_point;
+            o.reference_note = f.reference_note.clone();
+        }
+        for (e, f) in self.envmaps.iter_mut().zip(&fresh.envmaps) {
+            e.reference_point = f.reference_point;
+        }
+        self.cube_near = fresh.cube_near;
+        self.proxy_radius = fresh.proxy_radius;
+        self.proxy_box = fresh.proxy_box;
+        Ok(())
+    }
+
     /// Device memory the plan's maps will hold (bytes), excluding the frame's own images.
     pub fn map_bytes(&self) -> u64 {
         self.stages.iter().map(|s| if let StageSpec::Map(m) = s { m.bytes } else { 0 }).sum()

@@ -10,6 +10,7 @@
 mod environment;
 pub mod gltf;
 pub mod shapes;
+pub mod update;
 
 pub use self::gltf::load;
 pub use environment::*;
@@ -105,6 +106,13 @@ pub struct Mesh {
     pub aliases: Vec<String>,
     /// The method the scene file asks for (`extras.specula.method`), if any.
     pub method: Option<String>,
+    /// The object-to-world transform its positions carry (every [`Mesh::transform`]
+    /// composed: the glTF node's world matrix, the C ABI's `transform`); identity for
+    /// geometry given in world space. [`Scene::set_object_transform`] replaces it.
+    pub world: Mat4,
+    /// The geometry in object space, kept once the object has been moved (see
+    /// `scene::update`), so that every new transform starts from the same data.
+    pub rest: Option<std::sync::Arc<update::Rest>>,
 }
 
 impl Mesh {
@@ -115,6 +123,7 @@ impl Mesh {
     /// last two indices of every triangle so that the winding stays counter-clockwise.
     /// Used by the glTF importer (node world transforms) and the C ABI (`transform`).
     pub fn transform(&mut self, world: Mat4) {
+        self.world = world * self.world;
         for p in &mut self.positions {
             *p = world.transform_point3(*p);
         }

@@ -90,6 +90,23 @@ impl Buffer {
         Ok(())
     }
 
+    /// Writes `bytes` at byte `offset` of a host-visible buffer (in place: the GPU must not
+    /// be reading that range, i.e. the frames that read it have completed).
+    pub fn write_at(&mut self, offset: usize, bytes: &[u8]) -> Result<()> {
+        let name = self.name.clone();
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| Error::invalid(&name, "buffer is not host-visible"))?;
+        let end = offset.checked_add(bytes.len()).filter(|&e| e <= slice.len());
+        let Some(end) = end else {
+            return Err(Error::invalid(&name, format!("{} bytes at {offset} do not fit in {}", bytes.len(), slice.len())));
+        };
+        slice[offset..end].copy_from_slice(bytes);
+        Ok(())
+    }
+
     /// Reads a host-visible buffer.
     pub fn read(&self) -> Result<&[u8]> {
         self.allocation.as_ref().and_then(|a| a.mapped_slice()).ok_or_else(|| Error::invalid(&self.name, "buffer is not host-visible"))

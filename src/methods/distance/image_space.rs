@@ -107,6 +107,17 @@ impl Stage for Backfaces {
         "image_space.backfaces"
     }
 
+    /// A moved (possibly scaled) refractor has other thicknesses: rewritten in place.
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
+        if !changes.moved.iter().any(|m| self.objects.contains(m)) {
+            return Ok(());
+        }
+        match maps.thickness.as_mut() {
+            Some(t) => t.write(bytemuck::cast_slice(&vertex_thickness(init.scene, &self.objects))),
+            None => Ok(()),
+        }
+    }
+
     /// The nearest back face of this pass's refractors, from the camera.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let Some(map) = io.maps.backfaces.as_mut() else { return };

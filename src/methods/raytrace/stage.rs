@@ -624,6 +624,40 @@ impl Stage for RayTrace {
         self.name
     }
 
+    /// Moved objects: the structure is rebuilt from the new triangles (on the CPU, like the
+    /// first one; a refit would keep a BVH's topology but let its boxes grow loose as
+    /// objects travel, and the grid and kd-tree have no refit), the per-triangle shading
+    /// rewritten in place and the rays' start offset follows the scene's size.
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut crate::frame::stage::Maps) -> Result<()> {
+        if changes.moved.is_empty() {
+            return Ok(());
+        }
+        let ctx = init.ctx;
+        let list = TriangleList::from_scene(init.scene);
+        let start = std::time::Instant::now();
+        let packed = self.scheme.build(&list)?;
+        self.build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let fresh = Structure::new(ctx, self.scheme, &list, &packed)?;
+        if let Some(mut old) = self.structure.replace(fresh) {
+            old.destroy(ctx);
+        }
+        let structure = self.structure.as_ref().expect("just set");
+        for &set in self.ray_sets.iter().chain(&self.shadow_sets) {
+            structure.write(ctx, set);
+        }
+        self.shading.write(bytemuck::cast_slice(&triangle_shading(init.scene)))?;
+        let mut params = self.params.read()?.to_vec();
+        let t_min = list_offset(&list);
+        let size = std::mem::size_of::<GpuTraceParams>();
+        for k in 0..=self.depth as usize {
+            let at = k * self.stride as usize;
+            let mut p: GpuTraceParams = bytemuck::pod_read_unaligned(&params[at..at + size]);
+            p.t_min = t_min;
+            params[at..at + size].copy_from_slice(bytemuck::bytes_of(&p));
+        }
+        self.params.write(&params)
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let view = io.views.camera;

@@ -1,0 +1,203 @@
+//! Frames over time (issue 13): a renderer takes moved objects, changed materials, lights
+//! and cameras in place, regenerates only the maps whose inputs changed, and its image then
+//! equals a fresh renderer's for the same state, bit for bit.
+
+mod common;
+
+use glam::{Mat4, Quat, Vec3};
+use specula::plan::{plan_with, Choices};
+use specula::scene::{Scene, SurfaceKind};
+use specula::{Method, Quality, Renderer};
+
+const SIZE: (u32, u32) = (40, 30);
+
+fn quality() -> Quality {
+    Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() }
+}
+
+fn renderer(ctx: &specula::vk::Context, scene: &Scene, m: Method, q: &Quality) -> Renderer {
+    let plan = plan_with(scene, &Choices::all(m), q).unwrap();
+    Renderer::new(ctx, scene, plan, SIZE.0, SIZE.1).unwrap()
+}
+
+fn mirror_index(s: &Scene) -> usize {
+    s.meshes.iter().position(|m| matches!(s.materials[m.material].kind, SurfaceKind::Mirror { .. })).unwrap()
+}
+
+/// The k-th pose of the moving mirror sphere: along a short arc, turning and growing a little.
+fn pose(k: usize, centre: Vec3) -> Mat4 {
+    let t = k as f32 * 0.07;
+    let to = centre + Vec3::new(0.3 * t.sin(), 0.05 * t, 0.2 * (1.0 - t.cos()));
+    Mat4::from_translation(to)
+        * Mat4::from_scale_rotation_translation(Vec3::splat(1.0 + 0.1 * t), Quat::from_rotation_y(t), Vec3::ZERO)
+        * Mat4::from_translation(-centre)
+}
+
+fn bits(f: &specula::Frame) -> Vec<u32> {
+    f.image.data.iter().map(|v| v.to_bits()).collect()
+}
+
+fn fresh(ctx: &specula::vk::Context, scene: &Scene, m: Method, q: &Quality) -> Vec<u32> {
+    let mut r = renderer(ctx, scene, m, q);
+    let f = r.render(ctx).unwrap();
+    r.destroy(ctx);
+    bits(&f)
+}
+
+/// Every GPU method: the mirror sphere moves for 10 frames (4 for the O(N)-per-ray ray
+/// engine and ray hierarchy); each incrementally updated
+/// frame equals a fresh render of the same scene.
+#[test]
+fn incremental_equals_fresh_for_every_gpu_method() {
+    let ctx = common::gpu();
+    let base = common::mirror_and_glass(24);
+    let i = mirror_index(&base);
+    let centre = base.meshes[i].bounds().center();
+    let q = quality();
+    for &m in specula::Method::ALL.iter().filter(|m| m.is_gpu()) {
+        let frames = if matches!(m.name(), "ray-engine" | "ray-hierarchy") { 4 } else { 10 };
+        let mut scene = base.clone();
+        let mut r = renderer(&ctx, &scene, m, &q);
+        r.render(&ctx).unwrap();
+        for k in 1..=frames {
+            scene.set_object_transform(i, pose(k, centre)).unwrap();
+            let c = r.update(&scene).unwrap();
+            assert_eq!(c.moved, vec![i]);
+            let got = bits(&r.render(&ctx).unwrap());
+            assert!(got == fresh(&ctx, &scene, m, &q), "{}: frame {k} after a move differs from a fresh render", m.name());
+        }
+        r.destroy(&ctx);
+    }
+    common::assert_clean(&ctx);
+}
+
+/// Ten frames of the demo's mirror sphere on a path (distance maps, shadow maps, the
+/// point light): incremental equals fresh at every frame.
+#[test]
+fn ten_frames_of_a_moving_mirror_sphere() {
+    let ctx = common::gpu();
+    let base = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
+    let i = mirror_index(&base);
+    let centre = base.meshes[i].bounds().center();
+    let q = quality();
+    let mut scene = base.clone();
+    let mut r = renderer(&ctx, &scene, specula::methods::DISTANCE, &q);
+    r.render(&ctx).unwrap();
+    for k in 1..=10 {
+        scene.set_object_transform(i, pose(k, centre)).unwrap();
+        r.update(&scene).unwrap();
+        let f = r.render(&ctx).unwrap();
+        let rebuilt: Vec<&str> = f.map_updates.iter().map(|u| u.stage).collect();
+        assert!(rebuilt.contains(&"shadow.generate") && rebuilt.contains(&"distance.generate"), "frame {k}: {rebuilt:?}");
+        assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::DISTANCE, &q), "frame {k} differs from a fresh render");
+    }
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+fn pass_names(f: &specula::Frame) -> Vec<&str> {
+    f.passes.iter().map(|p| p.name.as_str()).collect()
+}
+
+/// Nothing moves: frame 2 records no map pass. The light moves: shadow and distance maps
+/// are rebuilt. The camera moves: no map is. `map_updates=always` rebuilds every frame.
+#[test]
+fn only_what_changed_is_rebuilt() {
+    let ctx = common::gpu();
+    let mut scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
+    let q = quality();
+    let mut r = renderer(&ctx, &scene, specula::methods::DISTANCE, &q);
+    let first = r.render(&ctx).unwrap();
+    assert!(first.map_updates.iter().all(|u| u.reason == "first frame"), "{:?}", first.map_updates);
+    assert!(pass_names(&first).contains(&"distance.generate"));
+    let second = r.render(&ctx).unwrap();
+    assert!(second.map_updates.is_empty(), "{:?}", second.map_updates);
+    for p in ["shadow.generate", "distance.generate"] {
+        assert!(!pass_names(&second).contains(&p), "static frame 2 recorded {p}: {:?}", pass_names(&second));
+    }
+    assert!(bits(&second) == bits(&first), "a static scene's frame 2 equals frame 1");
+
+    // The camera moves: only camera passes.
+    let mut cam = scene.camera.unwrap();
+    cam.position += Vec3::new(0.1, 0.0, 0.0);
+    cam.world_from_camera = Mat4::from_translation(Vec3::new(0.1, 0.0, 0.0)) * cam.world_from_camera;
+    scene.camera = Some(cam);
+    let c = r.update(&scene).unwrap();
+    assert!(c.camera && c.moved.is_empty());
+    let f = r.render(&ctx).unwrap();
+    assert!(f.map_updates.is_empty(), "{:?}", f.map_updates);
+    assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::DISTANCE, &q));
+
+    // The light moves: shadow maps and the distance maps (they hold lit radiance).
+    let mut light = scene.lights[0].clone();
+    light.position += Vec3::new(0.2, -0.1, 0.0);
+    scene.set_light(0, light).unwrap();
+    r.update(&scene).unwrap();
+    let f = r.render(&ctx).unwrap();
+    let rebuilt: Vec<(&str, &str)> = f.map_updates.iter().map(|u| (u.stage, u.reason.as_str())).collect();
+    assert_eq!(rebuilt, vec![("shadow.generate", "light 'light'"), ("distance.generate", "light 'light'")]);
+    assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::DISTANCE, &q));
+
+    // A material: the maps that see it, not the shadow maps.
+    let box_material = scene.materials.iter().position(|m| m.name == "box").unwrap();
+    let mut m = scene.materials[box_material].clone();
+    m.base_color = Vec3::new(0.9, 0.2, 0.1);
+    scene.set_material(box_material, m).unwrap();
+    r.update(&scene).unwrap();
+    let f = r.render(&ctx).unwrap();
+    let rebuilt: Vec<&str> = f.map_updates.iter().map(|u| u.stage).collect();
+    assert_eq!(rebuilt, vec!["distance.generate"]);
+    assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::DISTANCE, &q));
+    r.destroy(&ctx);
+
+    // Benchmarks: every frame.
+    let always = Quality { map_updates_always: true, ..q.clone() };
+    let mut r = renderer(&ctx, &scene, specula::methods::DISTANCE, &always);
+    r.render(&ctx).unwrap();
+    let f = r.render(&ctx).unwrap();
+    assert!(pass_names(&f).contains(&"distance.generate") && f.map_updates.iter().all(|u| u.reason == "map_updates=always"));
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+/// Refused updates name the object, the field and the value, and change nothing.
+#[test]
+fn bad_updates_are_refused_and_keep_the_state() {
+    let mut scene = common::mirror_and_glass(12);
+    let before = scene.clone();
+    let i = mirror_index(&scene);
+    let nan = Mat4::from_translation(Vec3::new(f32::NAN, 0.0, 0.0));
+    let e = scene.set_object_transform(i, nan).unwrap_err().to_string();
+    assert!(e.contains("object 'mirror': transform") && e.contains("NaN"), "{e}");
+    let e = scene.set_object_transform(i, Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))).unwrap_err().to_string();
+    assert!(e.contains("determinant 0"), "{e}");
+    let e = scene.set_object_transform(i, Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).unwrap_err().to_string();
+    assert!(e.contains("opposite sign"), "{e}");
+    let e = scene.set_object_transform(99, Mat4::IDENTITY).unwrap_err().to_string();
+    assert!(e.contains("99 is out of range"), "{e}");
+    let far = Mat4::from_scale_rotation_translation(Vec3::new(1e-38, 3e38, 1.0), Quat::IDENTITY, Vec3::ZERO);
+    let e = scene.set_object_transform(i, far).unwrap_err().to_string();
+    assert!(e.contains("not finite"), "{e}");
+    let glass = scene.meshes.iter().find(|m| m.name == "glass").unwrap().material;
+    let mut m = scene.materials[glass].clone();
+    m.kind = SurfaceKind::Dielectric { ior: -1.0, thin: false };
+    let e = scene.set_material(glass, m.clone()).unwrap_err().to_string();
+    assert!(e.contains("ior") && e.contains("-1"), "{e}");
+    m.kind = SurfaceKind::Diffuse;
+    let e = scene.set_material(glass, m).unwrap_err().to_string();
+    assert!(e.contains("kind") && e.contains("solid dielectric"), "{e}");
+    assert!(scene == before, "refused updates changed the scene");
+
+    // A scene of another topology is refused by a renderer, which keeps its state.
+    let ctx = common::gpu();
+    let q = quality();
+    let mut r = renderer(&ctx, &scene, specula::methods::DISTANCE, &q);
+    let a = bits(&r.render(&ctx).unwrap());
+    let mut other = scene.clone();
+    other.meshes.pop();
+    let e = r.update(&other).unwrap_err().to_string();
+    assert!(e.contains("objects"), "{e}");
+    assert!(bits(&r.render(&ctx).unwrap()) == a);
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
