@@ -279,6 +279,14 @@ typedef struct {
   double cpu_ms;
 } SpeculaPassTiming;
 
+// A map a frame regenerated, and why (specula_get_map_updates).
+typedef struct {
+  // NUL-terminated stage name, e.g. "distance.generate".
+  char stage[48];
+  // NUL-terminated, e.g. "first frame", "moved 'mesh2'", "light 'light0'".
+  char reason[208];
+} SpeculaMapUpdate;
+
 #define SPECULA_SUCCESS 0
 
 // Warning: the output array was too small; `count` holds the number needed.
@@ -489,6 +497,38 @@ SpeculaResult specula_context_set_object_method(SpeculaContext *ctx,
 SpeculaResult specula_context_set_object_method_at(SpeculaContext *ctx,
                                                    uint32_t index,
                                                    SpeculaMethod method);
+
+// Sets object `object`'s world transform: 16 floats, column-major (like glTF and the
+// mesh descriptor's `transform`), replacing the one it was added or loaded with. Refused:
+// NaN or infinite entries, a singular matrix (zero scale), a mirroring matrix for an object
+// that was not mirrored (or the reverse), an unknown object. Not thread-safe with other
+// calls on the same context; the GPU need not be idle.
+SpeculaResult specula_context_set_object_transform(SpeculaContext *ctx,
+                                                   uint32_t object,
+                                                   const float *matrix);
+
+// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
+// surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
+// again). Validated like specula_context_add_material; the GPU need not be idle.
+SpeculaResult specula_context_set_material(SpeculaContext *ctx,
+                                           uint32_t index,
+                                           const SpeculaMaterialDesc *desc);
+
+// Replaces light `index` (position, direction, intensity, range, cone). Its kind must
+// stay. Validated like specula_context_add_light; the GPU need not be idle.
+SpeculaResult specula_context_set_light(SpeculaContext *ctx,
+                                        uint32_t index,
+                                        const SpeculaLightDesc *desc);
+
+// Copies the maps the last recorded frame regenerated, with why (first frame, a moved
+// object, a changed material or light, the camera for camera-space maps,
+// map_updates=always), into `out` (up to `capacity`), their number into `*count`. A map
+// not listed kept its contents. `out` may be NULL with capacity 0 to query the count.
+// Returns SPECULA_WARNING_TRUNCATED when capacity was too small.
+SpeculaResult specula_get_map_updates(SpeculaContext *ctx,
+                                      SpeculaMapUpdate *out,
+                                      uint32_t capacity,
+                                      uint32_t *count);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -53,14 +53,29 @@ pub fn render_plan(
     (width, height): (u32, u32),
     (warmup, frames): (u32, u32),
 ) -> Result<Frame> {
+    render_frames(ctx, scene, plan, (width, height), (warmup, frames), |_, _| {})
+}
+
+/// As [`render_plan`], handing every frame (warm-up ones included, numbered from 0) to
+/// `each` as it completes: what `specula render` prints of the maps each frame rebuilt.
+pub fn render_frames(
+    ctx: &vk::Context,
+    scene: &Scene,
+    plan: Plan,
+    (width, height): (u32, u32),
+    (warmup, frames): (u32, u32),
+    mut each: impl FnMut(u32, &Frame),
+) -> Result<Frame> {
     let mut r = Renderer::new(ctx, scene, plan, width, height)?;
     let result = (|| {
-        for _ in 0..warmup {
-            r.render(ctx)?;
+        for k in 0..warmup {
+            each(k, &r.render(ctx)?);
         }
         let mut all = Vec::new();
-        for _ in 0..frames.max(1) {
-            all.push(r.render(ctx)?);
+        for k in 0..frames.max(1) {
+            let f = r.render(ctx)?;
+            each(warmup + k, &f);
+            all.push(f);
         }
         let passes = profile::median_passes(&all);
         let mut last = all.pop().unwrap();

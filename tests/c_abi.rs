@@ -139,6 +139,16 @@ fn examples_render_the_same_image_through_every_link_mode() {
 }
 
 #[test]
+fn updates_from_c_move_objects_and_rebuild_only_what_changed() {
+    let dir = scratch();
+    let exe = dir.join("updates");
+    compile("tests/c/updates.c", &exe, Link::Shared, &["-lm"]);
+    let out = run(&exe, &[]);
+    assert!(out.contains("\n0 failure(s)"), "{out}");
+    assert!(out.lines().filter(|l| l.contains(" ok ")).count() >= 30, "{out}");
+}
+
+#[test]
 fn misuse_from_c_returns_codes_and_survives() {
     let dir = scratch();
     let exe = dir.join("misuse");

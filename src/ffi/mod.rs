@@ -9,7 +9,8 @@
 //!
 //! Files: `types` (the ABI's structs, constants and result codes), `handle` (the context
 //! handle, panic boundary, errors, create/destroy), `scene` (scene-building calls),
-//! `frames` (configure, render, record, timings), `objects` (per-object methods). cbindgen reads them in that order, which
+//! `frames` (configure, render, record, timings), `objects` (per-object methods), `updates`
+//! (changes between frames). cbindgen reads them in that order, which
 //! is the order of the header.
 
 #![allow(clippy::missing_safety_doc)] // the header documents every call's contract
@@ -26,8 +27,11 @@ mod frames;
 
 mod objects;
 
+mod updates;
+
 pub use frames::*;
 pub use handle::*;
 pub use objects::*;
 pub use scene::*;
 pub use types::*;
+pub use updates::*;

@@ -4,7 +4,7 @@ use std::ffi::c_char;
 
 use glam::{Mat4, Vec3};
 
-use super::handle::{cstr, fail, header, vec3, with_ctx, SpeculaContext};
+use super::handle::{cstr, fail, header, vec3, with_ctx, FfiResult, SpeculaContext};
 use super::types::*;
 use crate::scene::{Camera, Light, LightKind, Material, Mesh, SurfaceKind};
 
@@ -30,19 +30,7 @@ pub unsafe extern "C" fn specula_context_add_material(
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
         let d = header(desc, SPECULA_STRUCT_MATERIAL_DESC, "material")?;
-        let kind = match d.surface {
-            SPECULA_SURFACE_DIFFUSE => SurfaceKind::Diffuse,
-            SPECULA_SURFACE_MIRROR => SurfaceKind::Mirror { nu: vec3(d.nu), kappa: vec3(d.kappa) },
-            SPECULA_SURFACE_DIELECTRIC => SurfaceKind::Dielectric { ior: d.ior, thin: d.thin != 0 },
-            s => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("material.surface: unknown value {s}")),
-        };
-        let m = Material {
-            name: format!("material{}", c.scene.materials.len()),
-            base_color: vec3(d.base_color),
-            emissive: vec3(d.emission),
-            kind,
-            ..Default::default()
-        };
+        let m = material_from_desc(d, format!("material{}", c.scene.materials.len()))?;
         let i = c.scene.add_material(m)?;
         c.scene_version += 1;
         if !out_index.is_null() {
@@ -50,6 +38,32 @@ pub unsafe extern "C" fn specula_context_add_material(
         }
         Ok(SPECULA_SUCCESS)
     })
+}
+
+/// The material a descriptor describes (validated by the scene's setters).
+pub(super) fn material_from_desc(d: &SpeculaMaterialDesc, name: String) -> FfiResult<Material> {
+    let kind = match d.surface {
+        SPECULA_SURFACE_DIFFUSE => SurfaceKind::Diffuse,
+        SPECULA_SURFACE_MIRROR => SurfaceKind::Mirror { nu: vec3(d.nu), kappa: vec3(d.kappa) },
+        SPECULA_SURFACE_DIELECTRIC => SurfaceKind::Dielectric { ior: d.ior, thin: d.thin != 0 },
+        s => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("material.surface: unknown value {s}")),
+    };
+    Ok(Material { name, base_color: vec3(d.base_color), emissive: vec3(d.emission), kind, ..Default::default() })
+}
+
+/// The light a descriptor describes (validated by the scene's setters).
+pub(super) fn light_from_desc(d: &SpeculaLightDesc, name: String) -> FfiResult<Light> {
+    let kind = match d.kind {
+        SPECULA_LIGHT_POINT => LightKind::Point,
+        SPECULA_LIGHT_SPOT => LightKind::Spot { inner_cone: d.inner_cone, outer_cone: d.outer_cone },
+        SPECULA_LIGHT_DIRECTIONAL => LightKind::Directional,
+        k => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.kind: unknown value {k}")),
+    };
+    if d.range.is_nan() || d.range < 0.0 {
+        return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.range: must be ≥ 0 (0: unbounded), got {}", d.range));
+    }
+    let range = (d.range > 0.0).then_some(d.range);
+    Ok(Light { name, kind, position: vec3(d.position), direction: vec3(d.direction), intensity: vec3(d.intensity), range })
 }
 
 /// Adds a triangle mesh (copied) to the context's scene.
@@ -113,25 +127,8 @@ pub unsafe extern "C" fn specula_context_add_mesh(
 pub unsafe extern "C" fn specula_context_add_light(ctx: *mut SpeculaContext, desc: *const SpeculaLightDesc) -> SpeculaResult {
     with_ctx(ctx, |c| {
         let d = header(desc, SPECULA_STRUCT_LIGHT_DESC, "light")?;
-        let kind = match d.kind {
-            SPECULA_LIGHT_POINT => LightKind::Point,
-            SPECULA_LIGHT_SPOT => LightKind::Spot { inner_cone: d.inner_cone, outer_cone: d.outer_cone },
-            SPECULA_LIGHT_DIRECTIONAL => LightKind::Directional,
-            k => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.kind: unknown value {k}")),
-        };
-        if d.range.is_nan() || d.range < 0.0 {
-            return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("light.range: must be ≥ 0 (0: unbounded), got {}", d.range));
-        }
-        let range = (d.range > 0.0).then_some(d.range);
-        let name = format!("light{}", c.scene.lights.len());
-        c.scene.add_light(Light {
-            name,
-            kind,
-            position: vec3(d.position),
-            direction: vec3(d.direction),
-            intensity: vec3(d.intensity),
-            range,
-        })?;
+        let l = light_from_desc(d, format!("light{}", c.scene.lights.len()))?;
+        c.scene.add_light(l)?;
         c.scene_version += 1;
         Ok(SPECULA_SUCCESS)
     })

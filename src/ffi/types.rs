@@ -275,3 +275,13 @@ pub struct SpeculaPassTiming {
     pub gpu_ms: f64,
     pub cpu_ms: f64,
 }
+
+/// A map a frame regenerated, and why (specula_get_map_updates).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct SpeculaMapUpdate {
+    /// NUL-terminated stage name, e.g. "distance.generate".
+    pub stage: [c_char; 48],
+    /// NUL-terminated, e.g. "first frame", "moved 'mesh2'", "light 'light0'".
+    pub reason: [c_char; 208],
+}

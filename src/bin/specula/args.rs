@@ -187,7 +187,9 @@ pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
         let which = if a.camera_target.is_some() { "--camera-target" } else { "--fov" };
         return Err(specula::Error::invalid(which, "needs --camera-pos (the scene's own camera is used otherwise)"));
     }
-    let mut quality = Quality::default();
+    // These commands time a static scene's frames: its maps are regenerated every frame
+    // (what a frame costs) unless `-q map_updates=on_change` asks for steady state.
+    let mut quality = Quality { map_updates_always: true, ..Quality::default() };
     for q in &a.quality {
         quality.set_pair(q)?;
     }

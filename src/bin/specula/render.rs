@@ -19,11 +19,18 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
     let ctx = context(args.validate, &args.device)?;
     let plan = job.plan(&job.quality)?;
     let methods: Vec<String> = plan.objects.iter().map(|o| format!("{}: {}", o.name, o.method.name())).collect();
-    let frame = specula::render_plan(&ctx, &job.scene, plan, (job.width, job.height), (args.warmup, args.frames))?;
+    let mut rebuilt = Vec::new();
+    let frame = specula::render_frames(&ctx, &job.scene, plan, (job.width, job.height), (args.warmup, args.frames), |k, f| {
+        let maps: Vec<String> = f.map_updates.iter().map(|u| format!("{} ({})", u.stage, u.reason)).collect();
+        rebuilt.push(format!("frame {k}: maps rebuilt: {}", if maps.is_empty() { "none".to_string() } else { maps.join(", ") }));
+    })?;
     write_image(out, &frame.image)?;
     println!("{} on {} ({}), {}x{}", job.label(), ctx.device_name, ctx.driver_info, job.width, job.height);
     if !methods.is_empty() {
         println!("objects: {}", methods.join(", "));
+    }
+    for line in &rebuilt {
+        println!("{line}");
     }
     print!("{}", specula::profile::table(&frame.passes, &frame.memory));
     for (name, value) in &frame.stats {

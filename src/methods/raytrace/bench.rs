@@ -150,7 +150,7 @@ pub struct Config {
 /// (`table1.svg`) and the rows (`table1.csv`) into `out`.
 pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     let methods = [BVH, KD_TREE, GRID, RAY_HIERARCHY, RAY_ENGINE];
-    let q = Quality { depth: c.depth, ..Quality::default() };
+    let q = Quality { depth: c.depth, map_updates_always: true, ..Quality::default() };
     let mut rows: Vec<Row> = Vec::new();
     let mut md = String::new();
     if c.parts.contains(&Part::Table1) {

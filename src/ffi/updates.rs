@@ -1,0 +1,129 @@
+//! Frames over time: an object's transform, a material, a light changed between frames.
+//! Each call validates like the scene-building calls, keeps the previous state when it
+//! refuses, and needs no idle GPU: a configured renderer takes the change in place and the
+//! next recorded frame uploads it (and regenerates only the maps that depend on it).
+
+use std::ffi::c_char;
+
+use glam::Mat4;
+
+use super::handle::{fail, header, with_ctx, FfiResult, SpeculaContext};
+use super::scene::{light_from_desc, material_from_desc};
+use super::types::*;
+use crate::scene::Scene;
+
+/// Applies `change` to the context's scene and hands the new state to its renderer (if one
+/// is configured for this scene); on any refusal the old `part` is put back.
+fn apply<T: Clone>(
+    c: &mut SpeculaContext,
+    get: impl Fn(&mut Scene) -> &mut T,
+    change: impl FnOnce(&mut Scene) -> crate::Result<()>,
+) -> FfiResult<SpeculaResult> {
+    let old = get(&mut c.scene).clone();
+    change(&mut c.scene)?;
+    if c.renderer_version == c.scene_version {
+        if let Some(r) = c.renderer.as_mut() {
+            if let Err(e) = r.update(&c.scene) {
+                *get(&mut c.scene) = old;
+                return Err(e.into());
+            }
+        }
+    }
+    Ok(SPECULA_SUCCESS)
+}
+
+fn index(i: u32, count: usize, what: &str) -> FfiResult<usize> {
+    if (i as usize) < count {
+        Ok(i as usize)
+    } else {
+        fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("{what}: {i} is out of range (the scene has {count})"))
+    }
+}
+
+/// Sets object `object`'s world transform: 16 floats, column-major (like glTF and the
+/// mesh descriptor's `transform`), replacing the one it was added or loaded with. Refused:
+/// NaN or infinite entries, a singular matrix (zero scale), a mirroring matrix for an object
+/// that was not mirrored (or the reverse), an unknown object. Not thread-safe with other
+/// calls on the same context; the GPU need not be idle.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_object_transform(ctx: *mut SpeculaContext, object: u32, matrix: *const f32) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if matrix.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "matrix is NULL");
+        }
+        let i = index(object, c.scene.meshes.len(), "object")?;
+        let m = Mat4::from_cols_slice(std::slice::from_raw_parts(matrix, 16));
+        apply(c, |s| &mut s.meshes[i], |s| s.set_object_transform(i, m))
+    })
+}
+
+/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
+/// surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
+/// again). Validated like specula_context_add_material; the GPU need not be idle.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_material(
+    ctx: *mut SpeculaContext,
+    index: u32,
+    desc: *const SpeculaMaterialDesc,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        let d = header(desc, SPECULA_STRUCT_MATERIAL_DESC, "material")?;
+        let i = self::index(index, c.scene.materials.len(), "material")?;
+        let m = material_from_desc(d, c.scene.materials[i].name.clone())?;
+        apply(c, |s| &mut s.materials[i], |s| s.set_material(i, m))
+    })
+}
+
+/// Replaces light `index` (position, direction, intensity, range, cone). Its kind must
+/// stay. Validated like specula_context_add_light; the GPU need not be idle.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_light(ctx: *mut SpeculaContext, index: u32, desc: *const SpeculaLightDesc) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        let d = header(desc, SPECULA_STRUCT_LIGHT_DESC, "light")?;
+        let i = self::index(index, c.scene.lights.len(), "light")?;
+        let l = light_from_desc(d, c.scene.lights[i].name.clone())?;
+        apply(c, |s| &mut s.lights[i], |s| s.set_light(i, l))
+    })
+}
+
+/// Copies the maps the last recorded frame regenerated, with why (first frame, a moved
+/// object, a changed material or light, the camera for camera-space maps,
+/// map_updates=always), into `out` (up to `capacity`), their number into `*count`. A map
+/// not listed kept its contents. `out` may be NULL with capacity 0 to query the count.
+/// Returns SPECULA_WARNING_TRUNCATED when capacity was too small.
+#[no_mangle]
+pub unsafe extern "C" fn specula_get_map_updates(
+    ctx: *mut SpeculaContext,
+    out: *mut SpeculaMapUpdate,
+    capacity: u32,
+    count: *mut u32,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if count.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
+        }
+        if out.is_null() && capacity > 0 {
+            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
+        }
+        let Some(r) = c.renderer.as_ref() else {
+            return fail(SPECULA_ERROR_WRONG_ORDER, "no renderer: call specula_context_configure first");
+        };
+        let updates = r.map_updates();
+        *count = updates.len() as u32;
+        fn copy<const N: usize>(s: &str) -> [c_char; N] {
+            let mut out = [0 as c_char; N];
+            let mut end = s.len().min(N - 1);
+            while !s.is_char_boundary(end) {
+                end -= 1;
+            }
+            for (d, b) in out.iter_mut().zip(s[..end].bytes()) {
+                *d = b as c_char;
+            }
+            out
+        }
+        for (i, u) in updates.iter().take(capacity as usize).enumerate() {
+            *out.add(i) = SpeculaMapUpdate { stage: copy(u.stage), reason: copy(&u.reason) };
+        }
+        Ok(if (capacity as usize) < updates.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+    })
+}
