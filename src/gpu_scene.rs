@@ -31,6 +31,9 @@ pub struct Draw {
     pub vertex_offset: i32,
     pub mesh: u32,
     pub specular: bool,
+    /// World-space bounds (per-face culling of cube-map passes); kept current by updates.
+    pub lo: glam::Vec3,
+    pub hi: glam::Vec3,
 }
 
 pub struct GpuScene {
@@ -101,6 +104,8 @@ impl GpuScene {
                 vertex_offset: vertices.len() as i32,
                 mesh: i as u32,
                 specular: scene.materials[m.material].kind.is_specular(),
+                lo: m.bounds().min,
+                hi: m.bounds().max,
             });
             vertices.extend(vertices_of(m));
             indices.extend_from_slice(&m.indices);

@@ -125,6 +125,8 @@ pub struct Renderer {
     first_frame: bool,
     /// The map stages the last recorded frame regenerated.
     map_updates: Vec<MapUpdate>,
+    /// Each view's eye (the view table's), for per-face culling.
+    view_eyes: Vec<glam::Vec3>,
 }
 
 impl Renderer {
@@ -178,6 +180,7 @@ impl Renderer {
             latency_left: Vec::new(),
             first_frame: true,
             map_updates: Vec::new(),
+            view_eyes: Vec::new(),
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -348,6 +351,8 @@ impl Renderer {
                 let v: Vec<crate::gpu_scene::Vertex> = crate::gpu_scene::vertices_of(&self.cpu.meshes[i]).collect();
                 let at = d.vertex_offset as usize * std::mem::size_of::<crate::gpu_scene::Vertex>();
                 self.scene.vertices.write_at(at, bytemuck::cast_slice(&v))?;
+                let b = self.cpu.meshes[i].bounds();
+                (self.scene.draws[i].lo, self.scene.draws[i].hi) = (b.min, b.max);
             }
             self.objects.write(bytemuck::cast_slice(&object_table(&self.cpu, &self.plan)))?;
         }
@@ -475,6 +480,7 @@ impl Renderer {
 
     fn write_views(&mut self) -> Result<()> {
         let views = views::view_table(&self.plan, &self.views, &self.light_table, self.camera_view_proj(), self.camera.position);
+        self.view_eyes = views.iter().map(|v| glam::Vec3::from_slice(&v.eye[..3])).collect();
         self.view_buffer.write(bytemuck::cast_slice(&views))
     }
 
@@ -505,6 +511,7 @@ impl Renderer {
             depth: &mut self.depth,
             maps: &mut self.maps,
             sets: &self.sets,
+            view_eyes: &self.view_eyes,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
         };
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {

@@ -201,3 +201,58 @@ fn bad_updates_are_refused_and_keep_the_state() {
     r.destroy(&ctx);
     common::assert_clean(&ctx);
 }
+
+/// Per-face culling: a small mirror sphere straight ahead (+X) of the light and a floor
+/// below it; each shadow-cube face draws only what lies in its frustum, the sphere's own map
+/// leaves the sphere out and draws the floor in the two faces it spans, multiview (one pass
+/// for six faces) cannot cull, and culling changes no pixel.
+#[test]
+fn cube_faces_draw_only_what_they_see() {
+    use specula::scene::{shapes, Light, LightKind, Material};
+    let ctx = common::gpu();
+    let mut s = Scene::new();
+    let white = s.add_material(Material { name: "white".into(), ..Default::default() }).unwrap();
+    let mirror = s
+        .add_material(Material {
+            name: "mirror".into(),
+            kind: SurfaceKind::Mirror { nu: Vec3::splat(0.2), kappa: Vec3::splat(3.0) },
+            ..Default::default()
+        })
+        .unwrap();
+    // The floor lies below the light only; the sphere is straight ahead (+X) of the light.
+    s.add_mesh(shapes::quad("floor", Vec3::new(-1.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0), 1, white)).unwrap();
+    s.add_mesh(shapes::uv_sphere("ball", Vec3::new(3.0, 2.0, 0.0), 0.2, 8, 4, mirror)).unwrap();
+    s.add_light(Light {
+        name: "lamp".into(),
+        kind: LightKind::Point,
+        position: Vec3::new(0.0, 2.0, 0.0),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(5.0),
+        range: None,
+    })
+    .unwrap();
+    s.camera = Some(specula::scene::Camera::look_at(Vec3::new(0.0, 1.5, 4.0), Vec3::new(1.0, 1.0, 0.0), 1.0));
+    let q = quality();
+    let mut r = renderer(&ctx, &s, specula::methods::ENVMAP, &q);
+    let f = r.render(&ctx).unwrap();
+    let stat = |name: &str| {
+        f.stats.iter().find(|(k, _)| k == name).map(|(_, v)| *v as u32).unwrap_or_else(|| panic!("no stat {name}: {:?}", f.stats))
+    };
+    let shadow: Vec<u32> = (0..6).map(|k| stat(&format!("shadow.generate.draws.face{k}"))).collect();
+    // +X (0) sees the ball, −Y (3) the floor; the other faces nothing.
+    assert_eq!(shadow, vec![1, 0, 0, 1, 0, 0], "shadow cube draws per face");
+    // The ball's own map leaves the ball out: the floor lies below-left of it (−X and −Y).
+    let env: Vec<u32> = (0..6).map(|k| stat(&format!("envmap.generate.draws.face{k}"))).collect();
+    assert_eq!(env, vec![0, 1, 0, 1, 0, 0], "envmap draws per face");
+    r.destroy(&ctx);
+    // Multiview renders the six faces in one pass: no per-face culling.
+    let mv = Quality { cube_mode: specula::quality::CubeMode::Multiview, ..q.clone() };
+    let mut r = renderer(&ctx, &s, specula::methods::ENVMAP, &mv);
+    let g = r.render(&ctx).unwrap();
+    let env: Vec<u32> =
+        (0..6).map(|k| g.stats.iter().find(|(n, _)| *n == format!("envmap.generate.draws.face{k}")).unwrap().1 as u32).collect();
+    assert_eq!(env.iter().sum::<u32>(), 1, "multiview: one pass drawing the floor once, counted under face 0: {env:?}");
+    assert!(bits(&g) == bits(&f), "culling changes no pixel");
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}

@@ -23,6 +23,8 @@ pub struct ShadowMaps {
     cube_pipeline: vk::Pipeline,
     plane_pipeline: vk::Pipeline,
     mode: Option<CubeMode>,
+    /// Mesh draws per cube face in the last frame recorded, over all shadow cubes.
+    face_draws: [u32; 6],
 }
 
 impl ShadowMaps {
@@ -83,6 +85,12 @@ impl Stage for ShadowMaps {
         "shadow.generate"
     }
 
+    /// Mesh draws per cube face in the last frame this stage recorded (six-pass mode culls
+    /// each face to the objects in its frustum).
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        (0..6).map(|k| (format!("shadow.generate.draws.face{k}"), self.face_draws[k] as f64)).collect()
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let maps = &mut *io.maps;
         if maps.shadow_cubes.is_none() && maps.shadow_planes.is_none() {
@@ -99,10 +107,16 @@ impl Stage for ShadowMaps {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let clear = [FAR, 0.0, 0.0, 0.0];
         if let (Some(cubes), Some(depth), Some(mode)) = (maps.shadow_cubes.as_ref(), self.cube_depth.as_mut(), self.mode) {
+            self.face_draws = [0; 6];
+            let (eyes, six, face_draws) = (io.view_eyes, mode == CubeMode::SixPasses, &mut self.face_draws);
             for (k, &view) in io.views.shadow_cubes.iter().enumerate() {
                 render_cube_faces(rec, cubes, depth, k as u32, view, mode, clear, |cmd, v| {
+                    // Six passes: each face draws only the objects inside its frustum.
+                    let face = (v - view) as usize;
+                    let eye = eyes.get(v as usize).copied().unwrap_or_default();
                     f.bind(ctx, cmd, self.cube_pipeline);
-                    for d in &f.scene.draws {
+                    for d in f.scene.draws.iter().filter(|d| !six || crate::cube::face_sees_box(face, eye, d.lo, d.hi)) {
+                        face_draws[face] += 1;
                         f.draw(ctx, cmd, v, d);
                     }
                 });

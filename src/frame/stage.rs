@@ -194,6 +194,8 @@ pub struct FrameIo<'a> {
     pub depth: &'a mut Image,
     pub maps: &'a mut Maps,
     pub sets: &'a MapSets,
+    /// Each view's eye (world space), by view index: where a cube face looks from.
+    pub view_eyes: &'a [glam::Vec3],
     /// Images every pass that shades diffuse surfaces samples (textures, environment).
     pub scene_images: Vec<&'a Image>,
 }

@@ -45,6 +45,8 @@ pub struct CubeMaps {
     inter_object: bool,
     /// Frames recorded so far (frame-latency mode reads the previous frame's maps).
     frames: u64,
+    /// Mesh draws the last frame recorded per cube face (per-face culling), over all cubes.
+    face_draws: [u32; 6],
 }
 
 /// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
@@ -77,6 +79,7 @@ impl CubeMaps {
             frame_latency: plan.frame_latency && inter_object,
             inter_object,
             frames: 0,
+            face_draws: [0; 6],
         };
         build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
@@ -175,6 +178,12 @@ impl Stage for CubeMaps {
     /// Records this frame's cycles. The maps set (set 1) `io.sets.generate[i]` samples
     /// distance image i (and the refractor maps); `io.sets.empty` holds null descriptors
     /// (distance-map shaders always declare set 1).
+    /// Mesh draws per cube face in the last frame this stage recorded (six-pass mode culls
+    /// each face to the objects in its frustum; multiview draws every object in every face).
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        (0..6).map(|k| (format!("{}.draws.face{k}", self.name()), self.face_draws[k] as f64)).collect()
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let cycles = if self.frame_latency { 1 } else { self.cycles };
         // The images are taken out of the frame's maps while this pass writes them.
@@ -192,6 +201,8 @@ impl Stage for CubeMaps {
         let open = pass.begin();
         let ctx = rec.ctx;
         let mut latest = 0;
+        self.face_draws = [0; 6];
+        let (eyes, six) = (io.view_eyes, self.mode == CubeMode::SixPasses);
         for cycle in 0..cycles {
             let write = (first_write + cycle as usize) % count;
             let read = (write + 1) % count;
@@ -213,7 +224,12 @@ impl Stage for CubeMaps {
                     Some(LeavesOut::Nothing) => None,
                     _ => Some(mesh),
                 };
+                let face_draws = &mut self.face_draws;
                 render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
+                    // Six passes: each face draws only the objects inside its frustum.
+                    let face = (v - view) as usize;
+                    let eye = eyes.get(v as usize).copied().unwrap_or_default();
+                    let sees = |d: &&crate::gpu_scene::Draw| !six || crate::cube::face_sees_box(face, eye, d.lo, d.hi);
                     f.bind(ctx, cmd, self.sky);
                     f.push_flags(ctx, cmd, v, 0, f.flags | flags);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
@@ -221,7 +237,8 @@ impl Stage for CubeMaps {
                     if uses_maps {
                         f.bind_maps(ctx, cmd, read_set);
                     }
-                    for d in f.scene.draws.iter().filter(|d| Some(d.mesh as usize) != skip) {
+                    for d in f.scene.draws.iter().filter(|d| Some(d.mesh as usize) != skip).filter(sees) {
+                        face_draws[face] += 1;
                         f.push_flags(ctx, cmd, v, d.mesh, f.flags | flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
                     }
