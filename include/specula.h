@@ -507,6 +507,12 @@ SpeculaResult specula_context_set_object_transform(SpeculaContext *ctx,
                                                    uint32_t object,
                                                    const float *matrix);
 
+// Hides object `object` (visible = 0: drawn nowhere, in no map, hit by no ray) or shows it
+// again (visible ≠ 0). The GPU need not be idle.
+SpeculaResult specula_context_set_object_visible(SpeculaContext *ctx,
+                                                 uint32_t object,
+                                                 uint32_t visible);
+
 // Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
 // surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 // again). Validated like specula_context_add_material; the GPU need not be idle.

@@ -100,7 +100,7 @@ impl GpuScene {
         for (i, m) in scene.meshes.iter().enumerate() {
             draws.push(Draw {
                 first_index: indices.len() as u32,
-                index_count: m.indices.len() as u32,
+                index_count: if m.hidden { 0 } else { m.indices.len() as u32 },
                 vertex_offset: vertices.len() as i32,
                 mesh: i as u32,
                 specular: scene.materials[m.material].kind.is_specular(),

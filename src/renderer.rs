@@ -351,8 +351,12 @@ impl Renderer {
                 let v: Vec<crate::gpu_scene::Vertex> = crate::gpu_scene::vertices_of(&self.cpu.meshes[i]).collect();
                 let at = d.vertex_offset as usize * std::mem::size_of::<crate::gpu_scene::Vertex>();
                 self.scene.vertices.write_at(at, bytemuck::cast_slice(&v))?;
-                let b = self.cpu.meshes[i].bounds();
-                (self.scene.draws[i].lo, self.scene.draws[i].hi) = (b.min, b.max);
+                let mesh = &self.cpu.meshes[i];
+                let b = mesh.bounds();
+                let draw = &mut self.scene.draws[i];
+                (draw.lo, draw.hi) = (b.min, b.max);
+                // A hidden object draws no triangle anywhere.
+                draw.index_count = if mesh.hidden { 0 } else { mesh.indices.len() as u32 };
             }
             self.objects.write(bytemuck::cast_slice(&object_table(&self.cpu, &self.plan)))?;
         }

@@ -57,6 +57,16 @@ pub unsafe extern "C" fn specula_context_set_object_transform(ctx: *mut SpeculaC
     })
 }
 
+/// Hides object `object` (visible = 0: drawn nowhere, in no map, hit by no ray) or shows it
+/// again (visible ≠ 0). The GPU need not be idle.
+#[no_mangle]
+pub unsafe extern "C" fn specula_context_set_object_visible(ctx: *mut SpeculaContext, object: u32, visible: u32) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        let i = index(object, c.scene.meshes.len(), "object")?;
+        apply(c, |s| &mut s.meshes[i], |s| s.set_object_visible(i, visible != 0))
+    })
+}
+
 /// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
 /// surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 /// again). Validated like specula_context_add_material; the GPU need not be idle.

@@ -115,7 +115,9 @@ impl Stage for ShadowMaps {
                     let face = (v - view) as usize;
                     let eye = eyes.get(v as usize).copied().unwrap_or_default();
                     f.bind(ctx, cmd, self.cube_pipeline);
-                    for d in f.scene.draws.iter().filter(|d| !six || crate::cube::face_sees_box(face, eye, d.lo, d.hi)) {
+                    for d in
+                        f.scene.draws.iter().filter(|d| d.index_count > 0 && (!six || crate::cube::face_sees_box(face, eye, d.lo, d.hi)))
+                    {
                         face_draws[face] += 1;
                         f.draw(ctx, cmd, v, d);
                     }

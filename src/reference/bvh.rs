@@ -85,7 +85,7 @@ impl Bounds {
 impl Bvh {
     /// Builds the hierarchy over every triangle of every mesh.
     pub fn new(scene: &Scene) -> Bvh {
-        let soup = scene.meshes.iter().enumerate().flat_map(|(m, mesh)| {
+        let soup = scene.meshes.iter().enumerate().filter(|(_, mesh)| !mesh.hidden).flat_map(|(m, mesh)| {
             mesh.indices.chunks_exact(3).enumerate().map(move |(k, idx)| {
                 let p = |i: u32| mesh.positions[i as usize].as_dvec3();
                 ([p(idx[0]), p(idx[1]), p(idx[2])], m as u32, k as u32)

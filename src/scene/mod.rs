@@ -113,6 +113,9 @@ pub struct Mesh {
     /// The geometry in object space, kept once the object has been moved (see
     /// `scene::update`), so that every new transform starts from the same data.
     pub rest: Option<std::sync::Arc<update::Rest>>,
+    /// Hidden objects are drawn nowhere (camera, maps, shadows) and hit by no ray; they
+    /// keep their place in the scene so that showing them again is an update.
+    pub hidden: bool,
 }
 
 impl Mesh {

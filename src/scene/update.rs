@@ -97,6 +97,17 @@ impl Scene {
         Ok(())
     }
 
+    /// Hides object `index` (drawn nowhere, hit by no ray) or shows it again.
+    pub fn set_object_visible(&mut self, index: usize, visible: bool) -> Result<()> {
+        let count = self.meshes.len();
+        let m = self
+            .meshes
+            .get_mut(index)
+            .ok_or_else(|| Error::invalid("object", format!("{index} is out of range (the scene has {count} objects)")))?;
+        m.hidden = !visible;
+        Ok(())
+    }
+
     /// Replaces material `index`'s parameters (ν, κ, ior, base colour, emission, specular
     /// colour and factor, textures), validated like [`Scene::add_material`]. Its kind stays:
     /// a mirror stays a mirror (a new kind changes which method serves the objects: make a
@@ -157,7 +168,7 @@ impl Scene {
 /// dependency tracking reads it.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Changes {
-    /// Objects whose geometry (positions or normals) changed.
+    /// Objects whose geometry (positions or normals) or visibility changed.
     pub moved: Vec<usize>,
     pub materials: Vec<usize>,
     pub lights: Vec<usize>,
@@ -209,7 +220,7 @@ impl Changes {
             if a.indices != b.indices || a.positions.len() != b.positions.len() || a.material != b.material || a.uvs != b.uvs {
                 return refuse(format!("object '{}' has other triangles, uvs or material", b.name));
             }
-            if a.positions != b.positions || a.normals != b.normals || a.reference_point != b.reference_point {
+            if a.positions != b.positions || a.normals != b.normals || a.reference_point != b.reference_point || a.hidden != b.hidden {
                 c.moved.push(i);
             }
         }

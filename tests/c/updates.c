@@ -128,6 +128,17 @@ int main(void) {
     updates(ctx, u, sizeof u);
     check("a material rebuilds the distance maps only", strcmp(u, "distance.generate(material 'material0')") == 0, u);
 
+    /* Hiding the mirror changes the image and rebuilds the maps; showing it restores frame 5. */
+    expect(ctx, "hide the mirror", specula_context_set_object_visible(ctx, mirror_id, 0), SPECULA_SUCCESS);
+    expect(ctx, "frame 5a", specula_context_render(ctx, SPECULA_PIXEL_RGBA32F, img, sizeof img), SPECULA_SUCCESS);
+    updates(ctx, u, sizeof u);
+    check("hiding rebuilds shadow and distance maps", strstr(u, "shadow.generate(moved 'mesh1')") && strstr(u, "distance.generate(moved 'mesh1')"), u);
+    check("the hidden mirror is gone from the image", memcmp(img, before, sizeof img) != 0, NULL);
+    expect(ctx, "show the mirror", specula_context_set_object_visible(ctx, mirror_id, 1), SPECULA_SUCCESS);
+    expect(ctx, "frame 5b", specula_context_render(ctx, SPECULA_PIXEL_RGBA32F, img, sizeof img), SPECULA_SUCCESS);
+    check("shown again, the image of frame 5 returns", memcmp(img, before, sizeof img) == 0, NULL);
+    expect(ctx, "hide an unknown object", specula_context_set_object_visible(ctx, 9, 0), SPECULA_ERROR_INVALID_ARGUMENT);
+
     /* Misuse: a code, a message, and the previous state kept (the next frame equals frame 5). */
     float nan_m[16];
     translation(nan_m, NAN, 0, 0);

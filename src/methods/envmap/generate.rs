@@ -229,7 +229,8 @@ impl Stage for CubeMaps {
                     // Six passes: each face draws only the objects inside its frustum.
                     let face = (v - view) as usize;
                     let eye = eyes.get(v as usize).copied().unwrap_or_default();
-                    let sees = |d: &&crate::gpu_scene::Draw| !six || crate::cube::face_sees_box(face, eye, d.lo, d.hi);
+                    let sees =
+                        |d: &&crate::gpu_scene::Draw| d.index_count > 0 && (!six || crate::cube::face_sees_box(face, eye, d.lo, d.hi));
                     f.bind(ctx, cmd, self.sky);
                     f.push_flags(ctx, cmd, v, 0, f.flags | flags);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };

@@ -200,7 +200,10 @@ impl TriangleList {
         for mesh in &scene.meshes {
             list.mesh_offsets.push(list.triangles.len() as u32);
             for t in mesh.indices.chunks_exact(3) {
-                list.triangles.push([0, 1, 2].map(|k| mesh.positions[t[k] as usize]));
+                // A hidden object's triangles collapse to a point: zero area, never hit,
+                // never rasterised, while every triangle keeps its id.
+                let corners = [0, 1, 2].map(|k| mesh.positions[t[k] as usize]);
+                list.triangles.push(if mesh.hidden { [corners[0]; 3] } else { corners });
             }
         }
         list
