@@ -652,6 +652,7 @@ fn geometry_of(scene: &Scene) -> Scene {
         textures: Vec::new(),
         environment: None,
         skipped: Vec::new(),
+        animation: None,
     }
 }
 

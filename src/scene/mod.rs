@@ -7,6 +7,7 @@
 //! (point, spot) or irradiance [W/m²] (directional); emission and images are linear
 //! radiance.
 
+pub mod animation;
 mod environment;
 pub mod gltf;
 pub mod shapes;
@@ -354,6 +355,8 @@ pub struct Scene {
     /// What the importer read but could not render (points, lines, empty primitives, meshes
     /// without primitives), with its place in the file; says why a scene has no triangles.
     pub skipped: Vec<String>,
+    /// The file's animations (glTF), if any: [`Scene::set_time`] poses the scene.
+    pub animation: Option<animation::Animation>,
 }
 
 impl Scene {

@@ -27,7 +27,9 @@
 //!   name, or "auto"); an unknown name is an error naming the field.
 //! - Objects are named `<mesh name>/<primitive>`; the mesh name and the node name address
 //!   them too (`--object NAME=METHOD`, the C ABI).
-//! - Skins, morph targets and animations are ignored (the static node transforms are used).
+//! - Animations (translation, rotation, scale; STEP, LINEAR, CUBICSPLINE) are read into
+//!   `Scene::animation`; the scene is loaded in the nodes' static pose and
+//!   `Scene::set_time` poses it. Skins and morph targets are ignored.
 //! - A node hierarchy with a cycle is an error.
 //!
 //! - The glTF schema's rules the `gltf` crate leaves unchecked (versions, required
@@ -39,6 +41,7 @@
 //! meshes, materials, lights and the camera into the scene.
 
 mod accessors;
+mod animations;
 pub mod schema;
 mod translate;
 
@@ -148,6 +151,7 @@ fn import(file: &str, base: PathBuf, bytes: &[u8]) -> Result<Scene> {
         imp.check_material_scalars(&material)?;
     }
     imp.walk()?;
+    imp.import_animations()?;
     Ok(imp.scene)
 }
 

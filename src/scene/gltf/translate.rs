@@ -109,7 +109,7 @@ impl Importer<'_> {
             let node = &nodes[index];
             let local = Mat4::from_cols_array_2d(&node.transform().matrix());
             let world = parent * local;
-            self.visit(node, world)?;
+            self.visit(node, world, &path)?;
             for child in node.children().collect::<Vec<_>>().into_iter().rev() {
                 stack.push((child.index(), world, depth + 1));
             }
@@ -117,7 +117,9 @@ impl Importer<'_> {
         Ok(())
     }
 
-    fn visit(&mut self, node: &gltf::Node, world: Mat4) -> Result<()> {
+    fn visit(&mut self, node: &gltf::Node, world: Mat4, path: &[usize]) -> Result<()> {
+        let animated = self.doc.animations().len() > 0;
+        let (meshes, lights) = (self.scene.meshes.len(), self.scene.lights.len());
         if let Some(mesh) = node.mesh() {
             if let Err(Error::InvalidInput { message, .. }) = crate::scene::validate_transform(&world, "node") {
                 let field = format!("nodes[{}]", node.index());
@@ -138,9 +140,18 @@ impl Importer<'_> {
         if let Some(light) = node.light() {
             self.import_light(node, &light, world)?;
         }
+        // Where the animation will find them: the node path of each object just imported.
+        if animated {
+            let anim = self.scene.animation.get_or_insert_with(Default::default);
+            anim.meshes.extend((meshes..self.scene.meshes.len()).map(|m| (m, path.to_vec())));
+            anim.lights.extend((lights..self.scene.lights.len()).map(|l| (l, path.to_vec())));
+        }
         if self.scene.camera.is_none() {
             if let Some(cam) = node.camera() {
                 self.import_camera(node, cam.index(), world)?;
+                if animated && self.scene.camera.is_some() {
+                    self.scene.animation.get_or_insert_with(Default::default).camera = Some(path.to_vec());
+                }
             }
         }
         Ok(())
