@@ -153,15 +153,34 @@ struct Bin {
 }
 
 impl Bin {
+    /// A buffer view of `bytes`; target 0: none (animation data).
     fn view(&mut self, bytes: &[u8], target: u32) -> usize {
         while self.data.len() % 4 != 0 {
             self.data.push(0);
         }
-        self.views.push(json!({
-            "buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len(), "target": target
-        }));
+        let mut v = json!({ "buffer": 0, "byteOffset": self.data.len(), "byteLength": bytes.len() });
+        if target != 0 {
+            v["target"] = json!(target);
+        }
+        self.views.push(v);
         self.data.extend_from_slice(bytes);
         self.views.len() - 1
+    }
+
+    /// Float keys or values of an animation sampler (SCALAR or VEC3); inputs get min/max.
+    fn animation_accessor(&mut self, values: &[f32], dims: usize) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, 0);
+        let mut acc = json!({
+            "bufferView": view, "componentType": 5126, "count": values.len() / dims,
+            "type": if dims == 1 { "SCALAR" } else { "VEC3" }
+        });
+        if dims == 1 {
+            acc["min"] = json!([values.iter().copied().fold(f32::INFINITY, f32::min)]);
+            acc["max"] = json!([values.iter().copied().fold(f32::NEG_INFINITY, f32::max)]);
+        }
+        self.accessors.push(acc);
+        self.accessors.len() - 1
     }
 
     fn vec_accessor(&mut self, values: &[f32], dims: usize, bounds: bool) -> usize {
@@ -306,6 +325,18 @@ fn main() {
     nodes.push(json!({ "name": "camera", "camera": 0, "translation": eye.to_array(), "rotation": rotation.normalize().to_array() }));
     let camera = nodes.len() - 1;
 
+    // The mirror sphere's path (LINEAR, 4 s, a closed loop through its static place): it
+    // moves past the glass sphere, so that `specula animate` shows maps following it.
+    let times = [0.0f32, 1.5, 3.0, 4.0];
+    let path = [Vec3::new(-1.2, 0.5, -1.1), Vec3::new(-1.2, 0.5, -0.2), Vec3::new(-0.5, 0.5, -0.6), Vec3::new(-1.2, 0.5, -1.1)];
+    let input = bin.animation_accessor(&times, 1);
+    let output = bin.animation_accessor(&path.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>(), 3);
+    let animations = json!([{
+        "name": "mirror_path",
+        "channels": [{ "sampler": 0, "target": { "node": mirror, "path": "translation" } }],
+        "samplers": [{ "input": input, "output": output, "interpolation": "LINEAR" }],
+    }]);
+
     let bin_name = "demo.bin";
     let doc = json!({
         "asset": { "version": "2.0", "generator": "specula examples/make_demo_scene.rs" },
@@ -328,6 +359,7 @@ fn main() {
         "buffers": [{ "uri": bin_name, "byteLength": bin.data.len() }],
         "bufferViews": bin.views,
         "accessors": bin.accessors,
+        "animations": animations,
     });
     std::fs::write(out.join(bin_name), &bin.data).expect("write demo.bin");
     let gltf_path = out.join("demo.gltf");
@@ -341,6 +373,7 @@ fn main() {
     let solids = count(&|k| matches!(k, SurfaceKind::Dielectric { thin: false, .. }));
     assert_eq!((diffuse, mirrors, solids, scene.materials.len()), (7, 1, 1, 9), "demo classification");
     assert!(scene.camera.is_some() && scene.lights.len() == 1 && scene.textures.len() == 6);
+    assert_eq!(scene.animation.as_ref().map(|a| a.duration), Some(4.0), "the mirror sphere's path");
     println!(
         "wrote {} ({} meshes, {} triangles, {} materials: {diffuse} diffuse, {mirrors} mirror, {solids} solid dielectric; {} textures, {} light)",
         gltf_path.display(),

@@ -69,7 +69,7 @@ impl Channel {
         if n == 0 {
             return Vec4::ZERO;
         }
-        if !(t > self.times[0]) {
+        if t <= self.times[0] || t.is_nan() {
             return value(0);
         }
         if t >= self.times[n - 1] {
@@ -111,7 +111,7 @@ impl Channel {
         if let Some(i) = self.times.iter().position(|t| !t.is_finite() || *t < 0.0) {
             return Err((input, format!("key time {i} must be finite and ≥ 0, got {}", self.times[i])));
         }
-        if let Some(i) = self.times.windows(2).position(|w| !(w[1] > w[0])) {
+        if let Some(i) = self.times.windows(2).position(|w| w[1] <= w[0]) {
             return Err((input, format!("key times must increase: {} then {} at key {}", self.times[i], self.times[i + 1], i + 1)));
         }
         let per = if self.interpolation == Interpolation::CubicSpline { 3 } else { 1 };

@@ -40,6 +40,9 @@ pub struct RenderArgs {
     /// Vertical field of view in degrees (with --camera-pos; default 60).
     #[arg(long)]
     pub fov: Option<f32>,
+    /// Pose the scene at this time of its glTF animations (seconds).
+    #[arg(long)]
+    pub time: Option<f32>,
     /// Enable the Khronos validation layer; any validation error fails the command.
     #[arg(long)]
     pub validate: bool,
@@ -165,6 +168,12 @@ pub fn renderable(path: &Path, scene: &Scene) -> specula::Result<()> {
 
 pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
     let mut scene = load_renderable(&a.scene)?;
+    if let Some(t) = a.time {
+        scene.set_time(t).map_err(|e| match e {
+            specula::Error::InvalidInput { message, .. } => specula::Error::invalid("--time", message),
+            other => other,
+        })?;
+    }
     if let Some(env) = &a.env {
         scene.set_environment(scene::load_environment(env)?)?;
     }

@@ -67,5 +67,24 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     print!("{report}");
     let table = outdir.join("timings.txt");
     specula::output::write_file(&table, report.as_bytes())?;
-    Ok(())
+
+    // Frames over time: the mirror sphere on its path (the scene's glTF animation), the
+    // planner's methods, maps regenerated only when what they see moved.
+    let anim = crate::args::RenderArgs {
+        scene: scene_path.to_path_buf(),
+        method: "auto".into(),
+        objects: Vec::new(),
+        size: "128x128".into(),
+        quality: vec!["cube_size=128".into(), "map_updates=on_change".into()],
+        env: None,
+        camera_pos: None,
+        camera_target: None,
+        fov: None,
+        time: None,
+        validate,
+        device: device.clone(),
+        warmup: 0,
+        frames: 1,
+    };
+    crate::animate::run(&anim, 12.0, None, &outdir.join("animation"))
 }

@@ -2,6 +2,7 @@
 //! One file per subcommand; `args` holds what they share (argument structs, parsers, the
 //! scene-and-knobs preparation, image output, the timed CPU reference).
 
+mod animate;
 mod args;
 mod bench;
 mod compare;
@@ -113,6 +114,21 @@ enum Command {
         #[arg(long)]
         device: Option<String>,
     },
+    /// Render a frame sequence of a scene's glTF animations: PNG + EXR per frame, per-frame
+    /// timings with the maps each frame rebuilt (OUT/frames.csv), an animated preview
+    /// (OUT/preview.gif).
+    Animate {
+        #[command(flatten)]
+        args: RenderArgs,
+        /// Frames per second.
+        #[arg(long, default_value_t = 24.0)]
+        fps: f32,
+        /// Seconds to render; default: the animation's duration (2 s without animations).
+        #[arg(long)]
+        duration: Option<f32>,
+        #[arg(long, default_value = "animation")]
+        out: PathBuf,
+    },
     /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
     Demo {
         #[arg(default_value = "out")]
@@ -183,6 +199,7 @@ fn run(cmd: Command) -> specula::Result<()> {
     match cmd {
         Command::Render { args, out, profile } => render::run(&args, &out, profile.as_deref()),
         Command::Info { scene } => info::run(&scene),
+        Command::Animate { args, fps, duration, out } => animate::run(&args, fps, duration, &out),
         Command::Plan { args, json } => plan::run(&args, json),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),

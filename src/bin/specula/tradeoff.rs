@@ -22,6 +22,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
         camera_pos: None,
         camera_target: None,
         fov: None,
+        time: None,
         validate: a.validate,
         device: a.device.clone(),
         warmup: a.warmup,
