@@ -95,6 +95,9 @@ pub struct Quality {
     /// Maps (shadow, environment, distance, refractor) regenerated every frame, else only
     /// when what they depend on changed (frames over time).
     pub map_updates_always: bool,
+    /// Supersampling of the camera passes: 1 (off), 2 or 4 samples per pixel along each
+    /// axis (a regular grid, box-filtered on the GPU).
+    pub ssaa: u32,
 }
 
 /// One knob, declared once.
@@ -142,6 +145,7 @@ const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single",
 const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
 const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
 const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
+const AA: &[(&str, u32)] = &[("off", 1), ("ssaa2", 2), ("ssaa4", 4)];
 const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
@@ -454,6 +458,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| q.proxy_radius.map_or("auto".into(), |r| r.to_string()),
     },
     Knob {
+        name: "aa",
+        values: "off|ssaa2|ssaa4",
+        default: "off",
+        doc: "anti-aliasing of every GPU method's camera passes: supersampling on a regular 2×2 (ssaa2) or 4×4 (ssaa4) grid per pixel, box-filtered on the GPU (the reference's stratified sample positions)",
+        set: |q, v| {
+            q.ssaa = one_of(v, AA)?;
+            Ok(())
+        },
+        get: |q| name_of(q.ssaa, AA),
+    },
+    Knob {
         name: "map_updates",
         values: "on_change|always",
         default: "on_change",
@@ -508,6 +523,7 @@ impl Default for Quality {
             tile_size: 16,
             ray_stats: false,
             map_updates_always: false,
+            ssaa: 1,
         }
     }
 }

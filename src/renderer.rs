@@ -127,6 +127,10 @@ pub struct Renderer {
     map_updates: Vec<MapUpdate>,
     /// Each view's eye (the view table's), for per-face culling.
     view_eyes: Vec<glam::Vec3>,
+    /// Supersampling per axis (`aa`): the camera passes render `ssaa`² samples per pixel
+    /// into `target`, and `resolve` halves it down to the output size (2×2 box each step).
+    ssaa: u32,
+    resolve: Vec<Image>,
 }
 
 impl Renderer {
@@ -141,6 +145,10 @@ impl Renderer {
         }
         let camera = scene.camera_or_default();
         camera.validate()?;
+        let ssaa = plan.quality.ssaa.max(1);
+        if width * ssaa > 16384 || height * ssaa > 16384 {
+            return Err(Error::invalid("knob aa", format!("{width}x{height} with {ssaa}×{ssaa} samples exceeds 16384 per axis")));
+        }
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.
         let r = Renderer {
@@ -181,6 +189,8 @@ impl Renderer {
             first_frame: true,
             map_updates: Vec::new(),
             view_eyes: Vec::new(),
+            ssaa,
+            resolve: Vec::new(),
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -225,21 +235,39 @@ impl Renderer {
         }
         self.sets = self.maps.sets(&self.owned_sets.iter().map(|s| s.set).collect::<Vec<_>>());
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED;
-        self.target = Image::new(
-            ctx,
-            &ImageDesc { name: "frame.color", format: TARGET_FORMAT, width: self.width, height: self.height, kind: ImageKind::D2, usage },
-        )?;
+        let (sw, sh) = (self.width * self.ssaa, self.height * self.ssaa);
+        self.target =
+            Image::new(ctx, &ImageDesc { name: "frame.color", format: TARGET_FORMAT, width: sw, height: sh, kind: ImageKind::D2, usage })?;
         self.depth = Image::new(
             ctx,
             &ImageDesc {
                 name: "frame.depth",
                 format: DEPTH_FORMAT,
-                width: self.width,
-                height: self.height,
+                width: sw,
+                height: sh,
                 kind: ImageKind::D2,
                 usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
             },
         )?;
+        // Supersampling: halving steps down to the output size (linear 2:1 blits average
+        // each 2×2 block exactly).
+        if self.ssaa > 1 {
+            let props = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, TARGET_FORMAT) };
+            let need =
+                vk::FormatFeatureFlags::BLIT_SRC | vk::FormatFeatureFlags::BLIT_DST | vk::FormatFeatureFlags::SAMPLED_IMAGE_FILTER_LINEAR;
+            if !props.optimal_tiling_features.contains(need) {
+                return Err(Error::invalid("knob aa", format!("the device cannot blit {TARGET_FORMAT:?} with linear filtering")));
+            }
+            let mut f = self.ssaa;
+            while f > 1 {
+                f /= 2;
+                let usage = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED;
+                let name = if f == 1 { "frame.resolved" } else { "frame.resolve_half" };
+                let desc =
+                    ImageDesc { name, format: TARGET_FORMAT, width: self.width * f, height: self.height * f, kind: ImageKind::D2, usage };
+                self.resolve.push(Image::new(ctx, &desc)?);
+            }
+        }
         self.profiler = Profiler::new(ctx, MAX_PASSES)?;
         self.write_descriptors(ctx);
         Ok(())
@@ -270,8 +298,8 @@ impl Renderer {
             plan: &self.plan,
             layout: self.layout,
             set_layouts: [self.set_layout, self.maps_layout],
-            width: self.width,
-            height: self.height,
+            width: self.width * self.ssaa,
+            height: self.height * self.ssaa,
         };
         for spec in &self.plan.stages {
             self.deps.push(match spec {
@@ -379,8 +407,8 @@ impl Renderer {
                 plan: &self.plan,
                 layout: self.layout,
                 set_layouts: [self.set_layout, self.maps_layout],
-                width: self.width,
-                height: self.height,
+                width: self.width * self.ssaa,
+                height: self.height * self.ssaa,
             };
             for s in &mut self.stages {
                 s.update(&init, &c, &mut self.maps)?;
@@ -524,9 +552,29 @@ impl Renderer {
             }
             stage.record(&mut rec, &f, &mut io);
         }
+        // Supersampling: 2×2 box steps down to the output size.
+        for i in 0..self.resolve.len() {
+            let (done, rest) = self.resolve.split_at_mut(i);
+            let src = done.last_mut().unwrap_or(&mut self.target);
+            let dst = &mut rest[0];
+            let open = rec.pass("frame.resolve").reads(src, Access::TransferSrc).writes(dst, Access::TransferDst).begin();
+            let layers =
+                vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 };
+            let corner = |i: &Image| vk::Offset3D { x: i.width as i32, y: i.height as i32, z: 1 };
+            let region = vk::ImageBlit {
+                src_subresource: layers,
+                src_offsets: [vk::Offset3D::default(), corner(src)],
+                dst_subresource: layers,
+                dst_offsets: [vk::Offset3D::default(), corner(dst)],
+            };
+            let (s, d) = (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            unsafe { ctx.device.cmd_blit_image(cmd, src.raw, s, dst.raw, d, &[region], vk::Filter::LINEAR) };
+            rec.end(open);
+        }
         if let Some(rb) = &self.readback {
-            let open = rec.pass("frame.readback").reads(&self.target, Access::TransferSrc).begin();
-            record_copy_to_buffer(ctx, cmd, &self.target, rb);
+            let out = self.resolve.last().unwrap_or(&self.target);
+            let open = rec.pass("frame.readback").reads(out, Access::TransferSrc).begin();
+            record_copy_to_buffer(ctx, cmd, out, rb);
             rec.end(open);
         }
         Ok(())
@@ -549,7 +597,7 @@ impl Renderer {
         }
         self.record(ctx, cmd)?;
         let mut rec = Recorder::resume(ctx, cmd, &mut self.profiler);
-        output::record_copy(&mut rec, &self.target, host, final_layout);
+        output::record_copy(&mut rec, self.resolve.last().unwrap_or(&self.target), host, final_layout);
         Ok(())
     }
 
@@ -568,7 +616,7 @@ impl Renderer {
             self.readback = Some(Buffer::new(
                 ctx,
                 "frame.readback",
-                self.target.byte_size(),
+                self.resolve.last().unwrap_or(&self.target).byte_size(),
                 vk::BufferUsageFlags::TRANSFER_DST,
                 MemoryLocation::GpuToCpu,
             )?);
@@ -578,7 +626,7 @@ impl Renderer {
         let passes = self.profiler.results(ctx)?;
         self.last_timings = passes.clone();
         let rb = self.readback.as_ref().unwrap();
-        let image = crate::vk::decode(self.target.format, self.width, self.height, 1, rb.read()?)?;
+        let image = crate::vk::decode(TARGET_FORMAT, self.width, self.height, 1, rb.read()?)?;
         let errors = ctx.validation.error_count();
         if errors > 0 {
             return Err(Error::Validation(errors));
@@ -596,6 +644,10 @@ impl Renderer {
         self.maps.destroy(ctx);
         self.target.destroy(ctx);
         self.depth.destroy(ctx);
+        for i in &mut self.resolve {
+            i.destroy(ctx);
+        }
+        self.resolve.clear();
         for b in [Some(&mut self.view_buffer), Some(&mut self.objects), self.lights.as_mut(), self.readback.as_mut()].into_iter().flatten()
         {
             b.destroy(ctx);
