@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Frames over time and anti-aliasing, measured with the CLI (BENCHMARKS.md, issue 13):
+#   1. the static demo scene, per method: frame 1 (every map generated) against the median of
+#      frames 2–4 with map_updates=on_change (only what changed: nothing, so camera passes);
+#   2. the animated demo (the mirror sphere on its path), mean GPU frame with on_change vs always;
+#   3. aa=off|ssaa2|ssaa4 at 512² with bvh: GPU ms and PSNR against the 16-spp reference.
+# Usage: scripts/bench-frames.sh [OUTDIR]   (needs a release build: cargo build --release)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out=${1:-bench-frames}
+mkdir -p "$out"
+bin=./target/release/specula
+scene=assets/demo/demo.gltf
+frame_ms() { grep -E '^frame +[0-9.]+ +[0-9.]+$' | awk '{print $2}'; }
+
+echo "## Static demo scene, 256x256: frame 1 vs frames 2-4 (map_updates=on_change), GPU ms"
+echo "| method | frame 1 | frames 2+ (median) | ratio |"
+echo "|---|---:|---:|---:|"
+for m in envmap proxy-sphere proxy-box distance distance-multi refractor-map image-space-refraction bvh; do
+  f1=$($bin render $scene --method $m --size 256x256 -q map_updates=on_change --warmup 0 --frames 1 --out "$out/f1.exr" | frame_ms)
+  f2=$($bin render $scene --method $m --size 256x256 -q map_updates=on_change --warmup 1 --frames 3 --out "$out/f2.exr" | frame_ms)
+  echo "| $m | $f1 | $f2 | $(awk -v a="$f1" -v b="$f2" 'BEGIN { printf "%.1f×", a / b }') |"
+done
+
+echo
+echo "## Animated demo (mirror sphere on its path), 256x256, 12 fps x 4 s: mean GPU ms per frame"
+echo "| method | on_change | always |"
+echo "|---|---:|---:|"
+for m in envmap distance distance-multi bvh; do
+  a=$($bin animate $scene --method $m --size 256x256 --fps 12 -q map_updates=on_change --out "$out/anim_$m" 2>/dev/null | sed -n 's/.*mean \([0-9.]*\) ms.*/\1/p')
+  b=$($bin animate $scene --method $m --size 256x256 --fps 12 -q map_updates=always --out "$out/anim_$m" 2>/dev/null | sed -n 's/.*mean \([0-9.]*\) ms.*/\1/p')
+  echo "| $m | $a | $b |"
+done
+
+echo
+echo "## Anti-aliasing at 512x512, bvh (depth 4): GPU ms and PSNR against the 16-spp reference"
+$bin render $scene --method reference --size 512x512 -q spp=16 -q depth=4 --out "$out/ref16.exr" > /dev/null
+echo "| aa | frame ms | PSNR |"
+echo "|---|---:|---:|"
+for aa in off ssaa2 ssaa4; do
+  ms=$($bin render $scene --method bvh --size 512x512 -q depth=4 -q aa=$aa --out "$out/bvh_$aa.exr" | frame_ms)
+  psnr=$($bin compare "$out/bvh_$aa.exr" "$out/ref16.exr" | awk '/^PSNR/ {print $2}')
+  echo "| $aa | $ms | $psnr dB |"
+done
+for aa in off ssaa4; do
+  ms=$($bin render $scene --method distance --size 512x512 -q depth=4 -q aa=$aa --out "$out/distance_$aa.exr" | frame_ms)
+  psnr=$($bin compare "$out/distance_$aa.exr" "$out/ref16.exr" | awk '/^PSNR/ {print $2}')
+  echo "| distance, $aa | $ms | $psnr dB |"
+done
