@@ -145,7 +145,10 @@ impl Renderer {
         }
         let camera = scene.camera_or_default();
         camera.validate()?;
-        let ssaa = plan.quality.ssaa.max(1);
+        let ssaa = plan.quality.ssaa;
+        if ![1, 2, 4].contains(&ssaa) {
+            return Err(Error::invalid("knob aa", format!("{ssaa} samples per axis: supersampling takes 1, 2 or 4")));
+        }
         if width * ssaa > 16384 || height * ssaa > 16384 {
             return Err(Error::invalid("knob aa", format!("{width}x{height} with {ssaa}×{ssaa} samples exceeds 16384 per axis")));
         }
@@ -372,7 +375,15 @@ impl Renderer {
     /// records. Called by `record`: every earlier frame has completed (the one-frame-in-
     /// flight rule), so the host-visible buffers are free to write.
     fn apply_updates(&mut self, ctx: &Context) -> Result<()> {
-        let c = std::mem::take(&mut self.pending);
+        // The changes stay pending until they are all in: a frame that fails half-way (a
+        // structure rebuild out of memory) leaves them for the next one, which redoes them.
+        let c = self.pending.clone();
+        self.apply(ctx, &c)?;
+        self.pending = Changes::default();
+        Ok(())
+    }
+
+    fn apply(&mut self, ctx: &Context, c: &Changes) -> Result<()> {
         if !c.moved.is_empty() {
             for &i in &c.moved {
                 let d = self.scene.draws[i];
@@ -411,7 +422,7 @@ impl Renderer {
                 height: self.height * self.ssaa,
             };
             for s in &mut self.stages {
-                s.update(&init, &c, &mut self.maps)?;
+                s.update(&init, c, &mut self.maps)?;
             }
         }
         self.map_updates.clear();

@@ -52,4 +52,8 @@ fn ssaa_refuses_sizes_beyond_the_limit() {
     let e = specula::Renderer::new(&ctx, &scene, plan, 8192, 16).err().expect("32768 samples per row are refused").to_string();
     assert!(e.contains("knob aa") && e.contains("16384"), "{e}");
     assert!(Quality::default().set("aa", "msaa3").unwrap_err().to_string().contains("off, ssaa2, ssaa4"));
+    // The field set by hand: only 1, 2 or 4 samples per axis.
+    let plan = specula::plan(&scene, specula::methods::ENVMAP, &Quality { ssaa: 3, ..Quality::default() });
+    let e = specula::Renderer::new(&ctx, &scene, plan, 16, 16).err().expect("3 samples per axis are refused").to_string();
+    assert!(e.contains("1, 2 or 4"), "{e}");
 }

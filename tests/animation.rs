@@ -15,6 +15,11 @@ fn f32s(v: &[f32]) -> Vec<u8> {
 
 /// Writes `dir/anim.gltf` + `anim.bin`; `times_b` are the STEP channel's key times.
 fn write_animated(dir: &Path, times_b: &[f32]) -> PathBuf {
+    write_animated_with(dir, times_b, "")
+}
+
+/// As `write_animated`, with extra JSON members on node 3 (the scaled parent).
+fn write_animated_with(dir: &Path, times_b: &[f32], node3: &str) -> PathBuf {
     std::fs::create_dir_all(dir).unwrap();
     let q90 = Quat::from_rotation_y(std::f32::consts::FRAC_PI_2);
     // (name, bytes, accessor type, count, extra JSON)
@@ -44,7 +49,7 @@ fn write_animated(dir: &Path, times_b: &[f32]) -> PathBuf {
     }
     let json = format!(
         r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1,3]}}],
-"nodes":[{{"mesh":0}},{{"mesh":0,"translation":[3,0,0]}},{{"mesh":0,"translation":[0,0,5]}},{{"children":[2]}}],
+"nodes":[{{"mesh":0}},{{"mesh":0,"translation":[3,0,0]}},{{"mesh":0,"translation":[0,0,5]}},{{"children":[2]{node3}}}],
 "meshes":[{{"name":"tri","primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
 "animations":[{{"channels":[{{"sampler":0,"target":{{"node":0,"path":"translation"}}}},{{"sampler":1,"target":{{"node":1,"path":"rotation"}}}},{{"sampler":2,"target":{{"node":3,"path":"scale"}}}}],
 "samplers":[{{"input":1,"output":2,"interpolation":"LINEAR"}},{{"input":3,"output":4,"interpolation":"STEP"}},{{"input":5,"output":6,"interpolation":"CUBICSPLINE"}}]}}],
@@ -134,5 +139,20 @@ fn animated_frames_render_like_fresh_ones() {
     }
     r.destroy(&ctx);
     common::assert_clean(&ctx);
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A node at scale 0 in its static pose that its animation scales up (a pop-in) is imported
+/// hidden and appears when the animation gives it a scale.
+#[test]
+fn a_node_scaled_up_from_zero_appears() {
+    let dir = std::env::temp_dir().join(format!("specula-anim-pop-{}", std::process::id()));
+    let mut s = specula::scene::load(&write_animated_with(&dir, &[0.0, 1.0], r#","scale":[0,0,0]"#)).unwrap();
+    assert_eq!(s.meshes.len(), 3, "the zero-scale node's mesh is imported: {:?}", s.skipped);
+    assert!(s.meshes[2].hidden && !s.meshes[0].hidden);
+    s.set_time(1.0).unwrap();
+    assert!(!s.meshes[2].hidden);
+    // Scale 1 + 2 (3u² − 2u³) at u = 1/2: 2.
+    assert!(close(s.meshes[2].positions[2], 2.0 * Vec3::new(0.0, 1.0, 5.0)), "{}", s.meshes[2].positions[2]);
     std::fs::remove_dir_all(&dir).ok();
 }

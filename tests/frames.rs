@@ -289,3 +289,34 @@ fn a_hidden_object_disappears_everywhere() {
     assert!(base.clone().set_object_visible(99, false).unwrap_err().to_string().contains("99 is out of range"));
     common::assert_clean(&ctx);
 }
+
+/// Frame latency (one inter-object cycle per frame): after a move the cycles start again,
+/// so `cycles` frames later the image equals a fresh renderer's after as many frames.
+#[test]
+fn frame_latency_restarts_its_cycles_after_a_change() {
+    let ctx = common::gpu();
+    let base = common::mirror_and_glass(16);
+    let i = mirror_index(&base);
+    let centre = base.meshes[i].bounds().center();
+    let q = Quality { frame_latency: true, cycles: 3, ..quality() };
+    let m = specula::methods::DISTANCE_MULTI;
+    let mut scene = base.clone();
+    let mut r = renderer(&ctx, &scene, m, &q);
+    for _ in 0..4 {
+        r.render(&ctx).unwrap();
+    }
+    scene.set_object_transform(i, pose(3, centre)).unwrap();
+    r.update(&scene).unwrap();
+    let mut fresh_r = renderer(&ctx, &scene, m, &q);
+    for k in 0..3 {
+        let a = r.render(&ctx).unwrap();
+        let b = fresh_r.render(&ctx).unwrap();
+        assert!(bits(&a) == bits(&b), "frame {k} after the move differs from a fresh renderer's frame {k}");
+        assert!(a.map_updates.iter().any(|u| u.stage == "distance.generate"), "frame {k}: {:?}", a.map_updates);
+    }
+    // The cycles have converged: nothing more to regenerate.
+    assert!(r.render(&ctx).unwrap().map_updates.is_empty());
+    r.destroy(&ctx);
+    fresh_r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}

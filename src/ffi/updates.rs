@@ -67,8 +67,8 @@ pub unsafe extern "C" fn specula_context_set_object_visible(ctx: *mut SpeculaCon
     })
 }
 
-/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
-/// surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
+/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior; its
+/// textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 /// again). Validated like specula_context_add_material; the GPU need not be idle.
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_set_material(
@@ -79,7 +79,10 @@ pub unsafe extern "C" fn specula_context_set_material(
     with_ctx(ctx, |c| {
         let d = header(desc, SPECULA_STRUCT_MATERIAL_DESC, "material")?;
         let i = self::index(index, c.scene.materials.len(), "material")?;
-        let m = material_from_desc(d, c.scene.materials[i].name.clone())?;
+        let old = c.scene.materials[i].clone();
+        let d = material_from_desc(d, old.name.clone())?;
+        // What the descriptor does not carry (textures, KHR_materials_specular) stays.
+        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, ..old };
         apply(c, |s| &mut s.materials[i], |s| s.set_material(i, m))
     })
 }

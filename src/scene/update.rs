@@ -38,6 +38,12 @@ impl Rest {
     }
 }
 
+/// Whether a material keeps its class (diffuse, mirror, solid or thin dielectric), which
+/// decides the methods that may serve its objects.
+fn same_kind(a: &SurfaceKind, b: &SurfaceKind) -> bool {
+    kind_name(a) == kind_name(b)
+}
+
 fn kind_name(k: &SurfaceKind) -> &'static str {
     match k {
         SurfaceKind::Diffuse => "diffuse",
@@ -118,9 +124,7 @@ impl Scene {
             .materials
             .get(index)
             .ok_or_else(|| Error::invalid("material", format!("{index} is out of range (the scene has {count} materials)")))?;
-        if std::mem::discriminant(&old.kind) != std::mem::discriminant(&m.kind)
-            || matches!((&old.kind, &m.kind), (SurfaceKind::Dielectric { thin: a, .. }, SurfaceKind::Dielectric { thin: b, .. }) if a != b)
-        {
+        if !same_kind(&old.kind, &m.kind) {
             return Err(Error::invalid(
                 format!("material '{}': kind", old.name),
                 format!("is {}, the update makes it {}: a change of kind needs a new plan", kind_name(&old.kind), kind_name(&m.kind)),
@@ -225,7 +229,7 @@ impl Changes {
             }
         }
         for (i, (a, b)) in old.materials.iter().zip(&new.materials).enumerate() {
-            if std::mem::discriminant(&a.kind) != std::mem::discriminant(&b.kind) {
+            if !same_kind(&a.kind, &b.kind) {
                 return refuse(format!("material '{}' changes kind", b.name));
             }
             if a != b {

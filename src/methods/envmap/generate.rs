@@ -184,6 +184,17 @@ impl Stage for CubeMaps {
         (0..6).map(|k| (format!("{}.draws.face{k}", self.name()), self.face_draws[k] as f64)).collect()
     }
 
+    /// With frame latency the inter-object cycles run one per frame on the previous frame's
+    /// maps: after a change they start again from the sky, like a fresh renderer's, so that
+    /// no bounce keeps the old scene.
+    fn update(&mut self, _init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+        let seen = !changes.moved.is_empty() || !changes.materials.is_empty() || !changes.lights.is_empty();
+        if self.frame_latency && seen {
+            self.frames = 0;
+        }
+        Ok(())
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let cycles = if self.frame_latency { 1 } else { self.cycles };
         // The images are taken out of the frame's maps while this pass writes them.

@@ -121,20 +121,33 @@ impl Importer<'_> {
         let animated = self.doc.animations().len() > 0;
         let (meshes, lights) = (self.scene.meshes.len(), self.scene.lights.len());
         if let Some(mesh) = node.mesh() {
+            let mut hidden = false;
+            let mut world = world;
             if let Err(Error::InvalidInput { message, .. }) = crate::scene::validate_transform(&world, "node") {
                 let field = format!("nodes[{}]", node.index());
                 if !world.is_finite() {
                     return Err(self.err(field, format!("the node's world transform {message}")));
                 }
-                // glTF hides nodes by scale 0: skipped, with a note saying why.
-                self.scene.skipped.push(format!("{field} (meshes[{}]): the world transform {message}", mesh.index()));
-                return Ok(());
+                // glTF hides nodes by scale 0. One that an animation scales up later (a node
+                // on its path is animated) is imported hidden, in object space, so that
+                // `Scene::set_time` can show it; any other is skipped, with a note saying why.
+                let on_path = |n: usize| path.contains(&n);
+                let animated_path = self.doc.animations().any(|a| a.channels().any(|c| on_path(c.target().node().index())));
+                if !animated_path {
+                    self.scene.skipped.push(format!("{field} (meshes[{}]): the world transform {message}", mesh.index()));
+                    return Ok(());
+                }
+                hidden = true;
+                world = Mat4::IDENTITY;
             }
             if mesh.primitives().len() == 0 {
                 self.scene.skipped.push(format!("meshes[{}] (node {}) has no primitives", mesh.index(), node.index()));
             }
             for prim in mesh.primitives() {
                 self.import_primitive(node, &mesh, &prim, world)?;
+            }
+            for m in &mut self.scene.meshes[meshes..] {
+                m.hidden = hidden;
             }
         }
         if let Some(light) = node.light() {
