@@ -513,8 +513,8 @@ SpeculaResult specula_context_set_object_visible(SpeculaContext *ctx,
                                                  uint32_t object,
                                                  uint32_t visible);
 
-// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior). Its
-// surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
+// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior; its
+// textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 // again). Validated like specula_context_add_material; the GPU need not be idle.
 SpeculaResult specula_context_set_material(SpeculaContext *ctx,
                                            uint32_t index,
