@@ -13,9 +13,19 @@ use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layou
 use specula::vk::{read_image, Access, Image, ImageDesc, ImageKind, Profiler, Recorder};
 use specula::{plan, Quality, Renderer};
 
+/// One test at a time: the Khronos validation layer 1.3.239 crashed (SIGSEGV inside
+/// libVkLayer_khronos_validation.so, seen once in a fresh-clone CI run) while these tests
+/// created and used their devices concurrently.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+fn gpu() -> (std::sync::MutexGuard<'static, ()>, specula::vk::Context) {
+    let guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    (guard, common::gpu())
+}
+
 #[test]
 fn compute_pass_writes_known_pattern() {
-    let ctx = common::gpu();
+    let (_serial, ctx) = gpu();
     let (w, h) = (37u32, 21u32); // not multiples of the 8×8 workgroup
     let mut img = Image::new(
         &ctx,
@@ -74,7 +84,7 @@ fn compute_pass_writes_known_pattern() {
 fn graphics_pass_draws_known_pixels() {
     // A camera at the centre of the emissive quadrant room looking down −Z with a 90°
     // field of view: every pixel's colour is the quadrant its ray hits.
-    let ctx = common::gpu();
+    let (_serial, ctx) = gpu();
     let mut scene = Scene::new();
     common::emissive_room(&mut scene, Vec3::ZERO, 1.0);
     scene.camera = Some(Camera::look_at(Vec3::ZERO, Vec3::NEG_Z, 90f32.to_radians()));
@@ -112,7 +122,7 @@ fn graphics_pass_draws_known_pixels() {
 /// for every face and every quadrant of it, the texel against the direction the Vulkan
 /// cube-map table assigns to it (§16.5.4): a flipped or swapped face fails.
 fn cube_faces_follow_vulkan_table(mode: &str) {
-    let ctx = common::gpu();
+    let (_serial, ctx) = gpu();
     let mut scene = Scene::new();
     common::emissive_room(&mut scene, Vec3::ZERO, 1.0);
     let m = scene.add_material(common::mirror(0.5)).unwrap();
@@ -156,7 +166,7 @@ fn cube_faces_follow_vulkan_table_multiview() {
 
 #[test]
 fn renderer_frees_every_allocation() {
-    let ctx = common::gpu();
+    let (_serial, ctx) = gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     let mut q = Quality::default();
     q.set("cube_size", "32").unwrap();
