@@ -55,9 +55,22 @@ static uint32_t memory_type(VkPhysicalDevice pd, uint32_t bits, VkMemoryProperty
     exit(1);
 }
 
+/* An optional KEY=VALUE knob from the command line (e.g. depth=4). */
+static void knob(SpeculaContext *ctx, const char *pair) {
+    const char *eq = strchr(pair, '=');
+    char key[64];
+    if (!eq || (size_t)(eq - pair) >= sizeof key) {
+        fprintf(stderr, "knob '%s' is not KEY=VALUE\n", pair);
+        exit(1);
+    }
+    memcpy(key, pair, (size_t)(eq - pair));
+    key[eq - pair] = 0;
+    specula_check(ctx, specula_context_set_knob(ctx, key, eq + 1), "set_knob");
+}
+
 int main(int argc, char **argv) {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s SCENE.gltf OUT.f32 [METHOD]\n", argv[0]);
+        fprintf(stderr, "usage: %s SCENE.gltf OUT.f32 [METHOD [KEY=VALUE]]\n", argv[0]);
         return 2;
     }
     int validate = getenv("SPECULA_VALIDATE") != NULL;
@@ -147,6 +160,7 @@ int main(int argc, char **argv) {
     specula_check(ctx, specula_context_load_gltf(ctx, argv[1]), "load_gltf");
     specula_check(ctx, specula_context_set_knob(ctx, "cube_size", "64"), "set_knob");
     specula_check(ctx, specula_context_set_knob(ctx, "shadow_size", "64"), "set_knob");
+    if (argc > 4) knob(ctx, argv[4]);
     SpeculaMethod method = argc > 3 ? (SpeculaMethod)atoi(argv[3]) : SPECULA_METHOD_ENVMAP;
     SpeculaRenderDesc rd = {SPECULA_STRUCT_RENDER_DESC, sizeof rd, method, W, H};
     specula_check(ctx, specula_context_configure(ctx, &rd), "configure");

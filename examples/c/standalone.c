@@ -8,6 +8,7 @@
  * SPECULA_METHOD_* value (default SPECULA_METHOD_ENVMAP). */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "specula.h"
 
@@ -22,9 +23,22 @@ static int check(SpeculaContext *ctx, SpeculaResult r, const char *what) {
     return 1;
 }
 
+/* An optional KEY=VALUE knob from the command line (e.g. depth=4). */
+static int knob(SpeculaContext *ctx, const char *pair) {
+    const char *eq = strchr(pair, '=');
+    char key[64];
+    if (!eq || (size_t)(eq - pair) >= sizeof key) {
+        fprintf(stderr, "knob '%s' is not KEY=VALUE\n", pair);
+        return 0;
+    }
+    memcpy(key, pair, (size_t)(eq - pair));
+    key[eq - pair] = 0;
+    return check(ctx, specula_context_set_knob(ctx, key, eq + 1), "set_knob");
+}
+
 int main(int argc, char **argv) {
     if (argc < 3) {
-        fprintf(stderr, "usage: %s SCENE.gltf OUT.ppm [OUT.f32 [METHOD]]\n", argv[0]);
+        fprintf(stderr, "usage: %s SCENE.gltf OUT.ppm [OUT.f32 [METHOD [KEY=VALUE]]]\n", argv[0]);
         return 2;
     }
     SpeculaContextDesc desc = {SPECULA_STRUCT_CONTEXT_DESC, sizeof desc, NULL, getenv("SPECULA_VALIDATE") != NULL};
@@ -39,7 +53,7 @@ int main(int argc, char **argv) {
     static float rgba32f[W * H * 4];
     int ok = check(ctx, specula_context_load_gltf(ctx, argv[1]), "load_gltf") &&
              check(ctx, specula_context_set_knob(ctx, "cube_size", "64"), "set_knob") &&
-             check(ctx, specula_context_set_knob(ctx, "shadow_size", "64"), "set_knob") &&
+             check(ctx, specula_context_set_knob(ctx, "shadow_size", "64"), "set_knob") && (argc <= 5 || knob(ctx, argv[5])) &&
              check(ctx, specula_context_configure(ctx, &render), "configure") &&
              check(ctx, specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, rgba8, sizeof rgba8), "render");
     if (ok) {
