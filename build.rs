@@ -15,7 +15,7 @@ mod shaderc;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-use shaderc::{collect, compile_with};
+use shaderc::{collect, compile_variant, variants};
 
 fn main() {
     let root = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
@@ -57,11 +57,16 @@ fn main() {
 
     let compiler = std::env::var("GLSLANG_VALIDATOR").unwrap_or_else(|_| "glslangValidator".into());
     let results: Vec<Result<(String, PathBuf), String>> = std::thread::scope(|s| {
-        let handles: Vec<_> = sources
+        // Each source, then each variant it declares.
+        let jobs: Vec<(&PathBuf, Option<String>)> = sources
             .iter()
-            .map(|src| {
+            .flat_map(|src| std::iter::once((src, None)).chain(variants(src).into_iter().map(move |v| (src, Some(v)))))
+            .collect();
+        let handles: Vec<_> = jobs
+            .into_iter()
+            .map(|(src, variant)| {
                 let (glsl, out, compiler, generated) = (&glsl, &out, &compiler, &generated);
-                s.spawn(move || compile_with(compiler, glsl, &[generated], out, src))
+                s.spawn(move || compile_variant(compiler, glsl, &[generated], out, src, variant.as_deref()))
             })
             .collect();
         handles.into_iter().map(|h| h.join().unwrap()).collect()

@@ -28,10 +28,37 @@ pub fn compile(compiler: &str, glsl: &Path, out: &Path, src: &Path) -> Result<(S
 /// `compile`, with more include directories searched after `glsl` (build.rs: the generated
 /// headers in `$OUT_DIR/glsl`).
 pub fn compile_with(compiler: &str, glsl: &Path, includes: &[&Path], out: &Path, src: &Path) -> Result<(String, PathBuf), String> {
-    let name = src.strip_prefix(glsl).unwrap().to_string_lossy().replace('\\', "/");
-    let spv = out.join(format!("{}.spv", name.replace('/', "__")));
+    compile_variant(compiler, glsl, includes, out, src, None)
+}
+
+/// The variants a shader declares on a line `// variants: NAME …` among its first lines:
+/// each is compiled again with `-DNAME`, embedded as `path#NAME`.
+pub fn variants(src: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(src).unwrap_or_default();
+    text.lines()
+        .take(12)
+        .filter_map(|l| l.trim().strip_prefix("// variants:"))
+        .flat_map(|v| v.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+        .collect()
+}
+
+/// `compile_with`, with the preprocessor symbol `variant` defined (named `path#VARIANT`).
+pub fn compile_variant(
+    compiler: &str,
+    glsl: &Path,
+    includes: &[&Path],
+    out: &Path,
+    src: &Path,
+    variant: Option<&str>,
+) -> Result<(String, PathBuf), String> {
+    let mut name = src.strip_prefix(glsl).unwrap().to_string_lossy().replace('\\', "/");
+    if let Some(v) = variant {
+        name = format!("{name}#{v}");
+    }
+    let spv = out.join(format!("{}.spv", name.replace('/', "__").replace('#', "__variant_")));
     let output = Command::new(compiler)
         .args(["-V", "--target-env", "vulkan1.3", "-Os"])
+        .args(variant.map(|v| format!("-D{v}")))
         .arg("-I".to_string() + &glsl.display().to_string())
         .args(includes.iter().map(|i| "-I".to_string() + &i.display().to_string()))
         .arg("-o")

@@ -95,9 +95,48 @@ pub struct Quality {
     /// Maps (shadow, environment, distance, refractor) regenerated every frame, else only
     /// when what they depend on changed (frames over time).
     pub map_updates_always: bool,
-    /// Supersampling of the camera passes: 1 (off), 2 or 4 samples per pixel along each
-    /// axis (a regular grid, box-filtered on the GPU).
-    pub ssaa: u32,
+    /// Anti-aliasing of the camera passes (`aa`).
+    pub aa: Aa,
+    /// With MSAA: the specular camera passes shade every sample (their search depends on
+    /// the sample's position and normal), else once per pixel and coverage.
+    pub msaa_per_sample: bool,
+}
+
+/// Anti-aliasing of the camera passes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Aa {
+    Off,
+    /// Multisampling with this many samples per pixel (2, 4 or 8; the device's standard
+    /// sample positions), resolved (averaged) on the GPU.
+    Msaa(u32),
+    /// Supersampling: this many samples per pixel along each axis (2 or 4, a regular
+    /// grid), box-filtered on the GPU.
+    Ssaa(u32),
+}
+
+/// Serialised as the knob's value (`msaa4`).
+impl serde::Serialize for Aa {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(&name_of(*self, AA))
+    }
+}
+
+impl Aa {
+    /// Supersampling factor per axis (1 unless `Ssaa`).
+    pub fn ssaa(self) -> u32 {
+        match self {
+            Aa::Ssaa(n) => n,
+            _ => 1,
+        }
+    }
+
+    /// Samples per pixel of the camera target (1 unless `Msaa`).
+    pub fn msaa(self) -> u32 {
+        match self {
+            Aa::Msaa(n) => n,
+            _ => 1,
+        }
+    }
 }
 
 /// One knob, declared once.
@@ -145,7 +184,15 @@ const PRECISIONS: &[(&str, Precision)] = &[("half", Precision::Half), ("single",
 const CUBE_MODES: &[(&str, CubeMode)] = &[("six", CubeMode::SixPasses), ("multiview", CubeMode::Multiview)];
 const FRESNEL: &[(&str, FresnelMode)] = &[("schlick", FresnelMode::Schlick), ("exact", FresnelMode::Exact)];
 const ON_OFF: &[(&str, bool)] = &[("on", true), ("off", false)];
-const AA: &[(&str, u32)] = &[("off", 1), ("ssaa2", 2), ("ssaa4", 4)];
+const AA: &[(&str, Aa)] = &[
+    ("off", Aa::Off),
+    ("msaa2", Aa::Msaa(2)),
+    ("msaa4", Aa::Msaa(4)),
+    ("msaa8", Aa::Msaa(8)),
+    ("ssaa2", Aa::Ssaa(2)),
+    ("ssaa4", Aa::Ssaa(4)),
+];
+const MSAA_SHADING: &[(&str, bool)] = &[("sample", true), ("pixel", false)];
 const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
@@ -459,14 +506,25 @@ pub const KNOBS: &[Knob] = &[
     },
     Knob {
         name: "aa",
-        values: "off|ssaa2|ssaa4",
+        values: "off|msaa2|msaa4|msaa8|ssaa2|ssaa4",
         default: "off",
-        doc: "anti-aliasing of every GPU method's camera passes: supersampling on a regular 2×2 (ssaa2) or 4×4 (ssaa4) grid per pixel, box-filtered on the GPU (the reference's stratified sample positions)",
+        doc: "anti-aliasing of every GPU method's camera passes: multisampling with 2, 4 or 8 samples per pixel at the device's standard positions (ray-tracing methods trace one ray per sample; the counts a device offers vary: lavapipe has 4 only), or supersampling on a regular 2×2 (ssaa2) or 4×4 (ssaa4) grid per pixel; resolved by averaging on the GPU",
         set: |q, v| {
-            q.ssaa = one_of(v, AA)?;
+            q.aa = one_of(v, AA)?;
             Ok(())
         },
-        get: |q| name_of(q.ssaa, AA),
+        get: |q| name_of(q.aa, AA),
+    },
+    Knob {
+        name: "msaa_shading",
+        values: "sample|pixel",
+        default: "sample",
+        doc: "with aa=msaaN: the specular camera passes shade every sample (reflections inside curved objects anti-aliased too) or once per pixel (edges only); diffuse surfaces always shade once per pixel",
+        set: |q, v| {
+            q.msaa_per_sample = one_of(v, MSAA_SHADING)?;
+            Ok(())
+        },
+        get: |q| name_of(q.msaa_per_sample, MSAA_SHADING),
     },
     Knob {
         name: "map_updates",
@@ -523,7 +581,8 @@ impl Default for Quality {
             tile_size: 16,
             ray_stats: false,
             map_updates_always: false,
-            ssaa: 1,
+            aa: Aa::Off,
+            msaa_per_sample: true,
         }
     }
 }

@@ -20,7 +20,9 @@ use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::update::Changes;
 use crate::scene::{Camera, Scene};
-use crate::vk::pipeline::{allocate_set, descriptor_set_layout, pipeline_layout, sampler, write_buffer, write_image};
+use crate::vk::pipeline::{
+    allocate_set, descriptor_set_layout, pipeline_layout, sample_count_flags, sampler, write_buffer, write_image, Multisample,
+};
 use crate::vk::{
     record_copy_to_buffer, Access, Buffer, Context, Image, ImageData, ImageDesc, ImageKind, MemoryLocation, PassTiming, Profiler, Recorder,
 };
@@ -127,10 +129,66 @@ pub struct Renderer {
     map_updates: Vec<MapUpdate>,
     /// Each view's eye (the view table's), for per-face culling.
     view_eyes: Vec<glam::Vec3>,
-    /// Supersampling per axis (`aa`): the camera passes render `ssaa`² samples per pixel
-    /// into `target`, and `resolve` halves it down to the output size (2×2 box each step).
+    /// Supersampling per axis (`aa=ssaaN`): the camera passes render `ssaa`² samples per
+    /// pixel into `target`, and `resolve` halves it down to the output size (2×2 box each
+    /// step). Multisampling (`aa=msaaN`): `target` and `depth` hold `multisample.samples`
+    /// samples per pixel, and `resolve` is the one image they are averaged into.
     ssaa: u32,
+    multisample: Multisample,
     resolve: Vec<Image>,
+}
+
+/// The camera target's samples for the plan's `aa` (MSAA), checked against what the
+/// device can render: the sample counts of the target's colour and depth formats, and
+/// sample-rate shading (the per-sample passes, and the ray pipelines' one ray per sample).
+fn camera_multisample(ctx: &Context, plan: &Plan) -> Result<Multisample> {
+    let q = &plan.quality;
+    let samples = q.aa.msaa();
+    if samples == 1 {
+        return Ok(Multisample::OFF);
+    }
+    let name = format!("msaa{samples}");
+    if ![2, 4, 8].contains(&samples) {
+        return Err(Error::invalid("knob aa", format!("{name}: multisampling takes 2, 4 or 8 samples per pixel")));
+    }
+    let counts = |format: vk::Format, usage: vk::ImageUsageFlags| unsafe {
+        ctx.instance
+            .get_physical_device_image_format_properties(
+                ctx.physical,
+                format,
+                vk::ImageType::TYPE_2D,
+                vk::ImageTiling::OPTIMAL,
+                usage,
+                vk::ImageCreateFlags::empty(),
+            )
+            .map_or(vk::SampleCountFlags::TYPE_1, |p| p.sample_counts)
+    };
+    let colour = counts(TARGET_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC);
+    let depth = counts(DEPTH_FORMAT, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT);
+    let both =
+        colour & depth & ctx.properties.limits.framebuffer_color_sample_counts & ctx.properties.limits.framebuffer_depth_sample_counts;
+    if !both.contains(sample_count_flags(samples)) {
+        let offered: Vec<String> =
+            [2u32, 4, 8, 16].iter().filter(|&&n| both.contains(sample_count_flags(n))).map(|n| format!("msaa{n}")).collect();
+        let offered = if offered.is_empty() { "none".to_string() } else { offered.join(", ") };
+        return Err(Error::invalid(
+            "knob aa",
+            format!(
+                "{name}: {} cannot render {TARGET_FORMAT:?} colour with {DEPTH_FORMAT:?} depth at {samples} samples per pixel (it offers: {offered}; ssaa2 and ssaa4 work everywhere)",
+                ctx.device_name
+            ),
+        ));
+    }
+    if !ctx.sample_rate_shading {
+        return Err(Error::invalid(
+            "knob aa",
+            format!(
+                "{name} shades specular passes and ray-traced pixels per sample, which needs the device feature sampleRateShading: {} (ssaa2 and ssaa4 need nothing)",
+                if ctx.queue.is_none() { "a host device does not tell whether it enabled it" } else { "this device lacks it" }
+            ),
+        ));
+    }
+    Ok(Multisample { samples, per_sample: q.msaa_per_sample })
 }
 
 impl Renderer {
@@ -145,13 +203,14 @@ impl Renderer {
         }
         let camera = scene.camera_or_default();
         camera.validate()?;
-        let ssaa = plan.quality.ssaa;
+        let ssaa = plan.quality.aa.ssaa();
         if ![1, 2, 4].contains(&ssaa) {
             return Err(Error::invalid("knob aa", format!("{ssaa} samples per axis: supersampling takes 1, 2 or 4")));
         }
         if width * ssaa > 16384 || height * ssaa > 16384 {
             return Err(Error::invalid("knob aa", format!("{width}x{height} with {ssaa}×{ssaa} samples exceeds 16384 per axis")));
         }
+        let multisample = camera_multisample(ctx, &plan)?;
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.
         let r = Renderer {
@@ -193,6 +252,7 @@ impl Renderer {
             map_updates: Vec::new(),
             view_eyes: Vec::new(),
             ssaa,
+            multisample,
             resolve: Vec::new(),
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
@@ -239,8 +299,11 @@ impl Renderer {
         self.sets = self.maps.sets(&self.owned_sets.iter().map(|s| s.set).collect::<Vec<_>>());
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::SAMPLED;
         let (sw, sh) = (self.width * self.ssaa, self.height * self.ssaa);
-        self.target =
-            Image::new(ctx, &ImageDesc { name: "frame.color", format: TARGET_FORMAT, width: sw, height: sh, kind: ImageKind::D2, usage })?;
+        let samples = self.multisample.samples;
+        let kind = if samples > 1 { ImageKind::D2Multisample { samples } } else { ImageKind::D2 };
+        // A multisampled target is only resolved from, never sampled.
+        let usage = if samples > 1 { usage & !vk::ImageUsageFlags::SAMPLED } else { usage };
+        self.target = Image::new(ctx, &ImageDesc { name: "frame.color", format: TARGET_FORMAT, width: sw, height: sh, kind, usage })?;
         self.depth = Image::new(
             ctx,
             &ImageDesc {
@@ -248,10 +311,15 @@ impl Renderer {
                 format: DEPTH_FORMAT,
                 width: sw,
                 height: sh,
-                kind: ImageKind::D2,
+                kind,
                 usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
             },
         )?;
+        if samples > 1 {
+            let usage = vk::ImageUsageFlags::TRANSFER_SRC | vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::SAMPLED;
+            let desc = ImageDesc { name: "frame.resolved", format: TARGET_FORMAT, width: sw, height: sh, kind: ImageKind::D2, usage };
+            self.resolve.push(Image::new(ctx, &desc)?);
+        }
         // Supersampling: halving steps down to the output size (linear 2:1 blits average
         // each 2×2 block exactly).
         if self.ssaa > 1 {
@@ -303,6 +371,7 @@ impl Renderer {
             set_layouts: [self.set_layout, self.maps_layout],
             width: self.width * self.ssaa,
             height: self.height * self.ssaa,
+            multisample: self.multisample,
         };
         for spec in &self.plan.stages {
             self.deps.push(match spec {
@@ -318,11 +387,11 @@ impl Renderer {
                     continue;
                 }
                 StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
-                StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout)?),
+                StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout, self.multisample)?),
                 StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
                 StageSpec::Camera(c) => match c.pass.create {
                     Some(create) => create(&init, c)?,
-                    None => Box::new(CameraShade::new(ctx, self.layout, c)?),
+                    None => Box::new(CameraShade::new(ctx, self.layout, c, self.multisample)?),
                 },
             };
             self.stages.push(stage);
@@ -420,6 +489,7 @@ impl Renderer {
                 set_layouts: [self.set_layout, self.maps_layout],
                 width: self.width * self.ssaa,
                 height: self.height * self.ssaa,
+                multisample: self.multisample,
             };
             for s in &mut self.stages {
                 s.update(&init, c, &mut self.maps)?;
@@ -563,8 +633,25 @@ impl Renderer {
             }
             stage.record(&mut rec, &f, &mut io);
         }
+        if self.multisample.samples > 1 {
+            // Multisampling: the samples' average (vkCmdResolveImage on a float format).
+            let dst = &mut self.resolve[0];
+            let open = rec.pass("frame.resolve").reads(&self.target, Access::TransferSrc).writes(dst, Access::TransferDst).begin();
+            let layers =
+                vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 };
+            let region = vk::ImageResolve {
+                src_subresource: layers,
+                src_offset: vk::Offset3D::default(),
+                dst_subresource: layers,
+                dst_offset: vk::Offset3D::default(),
+                extent: vk::Extent3D { width: dst.width, height: dst.height, depth: 1 },
+            };
+            let (s, d) = (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+            unsafe { ctx.device.cmd_resolve_image(cmd, self.target.raw, s, dst.raw, d, &[region]) };
+            rec.end(open);
+        }
         // Supersampling: 2×2 box steps down to the output size.
-        for i in 0..self.resolve.len() {
+        for i in 0..self.resolve.len() * (self.ssaa > 1) as usize {
             let (done, rest) = self.resolve.split_at_mut(i);
             let src = done.last_mut().unwrap_or(&mut self.target);
             let dst = &mut rest[0];

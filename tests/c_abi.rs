@@ -138,6 +138,23 @@ fn examples_render_the_same_image_through_every_link_mode() {
         run(&host, &[&scene, &b, Path::new(method), depth]);
         assert!(read_f32(&a) == read_f32(&b), "method {method}: host-device image differs from standalone");
     }
+    // MSAA: standalone contexts enable sampleRateShading and render it; a host device does
+    // not say whether it enabled the feature, so the renderer refuses MSAA there by name
+    // (the process stays alive and reports it) and SSAA works on both.
+    let a = dir.join("msaa_standalone.f32");
+    run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new("1"), Path::new("aa=msaa4")]);
+    assert!(read_f32(&a) != *reference, "msaa4 changes the standalone image");
+    let o = Command::new(&host)
+        .args([&scene, &dir.join("msaa_host.f32"), Path::new("1"), Path::new("aa=msaa4")])
+        .current_dir(ROOT)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && stderr.contains("knob aa") && stderr.contains("sampleRateShading"), "host with msaa4: {stderr}");
+    let (a, b) = (dir.join("ssaa_standalone.f32"), dir.join("ssaa_host.f32"));
+    run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new("1"), Path::new("aa=ssaa2")]);
+    run(&host, &[&scene, &b, Path::new("1"), Path::new("aa=ssaa2")]);
+    assert!(read_f32(&a) == read_f32(&b), "ssaa2: host-device image differs from standalone");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -81,3 +81,19 @@ fn the_cli_exits_1_on_huge_declared_images() {
     }
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// A reader that closes the pipe early (`specula knobs | head -1`) ends the CLI quietly: no
+/// panic message from a failed `println!`. The read end is closed before the CLI writes.
+#[test]
+fn the_cli_stops_quietly_when_its_reader_closes_the_pipe() {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_specula"))
+        .arg("knobs")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!err.contains("panicked") && !err.contains("Broken pipe"), "{err}");
+}

@@ -7,4 +7,12 @@
 
 #include "generated/layout.glsl"
 
+// A camera shader's interpolated inputs: at each sample's position in its PER_SAMPLE
+// variant (aa=msaaN with msaa_shading=sample runs it once per sample), else at the pixel.
+#ifdef PER_SAMPLE
+#define SAMPLE_INTERP sample
+#else
+#define SAMPLE_INTERP
+#endif
+
 #endif

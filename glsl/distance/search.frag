@@ -1,14 +1,15 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
 // distance.search: single reflections and refractions using the sampled geometry (§4.2):
 // the reflected and refracted rays are traced in the object's distance map and the hit
 // texel's radiance is weighted by Fresnel.
 #include "common/specular.glsl"
 #include "common/traced.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
 layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 

@@ -1,14 +1,15 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
 // proxy.shade: localised environment mapping (survey §3.2, Figure 15): the reflected or
 // refracted ray is intersected with a proxy of the environment, a sphere around the
 // reference point or a box (a "parallax-corrected cube map"), and the cube map is looked
 // up in the direction of the proxy hit.
 #include "common/specular.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
 layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 

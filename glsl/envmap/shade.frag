@@ -1,13 +1,14 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
 // envmap.shade: classic environment mapping (survey §3, §3.1). The reflected and the
 // refracted direction look the object's cube map up, ignoring the ray origin; the
 // radiances are weighted by the Fresnel function (survey eq. 1).
 #include "common/specular.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
 layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 

@@ -10,6 +10,20 @@
 // loops (gallivm's loop limiter: the loop that exhausts it stops). Traversals stay far
 // below it (a ray visits hundreds of nodes or cells); brute force unrolls its loop.
 
+// Sample s of n per pixel, in the pixel's [0, 1)² (framebuffer axes): the Vulkan spec's
+// standard sample locations for n = 2, 4, 8 (the positions an MSAA camera target samples
+// where the device reports standardSampleLocations), the pixel centre for n = 1.
+vec2 sample_position(uint s, uint n) {
+    const vec2 two[2] = vec2[2](vec2(0.75, 0.75), vec2(0.25, 0.25));
+    const vec2 four[4] = vec2[4](vec2(0.375, 0.125), vec2(0.875, 0.375), vec2(0.125, 0.625), vec2(0.625, 0.875));
+    const vec2 eight[8] = vec2[8](vec2(0.5625, 0.3125), vec2(0.4375, 0.6875), vec2(0.8125, 0.5625), vec2(0.3125, 0.1875),
+                                  vec2(0.1875, 0.8125), vec2(0.0625, 0.4375), vec2(0.6875, 0.9375), vec2(0.9375, 0.0625));
+    if (n == 2u) return two[s & 1u];
+    if (n == 4u) return four[s & 3u];
+    if (n == 8u) return eight[s & 7u];
+    return vec2(0.5);
+}
+
 RayHit no_hit(RayQuery q) {
     return RayHit(q.direction.w, 0.0, 0.0, RAY_NO_TRIANGLE);
 }

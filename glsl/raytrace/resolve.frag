@@ -1,19 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Writes the traced radiance of the pixels this stage renders into the frame's target
-// (64-bit fixed-point sums → float); other pixels keep what earlier passes drew.
-#include "raytrace/trace.glsl"
-
-layout(location = 0) out vec4 colour;
+// One ray per pixel: its radiance into the frame's target (raytrace/resolve.glsl).
+#include "raytrace/resolve.glsl"
 
 void main() {
-    ivec2 xy = ivec2(gl_FragCoord.xy);
-    uint id = imageLoad(visibility, xy).r;
-    if (id == RAY_NO_TRIANGLE || handled[floatBitsToUint(shading[id].uv2.z)] == 0u) discard;
-    uint i = 6u * (uint(xy.y) * trace.width + uint(xy.x));
-    vec3 c;
-    for (uint k = 0u; k < 3u; ++k) {
-        c[k] = (float(accum[i + 2u * k + 1u]) * 4294967296.0 + float(accum[i + 2u * k])) / ACCUM_SCALE;
-    }
-    colour = vec4(c, 1.0);
+    resolve(0u);
 }

@@ -77,11 +77,12 @@ bool push_shadow(RayQuery q, RayPayload p) {
     return true;
 }
 
-// The pixel-centre camera ray of pixel (x, y) through the camera view's inverse
-// projection: the reference's CameraRays (src/reference/mod.rs).
-void camera_ray(uint x, uint y, out vec3 o, out vec3 d) {
+// The camera ray of pixel (x, y) through its sample s (the pixel centre without MSAA)
+// through the camera view's inverse projection: the reference's CameraRays
+// (src/reference/mod.rs).
+void camera_ray(uint x, uint y, uint s, out vec3 o, out vec3 d) {
     View v = views[push.view];
-    vec2 ndc = (vec2(x, y) + 0.5) / vec2(trace.width, trace.height) * 2.0 - 1.0;
+    vec2 ndc = (vec2(x, y) + sample_position(s, trace.samples)) / vec2(trace.width, trace.height) * 2.0 - 1.0;
     vec4 far_point = v.inv_view_proj * vec4(ndc, 1e-4, 1.0);
     o = v.eye.xyz;
     d = normalize(far_point.xyz / far_point.w - o);

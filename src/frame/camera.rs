@@ -9,7 +9,7 @@ use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::stage::{FrameIo, Stage};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs};
 use crate::plan::CameraPlan;
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{Access, Context, Recorder};
 use crate::Result;
 
@@ -21,14 +21,18 @@ pub struct CameraShade {
 }
 
 impl CameraShade {
-    pub fn new(ctx: &Context, layout: vk::PipelineLayout, plan: &CameraPlan) -> Result<CameraShade> {
+    /// With per-sample MSAA the fragment shader's PER_SAMPLE variant runs (its inputs
+    /// interpolated at each sample, so the search starts from the sample's own point).
+    pub fn new(ctx: &Context, layout: vk::PipelineLayout, plan: &CameraPlan, multisample: Multisample) -> Result<CameraShade> {
+        let per_sample = multisample.per_sample && multisample.samples > 1;
+        let fragment = if per_sample { format!("{}#PER_SAMPLE", plan.pass.fragment) } else { plan.pass.fragment.to_string() };
         let pipeline = graphics_pipeline(
             ctx,
             layout,
             &GraphicsDesc {
                 name: plan.name,
                 vertex: plan.pass.vertex,
-                fragment: plan.pass.fragment,
+                fragment: &fragment,
                 vertex_input: VertexInput::Mesh,
                 color_formats: &[TARGET_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
@@ -36,6 +40,7 @@ impl CameraShade {
                 depth_write: true,
                 view_mask: 0,
                 cull: vk::CullModeFlags::NONE,
+                multisample,
             },
         )?;
         Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone() })

@@ -6,7 +6,7 @@ use ash::vk;
 
 use super::stage::{FrameIo, Stage};
 use super::{begin_camera_rendering, destroy_pipelines, FrameInputs};
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{Access, Context, Recorder};
 use crate::Result;
 
@@ -25,6 +25,7 @@ pub fn sky_and_direct(
     layout: vk::PipelineLayout,
     format: vk::Format,
     view_mask: u32,
+    multisample: Multisample,
     name: &str,
 ) -> Result<(vk::Pipeline, vk::Pipeline)> {
     let formats = [format];
@@ -42,6 +43,7 @@ pub fn sky_and_direct(
             depth_write: false,
             view_mask,
             cull: vk::CullModeFlags::NONE,
+            multisample,
         },
     )?;
     let direct = graphics_pipeline(
@@ -58,6 +60,7 @@ pub fn sky_and_direct(
             depth_write: true,
             view_mask,
             cull: vk::CullModeFlags::NONE,
+            multisample,
         },
     );
     match direct {
@@ -70,8 +73,11 @@ pub fn sky_and_direct(
 }
 
 impl SceneDirect {
-    pub fn new(ctx: &Context, layout: vk::PipelineLayout) -> Result<SceneDirect> {
-        let (sky, direct) = sky_and_direct(ctx, layout, TARGET_FORMAT, 0, "scene")?;
+    /// Its pipelines draw into the camera target's samples (`multisample`), shading once
+    /// per pixel: diffuse surfaces need coverage only, their textures are filtered.
+    pub fn new(ctx: &Context, layout: vk::PipelineLayout, multisample: Multisample) -> Result<SceneDirect> {
+        let ms = Multisample { per_sample: false, ..multisample };
+        let (sky, direct) = sky_and_direct(ctx, layout, TARGET_FORMAT, 0, ms, "scene")?;
         Ok(SceneDirect { sky, direct })
     }
 }

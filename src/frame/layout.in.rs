@@ -152,7 +152,9 @@ gpu_structs! {
         /// the ray hierarchy (§2.2.1): edge of a tile of the ray texture, and tiles per row
         tile_size: uint,
         tiles_per_row: uint,
-        pad: [uint; 2],
+        /// camera rays per pixel (MSAA samples; 1 without)
+        samples: uint,
+        pad: uint,
     }
 
     /// What an acceleration scheme's kernel needs besides its node and reference buffers.
@@ -302,7 +304,7 @@ descriptor_sets! {
         HANDLED = 8: STORAGE_BUFFER => "readonly buffer Handled { uint handled[]; }";
         TRACE = 9: STORAGE_BUFFER => "readonly buffer Trace { TraceParams trace; }";
         /// The primary hits: each pixel's nearest triangle id, from rasterisation
-        VISIBILITY = 10: STORAGE_IMAGE => "layout(r32ui) uniform readonly uimage2D visibility";
+        VISIBILITY = 10: STORAGE_IMAGE => "layout(r32ui) uniform readonly uimage2DArray visibility";
         /// Indirect dispatch arguments of the next kernels (args.comp)
         DISPATCH = 11: STORAGE_BUFFER => "buffer Dispatch { uint dispatch[]; }";
         /// The first queue's hits (primary.comp writes them from the visibility image)

@@ -8,7 +8,7 @@ use super::stage::{FrameIo, Maps, Stage, StageInit};
 use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::plan::Plan;
 use crate::quality::CubeMode;
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
@@ -48,6 +48,7 @@ impl ShadowMaps {
             depth_write: true,
             view_mask,
             cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };

@@ -209,8 +209,12 @@ pub struct StageInit<'a> {
     pub layout: vk::PipelineLayout,
     /// The frame's descriptor set layouts (set 0, set 1), for stages with layouts of their own.
     pub set_layouts: [vk::DescriptorSetLayout; 2],
+    /// The camera target's size (the output's, times the supersampling factor).
     pub width: u32,
     pub height: u32,
+    /// The camera target's samples per pixel, and whether specular camera passes shade
+    /// each sample (`aa=msaaN`, `msaa_shading`).
+    pub multisample: crate::vk::pipeline::Multisample,
 }
 
 /// A map pass's constructor: the pass for `objects` (mesh indices), its images into `maps`.

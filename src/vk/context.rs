@@ -140,6 +140,9 @@ pub struct Context {
     pub memory: MemoryRegistry,
     allocator: Mutex<Option<Allocator>>,
     owned: bool,
+    /// The device was created with `sampleRateShading` (MSAA's per-sample passes need it).
+    /// Only the library's own devices: a host device's enabled features are not known.
+    pub sample_rate_shading: bool,
 }
 
 /// Device extensions the library needs beyond Vulkan 1.3: null descriptors stand in for
@@ -281,7 +284,9 @@ impl Context {
 
         let prio = [1.0f32];
         let qci = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];
-        let features = vk::PhysicalDeviceFeatures::default().image_cube_array(true);
+        let supported = unsafe { instance_ref.get_physical_device_features(physical) };
+        let sample_rate_shading = supported.sample_rate_shading == vk::TRUE;
+        let features = vk::PhysicalDeviceFeatures::default().image_cube_array(true).sample_rate_shading(sample_rate_shading);
         let mut f11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
         let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
@@ -299,6 +304,7 @@ impl Context {
         let mut ctx =
             Context::assemble(entry, instance, physical, device, queue_family, Some(queue), debug_instance, messenger, validation, true)?;
         ctx.owned = true;
+        ctx.sample_rate_shading = sample_rate_shading;
         Ok(ctx)
     }
 
@@ -394,6 +400,7 @@ impl Context {
             memory: MemoryRegistry::default(),
             allocator: Mutex::new(Some(allocator)),
             owned,
+            sample_rate_shading: false,
         })
     }
 

@@ -130,6 +130,38 @@ pub struct GraphicsDesc<'a> {
     /// Faces to cull; NONE draws both sides (rooms are seen from inside, refractors from
     /// both sides), FRONT keeps back faces (image-space refraction's first pass).
     pub cull: vk::CullModeFlags,
+    /// Samples per pixel of the attachments, and whether every sample runs the fragment
+    /// shader (sample-rate shading).
+    pub multisample: Multisample,
+}
+
+/// The rasteriser's samples per pixel for a pipeline.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Multisample {
+    pub samples: u32,
+    pub per_sample: bool,
+}
+
+impl Multisample {
+    /// One sample per pixel (every map pass, and camera passes without MSAA).
+    pub const OFF: Multisample = Multisample { samples: 1, per_sample: false };
+
+    pub fn flags(self) -> vk::SampleCountFlags {
+        sample_count_flags(self.samples)
+    }
+}
+
+/// The Vulkan flag of a sample count (1, 2, 4, 8, 16, 32 or 64; anything else is 1).
+pub fn sample_count_flags(samples: u32) -> vk::SampleCountFlags {
+    match samples {
+        2 => vk::SampleCountFlags::TYPE_2,
+        4 => vk::SampleCountFlags::TYPE_4,
+        8 => vk::SampleCountFlags::TYPE_8,
+        16 => vk::SampleCountFlags::TYPE_16,
+        32 => vk::SampleCountFlags::TYPE_32,
+        64 => vk::SampleCountFlags::TYPE_64,
+        _ => vk::SampleCountFlags::TYPE_1,
+    }
 }
 
 pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &GraphicsDesc) -> Result<vk::Pipeline> {
@@ -167,7 +199,11 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
         // stay counter-clockwise in the framebuffer (tests/image_space checks it).
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
-    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let per_sample = desc.multisample.per_sample && desc.multisample.samples > 1;
+    let ms = vk::PipelineMultisampleStateCreateInfo::default()
+        .rasterization_samples(desc.multisample.flags())
+        .sample_shading_enable(per_sample)
+        .min_sample_shading(if per_sample { 1.0 } else { 0.0 });
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(desc.depth_test)
         .depth_write_enable(desc.depth_write)

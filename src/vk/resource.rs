@@ -182,9 +182,17 @@ impl ImageState {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageKind {
     D2,
-    D2Array { layers: u32 },
+    D2Array {
+        layers: u32,
+    },
     Cube,
-    CubeArray { cubes: u32 },
+    CubeArray {
+        cubes: u32,
+    },
+    /// A multisampled 2D image (a camera attachment with MSAA).
+    D2Multisample {
+        samples: u32,
+    },
 }
 
 impl ImageKind {
@@ -194,6 +202,14 @@ impl ImageKind {
             ImageKind::D2Array { layers } => layers,
             ImageKind::Cube => 6,
             ImageKind::CubeArray { cubes } => 6 * cubes,
+            ImageKind::D2Multisample { .. } => 1,
+        }
+    }
+
+    pub fn samples(self) -> u32 {
+        match self {
+            ImageKind::D2Multisample { samples } => samples,
+            _ => 1,
         }
     }
 }
@@ -242,7 +258,7 @@ impl Image {
             .extent(vk::Extent3D { width: desc.width, height: desc.height, depth: 1 })
             .mip_levels(1)
             .array_layers(layers)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(crate::vk::pipeline::sample_count_flags(desc.kind.samples()))
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
@@ -352,7 +368,7 @@ impl Image {
     fn create_views(&mut self, ctx: &Context, usage: vk::ImageUsageFlags) -> Result<()> {
         let layers = self.kind.layers();
         let view_type = match self.kind {
-            ImageKind::D2 => vk::ImageViewType::TYPE_2D,
+            ImageKind::D2 | ImageKind::D2Multisample { .. } => vk::ImageViewType::TYPE_2D,
             ImageKind::D2Array { .. } => vk::ImageViewType::TYPE_2D_ARRAY,
             ImageKind::Cube => vk::ImageViewType::CUBE,
             ImageKind::CubeArray { .. } => vk::ImageViewType::CUBE_ARRAY,
@@ -440,7 +456,7 @@ impl Image {
     }
 
     pub fn byte_size(&self) -> u64 {
-        self.width as u64 * self.height as u64 * self.layers() as u64 * format_bytes(self.format) as u64
+        self.width as u64 * self.height as u64 * self.layers() as u64 * self.kind.samples() as u64 * format_bytes(self.format) as u64
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

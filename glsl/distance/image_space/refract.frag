@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
 // image_space.refract: Wyman's front-face/back-face double refraction (survey §4.4). The
 // distance to the second interface is interpolated between d_V (back-face distance along
 // the view ray, from the first pass) and d_N (precomputed along the inverted normal) by the
@@ -8,11 +9,11 @@
 #include "common/specular.glsl"
 #include "common/traced.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
 layout(location = 3) flat in uint in_view;
-layout(location = 4) in float in_thickness;
+layout(location = 4) SAMPLE_INTERP in float in_thickness;
 layout(location = 0) out vec4 out_color;
 
 void main() {

@@ -1,11 +1,12 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
 // refractor.search: self refraction with a refractor map (survey §4.4), seen by the camera.
 #include "distance/refractor/trace.glsl"
 
-layout(location = 0) in vec3 in_position;
-layout(location = 1) in vec3 in_normal;
-layout(location = 2) in vec2 in_uv;
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
 layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 

@@ -142,7 +142,23 @@ enum Command {
     },
 }
 
+/// Output piped into a reader that stops early (`specula compare … | head -3`) ends the
+/// process quietly, as other Unix tools do, instead of a panic in `println!`: Rust ignores
+/// SIGPIPE by default, so the default action is restored first.
+#[cfg(unix)]
+fn restore_sigpipe() {
+    extern "C" {
+        fn signal(signum: i32, handler: usize) -> usize;
+    }
+    const SIGPIPE: i32 = 13;
+    const SIG_DFL: usize = 0;
+    // SAFETY: setting a signal's disposition to its default touches no Rust state.
+    unsafe { signal(SIGPIPE, SIG_DFL) };
+}
+
 fn main() -> ExitCode {
+    #[cfg(unix)]
+    restore_sigpipe();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return parse_error(e),

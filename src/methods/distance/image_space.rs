@@ -12,7 +12,7 @@ use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs};
 use crate::optics::ray_triangle;
 use crate::scene::Scene;
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
@@ -95,6 +95,7 @@ impl Backfaces {
                     depth_write: true,
                     view_mask: 0,
                     cull: vk::CullModeFlags::FRONT,
+                    multisample: Multisample::OFF,
                 },
             )?;
             Ok(())

@@ -11,7 +11,7 @@ use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::methods::envmap::generate::radiance_format;
 use crate::quality::CubeMode;
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};
 use crate::Result;
 
@@ -57,6 +57,7 @@ impl RefractorMaps {
                     depth_write: true,
                     view_mask: view_mask(q.cube_mode),
                     cull: vk::CullModeFlags::NONE,
+                    multisample: Multisample::OFF,
                 },
             )?;
             Ok(())

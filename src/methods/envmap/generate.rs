@@ -17,7 +17,7 @@ use crate::methods::distance::distance_images;
 use crate::methods::registry::LeavesOut;
 use crate::plan::Plan;
 use crate::quality::{CubeMode, Precision};
-use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, VertexInput};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};
 use crate::Result;
 
@@ -125,6 +125,7 @@ impl CubeMaps {
             depth_write: depth_test,
             view_mask: view_mask(q.cube_mode),
             cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
         };
         self.sky = graphics_pipeline(
             ctx,

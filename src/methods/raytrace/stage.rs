@@ -31,7 +31,7 @@ use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, Push,
 use crate::methods::Choice;
 use crate::plan::CameraPlan;
 use crate::vk::pipeline::{
-    compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, GraphicsDesc, VertexInput,
+    compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, GraphicsDesc, Multisample, VertexInput,
 };
 use crate::vk::{begin_rendering, Access, Buffer, Context, Image, ImageDesc, ImageKind, MemoryLocation, Recorder, Target};
 
@@ -103,6 +103,9 @@ pub struct RayTrace {
     depth: u32,
     width: u32,
     height: u32,
+    /// Rays per pixel: the camera target's MSAA samples (one camera ray at each sample's
+    /// standard position; 1 without MSAA).
+    samples: u32,
     triangle_count: u32,
     structure: Option<Structure>,
     shading: Buffer,
@@ -155,6 +158,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         depth: q.depth,
         width: init.width,
         height: init.height,
+        samples: init.multisample.samples,
         triangle_count: 0,
         structure: None,
         shading: Buffer::placeholder(),
@@ -239,7 +243,8 @@ impl RayTrace {
         }
         self.handled = Buffer::with_data(ctx, "raytrace.handled", &handled, STORAGE)?;
 
-        let pixels = self.width as u64 * self.height as u64;
+        // One camera ray per sample: each (pixel, sample) pair accumulates on its own.
+        let pixels = self.width as u64 * self.height as u64 * self.samples as u64;
         let capacity = pixels * q.ray_budget as u64;
         let lights = scene.lights.len().max(1) as u64;
         if capacity > u32::MAX as u64 / 2 || capacity * lights > u32::MAX as u64 / 2 {
@@ -305,7 +310,8 @@ impl RayTrace {
                 ray_texture_width: width,
                 tile_size: tile.max(1),
                 tiles_per_row,
-                pad: [0; 2],
+                samples: self.samples,
+                pad: 0,
             };
             let at = (k * self.stride) as usize;
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
@@ -314,11 +320,14 @@ impl RayTrace {
         self.dispatch =
             Buffer::new(ctx, "raytrace.dispatch", 32 * bounces, STORAGE | vk::BufferUsageFlags::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
         self.accum = Buffer::new(ctx, "raytrace.accum", pixels * 24, counter_usage, MemoryLocation::GpuOnly)?;
-        let image = |name: &'static str, format, usage| {
-            Image::new(ctx, &ImageDesc { name, format, width: self.width, height: self.height, kind: ImageKind::D2, usage })
+        let image = |name: &'static str, format, kind, usage| {
+            Image::new(ctx, &ImageDesc { name, format, width: self.width, height: self.height, kind, usage })
         };
-        self.vis = Some(image("raytrace.visibility", VIS_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE)?);
-        self.vis_depth = Some(image("raytrace.visibility_depth", VIS_DEPTH, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?);
+        // One layer per sample: layer s is the nearest triangle at sample s's position.
+        let layers = ImageKind::D2Array { layers: self.samples };
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::STORAGE;
+        self.vis = Some(image("raytrace.visibility", VIS_FORMAT, layers, usage)?);
+        self.vis_depth = Some(image("raytrace.visibility_depth", VIS_DEPTH, ImageKind::D2, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT)?);
 
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stages)?;
@@ -341,6 +350,7 @@ impl RayTrace {
             depth_write: depth.is_some(),
             view_mask: 0,
             cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
         };
         self.p.primary_raster = graphics_pipeline(
             ctx,
@@ -351,12 +361,14 @@ impl RayTrace {
         let mut resolve = raster(
             "raytrace.resolve",
             "raytrace/resolve.vert",
-            "raytrace/resolve.frag",
+            if self.samples > 1 { "raytrace/resolve_samples.frag" } else { "raytrace/resolve.frag" },
             &[crate::frame::direct::TARGET_FORMAT],
             Some(crate::frame::direct::DEPTH_FORMAT),
         );
         resolve.depth_test = false;
         resolve.depth_write = false;
+        // With MSAA each sample takes its own ray's radiance (gl_SampleID).
+        resolve.multisample = Multisample { samples: self.samples, per_sample: self.samples > 1 };
         self.p.resolve = graphics_pipeline(ctx, self.layout, &resolve)?;
         match self.scheme {
             Scheme::RayEngine | Scheme::RayHierarchy { .. } => {
@@ -679,32 +691,43 @@ impl Stage for RayTrace {
             }
         }
         let none = f32::from_bits(u32::MAX); // clears the R32_UINT ids to RAY_NO_TRIANGLE
-        begin_rendering(
-            ctx,
-            cmd,
-            &Target {
-                color: &[vis.view],
-                depth: Some(vis_depth.view),
-                width: self.width,
-                height: self.height,
-                view_mask: 0,
-                layer_count: 1,
-                clear_color: [none; 4],
-                clear: true,
-            },
-        );
-        self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.primary_raster, f, [self.ray_sets[0], self.primary_set]);
-        self.push(ctx, cmd, f, view);
-        unsafe {
-            ctx.device.cmd_draw(cmd, 3 * self.triangle_count, 1, 0, 0);
-            ctx.device.cmd_end_rendering(cmd);
+                                             // One raster pass per sample, the projection shifted by the sample's offset from the
+                                             // pixel centre (primary.vert), into layer s.
+        let layer_views: Vec<vk::ImageView> = (0..self.samples).map(|s| vis.layer_view(s)).collect();
+        let depth_view = vis_depth.view;
+        for (s, &layer) in layer_views.iter().enumerate() {
+            if s > 0 {
+                if let Some(d) = self.vis_depth.as_mut() {
+                    rec.barrier(d, Access::DepthAttachment);
+                }
+            }
+            begin_rendering(
+                ctx,
+                cmd,
+                &Target {
+                    color: &[layer],
+                    depth: Some(depth_view),
+                    width: self.width,
+                    height: self.height,
+                    view_mask: 0,
+                    layer_count: 1,
+                    clear_color: [none; 4],
+                    clear: true,
+                },
+            );
+            self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.primary_raster, f, [self.ray_sets[0], self.primary_set]);
+            self.push_object(ctx, cmd, f, view, s as u32);
+            unsafe {
+                ctx.device.cmd_draw(cmd, 3 * self.triangle_count, 1, 0, 0);
+                ctx.device.cmd_end_rendering(cmd);
+            }
         }
         rec.end(open);
         let vis = self.vis.as_mut().expect("checked above");
         let open = rec.pass("raytrace.primary").after_buffer_writes().writes(vis, Access::ComputeStorage).begin();
         self.bind(ctx, cmd, compute, self.p.primary, f, [self.ray_sets[0], self.primary_set]);
         self.push(ctx, cmd, f, view);
-        unsafe { ctx.device.cmd_dispatch(cmd, self.width.div_ceil(8), self.height.div_ceil(8), 1) };
+        unsafe { ctx.device.cmd_dispatch(cmd, self.width.div_ceil(8), self.height.div_ceil(8), self.samples) };
         rec.end(open);
 
         // 2. The bounces.
