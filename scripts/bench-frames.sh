@@ -3,16 +3,21 @@
 #   1. the static demo scene, per method: frame 1 (every map generated) against the median of
 #      frames 2–4 with map_updates=on_change (only what changed: nothing, so camera passes);
 #   2. the animated demo (the mirror sphere on its path), mean GPU frame with on_change vs always;
-#   3. aa=off|ssaa2|ssaa4 at 512² with bvh: GPU ms and PSNR against the 16-spp reference.
-# Usage: scripts/bench-frames.sh [OUTDIR]   (needs a release build: cargo build --release)
+#   3. aa=off|msaa4|ssaa2|ssaa4 at 512² with bvh, distance and envmap (msaa4 with per-sample
+#      and per-pixel shading of the specular passes): GPU ms and PSNR / mean FLIP against the
+#      16-spp reference.
+# Usage: scripts/bench-frames.sh [OUTDIR] [SECTIONS]   (SECTIONS: e.g. 3, default 123; needs a
+# release build: cargo build --release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-bench-frames}
+sections=${2:-123}
 mkdir -p "$out"
 bin=./target/release/specula
 scene=assets/demo/demo.gltf
 frame_ms() { grep -E '^frame +[0-9.]+ +[0-9.]+$' | awk '{print $2}'; }
 
+if [[ $sections == *1* ]]; then
 echo "## Static demo scene, 256x256: frame 1 vs frames 2-4 (map_updates=on_change), GPU ms"
 echo "| method | frame 1 | frames 2+ (median) | ratio |"
 echo "|---|---:|---:|---:|"
@@ -22,6 +27,9 @@ for m in envmap proxy-sphere proxy-box distance distance-multi refractor-map ima
   echo "| $m | $f1 | $f2 | $(awk -v a="$f1" -v b="$f2" 'BEGIN { printf "%.1f×", a / b }') |"
 done
 
+fi
+
+if [[ $sections == *2* ]]; then
 echo
 echo "## Animated demo (mirror sphere on its path), 256x256, 12 fps x 4 s: mean GPU ms per frame"
 echo "| method | on_change | always |"
@@ -32,18 +40,23 @@ for m in envmap distance distance-multi bvh; do
   echo "| $m | $a | $b |"
 done
 
+fi
+
+if [[ $sections == *3* ]]; then
 echo
-echo "## Anti-aliasing at 512x512, bvh (depth 4): GPU ms and PSNR against the 16-spp reference"
+echo "## Anti-aliasing at 512x512 (depth 4): GPU ms and errors against the 16-spp reference"
 $bin render $scene --method reference --size 512x512 -q spp=16 -q depth=4 --out "$out/ref16.exr" > /dev/null
-echo "| aa | frame ms | PSNR |"
-echo "|---|---:|---:|"
-for aa in off ssaa2 ssaa4; do
-  ms=$($bin render $scene --method bvh --size 512x512 -q depth=4 -q aa=$aa --out "$out/bvh_$aa.exr" | frame_ms)
-  psnr=$($bin compare "$out/bvh_$aa.exr" "$out/ref16.exr" | awk '/^PSNR/ {print $2}')
-  echo "| $aa | $ms | $psnr dB |"
+echo "| method | aa | msaa_shading | frame ms | PSNR | mean FLIP |"
+echo "|---|---|---|---:|---:|---:|"
+for run in "bvh off sample" "bvh msaa4 sample" "bvh ssaa2 sample" "bvh ssaa4 sample" \
+           "distance off sample" "distance msaa4 sample" "distance msaa4 pixel" "distance ssaa2 sample" "distance ssaa4 sample" \
+           "envmap off sample" "envmap msaa4 sample" "envmap msaa4 pixel" "envmap ssaa4 sample"; do
+  read -r m aa sh <<< "$run"
+  img="$out/${m}_${aa}_${sh}.exr"
+  ms=$($bin render $scene --method "$m" --size 512x512 -q depth=4 -q aa="$aa" -q msaa_shading="$sh" --out "$img" | frame_ms)
+  errors=$($bin compare "$img" "$out/ref16.exr")
+  psnr=$(awk '/^PSNR/ {print $2}' <<< "$errors")
+  flip=$(awk '/^mean FLIP/ {print $3}' <<< "$errors")
+  echo "| $m | $aa | $sh | $ms | $psnr dB | $flip |"
 done
-for aa in off ssaa4; do
-  ms=$($bin render $scene --method distance --size 512x512 -q depth=4 -q aa=$aa --out "$out/distance_$aa.exr" | frame_ms)
-  psnr=$($bin compare "$out/distance_$aa.exr" "$out/ref16.exr" | awk '/^PSNR/ {print $2}')
-  echo "| distance, $aa | $ms | $psnr dB |"
-done
+fi
