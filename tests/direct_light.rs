@@ -54,41 +54,94 @@ fn point_light_follows_inverse_square_and_cosine() {
     common::assert_clean(&ctx);
 }
 
+/// KHR_lights_punctual's recommended spot falloff, written out as the extension's sample
+/// implementation states it (not from the library's code): a ramp linear in cos θ from the
+/// outer to the inner cone, squared.
+fn gltf_spot_attenuation(cd: f32, inner: f32, outer: f32) -> f32 {
+    let light_angle_scale = 1.0 / (inner.cos() - outer.cos()).max(0.001);
+    let light_angle_offset = -outer.cos() * light_angle_scale;
+    let a = (cd * light_angle_scale + light_angle_offset).clamp(0.0, 1.0);
+    a * a
+}
+
 #[test]
-fn occluder_casts_a_shadow_from_point_and_directional_lights() {
+fn spot_light_follows_the_gltf_falloff_on_the_gpu_and_in_the_reference() {
     let ctx = common::gpu();
+    let (inner, outer) = (0.3f32, 0.6f32);
+    let mut s = floor_scene(false);
+    s.add_light(light(LightKind::Spot { inner_cone: inner, outer_cone: outer }, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 10.0)).unwrap();
+    let gpu = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap().image;
+    let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
+    // Floor points inside the inner cone, across the ramp, and outside the outer cone.
+    let mut ramp_points = 0;
+    for x in [32, 40, 44, 46, 48, 50, 52, 54, 60] {
+        let p = floor_point(x, 32);
+        let d = Vec3::new(0.0, 2.0, 0.0) - p;
+        let cd = d.y / d.length();
+        let att = gltf_spot_attenuation(cd, inner, outer);
+        ramp_points += (att > 0.05 && att < 0.95) as usize;
+        let expected = ALBEDO / std::f32::consts::PI * 10.0 * cd / d.length_squared() * att;
+        for (name, img) in [("gpu", &gpu), ("reference", &reference)] {
+            let got = img.texel(0, x, 32)[0];
+            assert!((got - expected).abs() <= 0.01 * expected + 1e-5, "{name}: floor point {p} (cos θ {cd:.4}): {got} vs {expected}");
+        }
+    }
+    assert!(ramp_points >= 3, "the points sample the ramp: {ramp_points}");
+    common::assert_clean(&ctx);
+}
+
+#[test]
+fn occluder_casts_a_shadow_from_point_spot_and_directional_lights() {
+    let ctx = common::gpu();
+    let tilted = Vec3::new(0.5, -1.0, 0.0).normalize();
     for kind in [LightKind::Point, LightKind::Directional, LightKind::Spot { inner_cone: 0.5, outer_cone: 0.7 }] {
         let mut s = floor_scene(true);
-        s.add_light(light(kind, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 2.0)).unwrap();
+        // The directional light comes in tilted, so that its shadow falls beside the
+        // occluder's own silhouette (straight down, the occluder would hide its shadow).
+        let direction = if kind == LightKind::Directional { tilted } else { Vec3::NEG_Y };
+        s.add_light(light(kind, Vec3::new(0.0, 2.0, 0.0), direction, 2.0)).unwrap();
         let f = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap();
         let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
         assert!(names.contains(&"shadow.generate"));
-        // A lit floor point away from the occluder gets exactly the direct light.
-        let lit = f.image.texel(0, 8, 8)[0];
-        let p = floor_point(8, 8);
+        // A lit floor point away from the occluder gets exactly the direct light: for the
+        // spot, one inside its inner cone (0.5 rad: 1.09 m from its foot), so that a spot
+        // that emits nothing fails.
+        let (lx, ly) = if matches!(kind, LightKind::Spot { .. }) { (46, 32) } else { (8, 8) };
+        let lit = f.image.texel(0, lx, ly)[0];
+        let p = floor_point(lx, ly);
         let expected = match kind {
-            LightKind::Directional => ALBEDO / std::f32::consts::PI * 2.0,
+            LightKind::Directional => ALBEDO / std::f32::consts::PI * 2.0 * -tilted.y,
             _ => {
                 let d = Vec3::new(0.0, 2.0, 0.0) - p;
-                let cone = if let LightKind::Spot { inner_cone, outer_cone } = kind {
-                    let c = (d.y / d.length()).min(1.0);
-                    ((c - outer_cone.cos()) / (inner_cone.cos() - outer_cone.cos())).clamp(0.0, 1.0)
-                } else {
-                    1.0
-                };
-                ALBEDO / std::f32::consts::PI * 2.0 * (d.y / d.length()) / d.length_squared() * cone
+                if let LightKind::Spot { inner_cone, .. } = kind {
+                    assert!((d.y / d.length()) > inner_cone.cos(), "{p} lies inside the inner cone");
+                }
+                ALBEDO / std::f32::consts::PI * 2.0 * (d.y / d.length()) / d.length_squared()
             }
         };
-        assert!((lit - expected).abs() < 0.01 * expected.max(1e-3) + 1e-4, "{kind:?}: lit {lit} vs {expected}");
-        if kind == LightKind::Point {
-            // The point light at 2 m casts the 0.4 m occluder at 1 m to a 0.8 m shadow:
-            // floor points 0.3 m from the centre are dark, though outside the occluder.
-            // Pixel 38 sees the floor at x ≈ 0.35 m: past the occluder's silhouette (0.3 m
-            // seen from 3 m) but inside its shadow (0.4 m).
-            let (x, y) = (38, 32);
-            let p = floor_point(x, y);
-            assert!(p.x > 0.31 && p.x < 0.39, "{p}");
-            assert_eq!(f.image.texel(0, x, y)[0], 0.0, "shadowed floor point {p}");
+        assert!(expected > 0.02, "{kind:?}: the lit point is lit ({expected})");
+        assert!((lit - expected).abs() < 0.01 * expected, "{kind:?}: lit {lit} vs {expected}");
+        // A floor point outside the occluder's silhouette (0.3 m from the centre, seen from
+        // 3 m) but inside its shadow.
+        let (x, y) = match kind {
+            // The point and spot light at 2 m cast the 0.4 m occluder at 1 m to a 0.8 m
+            // shadow: pixel 38 sees the floor at x ≈ 0.35 m.
+            LightKind::Point | LightKind::Spot { .. } => (38, 32),
+            // The tilted sun shifts the shadow by 0.5 m along +x: x ∈ [0.3, 0.7] m; pixel
+            // 41 sees the floor at x ≈ 0.5 m.
+            LightKind::Directional => (41, 32),
+        };
+        let p = floor_point(x, y);
+        let in_shadow = match kind {
+            LightKind::Directional => p.x > 0.31 && p.x < 0.69 && p.z.abs() < 0.19,
+            _ => p.x > 0.31 && p.x < 0.39,
+        };
+        assert!(in_shadow, "{kind:?}: {p}");
+        assert_eq!(f.image.texel(0, x, y)[0], 0.0, "{kind:?}: shadowed floor point {p}");
+        // Its mirror image across the occluder is lit for the tilted sun (the shadow is
+        // where the light says, not all around).
+        if kind == LightKind::Directional {
+            assert!(f.image.texel(0, 63 - x, y)[0] > 0.5 * expected, "{kind:?}: floor at {} is lit", floor_point(63 - x, y));
         }
     }
     common::assert_clean(&ctx);

@@ -68,8 +68,11 @@ vec3 light_irradiance(Light l, vec3 p, out vec3 wi, out float dist) {
         e *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
     }
     if (kind == LIGHT_SPOT) {
+        // KHR_lights_punctual's recommended falloff: the ramp linear in cos θ between the
+        // outer and inner cone, squared (src/reference/shade.rs is its twin).
         float cd = dot(l.direction_kind.xyz, -wi);
-        e *= clamp((cd - l.cone.x) / max(l.cone.y - l.cone.x, 1e-4), 0.0, 1.0);
+        float ramp = clamp((cd - l.cone.x) / max(l.cone.y - l.cone.x, 1e-4), 0.0, 1.0);
+        e *= ramp * ramp;
     }
     return e;
 }

@@ -136,8 +136,11 @@ impl ShadeLight {
             e *= (1.0 - r * r * r * r).clamp(0.0, 1.0).powi(2);
         }
         if matches!(self.kind, LightKind::Spot { .. }) {
+            // KHR_lights_punctual's recommended falloff (the ramp in cos θ, squared), as the
+            // shader's `light_irradiance`.
             let cd = self.direction.dot(-wi);
-            e *= ((cd - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-4)).clamp(0.0, 1.0);
+            let ramp = ((cd - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-4)).clamp(0.0, 1.0);
+            e *= ramp * ramp;
         }
         (wi, e, dist)
     }
