@@ -63,6 +63,8 @@
 #define SPECULA_METHOD_RAY_ENGINE 10
 /* ray-hierarchy (§2.2.1) */
 #define SPECULA_METHOD_RAY_HIERARCHY 11
+/* planar-mirror (§5) */
+#define SPECULA_METHOD_PLANAR_MIRROR 12
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

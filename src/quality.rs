@@ -97,6 +97,8 @@ pub struct Quality {
     pub map_updates_always: bool,
     /// Anti-aliasing of the camera passes (`aa`).
     pub aa: Aa,
+    /// `planar-mirror` (§5): the most mirrored views a frame renders.
+    pub mirror_budget: u32,
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
@@ -278,7 +280,7 @@ pub const KNOBS: &[Knob] = &[
         name: "depth",
         values: "1..=64 bounces",
         default: "16",
-        doc: "specular recursion depth R of the exact renderers (the reference): paths still specular after R bounces end black; the default is converged for glass",
+        doc: "specular recursion depth R of the exact renderers (the reference, ray tracing) and of planar mirrors seen in planar mirrors: paths still specular after R bounces end black; the default is converged for glass",
         set: |q, v| {
             q.depth = count(v, 1, 64)?;
             Ok(())
@@ -516,6 +518,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.aa, AA),
     },
     Knob {
+        name: "mirror_budget",
+        values: "0..=64 views",
+        default: "8",
+        doc: "planar-mirror (§5): the most mirrored views a frame renders (breadth first: mirrors seen from the camera before mirrors seen in mirrors); mirrors beyond it, or deeper than depth, show the environment along their reflected rays (black in a closed room)",
+        set: |q, v| {
+            q.mirror_budget = count(v, 0, 64)?;
+            Ok(())
+        },
+        get: |q| q.mirror_budget.to_string(),
+    },
+    Knob {
         name: "msaa_shading",
         values: "sample|pixel",
         default: "sample",
@@ -583,6 +596,7 @@ impl Default for Quality {
             map_updates_always: false,
             aa: Aa::Off,
             msaa_per_sample: true,
+            mirror_budget: 8,
         }
     }
 }

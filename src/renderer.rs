@@ -16,6 +16,7 @@ use crate::frame::stage::{order, FrameIo, LayerField, MapSets, Maps, Stage, Stag
 use crate::frame::{output, views};
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, PUSH_BYTES};
 use crate::gpu_scene::{GpuLight, GpuObject, GpuScene, GpuView};
+use crate::methods::geometry::views::MirrorViews;
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::update::Changes;
@@ -136,6 +137,8 @@ pub struct Renderer {
     ssaa: u32,
     multisample: Multisample,
     resolve: Vec<Image>,
+    /// Planar mirrors' views (§5), when the plan has planar mirrors.
+    mirrors: Option<MirrorViews>,
 }
 
 /// The camera target's samples for the plan's `aa` (MSAA), checked against what the
@@ -254,6 +257,7 @@ impl Renderer {
             ssaa,
             multisample,
             resolve: Vec::new(),
+            mirrors: None,
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -339,7 +343,10 @@ impl Renderer {
                 self.resolve.push(Image::new(ctx, &desc)?);
             }
         }
-        self.profiler = Profiler::new(ctx, MAX_PASSES)?;
+        self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, &mut self.maps)?;
+        // Each mirrored view records the camera's passes again, and its copy.
+        let view_passes = (self.plan.mirror_layers[0] + self.plan.mirror_layers[1]) * (self.stages.len() as u32 + 1);
+        self.profiler = Profiler::new(ctx, MAX_PASSES + view_passes)?;
         self.write_descriptors(ctx);
         Ok(())
     }
@@ -592,7 +599,13 @@ impl Renderer {
     }
 
     fn write_views(&mut self) -> Result<()> {
-        let views = views::view_table(&self.plan, &self.views, &self.light_table, self.camera_view_proj(), self.camera.position);
+        let vp = self.camera_view_proj();
+        let cos_corner = crate::methods::geometry::views::cos_corner(self.camera.yfov, self.width as f32 / self.height as f32);
+        if let Some(m) = self.mirrors.as_mut() {
+            m.plan_frame(&self.cpu, vp, self.camera.position, cos_corner);
+        }
+        let mirror_views = self.mirrors.as_ref().map_or(&[][..], |m| &m.frame.views[..]);
+        let views = views::view_table(&self.plan, &self.views, &self.light_table, vp, self.camera.position, mirror_views);
         self.view_eyes = views.iter().map(|v| glam::Vec3::from_slice(&v.eye[..3])).collect();
         self.view_buffer.write(bytemuck::cast_slice(&views))
     }
@@ -617,6 +630,10 @@ impl Renderer {
             tolerance: q.search_tolerance,
             internal_bounces: q.internal_bounces,
         };
+        let full =
+            vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: self.target.width, height: self.target.height } };
+        // The camera-dependent stages: camera-space maps, direct light and camera passes.
+        let per_view = |d: &Deps| matches!(d, Deps::EveryFrame | Deps::CameraMap);
         let mut io = FrameIo {
             plan: &self.plan,
             views: &self.views,
@@ -626,13 +643,71 @@ impl Renderer {
             sets: &self.sets,
             view_eyes: &self.view_eyes,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
+            area: full,
+            object_flags: &[],
         };
+        // The world's maps first.
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
-            if *deps != Deps::EveryFrame && !self.map_updates.iter().any(|u| u.stage == stage.name()) {
-                continue; // its maps still hold what this frame would draw
+            if per_view(deps) || !self.map_updates.iter().any(|u| u.stage == stage.name()) {
+                continue; // camera-dependent, or its maps still hold what this frame would draw
             }
             stage.record(&mut rec, &f, &mut io);
         }
+        drop(io);
+        // Planar mirrors' views (§5), deepest first: each renders the camera-dependent stages
+        // from its mirrored camera into the scratch target, within its mirror's pixels, and
+        // is stored in its layer for the views (and the camera) that see the mirror.
+        if let Some(mv) = self.mirrors.as_mut() {
+            rec.scope = Some("geometry.mirror_view");
+            for i in mv.frame.order() {
+                let v = mv.frame.views[i].clone();
+                let views = ViewLayout { camera: self.views.mirrors + i as u32, ..self.views.clone() };
+                let flags = mv.child_flags(Some(i));
+                let mut io = FrameIo {
+                    plan: &self.plan,
+                    views: &views,
+                    target: &mut mv.scratch,
+                    depth: &mut mv.depth,
+                    maps: &mut self.maps,
+                    sets: &self.sets,
+                    view_eyes: &self.view_eyes,
+                    scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
+                    area: crate::methods::geometry::views::render_area(v.rect),
+                    object_flags: &flags,
+                };
+                for (stage, _) in self.stages.iter_mut().zip(&self.deps).filter(|(_, d)| per_view(d)) {
+                    stage.record(&mut rec, &f, &mut io);
+                }
+                drop(io);
+                let parity = (v.level % 2 == 0) as usize;
+                if let Some(dst) = self.maps.mirror_views[parity].as_mut() {
+                    mv.record_store(&mut rec, dst, v.layer, v.rect);
+                }
+            }
+            rec.scope = None;
+        }
+        let camera_flags = self.mirrors.as_ref().map_or_else(Vec::new, |m| m.child_flags(None));
+        let mut io = FrameIo {
+            plan: &self.plan,
+            views: &self.views,
+            target: &mut self.target,
+            depth: &mut self.depth,
+            maps: &mut self.maps,
+            sets: &self.sets,
+            view_eyes: &self.view_eyes,
+            scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
+            area: full,
+            object_flags: &camera_flags,
+        };
+        // Mirrored views re-recorded the camera-space maps from their cameras.
+        let views_ran = self.mirrors.as_ref().is_some_and(|m| !m.frame.views.is_empty());
+        for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
+            let needed = *deps == Deps::EveryFrame || views_ran || self.map_updates.iter().any(|u| u.stage == stage.name());
+            if per_view(deps) && needed {
+                stage.record(&mut rec, &f, &mut io);
+            }
+        }
+        drop(io);
         if self.multisample.samples > 1 {
             // Multisampling: the samples' average (vkCmdResolveImage on a float format).
             let dst = &mut self.resolve[0];
@@ -729,7 +804,15 @@ impl Renderer {
         if errors > 0 {
             return Err(Error::Validation(errors));
         }
-        let stats = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
+        let mut stats: Vec<(String, f64)> = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
+        if let Some(m) = &self.mirrors {
+            // Planar mirrors (§5): the views this frame rendered, their deepest level, and
+            // the mirrors that showed the fallback for want of depth or budget.
+            let f = &m.frame;
+            stats.push(("geometry.mirror_views".into(), f.views.len() as f64));
+            stats.push(("geometry.mirror_depth".into(), f.views.iter().map(|v| v.level).max().unwrap_or(0) as f64));
+            stats.push(("geometry.mirror_fallbacks".into(), f.fallbacks as f64));
+        }
         Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates: self.map_updates.clone() })
     }
 
@@ -739,6 +822,10 @@ impl Renderer {
             s.destroy(ctx);
         }
         self.stages.clear();
+        if let Some(m) = self.mirrors.as_mut() {
+            m.destroy(ctx);
+        }
+        self.mirrors = None;
         self.maps.destroy(ctx);
         self.target.destroy(ctx);
         self.depth.destroy(ctx);

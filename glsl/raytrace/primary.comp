@@ -23,10 +23,16 @@ void main() {
     Triangle tr = triangles[id];
     vec3 tuv;
     bool known = ray_triangle(o, d, tr.v0.xyz, tr.v1.xyz, tr.v2.xyz, 0.0, 1.0 / 0.0, tuv);
+    // A planar mirror's view (survey §5) keeps only what lies in front of its mirror: rays
+    // the intersection kernel answers start at the mirror's plane.
+    View v = views[push.view];
+    float t0 = near_plane_t(d);
+    float side = dot(v.clip.xyz, o) + v.clip.w, towards = dot(v.clip.xyz, d);
+    if (side < 0.0 && towards > 0.0) t0 = max(t0, -side / towards);
     uint slot = atomicAdd(next_count, 1u);
     if (slot >= trace.capacity) return;
     uint pixel = (xy.y * trace.width + xy.x) * trace.samples + sample_id;
-    next_queries[slot] = make_query(o, d, near_plane_t(d), 1.0 / 0.0, RAY_NO_TRIANGLE, known ? RAY_HIT_KNOWN : 0u);
+    next_queries[slot] = make_query(o, d, t0, 1.0 / 0.0, RAY_NO_TRIANGLE, known ? RAY_HIT_KNOWN : 0u);
     next_payloads[slot] = make_payload(vec3(1.0), pixel);
     next_hits[slot] = known ? RayHit(tuv.x, tuv.y, tuv.z, id) : RayHit(1.0 / 0.0, 0.0, 0.0, RAY_NO_TRIANGLE);
 }

@@ -62,14 +62,15 @@ impl Stage for CameraShade {
         }
         let open = pass.begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        begin_camera_rendering(ctx, cmd, io.target, io.depth, false);
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, false);
         f.bind(ctx, cmd, self.pipeline);
         if let Some(&set) = io.sets.camera.get(io.maps.distance_latest) {
             f.bind_maps(ctx, cmd, set);
         }
         for d in f.scene.draws.iter() {
             let Some(&(_, flags)) = self.objects.iter().find(|(m, _)| *m == d.mesh as usize) else { continue };
-            f.push_flags(ctx, cmd, io.views.camera, d.mesh, f.flags | flags);
+            let view_flags = io.object_flags.iter().find(|(m, _)| *m == d.mesh as usize).map_or(0, |(_, fl)| *fl);
+            f.push_flags(ctx, cmd, io.views.camera, d.mesh, f.flags | flags | view_flags);
             unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
         }
         unsafe { ctx.device.cmd_end_rendering(cmd) };

@@ -95,7 +95,7 @@ impl Stage for SceneDirect {
         }
         let open = pass.begin();
         let (ctx, cmd, view) = (rec.ctx, rec.cmd, io.views.camera);
-        begin_camera_rendering(ctx, cmd, io.target, io.depth, true);
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, true);
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);

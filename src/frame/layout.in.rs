@@ -17,6 +17,10 @@ gpu_structs! {
         eye: vec4,
         /// xyz: direction for planar distance (directional shadow maps)
         dir: vec4,
+        /// World-space plane (n, w) a camera view keeps the side n·p + w ≥ 0 of: a planar
+        /// mirror's view (survey §5) sees only what lies in front of its mirror; (0, 0, 0, 1)
+        /// elsewhere. Its rasterisation clips there by an oblique near plane in `view_proj`.
+        clip: vec4,
     }
 
     /// std430 twin of `Material`.
@@ -226,6 +230,13 @@ gpu_consts! {
     /// First inter-object cycle: no map holds anything yet, specular objects in maps are black
     /// (paths longer than the requested depth end black, as in the reference).
     FLAG_FIRST_CYCLE: uint = 16;
+    /// `geometry.mirror` (§5): the mirror's reflection is the mirrored view in layer
+    /// `flags >> MIRROR_LAYER_SHIFT` of `mirror_views_odd` (the view drawing it is at an even
+    /// recursion level: the camera is level 0) or `mirror_views_even`; without the flag, the
+    /// budget's fallback (the environment along the reflected ray).
+    FLAG_MIRROR_VIEW: uint = 32;
+    FLAG_MIRROR_EVEN: uint = 64;
+    MIRROR_LAYER_SHIFT: uint = 16;
 
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
     RAY_NO_TRIANGLE: uint = 4294967295;
@@ -252,6 +263,11 @@ descriptor_sets! {
         SHADOW_CUBES = 6: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray shadow_cubes";
         SHADOW_PLANES = 7: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray shadow_planes";
         ENVMAPS = 8: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray envmaps";
+        /// Planar mirrors' views (survey §5), one layer per view: those at odd recursion
+        /// levels (1, 3, …) and at even ones (2, 4, …), so that a view renders into one image
+        /// while it samples its children in the other.
+        MIRROR_VIEWS_ODD = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views_odd";
+        MIRROR_VIEWS_EVEN = 10: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views_even";
     }
 
     /// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.

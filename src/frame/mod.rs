@@ -161,8 +161,9 @@ pub fn render_cube_faces(
     }
 }
 
-/// Starts rendering into the camera's colour and depth targets (cleared or kept).
-pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Image, depth: &Image, clear: bool) {
+/// Starts rendering into the camera's colour and depth targets (cleared or kept) within
+/// `area` (the whole target for the camera; a mirrored view's mirror pixels).
+pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Image, depth: &Image, area: vk::Rect2D, clear: bool) {
     let colors = [target.view];
     let t = Target {
         color: &colors,
@@ -174,7 +175,7 @@ pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Im
         clear_color: [0.0; 4],
         clear,
     };
-    begin_rendering(ctx, cmd, &t);
+    crate::vk::begin_rendering_in(ctx, cmd, &t, area);
 }
 
 /// The depth buffer cube rendering needs: six layers for multiview, one otherwise.

@@ -74,6 +74,9 @@ pub struct Maps {
     pub backfaces: Option<Image>,
     /// Set 1, binding 3: per-vertex thickness of image-space refraction.
     pub thickness: Option<Buffer>,
+    /// Set 0, bindings 9 and 10: planar mirrors' views at odd and even recursion levels
+    /// (§5), one layer per view.
+    pub mirror_views: [Option<Image>; 2],
 }
 
 impl Maps {
@@ -84,6 +87,7 @@ impl Maps {
         v.extend(self.distance.get(self.distance_latest));
         v.extend(self.refractor.iter());
         v.extend(self.backfaces.iter());
+        v.extend(self.mirror_views.iter().flatten());
         v
     }
 
@@ -121,6 +125,8 @@ impl Maps {
         write_image(ctx, frame, binding::SHADOW_CUBES, 0, cis, view(self.shadow_cubes.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::SHADOW_PLANES, 0, cis, view(self.shadow_planes.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::ENVMAPS, 0, cis, view(self.radiance.as_ref()), linear, ro);
+        write_image(ctx, frame, binding::MIRROR_VIEWS_ODD, 0, cis, view(self.mirror_views[0].as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::MIRROR_VIEWS_EVEN, 0, cis, view(self.mirror_views[1].as_ref()), nearest, ro);
         let refractor = view(self.refractor.as_ref());
         let backfaces = view(self.backfaces.as_ref());
         let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
@@ -149,7 +155,13 @@ impl Maps {
         for i in self.shadow_cubes.iter_mut().chain(self.shadow_planes.iter_mut()).chain(self.radiance.iter_mut()) {
             i.destroy(ctx);
         }
-        for i in self.distance.iter_mut().chain(self.refractor.iter_mut()).chain(self.backfaces.iter_mut()) {
+        for i in self
+            .distance
+            .iter_mut()
+            .chain(self.refractor.iter_mut())
+            .chain(self.backfaces.iter_mut())
+            .chain(self.mirror_views.iter_mut().flatten())
+        {
             i.destroy(ctx);
         }
         for b in self.thickness.iter_mut() {
@@ -176,6 +188,8 @@ pub struct ViewLayout {
     pub shadow_planes: Vec<u32>,
     /// First of the six views of `plan.envmaps[i]` (its reference point).
     pub envmaps: Vec<u32>,
+    /// First of the planar mirrors' views (§5): view `mirrors + i` is the frame's i-th.
+    pub mirrors: u32,
     pub count: u32,
 }
 
@@ -198,6 +212,12 @@ pub struct FrameIo<'a> {
     pub view_eyes: &'a [glam::Vec3],
     /// Images every pass that shades diffuse surfaces samples (textures, environment).
     pub scene_images: Vec<&'a Image>,
+    /// The camera passes draw within this rectangle of the target (the whole target for the
+    /// camera; for a planar mirror's view the mirror's pixels).
+    pub area: vk::Rect2D,
+    /// Push flags a camera pass adds for an object in this view: (mesh, flags), e.g. which
+    /// mirrored view a planar mirror shows (`FLAG_MIRROR_VIEW`).
+    pub object_flags: &'a [(usize, u32)],
 }
 
 /// What a stage's constructor may look at.

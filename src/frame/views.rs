@@ -28,6 +28,8 @@ impl ViewLayout {
             v.envmaps.push(v.count);
             v.count += 6;
         }
+        v.mirrors = v.count;
+        v.count += plan.mirror_layers[0] + plan.mirror_layers[1];
         v
     }
 }
@@ -38,11 +40,20 @@ fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
         inv_view_proj: view_proj.inverse().to_cols_array_2d(),
         eye: eye.to_array(),
         dir: dir.to_array(),
+        clip: [0.0, 0.0, 0.0, 1.0],
     }
 }
 
-/// The view table for a camera (`camera_view_proj`, eye) and the plan's lights and maps.
-pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], camera_view_proj: Mat4, eye: Vec3) -> Vec<GpuView> {
+/// The view table for a camera (`camera_view_proj`, eye), the plan's lights and maps, and
+/// this frame's mirrored views.
+pub fn view_table(
+    plan: &Plan,
+    layout: &ViewLayout,
+    lights: &[GpuLight],
+    camera_view_proj: Mat4,
+    eye: Vec3,
+    mirrors: &[crate::methods::geometry::mirror::MirrorView],
+) -> Vec<GpuView> {
     let mut views = vec![GpuView::zeroed(); layout.count as usize];
     views[layout.camera as usize] = view(camera_view_proj, eye.extend(0.0), Vec4::ZERO);
     let near = plan.cube_near;
@@ -63,6 +74,19 @@ pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], camera_
         for f in 0..6 {
             views[(base + f) as usize] =
                 view(face_view_proj(f as usize, e.reference_point, near), e.reference_point.extend(0.0), Vec4::ZERO);
+        }
+    }
+    for (i, m) in mirrors.iter().enumerate() {
+        if let Some(slot) = views.get_mut(layout.mirrors as usize + i) {
+            // Rasterisation clips at the mirror (oblique near plane); pixels unproject to
+            // rays through the plain mirrored projection.
+            *slot = GpuView {
+                view_proj: m.view_proj.to_cols_array_2d(),
+                inv_view_proj: m.plain_view_proj.inverse().to_cols_array_2d(),
+                eye: m.eye.extend(0.0).to_array(),
+                dir: [0.0; 4],
+                clip: m.clip.to_array(),
+            };
         }
     }
     views

@@ -8,12 +8,14 @@
 
 pub mod distance;
 pub mod envmap;
+pub mod geometry;
 pub mod raytrace;
 pub mod registry;
 
 pub use crate::reference::REFERENCE;
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
 pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
+pub use geometry::PLANAR_MIRROR;
 pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{Choice, Method, MethodInfo, ObjectClass};
 
@@ -32,6 +34,7 @@ pub const ALL: &[Method] = &[
     GRID,
     RAY_ENGINE,
     RAY_HIERARCHY,
+    PLANAR_MIRROR,
     REFERENCE,
 ];
 

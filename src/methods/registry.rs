@@ -144,8 +144,28 @@ pub struct MethodInfo {
     /// For objects it cannot serve when it is asked for the whole scene (`--method`): the
     /// method those objects get instead (e.g. refractor-map leaves mirrors to distance).
     pub fallback: Option<Method>,
+    /// What shape of object it can serve beyond its class (planar-mirror: planar only).
+    pub shape: Shape,
     /// The planner's rule: when this method is the right choice for an object, and why.
     pub rule: Rule,
+}
+
+/// The object shapes a method serves.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Shape {
+    Any,
+    /// All vertices on one plane, normals agreeing (`ObjectFacts::planar`).
+    Planar,
+}
+
+impl Shape {
+    pub fn fits(self, f: &ObjectFacts) -> bool {
+        match self {
+            Shape::Any => true,
+            Shape::Planar => f.planar,
+        }
+    }
 }
 
 /// A handle to a registered method: copyable, compared by name.
@@ -200,6 +220,11 @@ impl Method {
 
     pub fn can_serve(self, class: ObjectClass) -> bool {
         self.0.serves.contains(&class)
+    }
+
+    /// Whether it can serve this object: its class and its shape.
+    pub fn fits(self, f: &ObjectFacts) -> bool {
+        self.can_serve(f.class) && self.0.shape.fits(f)
     }
 
     pub fn parse(s: &str) -> Result<Method> {

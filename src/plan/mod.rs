@@ -151,6 +151,10 @@ pub struct Plan {
     /// Proxy geometry (§3.2): sphere radius and box, world space.
     pub proxy_radius: f32,
     pub proxy_box: (Vec3, Vec3),
+    /// Planar mirrors (§5), in mesh order, and the layers their views need at odd and even
+    /// recursion levels (within `mirror_budget`).
+    pub mirrors: Vec<usize>,
+    pub mirror_layers: [u32; 2],
 }
 
 impl Plan {
@@ -282,6 +286,8 @@ fn empty_plan(quality: &Quality) -> Plan {
         frame_latency: false,
         proxy_radius: 1.0,
         proxy_box: (Vec3::ZERO, Vec3::ZERO),
+        mirrors: Vec::new(),
+        mirror_layers: [0, 0],
     }
 }
 
@@ -290,7 +296,15 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
     let mesh = &scene.meshes[facts.mesh];
     let class = facts.class;
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
-        if m.can_serve(class) {
+        if m.can_serve(class) && !m.shape.fits(facts) {
+            Err(Error::invalid(
+                format!("object '{}'", mesh.name),
+                format!(
+                    "method '{}' serves planar reflectors only: the mesh's vertices do not lie on one plane with agreeing normals",
+                    m.name
+                ),
+            ))
+        } else if m.can_serve(class) {
             Ok((m, format!("{source}: {}", m.name)))
         } else {
             let serves: Vec<_> = m.serves.iter().map(|c| c.label()).collect();
@@ -304,11 +318,12 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
         return check(*m, "chosen for this object");
     }
     if let Choice::Method(m) = choices.method {
-        if m.can_serve(class) {
+        if m.fits(facts) {
             return Ok((m, format!("--method {}", m.name)));
         }
-        if let Some(f) = m.fallback.filter(|f| f.can_serve(class)) {
-            return Ok((f, format!("--method {} does not serve a {}: its fallback {}", m.name, class.label(), f.name)));
+        if let Some(f) = m.fallback.filter(|f| f.fits(facts)) {
+            let what = if m.can_serve(class) { format!("a non-planar {}", class.label()) } else { format!("a {}", class.label()) };
+            return Ok((f, format!("--method {} does not serve {what}: its fallback {}", m.name, f.name)));
         }
         return check(m, "--method");
     }
@@ -323,7 +338,7 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
 /// score wins (registry order breaks ties).
 pub fn auto(facts: &ObjectFacts, quality: &Quality) -> Result<(Method, String)> {
     let mut best: Option<(Method, Verdict)> = None;
-    for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.can_serve(facts.class)) {
+    for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(facts)) {
         if let Some(v) = (m.rule)(facts, quality) {
             if best.as_ref().is_none_or(|(_, b)| v.score > b.score) {
                 best = Some((m, v));
@@ -423,6 +438,8 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
         frame_latency: false,
         proxy_radius,
         proxy_box: (bounds.min, bounds.max),
+        mirrors: Vec::new(),
+        mirror_layers: [0, 0],
     };
     if !p.is_gpu() {
         p.stages.clear();
@@ -526,6 +543,9 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
             om.bytes = m.bytes / m.objects.len().max(1) as u64;
         }
     }
+    // Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
+    p.mirrors = p.objects.iter().filter(|o| o.method == crate::methods::PLANAR_MIRROR).map(|o| o.mesh).collect();
+    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(p.mirrors.len() as u32, q.depth, q.mirror_budget);
     stages.extend(maps.into_iter().map(StageSpec::Map));
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.

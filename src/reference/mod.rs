@@ -43,6 +43,7 @@ pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::met
     knobs: &["depth", "spp", "fresnel"],
     gpu: None,
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| None,
 });
 

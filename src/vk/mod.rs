@@ -15,7 +15,7 @@ pub use context::{
 pub use readback::{decode, read_image, record_copy_to_buffer};
 // ImageData moved to crate::image; the old path keeps working.
 pub use crate::image::ImageData;
-pub use recorder::{begin_rendering, OpenPass, PassTiming, Profiler, Recorder, Target};
+pub use recorder::{begin_rendering, begin_rendering_in, OpenPass, PassTiming, Profiler, Recorder, Target};
 /// An owner of device objects whose `destroy` frees whatever exists, a partly built owner
 /// included (handles start null or as placeholders).
 pub trait Owner {

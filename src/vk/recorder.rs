@@ -94,6 +94,9 @@ pub struct Recorder<'a> {
     pub ctx: &'a Context,
     pub cmd: vk::CommandBuffer,
     profiler: &'a mut Profiler,
+    /// While set, every pass is profiled under this name (a mirrored view's passes count as
+    /// `geometry.mirror_view`).
+    pub scope: Option<&'static str>,
 }
 
 /// An open pass, returned by `PassBuilder::begin` and closed by `Recorder::end`.
@@ -116,12 +119,12 @@ impl<'a> Recorder<'a> {
         unsafe { ctx.device.cmd_reset_query_pool(cmd, profiler.pool, 0, 2 * profiler.capacity) };
         profiler.names.clear();
         profiler.cpu_ms.clear();
-        Recorder { ctx, cmd, profiler }
+        Recorder { ctx, cmd, profiler, scope: None }
     }
 
     /// Continues recording passes of a frame that `new` started (same query pool).
     pub fn resume(ctx: &'a Context, cmd: vk::CommandBuffer, profiler: &'a mut Profiler) -> Recorder<'a> {
-        Recorder { ctx, cmd, profiler }
+        Recorder { ctx, cmd, profiler, scope: None }
     }
 
     pub fn pass<'r>(&'r mut self, name: &'static str) -> PassBuilder<'r, 'a> {
@@ -166,6 +169,7 @@ impl PassBuilder<'_, '_> {
 
     pub fn begin(self) -> OpenPass {
         let PassBuilder { rec, name, barriers, memory_barrier } = self;
+        let name = rec.scope.unwrap_or(name);
         let index = rec.profiler.names.len() as u32;
         assert!(index < rec.profiler.capacity, "profiler capacity exceeded: raise max_passes");
         let cpu_start = Instant::now();
@@ -205,6 +209,13 @@ pub struct Target<'a> {
 }
 
 pub fn begin_rendering(ctx: &Context, cmd: vk::CommandBuffer, t: &Target) {
+    let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.width, height: t.height } };
+    begin_rendering_in(ctx, cmd, t, area);
+}
+
+/// `begin_rendering` within `area` (render area and scissor; the viewport stays the whole
+/// attachment, so that pixels keep their positions).
+pub fn begin_rendering_in(ctx: &Context, cmd: vk::CommandBuffer, t: &Target, area: vk::Rect2D) {
     let load = if t.clear { vk::AttachmentLoadOp::CLEAR } else { vk::AttachmentLoadOp::LOAD };
     let colors: Vec<_> = t
         .color
@@ -227,7 +238,6 @@ pub fn begin_rendering(ctx: &Context, cmd: vk::CommandBuffer, t: &Target) {
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: 0 } })
     });
-    let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.width, height: t.height } };
     let mut info =
         vk::RenderingInfo::default().render_area(area).layer_count(t.layer_count).view_mask(t.view_mask).color_attachments(&colors);
     if let Some(d) = depth.as_ref() {

@@ -109,6 +109,7 @@ pub const DISTANCE: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[DISTANCE_CUBES], camera: SEARCH, map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: distance_rule,
 });
 
@@ -163,6 +164,7 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
         cycles: |q| if q.frame_latency { 1 } else { q.cycles },
     }),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: multi_rule,
 });
 
@@ -200,6 +202,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
         cycles: one,
     }),
     fallback: Some(DISTANCE),
+    shape: crate::methods::registry::Shape::Any,
     rule: refractor_rule,
 });
 
@@ -247,6 +250,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
         cycles: one,
     }),
     fallback: Some(DISTANCE),
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, q| {
         Some(Verdict {
             score: if q.planner.speed() { 3.0 } else { 2.0 },

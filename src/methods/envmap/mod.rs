@@ -64,6 +64,7 @@ pub const ENVMAP: Method = Method(&MethodInfo {
     knobs: KNOBS,
     gpu: Some(spec(SHADE)),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| Some(Verdict { score: 1.0, reason: "classic environment map: the cheapest lookup, but it ignores where the ray starts (§3.1)".into() }),
 });
 
@@ -77,6 +78,7 @@ pub const PROXY_SPHERE: Method = Method(&MethodInfo {
     knobs: &["cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "proxy_radius"],
     gpu: Some(spec(proxy(0))),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| Some(Verdict { score: 1.1, reason: "proxy sphere: localised by a sphere around the reference point (§3.2)".into() }),
 });
 
@@ -90,6 +92,7 @@ pub const PROXY_BOX: Method = Method(&MethodInfo {
     knobs: KNOBS,
     gpu: Some(spec(proxy(FLAG_PROXY_BOX))),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: proxy_box_rule,
 });
 

@@ -122,6 +122,7 @@ pub const BVH: Method = Method(&MethodInfo {
             stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
         })),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: bvh_rule,
 });
 
@@ -135,6 +136,7 @@ pub const RAY_ENGINE: Method = Method(&MethodInfo {
     knobs: RAY_KNOBS_ENGINE,
     gpu: Some(ray_tracer("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine))),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| None,
 });
 
@@ -150,6 +152,7 @@ pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
             stage::create(init, plan, Scheme::RayHierarchy { tile: init.plan.quality.tile_size })
         })),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| None,
 });
 
@@ -166,6 +169,7 @@ pub const KD_TREE: Method = Method(&MethodInfo {
             stage::create(init, plan, Scheme::KdTree { max_depth: q.kd_max_depth, leaf_size: q.kd_leaf_size, restart: q.kd_restart })
         })),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| None,
 });
 
@@ -182,6 +186,7 @@ pub const GRID: Method = Method(&MethodInfo {
             stage::create(init, plan, Scheme::Grid { density: q.grid_density, skip_empty: q.grid_skip })
         })),
     fallback: None,
+    shape: crate::methods::registry::Shape::Any,
     rule: |_, _| None,
 });
 

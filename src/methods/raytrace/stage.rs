@@ -769,7 +769,7 @@ impl Stage for RayTrace {
             .writes(io.target, Access::ColorAttachment)
             .writes(io.depth, Access::DepthAttachment)
             .begin();
-        begin_camera_rendering(ctx, cmd, io.target, io.depth, false);
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, false);
         self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.resolve, f, [self.ray_sets[0], self.trace_sets[0]]);
         self.push(ctx, cmd, f, view);
         unsafe {

@@ -1,0 +1,31 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
+// geometry.mirror: a planar mirror (survey §5, DB97/MBGN00). Its reflection is the scene
+// rendered from the camera mirrored through its plane, which lands on the mirror's own
+// pixels: the pixel's texel of that view, weighted by the mirror's Fresnel reflectance at
+// the eye ray's incidence. Beyond the recursion depth or the view budget, the environment
+// along the reflected ray (black in a closed room).
+#include "common/specular.glsl"
+#include "common/sky.glsl"
+
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+    vec3 reflected;
+    if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
+        ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(push.flags >> MIRROR_LAYER_SHIFT));
+        reflected = (push.flags & FLAG_MIRROR_EVEN) != 0u ? texelFetch(mirror_views_even, texel, 0).rgb
+                                                          : texelFetch(mirror_views_odd, texel, 0).rgb;
+    } else {
+        reflected = sky_radiance(s.r);
+    }
+    out_color = vec4(s.fr * reflected, 1.0);
+}

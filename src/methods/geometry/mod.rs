@@ -1,0 +1,48 @@
+//! Geometry transformation (survey §5). Planar reflectors are exact: the scene is rendered
+//! again from the camera mirrored through the reflector's plane (DB97, MBGN00), clipped at
+//! that plane by an oblique near plane, and the image is laid onto the mirror's pixels with
+//! its Fresnel weight (`geometry.mirror`). Mirrors seen in mirrors recurse: every mirrored
+//! view is a camera view of its own, in which every camera pass of the frame draws its
+//! objects (`mirror::MirrorViews` plans the views of a frame; the renderer records them
+//! before the camera's own view, deepest first).
+
+pub mod mirror;
+pub mod views;
+
+use crate::frame::stage::order;
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
+use crate::quality::Quality;
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+/// `geometry.mirror`: each planar mirror drawn from the camera (and from every mirrored view
+/// that sees it) with the mirrored view's image at its pixels, weighted by Fresnel.
+pub const MIRROR_PASS: CameraPass = CameraPass {
+    name: "geometry.mirror",
+    vertex: "scene/mesh.vert",
+    fragment: "geometry/mirror.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+};
+
+pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
+    name: "planar-mirror",
+    abi: 12,
+    section: "§5",
+    family: "geometry",
+    summary: "planar reflectors by geometry transformation: the scene rendered again from the camera mirrored through the mirror's plane (oblique near plane at the mirror), laid onto the mirror's pixels with its Fresnel weight; mirrors in mirrors recurse up to depth, at most mirror_budget views a frame",
+    serves: &[ObjectClass::Mirror],
+    knobs: &["depth", "mirror_budget", "fresnel"],
+    gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
+    fallback: Some(crate::methods::DISTANCE),
+    shape: Shape::Planar,
+    rule: |f, _| {
+        f.planar.then(|| Verdict {
+            score: 5.0,
+            reason: "planar reflector: exact by rendering the mirrored camera's view (§5, Table 1: exact, multiple reflections)".into(),
+        })
+    },
+});

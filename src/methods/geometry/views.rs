@@ -1,0 +1,145 @@
+//! The GPU side of planar mirrors' views (§5): a scratch target each mirrored view renders
+//! into (the camera target's format, size and samples, so that every camera pass draws into
+//! it with its own pipeline), and the two layered images the views are copied (or, with
+//! MSAA, resolved) into, one layer per view — odd recursion levels in one, even in the other,
+//! so that a view renders while its children are sampled.
+
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+use super::mirror::{Limits, MirrorFrame, Rect};
+use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
+use crate::frame::layout::{FLAG_MIRROR_EVEN, FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT};
+use crate::frame::stage::Maps;
+use crate::plan::Plan;
+use crate::scene::Scene;
+use crate::vk::pipeline::Multisample;
+use crate::vk::{Access, Context, Image, ImageDesc, ImageKind, Recorder};
+use crate::Result;
+
+pub struct MirrorViews {
+    meshes: Vec<usize>,
+    limits: Limits,
+    pub scratch: Image,
+    pub depth: Image,
+    samples: u32,
+    /// This frame's views (planned when the view table is written).
+    pub frame: MirrorFrame,
+}
+
+impl MirrorViews {
+    /// The views' images for a plan with planar mirrors (`None` without): the layered
+    /// images go into `maps` (set 0, bindings 9 and 10), the scratch target stays here.
+    pub fn new(ctx: &Context, plan: &Plan, size: (u32, u32), multisample: Multisample, maps: &mut Maps) -> Result<Option<MirrorViews>> {
+        let layers = plan.mirror_layers;
+        if plan.mirrors.is_empty() || layers == [0, 0] {
+            return Ok(None);
+        }
+        let (width, height) = size;
+        for (i, name) in ["geometry.mirror_views_odd", "geometry.mirror_views_even"].into_iter().enumerate() {
+            if layers[i] > 0 {
+                let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+                let desc = ImageDesc { name, format: TARGET_FORMAT, width, height, kind: ImageKind::D2Array { layers: layers[i] }, usage };
+                maps.mirror_views[i] = Some(Image::new(ctx, &desc)?);
+            }
+        }
+        let samples = multisample.samples;
+        let kind = if samples > 1 { ImageKind::D2Multisample { samples } } else { ImageKind::D2 };
+        let mut me = MirrorViews {
+            meshes: plan.mirrors.clone(),
+            limits: Limits { depth: plan.quality.depth, budget: plan.quality.mirror_budget, layers },
+            scratch: Image::placeholder(),
+            depth: Image::placeholder(),
+            samples,
+            frame: MirrorFrame::default(),
+        };
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        let made = Image::new(ctx, &ImageDesc { name: "geometry.mirror_view", format: TARGET_FORMAT, width, height, kind, usage })
+            .and_then(|s| {
+                me.scratch = s;
+                let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
+                Image::new(ctx, &ImageDesc { name: "geometry.mirror_view.depth", format: DEPTH_FORMAT, width, height, kind, usage })
+            });
+        match made {
+            Ok(d) => {
+                me.depth = d;
+                Ok(Some(me))
+            }
+            Err(e) => {
+                me.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// Plans this frame's views from the camera (`view_proj`, `eye`, the frustum's corner
+    /// cosine) over the current scene.
+    pub fn plan_frame(&mut self, scene: &Scene, view_proj: Mat4, eye: Vec3, cos_corner: f32) {
+        let size = (self.scratch.width, self.scratch.height);
+        self.frame = MirrorFrame::plan(scene, &self.meshes, view_proj, eye, size, cos_corner, self.limits);
+    }
+
+    /// The push flags of the planar mirrors the camera (`None`) or view `v` sees: which
+    /// layer of which image holds each one's reflection. Mirrors not listed fall back.
+    pub fn child_flags(&self, v: Option<usize>) -> Vec<(usize, u32)> {
+        self.frame
+            .children(v)
+            .into_iter()
+            .map(|(mesh, c)| {
+                let even = if c.level % 2 == 0 { FLAG_MIRROR_EVEN } else { 0 };
+                (mesh, FLAG_MIRROR_VIEW | even | (c.layer << MIRROR_LAYER_SHIFT))
+            })
+            .collect()
+    }
+
+    /// Copies (or, with MSAA, resolves) the scratch target's `rect` into layer `layer` of
+    /// `dst` (the view's level parity's image).
+    pub fn record_store(&mut self, rec: &mut Recorder, dst: &mut Image, layer: u32, rect: Rect) {
+        let open = rec.pass("geometry.mirror_view").reads(&self.scratch, Access::TransferSrc).writes(dst, Access::TransferDst).begin();
+        let sub = |base_array_layer| vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer,
+            layer_count: 1,
+        };
+        let offset = vk::Offset3D { x: rect.x0 as i32, y: rect.y0 as i32, z: 0 };
+        let extent = vk::Extent3D { width: rect.x1 - rect.x0, height: rect.y1 - rect.y0, depth: 1 };
+        let (s, d) = (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::TRANSFER_DST_OPTIMAL);
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        unsafe {
+            if self.samples > 1 {
+                let region = vk::ImageResolve {
+                    src_subresource: sub(0),
+                    src_offset: offset,
+                    dst_subresource: sub(layer),
+                    dst_offset: offset,
+                    extent,
+                };
+                ctx.device.cmd_resolve_image(cmd, self.scratch.raw, s, dst.raw, d, &[region]);
+            } else {
+                let region =
+                    vk::ImageCopy { src_subresource: sub(0), src_offset: offset, dst_subresource: sub(layer), dst_offset: offset, extent };
+                ctx.device.cmd_copy_image(cmd, self.scratch.raw, s, dst.raw, d, &[region]);
+            }
+        }
+        rec.end(open);
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        self.scratch.destroy(ctx);
+        self.depth.destroy(ctx);
+    }
+}
+
+/// The cosine of the angle between a perspective projection's axis and its frustum's corner
+/// rays (`proj` the camera's, as `Renderer::camera_view_proj` builds it).
+pub fn cos_corner(yfov: f32, aspect: f32) -> f32 {
+    let ty = (0.5 * yfov).tan();
+    let tx = ty * aspect;
+    1.0 / (1.0 + tx * tx + ty * ty).sqrt()
+}
+
+/// A rectangle as the render area it is.
+pub fn render_area(r: Rect) -> vk::Rect2D {
+    vk::Rect2D { offset: vk::Offset2D { x: r.x0 as i32, y: r.y0 as i32 }, extent: vk::Extent2D { width: r.x1 - r.x0, height: r.y1 - r.y0 } }
+}
