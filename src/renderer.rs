@@ -345,7 +345,7 @@ impl Renderer {
         }
         self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, &mut self.maps)?;
         // Each mirrored view records the camera's passes again, and its copy.
-        let view_passes = (self.plan.mirror_layers[0] + self.plan.mirror_layers[1]) * (self.stages.len() as u32 + 1);
+        let view_passes = self.plan.mirror_layers * (self.stages.len() as u32 + 1);
         self.profiler = Profiler::new(ctx, MAX_PASSES + view_passes)?;
         self.write_descriptors(ctx);
         Ok(())
@@ -679,8 +679,7 @@ impl Renderer {
                     stage.record(&mut rec, &f, &mut io);
                 }
                 drop(io);
-                let parity = (v.level % 2 == 0) as usize;
-                if let Some(dst) = self.maps.mirror_views[parity].as_mut() {
+                if let Some(dst) = self.maps.mirror_views.as_mut() {
                     mv.record_store(&mut rec, dst, v.layer, v.rect);
                 }
             }

@@ -22,8 +22,7 @@ void main() {
     vec3 reflected;
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
         ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(push.flags >> MIRROR_LAYER_SHIFT));
-        reflected = (push.flags & FLAG_MIRROR_EVEN) != 0u ? texelFetch(mirror_views_even, texel, 0).rgb
-                                                          : texelFetch(mirror_views_odd, texel, 0).rgb;
+        reflected = texelFetch(mirror_views, texel, 0).rgb;
     } else {
         reflected = sky_radiance(s.r);
     }

@@ -231,11 +231,9 @@ gpu_consts! {
     /// (paths longer than the requested depth end black, as in the reference).
     FLAG_FIRST_CYCLE: uint = 16;
     /// `geometry.mirror` (§5): the mirror's reflection is the mirrored view in layer
-    /// `flags >> MIRROR_LAYER_SHIFT` of `mirror_views_odd` (the view drawing it is at an even
-    /// recursion level: the camera is level 0) or `mirror_views_even`; without the flag, the
-    /// budget's fallback (the environment along the reflected ray).
+    /// `flags >> MIRROR_LAYER_SHIFT` of `mirror_views`; without the flag, the budget's
+    /// fallback (the environment along the reflected ray).
     FLAG_MIRROR_VIEW: uint = 32;
-    FLAG_MIRROR_EVEN: uint = 64;
     MIRROR_LAYER_SHIFT: uint = 16;
 
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
@@ -263,11 +261,10 @@ descriptor_sets! {
         SHADOW_CUBES = 6: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray shadow_cubes";
         SHADOW_PLANES = 7: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray shadow_planes";
         ENVMAPS = 8: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray envmaps";
-        /// Planar mirrors' views (survey §5), one layer per view: those at odd recursion
-        /// levels (1, 3, …) and at even ones (2, 4, …), so that a view renders into one image
-        /// while it samples its children in the other.
-        MIRROR_VIEWS_ODD = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views_odd";
-        MIRROR_VIEWS_EVEN = 10: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views_even";
+        /// Planar mirrors' views (survey §5), one layer per view of the frame. A view
+        /// renders into a scratch target while it samples its children here, and is copied
+        /// into its layer afterwards.
+        MIRROR_VIEWS = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views";
     }
 
     /// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.

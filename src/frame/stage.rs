@@ -74,9 +74,8 @@ pub struct Maps {
     pub backfaces: Option<Image>,
     /// Set 1, binding 3: per-vertex thickness of image-space refraction.
     pub thickness: Option<Buffer>,
-    /// Set 0, bindings 9 and 10: planar mirrors' views at odd and even recursion levels
-    /// (§5), one layer per view.
-    pub mirror_views: [Option<Image>; 2],
+    /// Set 0, binding 9: planar mirrors' views (§5), one layer per view of a frame.
+    pub mirror_views: Option<Image>,
 }
 
 impl Maps {
@@ -87,7 +86,7 @@ impl Maps {
         v.extend(self.distance.get(self.distance_latest));
         v.extend(self.refractor.iter());
         v.extend(self.backfaces.iter());
-        v.extend(self.mirror_views.iter().flatten());
+        v.extend(self.mirror_views.iter());
         v
     }
 
@@ -125,8 +124,7 @@ impl Maps {
         write_image(ctx, frame, binding::SHADOW_CUBES, 0, cis, view(self.shadow_cubes.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::SHADOW_PLANES, 0, cis, view(self.shadow_planes.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::ENVMAPS, 0, cis, view(self.radiance.as_ref()), linear, ro);
-        write_image(ctx, frame, binding::MIRROR_VIEWS_ODD, 0, cis, view(self.mirror_views[0].as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::MIRROR_VIEWS_EVEN, 0, cis, view(self.mirror_views[1].as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::MIRROR_VIEWS, 0, cis, view(self.mirror_views.as_ref()), nearest, ro);
         let refractor = view(self.refractor.as_ref());
         let backfaces = view(self.backfaces.as_ref());
         let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
@@ -155,12 +153,8 @@ impl Maps {
         for i in self.shadow_cubes.iter_mut().chain(self.shadow_planes.iter_mut()).chain(self.radiance.iter_mut()) {
             i.destroy(ctx);
         }
-        for i in self
-            .distance
-            .iter_mut()
-            .chain(self.refractor.iter_mut())
-            .chain(self.backfaces.iter_mut())
-            .chain(self.mirror_views.iter_mut().flatten())
+        for i in
+            self.distance.iter_mut().chain(self.refractor.iter_mut()).chain(self.backfaces.iter_mut()).chain(self.mirror_views.iter_mut())
         {
             i.destroy(ctx);
         }

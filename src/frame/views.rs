@@ -29,7 +29,7 @@ impl ViewLayout {
             v.count += 6;
         }
         v.mirrors = v.count;
-        v.count += plan.mirror_layers[0] + plan.mirror_layers[1];
+        v.count += plan.mirror_layers;
         v
     }
 }

@@ -151,10 +151,10 @@ pub struct Plan {
     /// Proxy geometry (§3.2): sphere radius and box, world space.
     pub proxy_radius: f32,
     pub proxy_box: (Vec3, Vec3),
-    /// Planar mirrors (§5), in mesh order, and the layers their views need at odd and even
-    /// recursion levels (within `mirror_budget`).
+    /// Planar mirrors (§5), in mesh order, and the most views a frame of them can have
+    /// (within `mirror_budget`): the layers of their views' image.
     pub mirrors: Vec<usize>,
-    pub mirror_layers: [u32; 2],
+    pub mirror_layers: u32,
 }
 
 impl Plan {
@@ -287,7 +287,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         proxy_radius: 1.0,
         proxy_box: (Vec3::ZERO, Vec3::ZERO),
         mirrors: Vec::new(),
-        mirror_layers: [0, 0],
+        mirror_layers: 0,
     }
 }
 
@@ -439,7 +439,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
         proxy_radius,
         proxy_box: (bounds.min, bounds.max),
         mirrors: Vec::new(),
-        mirror_layers: [0, 0],
+        mirror_layers: 0,
     };
     if !p.is_gpu() {
         p.stages.clear();

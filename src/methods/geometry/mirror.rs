@@ -22,8 +22,11 @@ use crate::scene::Scene;
 pub struct Mirror {
     pub mesh: usize,
     pub plane: Vec4,
-    /// World-space vertices (the polygon whose projection bounds its pixels).
+    /// World-space vertices.
     pub points: Vec<Vec3>,
+    /// The rectangle in its plane that bounds it (a convex polygon whose clipped
+    /// projection bounds its pixels).
+    pub outline: [Vec3; 4],
     /// Edge of the mirror's bounding box: the scale of "on the plane".
     pub size: f32,
 }
@@ -53,7 +56,19 @@ impl Mirror {
             return None;
         }
         let n = best.1 / best.0;
-        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), points, size })
+        // The bounding rectangle in the plane's basis (u, v).
+        let u = n.any_orthonormal_vector();
+        let v = n.cross(u);
+        let origin = best.2;
+        let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
+        for p in &points {
+            let q = glam::Vec2::new((*p - origin).dot(u), (*p - origin).dot(v));
+            lo = lo.min(q);
+            hi = hi.max(q);
+        }
+        let at = |a: f32, b: f32| origin + u * a + v * b;
+        let outline = [at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y)];
+        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), points, outline, size })
     }
 
     fn distance(&self, p: Vec3) -> f32 {
@@ -110,7 +125,7 @@ pub struct MirrorView {
     pub parent: Option<usize>,
     /// Index into `MirrorFrame::mirrors`.
     pub mirror: usize,
-    /// Layer in its level parity's image (odd levels: `mirror_views_odd`).
+    /// Its layer of the views' image (its index in the frame).
     pub layer: u32,
     /// The reflected eye (virtual camera position).
     pub eye: Vec3,
@@ -139,8 +154,8 @@ pub struct MirrorFrame {
 pub struct Limits {
     pub depth: u32,
     pub budget: u32,
-    /// Layers of the odd-level and even-level images.
-    pub layers: [u32; 2],
+    /// Layers of the views' image.
+    pub layers: u32,
 }
 
 impl MirrorFrame {
@@ -157,7 +172,6 @@ impl MirrorFrame {
     ) -> MirrorFrame {
         let mirrors: Vec<Mirror> = meshes.iter().filter_map(|&m| Mirror::of(scene, m)).collect();
         let mut frame = MirrorFrame { mirrors, views: Vec::new(), fallbacks: 0 };
-        let mut used = [0u32; 2];
         // Breadth first: (parent view, its eye, its plain view_proj, its clip plane, its rect,
         // its mirror, its level).
         struct Node {
@@ -186,8 +200,7 @@ impl MirrorFrame {
                 }
                 let Some(rect) = visible_rect(m, &parent.plain, parent.clip, parent.eye, parent.rect, size) else { continue };
                 let level = parent.level + 1;
-                let parity = (level % 2 == 0) as usize;
-                if level > lim.depth || frame.views.len() as u32 >= lim.budget || used[parity] >= lim.layers[parity] {
+                if level > lim.depth || frame.views.len() as u32 >= lim.budget.min(lim.layers) {
                     frame.fallbacks += 1;
                     continue;
                 }
@@ -204,14 +217,13 @@ impl MirrorFrame {
                     level,
                     parent: parent.index,
                     mirror: k,
-                    layer: used[parity],
+                    layer: frame.views.len() as u32,
                     eye: r.transform_point3(parent.eye),
                     view_proj: oblique(plain, keep, cos_corner),
                     plain_view_proj: plain,
                     clip: keep,
                     rect,
                 };
-                used[parity] += 1;
                 frame.views.push(view);
                 let index = frame.views.len() - 1;
                 let v = &frame.views[index];
@@ -242,33 +254,66 @@ impl MirrorFrame {
     }
 }
 
+/// Clips a convex polygon to the half-space `keep(p) ≥ 0` (Sutherland–Hodgman).
+fn clip_polygon<T: Copy>(poly: &[T], keep: impl Fn(&T) -> f32, lerp: impl Fn(&T, &T, f32) -> T) -> Vec<T> {
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for (i, a) in poly.iter().enumerate() {
+        let b = &poly[(i + 1) % poly.len()];
+        let (da, db) = (keep(a), keep(b));
+        if da >= 0.0 {
+            out.push(*a);
+        }
+        if (da >= 0.0) != (db >= 0.0) {
+            out.push(lerp(a, b, da / (da - db)));
+        }
+    }
+    out
+}
+
 /// The pixels mirror `m` covers in a view (its plain world → clip, kept side `clip`, eye,
 /// the parent's rectangle), or `None` when it is invisible there: edge-on (the eye on its
-/// plane), wholly behind the view's clip plane, or outside the rectangle.
+/// plane), behind the view's clip plane, outside its frustum or outside the rectangle. The
+/// mirror's outline is clipped to the view's clip plane and frustum, then projected.
 fn visible_rect(m: &Mirror, plain: &Mat4, clip: Vec4, eye: Vec3, within: Rect, size: (u32, u32)) -> Option<Rect> {
     let eps = 1e-6 * m.size.max(eye.abs().max_element());
     if m.distance(eye).abs() <= eps {
         return None; // seen edge-on: no pixel
     }
-    if m.points.iter().all(|p| clip.truncate().dot(*p) + clip.w <= 0.0) {
-        return None; // behind the mirror the view looks through
+    let lerp3 = |a: &Vec3, b: &Vec3, t: f32| *a + (*b - *a) * t;
+    let world = clip_polygon(&m.outline, |p| clip.truncate().dot(*p) + clip.w, lerp3);
+    let mut poly: Vec<Vec4> = world.iter().map(|p| *plain * p.extend(1.0)).collect();
+    let lerp4 = |a: &Vec4, b: &Vec4, t: f32| *a + (*b - *a) * t;
+    // In front of the eye, then within the four side planes of the frustum.
+    let near = 1e-7f32;
+    let sides: [fn(&Vec4) -> f32; 4] = [|c| c.w + c.x, |c| c.w - c.x, |c| c.w + c.y, |c| c.w - c.y];
+    poly = clip_polygon(&poly, |c| c.w - near * c.truncate().length().max(1e-30), lerp4);
+    for side in sides {
+        if poly.is_empty() {
+            break;
+        }
+        poly = clip_polygon(&poly, side, lerp4);
+    }
+    if poly.is_empty() {
+        return None;
     }
     let (w, h) = (size.0 as f32, size.1 as f32);
     let mut lo = glam::Vec2::splat(f32::MAX);
     let mut hi = glam::Vec2::splat(f32::MIN);
-    for p in &m.points {
-        let c = *plain * p.extend(1.0);
-        if c.w <= 1e-6 * c.length() {
-            // A corner at or behind the eye's plane: its projection bounds nothing; be
-            // conservative and keep the whole parent rectangle.
-            return Some(within);
-        }
-        let ndc = glam::Vec2::new(c.x, c.y) / c.w;
+    for c in &poly {
+        let ndc = glam::Vec2::new(c.x, c.y) / c.w.max(1e-30);
         let px = glam::Vec2::new((ndc.x * 0.5 + 0.5) * w, (ndc.y * 0.5 + 0.5) * h);
         lo = lo.min(px);
         hi = hi.max(px);
     }
-    let clampf = |v: f32, max: u32| v.clamp(0.0, max as f32) as u32;
+    let clampf = |v: f32, max: u32| {
+        if v.is_finite() {
+            v.clamp(0.0, max as f32) as u32
+        } else if v > 0.0 {
+            max
+        } else {
+            0
+        }
+    };
     let r = Rect {
         x0: clampf(lo.x.floor() - 1.0, size.0),
         y0: clampf(lo.y.floor() - 1.0, size.1),
@@ -279,23 +324,19 @@ fn visible_rect(m: &Mirror, plain: &Mat4, clip: Vec4, eye: Vec3, within: Rect, s
     (!r.is_empty()).then_some(r)
 }
 
-/// The most views a frame of `mirrors` planar mirrors can have at odd and at even recursion
-/// levels up to `depth`, within `budget`: the layers its two images need.
-pub fn layers_needed(mirrors: u32, depth: u32, budget: u32) -> [u32; 2] {
-    // Breadth first, as `MirrorFrame::plan` fills them: level k has m(m − 1)^(k−1) views.
-    let mut out = [0u64; 2];
-    let mut left = budget as u64;
+/// The most views a frame of `mirrors` planar mirrors can have up to recursion `depth`,
+/// within `budget`: the layers of the views' image. Level k can have m(m − 1)^(k−1) views.
+pub fn layers_needed(mirrors: u32, depth: u32, budget: u32) -> u32 {
+    let mut total = 0u64;
     let mut at_level = mirrors as u64;
-    for level in 1..=depth.min(64) {
-        let take = at_level.min(left);
-        out[(level % 2 == 0) as usize] += take;
-        left -= take;
+    for _ in 1..=depth.min(64) {
+        total = total.saturating_add(at_level);
         at_level = at_level.saturating_mul(mirrors.saturating_sub(1) as u64);
-        if at_level == 0 || left == 0 {
+        if at_level == 0 || total >= budget as u64 {
             break;
         }
     }
-    out.map(|n| n as u32)
+    total.min(budget as u64) as u32
 }
 
 #[cfg(test)]
@@ -337,10 +378,10 @@ mod tests {
 
     #[test]
     fn facing_mirrors_need_one_view_per_level_each() {
-        assert_eq!(layers_needed(1, 6, 64), [1, 0]);
-        assert_eq!(layers_needed(2, 6, 64), [6, 6]);
-        assert_eq!(layers_needed(2, 6, 5), [3, 2]);
-        assert_eq!(layers_needed(3, 3, 64), [3 + 12, 6]);
-        assert_eq!(layers_needed(0, 6, 8), [0, 0]);
+        assert_eq!(layers_needed(1, 6, 64), 1);
+        assert_eq!(layers_needed(2, 6, 64), 12);
+        assert_eq!(layers_needed(2, 6, 5), 5);
+        assert_eq!(layers_needed(3, 3, 64), 3 + 6 + 12);
+        assert_eq!(layers_needed(0, 6, 8), 0);
     }
 }

@@ -1,15 +1,15 @@
 //! The GPU side of planar mirrors' views (§5): a scratch target each mirrored view renders
 //! into (the camera target's format, size and samples, so that every camera pass draws into
-//! it with its own pipeline), and the two layered images the views are copied (or, with
-//! MSAA, resolved) into, one layer per view — odd recursion levels in one, even in the other,
-//! so that a view renders while its children are sampled.
+//! it with its own pipeline), and the layered image the views are copied (or, with MSAA,
+//! resolved) into, one layer per view: a view samples its children's layers while it renders
+//! into the scratch target, and is copied into its own layer afterwards.
 
 use ash::vk;
 use glam::{Mat4, Vec3};
 
 use super::mirror::{Limits, MirrorFrame, Rect};
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
-use crate::frame::layout::{FLAG_MIRROR_EVEN, FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT};
+use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT};
 use crate::frame::stage::Maps;
 use crate::plan::Plan;
 use crate::scene::Scene;
@@ -29,20 +29,17 @@ pub struct MirrorViews {
 
 impl MirrorViews {
     /// The views' images for a plan with planar mirrors (`None` without): the layered
-    /// images go into `maps` (set 0, bindings 9 and 10), the scratch target stays here.
+    /// image goes into `maps` (set 0, binding 9), the scratch target stays here.
     pub fn new(ctx: &Context, plan: &Plan, size: (u32, u32), multisample: Multisample, maps: &mut Maps) -> Result<Option<MirrorViews>> {
         let layers = plan.mirror_layers;
-        if plan.mirrors.is_empty() || layers == [0, 0] {
+        if plan.mirrors.is_empty() || layers == 0 {
             return Ok(None);
         }
         let (width, height) = size;
-        for (i, name) in ["geometry.mirror_views_odd", "geometry.mirror_views_even"].into_iter().enumerate() {
-            if layers[i] > 0 {
-                let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
-                let desc = ImageDesc { name, format: TARGET_FORMAT, width, height, kind: ImageKind::D2Array { layers: layers[i] }, usage };
-                maps.mirror_views[i] = Some(Image::new(ctx, &desc)?);
-            }
-        }
+        let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
+        let desc =
+            ImageDesc { name: "geometry.mirror_views", format: TARGET_FORMAT, width, height, kind: ImageKind::D2Array { layers }, usage };
+        maps.mirror_views = Some(Image::new(ctx, &desc)?);
         let samples = multisample.samples;
         let kind = if samples > 1 { ImageKind::D2Multisample { samples } } else { ImageKind::D2 };
         let mut me = MirrorViews {
@@ -82,18 +79,11 @@ impl MirrorViews {
     /// The push flags of the planar mirrors the camera (`None`) or view `v` sees: which
     /// layer of which image holds each one's reflection. Mirrors not listed fall back.
     pub fn child_flags(&self, v: Option<usize>) -> Vec<(usize, u32)> {
-        self.frame
-            .children(v)
-            .into_iter()
-            .map(|(mesh, c)| {
-                let even = if c.level % 2 == 0 { FLAG_MIRROR_EVEN } else { 0 };
-                (mesh, FLAG_MIRROR_VIEW | even | (c.layer << MIRROR_LAYER_SHIFT))
-            })
-            .collect()
+        self.frame.children(v).into_iter().map(|(mesh, c)| (mesh, FLAG_MIRROR_VIEW | (c.layer << MIRROR_LAYER_SHIFT))).collect()
     }
 
     /// Copies (or, with MSAA, resolves) the scratch target's `rect` into layer `layer` of
-    /// `dst` (the view's level parity's image).
+    /// `dst` (the views' layered image).
     pub fn record_store(&mut self, rec: &mut Recorder, dst: &mut Image, layer: u32, rect: Rect) {
         let open = rec.pass("geometry.mirror_view").reads(&self.scratch, Access::TransferSrc).writes(dst, Access::TransferDst).begin();
         let sub = |base_array_layer| vk::ImageSubresourceLayers {
