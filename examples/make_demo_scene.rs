@@ -8,6 +8,11 @@
 //! Run: `cargo run --example make_demo_scene [-- OUTPUT_DIR]` (default `assets/demo`).
 //! The output is deterministic and committed; the example reloads it through
 //! `specula::scene::load` and checks the material classification.
+//!
+//! `cargo run --example make_demo_scene -- --mirrors [OUTPUT_DIR]` writes the planar-mirror
+//! scene `assets/mirrors/mirrors.gltf` instead (survey §5's showcase): the same room with
+//! two facing mirror panels on the left and right walls (the corridor of images), the
+//! mirror sphere between them, the box and the light, no animation.
 
 use std::path::PathBuf;
 
@@ -230,8 +235,13 @@ fn kappa_for(f0: f32, nu: f32) -> f32 {
 }
 
 fn main() {
-    let out =
-        std::env::args_os().nth(1).map(PathBuf::from).unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo")));
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let mirrors_scene = args.first().is_some_and(|a| a == "--mirrors");
+    if mirrors_scene {
+        args.remove(0);
+    }
+    let (default_dir, stem) = if mirrors_scene { ("assets/mirrors", "mirrors") } else { ("assets/demo", "demo") };
+    let out = args.first().map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(default_dir));
     std::fs::create_dir_all(&out).expect("create output directory");
 
     let mut bin = Bin { data: Vec::new(), views: Vec::new(), accessors: Vec::new() };
@@ -284,23 +294,46 @@ fn main() {
     }));
     let prim = bin.primitive(&sphere(0.5, 64, 32), materials.len() - 1);
     meshes.push(json!({ "name": "mirror_sphere", "primitives": [prim] }));
-    nodes.push(json!({ "name": "mirror_sphere", "mesh": meshes.len() - 1, "translation": [-1.2, 0.5, -1.1] }));
+    let sphere_at = if mirrors_scene { [-0.3, 0.5, -0.9] } else { [-1.2, 0.5, -1.1] };
+    nodes.push(json!({ "name": "mirror_sphere", "mesh": meshes.len() - 1, "translation": sphere_at }));
     let mirror = nodes.len() - 1;
 
-    // Solid glass sphere.
-    materials.push(json!({
-        "name": "glass",
-        "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
-        "extensions": {
-            "KHR_materials_transmission": { "transmissionFactor": 1.0 },
-            "KHR_materials_ior": { "ior": 1.5 },
-            "KHR_materials_volume": { "thicknessFactor": 0.6 }
+    // The planar-mirror scene: two facing panels 2 cm off the left and right walls, a plain
+    // (κ = 0) mirror of F0 0.9.
+    let mut panels = Vec::new();
+    if mirrors_scene {
+        materials.push(json!({
+            "name": "panel",
+            "pbrMetallicRoughness": { "baseColorFactor": [0.9, 0.9, 0.9, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.0 }
+        }));
+        let panel_material = materials.len() - 1;
+        for (name, x, right) in [("panel_left", -1.98f32, Vec3::NEG_Z), ("panel_right", 1.98, Vec3::Z)] {
+            let g = wall(Vec3::new(x, 1.5, 0.0), right, Vec3::Y, 1.6, 1.2);
+            let prim = bin.primitive(&g, panel_material);
+            meshes.push(json!({ "name": name, "primitives": [prim] }));
+            nodes.push(json!({ "name": name, "mesh": meshes.len() - 1 }));
+            panels.push(nodes.len() - 1);
         }
-    }));
-    let prim = bin.primitive(&sphere(0.45, 64, 32), materials.len() - 1);
-    meshes.push(json!({ "name": "glass_sphere", "primitives": [prim] }));
-    nodes.push(json!({ "name": "glass_sphere", "mesh": meshes.len() - 1, "translation": [0.9, 0.45, -0.3] }));
-    let glass = nodes.len() - 1;
+    }
+
+    // Solid glass sphere (the demo only: the mirror scene shows planar mirrors, spheres
+    // and the box).
+    let mut glass = Vec::new();
+    if !mirrors_scene {
+        materials.push(json!({
+            "name": "glass",
+            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+            "extensions": {
+                "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+                "KHR_materials_ior": { "ior": 1.5 },
+                "KHR_materials_volume": { "thicknessFactor": 0.6 }
+            }
+        }));
+        let prim = bin.primitive(&sphere(0.45, 64, 32), materials.len() - 1);
+        meshes.push(json!({ "name": "glass_sphere", "primitives": [prim] }));
+        nodes.push(json!({ "name": "glass_sphere", "mesh": meshes.len() - 1, "translation": [0.9, 0.45, -0.3] }));
+        glass.push(nodes.len() - 1);
+    }
 
     // Occluder: a light grey 0.5 m box standing on the floor, turned 20° about +Y.
     materials.push(json!({
@@ -319,8 +352,12 @@ fn main() {
     }));
     let light = nodes.len() - 1;
 
-    let eye = Vec3::new(1.6, 1.6, 1.9);
-    let world_from_camera = Mat4::look_at_rh(eye, Vec3::new(-0.3, 0.8, -0.6), Vec3::Y).inverse();
+    let (eye, target) = if mirrors_scene {
+        (Vec3::new(1.2, 1.7, 1.9), Vec3::new(-1.98, 1.2, -0.4))
+    } else {
+        (Vec3::new(1.6, 1.6, 1.9), Vec3::new(-0.3, 0.8, -0.6))
+    };
+    let world_from_camera = Mat4::look_at_rh(eye, target, Vec3::Y).inverse();
     let (_, rotation, _) = world_from_camera.to_scale_rotation_translation();
     nodes.push(json!({ "name": "camera", "camera": 0, "translation": eye.to_array(), "rotation": rotation.normalize().to_array() }));
     let camera = nodes.len() - 1;
@@ -337,7 +374,11 @@ fn main() {
         "samplers": [{ "input": input, "output": output, "interpolation": "LINEAR" }],
     }]);
 
-    let bin_name = "demo.bin";
+    let bin_name = format!("{stem}.bin");
+    let mut scene_nodes = vec![room, mirror];
+    scene_nodes.extend(glass);
+    scene_nodes.extend(panels);
+    scene_nodes.extend([occluder, light, camera]);
     let doc = json!({
         "asset": { "version": "2.0", "generator": "specula examples/make_demo_scene.rs" },
         "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
@@ -345,7 +386,7 @@ fn main() {
             "KHR_lights_punctual": { "lights": [{ "name": "light", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 25.0 }] }
         },
         "scene": 0,
-        "scenes": [{ "name": "demo", "nodes": [room, mirror, glass, occluder, light, camera] }],
+        "scenes": [{ "name": stem, "nodes": scene_nodes }],
         "nodes": nodes,
         "meshes": meshes,
         "materials": materials,
@@ -359,10 +400,13 @@ fn main() {
         "buffers": [{ "uri": bin_name, "byteLength": bin.data.len() }],
         "bufferViews": bin.views,
         "accessors": bin.accessors,
-        "animations": animations,
     });
-    std::fs::write(out.join(bin_name), &bin.data).expect("write demo.bin");
-    let gltf_path = out.join("demo.gltf");
+    let mut doc = doc;
+    if !mirrors_scene {
+        doc["animations"] = animations;
+    }
+    std::fs::write(out.join(&bin_name), &bin.data).expect("write the .bin");
+    let gltf_path = out.join(format!("{stem}.gltf"));
     std::fs::write(&gltf_path, serde_json::to_string_pretty(&doc).unwrap() + "\n").expect("write demo.gltf");
 
     // Read it back through the importer.
@@ -371,9 +415,14 @@ fn main() {
     let diffuse = count(&|k| *k == SurfaceKind::Diffuse);
     let mirrors = count(&|k| matches!(k, SurfaceKind::Mirror { .. }));
     let solids = count(&|k| matches!(k, SurfaceKind::Dielectric { thin: false, .. }));
-    assert_eq!((diffuse, mirrors, solids, scene.materials.len()), (7, 1, 1, 9), "demo classification");
+    if mirrors_scene {
+        assert_eq!((diffuse, mirrors, solids), (7, 2, 0), "mirror scene classification");
+        assert!(scene.animation.is_none());
+    } else {
+        assert_eq!((diffuse, mirrors, solids, scene.materials.len()), (7, 1, 1, 9), "demo classification");
+        assert_eq!(scene.animation.as_ref().map(|a| a.duration), Some(4.0), "the mirror sphere's path");
+    }
     assert!(scene.camera.is_some() && scene.lights.len() == 1 && scene.textures.len() == 6);
-    assert_eq!(scene.animation.as_ref().map(|a| a.duration), Some(4.0), "the mirror sphere's path");
     println!(
         "wrote {} ({} meshes, {} triangles, {} materials: {diffuse} diffuse, {mirrors} mirror, {solids} solid dielectric; {} textures, {} light)",
         gltf_path.display(),

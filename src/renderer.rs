@@ -344,9 +344,9 @@ impl Renderer {
             }
         }
         self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, &mut self.maps)?;
-        // Each mirrored view records the camera's passes again, and its copy.
-        let view_passes = self.plan.mirror_layers * (self.stages.len() as u32 + 1);
-        self.profiler = Profiler::new(ctx, MAX_PASSES + view_passes)?;
+        // Each mirrored view records the camera's passes again (a ray pipeline is a hundred
+        // passes at depth 16), and its copy.
+        self.profiler = Profiler::new(ctx, MAX_PASSES * (1 + self.plan.mirror_layers))?;
         self.write_descriptors(ctx);
         Ok(())
     }
@@ -804,6 +804,9 @@ impl Renderer {
             return Err(Error::Validation(errors));
         }
         let mut stats: Vec<(String, f64)> = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
+        if self.profiler.untimed() > 0 {
+            stats.push(("profiler.untimed_passes".into(), self.profiler.untimed() as f64));
+        }
         if let Some(m) = &self.mirrors {
             // Planar mirrors (§5): the views this frame rendered, their deepest level, and
             // the mirrors that showed the fallback for want of depth or budget.

@@ -27,6 +27,8 @@ pub struct Profiler {
     capacity: u32,
     names: Vec<&'static str>,
     cpu_ms: Vec<f64>,
+    /// Passes of the last frame beyond `capacity`: recorded, not timed.
+    untimed: u32,
 }
 
 impl Profiler {
@@ -34,12 +36,12 @@ impl Profiler {
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * max_passes);
         let pool = unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
         ctx.name(pool, "profiler.timestamps");
-        Ok(Profiler { pool, capacity: max_passes, names: Vec::new(), cpu_ms: Vec::new() })
+        Ok(Profiler { pool, capacity: max_passes, names: Vec::new(), cpu_ms: Vec::new(), untimed: 0 })
     }
 
     /// An empty profiler that owns nothing: for partial construction.
     pub fn placeholder() -> Profiler {
-        Profiler { pool: vk::QueryPool::null(), capacity: 0, names: Vec::new(), cpu_ms: Vec::new() }
+        Profiler { pool: vk::QueryPool::null(), capacity: 0, names: Vec::new(), cpu_ms: Vec::new(), untimed: 0 }
     }
 
     /// Reads the timestamps of the last recorded frame; the GPU must have finished it.
@@ -81,6 +83,11 @@ impl Profiler {
         }
     }
 
+    /// How many passes of the last frame went untimed (the query pool was full).
+    pub fn untimed(&self) -> u32 {
+        self.untimed
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         if self.pool != vk::QueryPool::null() {
             unsafe { ctx.device.destroy_query_pool(self.pool, None) };
@@ -119,6 +126,7 @@ impl<'a> Recorder<'a> {
         unsafe { ctx.device.cmd_reset_query_pool(cmd, profiler.pool, 0, 2 * profiler.capacity) };
         profiler.names.clear();
         profiler.cpu_ms.clear();
+        profiler.untimed = 0;
         Recorder { ctx, cmd, profiler, scope: None }
     }
 
@@ -142,6 +150,10 @@ impl<'a> Recorder<'a> {
 
     pub fn end(&mut self, pass: OpenPass) {
         let (d, cmd) = (&self.ctx.device, self.cmd);
+        if pass.index == u32::MAX {
+            self.ctx.end_label(cmd);
+            return;
+        }
         unsafe { d.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, self.profiler.pool, 2 * pass.index + 1) };
         self.ctx.end_label(cmd);
         self.profiler.cpu_ms.push(pass.cpu_start.elapsed().as_secs_f64() * 1e3);
@@ -170,12 +182,17 @@ impl PassBuilder<'_, '_> {
     pub fn begin(self) -> OpenPass {
         let PassBuilder { rec, name, barriers, memory_barrier } = self;
         let name = rec.scope.unwrap_or(name);
-        let index = rec.profiler.names.len() as u32;
-        assert!(index < rec.profiler.capacity, "profiler capacity exceeded: raise max_passes");
+        let timed = (rec.profiler.names.len() as u32) < rec.profiler.capacity;
+        // Beyond the query pool's capacity a pass is recorded untimed (counted), never refused.
+        let index = if timed { rec.profiler.names.len() as u32 } else { u32::MAX };
         let cpu_start = Instant::now();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         ctx.begin_label(cmd, name);
-        unsafe { ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, rec.profiler.pool, 2 * index) };
+        if timed {
+            unsafe { ctx.device.cmd_write_timestamp2(cmd, vk::PipelineStageFlags2::ALL_COMMANDS, rec.profiler.pool, 2 * index) };
+        } else {
+            rec.profiler.untimed += 1;
+        }
         // Always a barrier after the first timestamp: without one lavapipe lets compute
         // work slip out from between the two timestamps (LAVAPIPE-NOTES).
         let mem = [vk::MemoryBarrier2::default()
@@ -189,7 +206,9 @@ impl PassBuilder<'_, '_> {
             })];
         let dep = vk::DependencyInfo::default().memory_barriers(&mem).image_memory_barriers(&barriers);
         unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &dep) };
-        rec.profiler.names.push(name);
+        if timed {
+            rec.profiler.names.push(name);
+        }
         OpenPass { index, cpu_start }
     }
 }

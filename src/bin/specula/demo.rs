@@ -64,6 +64,10 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     // All of them side by side (the survey's Figures 20 and 24 in one sheet).
     specula::demo::write_composite(outdir, &tiles, w, h)?;
     report += &format!("side by side: {}, {}\n", outdir.join("methods.png").display(), outdir.join("methods.svg").display());
+    // Planar mirrors (§5): the mirror scene's corridor of images, by the planner (planar
+    // mirrors mirrored, the sphere ray traced), by planar-mirror for every mirror it serves
+    // and by distance maps, against the reference.
+    report += &mirrors(&ctx, &outdir.join("mirrors"), (w, h), &q)?;
     print!("{report}");
     let table = outdir.join("timings.txt");
     specula::output::write_file(&table, report.as_bytes())?;
@@ -87,4 +91,25 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         frames: 1,
     };
     crate::animate::run(&anim, 12.0, None, &outdir.join("animation"))
+}
+
+/// The mirror scene (`assets/mirrors/`): images and a timing table into `outdir`.
+fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Quality) -> specula::Result<String> {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/mirrors/mirrors.gltf");
+    let scene = scene::load(&path)?;
+    std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
+    let mut report = format!("\n== planar mirrors (survey §5): {} at {w}x{h}\n", path.display());
+    let (reference, ref_ms) = render_reference(&scene, q, (w, h))?;
+    write_image(&outdir.join("reference.png"), &reference)?;
+    report += &format!("reference: {ref_ms:.0} ms CPU\n");
+    for choice in [Choice::Auto, Choice::Method(specula::methods::PLANAR_MIRROR), Choice::Method(specula::methods::DISTANCE)] {
+        let name = choice.name();
+        let frame = specula::render(ctx, &scene, choice, q, (w, h), (1, 3))?;
+        write_image(&outdir.join(format!("{name}.png")), &frame.image)?;
+        let e = specula::metrics::compare(&frame.image, &reference)?;
+        let views = frame.stats.iter().find(|(n, _)| n == "geometry.mirror_views").map_or(0.0, |(_, v)| *v);
+        report += &format!("-- {name}: {:.2} ms, {views} mirrored view(s), {e}\n", frame.gpu_ms());
+        report += &specula::profile::table(&frame.passes, &frame.memory);
+    }
+    Ok(report)
 }
