@@ -70,3 +70,35 @@ fn bad_animation_arguments_are_refused() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Poses where the plan's structure changes (with `auto`, the demo's mirror sphere comes into
+/// the glass sphere's view around t = 2.58 s and the objects start to compose through
+/// inter-object cycles) get a new renderer: the sequence goes on, and frames.csv says so.
+#[test]
+fn animate_replans_where_the_pose_changes_the_plan() {
+    let dir = temp("animate-replan");
+    let out_dir = dir.to_str().unwrap();
+    let args = [
+        "animate",
+        SCENE,
+        "--fps",
+        "12",
+        "--duration",
+        "2.7",
+        "--size",
+        "16x12",
+        "-q",
+        "cube_size=16",
+        "-q",
+        "shadow_size=16",
+        "--out",
+        out_dir,
+    ];
+    // Only the frames around the change are rendered at full rate: 2.7 s × 12 fps = 32 frames.
+    let (ok, out) = specula(&args);
+    assert!(ok, "{out}");
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 33, "{csv}");
+    assert!(csv.contains("new renderer (scene update: the plan changes"), "{csv}");
+    std::fs::remove_dir_all(&dir).ok();
+}

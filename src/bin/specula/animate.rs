@@ -47,12 +47,25 @@ pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, out: &Path) -> sp
         for k in 0..frames {
             let t = k as f32 / fps;
             scene.set_time(t)?;
-            r.update(&scene)?;
+            let mut replanned = None;
+            if let Err(e) = r.update(&scene) {
+                // The pose changed the plan's structure (say, objects came into each other's
+                // view and now compose through inter-object cycles): a renderer for this
+                // pose takes over. A pose no renderer accepts fails with that renderer's error.
+                let plan = specula::plan::plan_with(&scene, &job.choices, &job.quality)?;
+                let fresh = specula::Renderer::new(&ctx, &scene, plan, w, h)?;
+                r.destroy(&ctx);
+                r = fresh;
+                replanned = Some(e.to_string());
+            }
             let f = r.render(&ctx)?;
             let stem = out.join(format!("frame_{k:04}"));
             write_image(&stem.with_extension("png"), &f.image)?;
             write_image(&stem.with_extension("exr"), &f.image)?;
-            let maps: Vec<String> = f.map_updates.iter().map(|u| format!("{} ({})", u.stage, u.reason)).collect();
+            let mut maps: Vec<String> = f.map_updates.iter().map(|u| format!("{} ({})", u.stage, u.reason)).collect();
+            if let Some(why) = replanned {
+                maps.insert(0, format!("new renderer ({why})"));
+            }
             let ms = f.gpu_ms();
             total_ms += ms;
             rebuilt_frames += !maps.is_empty() as u32;
