@@ -504,7 +504,11 @@ SpeculaResult specula_context_set_object_method_at(SpeculaContext *ctx,
 // mesh descriptor's `transform`), replacing the one it was added or loaded with. Refused:
 // NaN or infinite entries, a singular matrix (zero scale), a mirroring matrix for an object
 // that was not mirrored (or the reverse), an unknown object. Not thread-safe with other
-// calls on the same context; the GPU need not be idle.
+// calls on the same context; the GPU need not be idle. A move that changes the plan (with
+// SPECULA_METHOD_AUTO, objects coming into each other's view may start to compose) is
+// accepted and logged as a warning: a standalone context reconfigures at its next
+// specula_context_render; a host-device context's next specula_context_record returns
+// SPECULA_ERROR_WRONG_ORDER until it is configured again (idle GPU).
 SpeculaResult specula_context_set_object_transform(SpeculaContext *ctx,
                                                    uint32_t object,
                                                    const float *matrix);

@@ -28,6 +28,12 @@ pub enum Error {
     Validation(u32),
     #[error("{0}")]
     Image(String),
+    /// A scene update the renderer cannot take in place: the plan a fresh renderer would make
+    /// for the new state has other stages or maps (objects came into each other's view, …).
+    /// The update itself is valid; a new renderer (or, through the C ABI, a reconfigure)
+    /// renders it.
+    #[error("scene update: the plan changes ({0}): make a new renderer")]
+    PlanChanged(String),
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

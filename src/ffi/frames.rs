@@ -62,6 +62,7 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
         c.choice = choice;
         c.renderer = Some(r);
         c.renderer_version = c.scene_version;
+        c.replan = false;
         Ok(SPECULA_SUCCESS)
     })
 }
@@ -87,6 +88,17 @@ pub unsafe extern "C" fn specula_context_render(
             SPECULA_PIXEL_RGBA32F => 16,
             f => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("pixel_format: unknown value {f}")),
         };
+        if c.replan {
+            // An update changed the plan (specula_context_set_object_transform …): the same
+            // configuration planned afresh for the scene as it is now.
+            let (width, height) = c.renderer.as_ref().map_or((0, 0), |r| (r.width, r.height));
+            let choices = Choices { method: c.choice, objects: c.object_methods.clone() };
+            let p = plan_with(&c.scene, &choices, &c.quality)?;
+            c.destroy_renderer();
+            c.renderer = Some(Renderer::new(&c.vk, &c.scene, p, width, height)?);
+            c.renderer_version = c.scene_version;
+            c.replan = false;
+        }
         let r = c.renderer()?;
         let need = r.width as usize * r.height as usize * bpp;
         if dst_size < need {

@@ -37,6 +37,8 @@ pub struct SpeculaContext {
     /// Bumped on every scene change; a renderer built for an older scene is stale.
     pub(super) scene_version: u64,
     pub(super) renderer_version: u64,
+    /// A standalone context's update changed the plan: the next render reconfigures.
+    pub(super) replan: bool,
     /// NUL-terminated message of the last failed call, overwritten in place so that a
     /// pointer the caller holds stays valid for the context's lifetime.
     last_error: [u8; MESSAGE_BYTES],
@@ -102,6 +104,7 @@ fn code(e: &Error) -> SpeculaResult {
         Error::OutOfMemory(_) => SPECULA_ERROR_OUT_OF_MEMORY,
         Error::Vulkan { .. } => SPECULA_ERROR_VULKAN,
         Error::Validation(_) => SPECULA_ERROR_VALIDATION,
+        Error::PlanChanged(_) => SPECULA_ERROR_WRONG_ORDER,
     }
 }
 
@@ -137,7 +140,7 @@ impl SpeculaContext {
         self.log(SPECULA_LOG_ERROR, &f.1);
     }
 
-    fn log(&self, level: SpeculaLogLevel, msg: &str) {
+    pub(super) fn log(&self, level: SpeculaLogLevel, msg: &str) {
         if let Some(cb) = self.log {
             if let Ok(m) = CString::new(msg.replace('\0', " ")) {
                 // A panicking callback must not unwind into us: C callbacks cannot unwind.
@@ -164,7 +167,10 @@ impl SpeculaContext {
             return fail(SPECULA_ERROR_WRONG_ORDER, "no renderer: call specula_context_configure first");
         }
         if self.renderer_version != self.scene_version {
-            return fail(SPECULA_ERROR_WRONG_ORDER, "the scene changed since specula_context_configure: configure again");
+            return fail(
+                SPECULA_ERROR_WRONG_ORDER,
+                "the scene changed since specula_context_configure (or an update changed its plan): configure again",
+            );
         }
         Ok(self.renderer.as_mut().unwrap())
     }
@@ -244,6 +250,7 @@ fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Contex
             renderer: None,
             scene_version: 0,
             renderer_version: 0,
+            replan: false,
             last_error: [0; MESSAGE_BYTES],
             log: None,
             log_user: std::ptr::null_mut(),

@@ -23,9 +23,22 @@ fn apply<T: Clone>(
     change(&mut c.scene)?;
     if c.renderer_version == c.scene_version {
         if let Some(r) = c.renderer.as_mut() {
-            if let Err(e) = r.update(&c.scene) {
-                *get(&mut c.scene) = old;
-                return Err(e.into());
+            match r.update(&c.scene) {
+                Ok(_) => {}
+                // A valid change the renderer cannot take in place: the scene keeps it, the
+                // renderer is stale. Standalone contexts rebuild it at the next render; a host
+                // configures again (with an idle GPU, as configuring always needs).
+                Err(crate::Error::PlanChanged(why)) => {
+                    c.scene_version += 1;
+                    let owned = c.vk.owns_device();
+                    c.replan = owned;
+                    let next = if owned { "the next specula_context_render reconfigures" } else { "call specula_context_configure again" };
+                    c.log(SPECULA_LOG_WARNING, &format!("the update changes the plan ({why}): {next}"));
+                }
+                Err(e) => {
+                    *get(&mut c.scene) = old;
+                    return Err(e.into());
+                }
             }
         }
     }
@@ -44,7 +57,11 @@ fn index(i: u32, count: usize, what: &str) -> FfiResult<usize> {
 /// mesh descriptor's `transform`), replacing the one it was added or loaded with. Refused:
 /// NaN or infinite entries, a singular matrix (zero scale), a mirroring matrix for an object
 /// that was not mirrored (or the reverse), an unknown object. Not thread-safe with other
-/// calls on the same context; the GPU need not be idle.
+/// calls on the same context; the GPU need not be idle. A move that changes the plan (with
+/// SPECULA_METHOD_AUTO, objects coming into each other's view may start to compose) is
+/// accepted and logged as a warning: a standalone context reconfigures at its next
+/// specula_context_render; a host-device context's next specula_context_record returns
+/// SPECULA_ERROR_WRONG_ORDER until it is configured again (idle GPU).
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_set_object_transform(ctx: *mut SpeculaContext, object: u32, matrix: *const f32) -> SpeculaResult {
     with_ctx(ctx, |c| {

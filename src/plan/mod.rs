@@ -211,7 +211,7 @@ impl Plan {
                     fresh.envmaps.iter().map(|e| e.mesh).collect::<Vec<_>>()
                 ),
             };
-            return Err(Error::invalid("scene update", format!("the plan changes ({what}): make a new renderer")));
+            return Err(Error::PlanChanged(what));
         }
         for (o, f) in self.objects.iter_mut().zip(&fresh.objects) {
             o.reference_point = f.reference_point;
