@@ -342,14 +342,17 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         assert_eq!(r, SPECULA_SUCCESS, "{}", unsafe { std::ffi::CStr::from_ptr(specula_context_last_error(ctx)) }.to_string_lossy());
         px
     };
-    unsafe {
-        let a = common::c_context();
-        assert_eq!(specula_context_load_gltf(a, demo.as_ptr().cast()), SPECULA_SUCCESS);
+    let knobs = |ctx: *mut SpeculaContext| {
         for k in ["cube_size=16", "shadow_size=32", "depth=4"] {
             let (key, value) = k.split_once('=').unwrap();
             let (key, value) = (std::ffi::CString::new(key).unwrap(), std::ffi::CString::new(value).unwrap());
-            assert_eq!(specula_context_set_knob(a, key.as_ptr(), value.as_ptr()), SPECULA_SUCCESS);
+            assert_eq!(unsafe { specula_context_set_knob(ctx, key.as_ptr(), value.as_ptr()) }, SPECULA_SUCCESS);
         }
+    };
+    unsafe {
+        let a = common::c_context();
+        assert_eq!(specula_context_load_gltf(a, demo.as_ptr().cast()), SPECULA_SUCCESS);
+        knobs(a);
         assert_eq!(specula_context_configure(a, &desc), SPECULA_SUCCESS);
         render(a);
         assert_eq!(specula_context_set_object_transform(a, sphere, moved.as_ptr()), SPECULA_SUCCESS, "the move is accepted");
@@ -357,11 +360,7 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
 
         let b = common::c_context();
         assert_eq!(specula_context_load_gltf(b, demo.as_ptr().cast()), SPECULA_SUCCESS);
-        for k in ["cube_size=16", "shadow_size=32", "depth=4"] {
-            let (key, value) = k.split_once('=').unwrap();
-            let (key, value) = (std::ffi::CString::new(key).unwrap(), std::ffi::CString::new(value).unwrap());
-            assert_eq!(specula_context_set_knob(b, key.as_ptr(), value.as_ptr()), SPECULA_SUCCESS);
-        }
+        knobs(b);
         assert_eq!(specula_context_set_object_transform(b, sphere, moved.as_ptr()), SPECULA_SUCCESS);
         assert_eq!(specula_context_configure(b, &desc), SPECULA_SUCCESS);
         let fresh = render(b);
