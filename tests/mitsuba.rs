@@ -1,0 +1,233 @@
+//! The CPU reference against a renderer no one here wrote (issue 16): small scenes built
+//! here, rendered by `specula::reference` and by Mitsuba 3's path tracer (`scalar_rgb`,
+//! installed from PyPI into `target/mitsuba-venv` by scripts/setup.sh; `SPECULA_PYTHON`
+//! names another interpreter). The conventions mapping lives in tests/mitsuba/render.py.
+//!
+//! The scenes keep to light transport both renderers compute: the reference is Whitted-style
+//! (perfect specular chains, direct light at diffuse surfaces, no diffuse interreflection),
+//! so diffuse surfaces are either emitters of albedo 0 or the only lit diffuse surface in a
+//! scene whose other surfaces are black (a path tracer's extra bounces then find nothing).
+//! Point lights make caustics unsampleable for Mitsuba's unidirectional tracer and absent
+//! from the reference alike.
+
+mod common;
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use serde_json::json;
+use specula::image::ImageData;
+use specula::scene::{shapes, Camera, Light, LightKind, Material, Scene, SurfaceKind};
+use specula::Quality;
+
+const SIZE: (u32, u32) = (48, 36);
+
+fn python() -> PathBuf {
+    if let Some(p) = std::env::var_os("SPECULA_PYTHON") {
+        return p.into();
+    }
+    let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/mitsuba-venv/bin/python");
+    assert!(
+        venv.exists(),
+        "{} is missing: scripts/setup.sh installs Mitsuba 3 there (or set SPECULA_PYTHON to a Python with `mitsuba`)",
+        venv.display()
+    );
+    venv
+}
+
+fn dir() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("specula-mitsuba-{}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write_obj(path: &Path, m: &specula::scene::Mesh) {
+    let mut s = String::new();
+    for p in &m.positions {
+        let _ = writeln!(s, "v {} {} {}", p.x, p.y, p.z);
+    }
+    for n in &m.normals {
+        let _ = writeln!(s, "vn {} {} {}", n.x, n.y, n.z);
+    }
+    for t in m.indices.chunks_exact(3) {
+        let _ = writeln!(s, "f {0}//{0} {1}//{1} {2}//{2}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+/// The scene as render.py reads it.
+fn describe(s: &Scene, name: &str, spp: u32, depth: u32) -> serde_json::Value {
+    let d = dir();
+    let mut meshes = Vec::new();
+    for (i, m) in s.meshes.iter().enumerate() {
+        let obj = d.join(format!("{name}_{i}.obj"));
+        write_obj(&obj, m);
+        let mat = &s.materials[m.material];
+        let v = |v: Vec3| json!([v.x, v.y, v.z]);
+        let bsdf = match mat.kind {
+            SurfaceKind::Diffuse if mat.base_color == Vec3::ZERO => json!({ "type": "black" }),
+            SurfaceKind::Diffuse => json!({ "type": "diffuse", "reflectance": v(mat.base_color) }),
+            SurfaceKind::Mirror { nu, kappa } => json!({ "type": "conductor", "eta": v(nu), "k": v(kappa) }),
+            SurfaceKind::Dielectric { ior, thin: false } => json!({ "type": "dielectric", "ior": ior }),
+            SurfaceKind::Dielectric { ior, thin: true } => json!({ "type": "thindielectric", "ior": ior }),
+        };
+        let mut e = json!({ "obj": obj.to_str().unwrap(), "bsdf": bsdf });
+        if mat.emissive != Vec3::ZERO {
+            e["radiance"] = v(mat.emissive);
+        }
+        meshes.push(e);
+    }
+    let lights: Vec<_> = s
+        .lights
+        .iter()
+        .map(|l| match l.kind {
+            LightKind::Point => json!({ "type": "point", "position": l.position.to_array(), "intensity": l.intensity.to_array() }),
+            LightKind::Directional => {
+                json!({ "type": "directional", "direction": l.direction.to_array(), "irradiance": l.intensity.to_array() })
+            }
+            LightKind::Spot { .. } => panic!("spot lights differ on purpose (the glTF falloff): not cross-checked"),
+        })
+        .collect();
+    let cam = s.camera_or_default();
+    let forward = -cam.world_from_camera.z_axis.truncate();
+    let up = cam.world_from_camera.y_axis.truncate();
+    json!({
+        "camera": {
+            "eye": cam.position.to_array(), "target": (cam.position + forward).to_array(), "up": up.to_array(),
+            "yfov_deg": cam.yfov.to_degrees(), "znear": cam.znear, "width": SIZE.0, "height": SIZE.1,
+        },
+        "meshes": meshes,
+        "lights": lights,
+        "spp": spp,
+        "max_depth": depth + 1,
+    })
+}
+
+fn mitsuba(s: &Scene, name: &str, spp: u32, depth: u32) -> ImageData {
+    let d = dir();
+    let (json_path, exr) = (d.join(format!("{name}.json")), d.join(format!("{name}.exr")));
+    std::fs::write(&json_path, describe(s, name, spp, depth).to_string()).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/mitsuba/render.py");
+    let o = std::process::Command::new(python()).arg(&script).arg(&json_path).arg(&exr).output().unwrap();
+    assert!(o.status.success(), "mitsuba on {name}: {}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    let e = specula::scene::load_environment(&exr).unwrap();
+    ImageData { width: e.width, height: e.height, layers: 1, channels: 4, data: e.rgba32f }
+}
+
+fn reference(s: &Scene, depth: u32) -> ImageData {
+    let mut q = Quality { depth, spp: 16, ..Quality::default() };
+    q.set("fresnel", "exact").unwrap();
+    specula::reference::render_reference(s, &q, SIZE).unwrap()
+}
+
+/// Mitsuba's image has no alpha; compare colour only.
+fn psnr(a: &ImageData, b: &ImageData) -> f64 {
+    let strip = |i: &ImageData| {
+        let mut c = i.clone();
+        c.data.chunks_exact_mut(4).for_each(|p| p[3] = 1.0);
+        c
+    };
+    specula::metrics::compare(&strip(a), &strip(b)).unwrap().psnr
+}
+
+fn save(name: &str, img: &ImageData) {
+    img.write_exr(&dir().join(format!("{name}_specula.exr"))).ok();
+}
+
+/// An emissive room of 24 distinct quadrants (albedo 0) around a specular ball, seen from
+/// a corner.
+fn room_with(material: Material) -> Scene {
+    let mut s = Scene::new();
+    common::emissive_room(&mut s, Vec3::ZERO, 2.0);
+    let m = s.add_material(material).unwrap();
+    s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.2, -0.3, -0.4), 0.8, 96, 48, m)).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(1.3, 0.9, 1.6), Vec3::new(0.1, -0.3, -0.4), 55f32.to_radians()));
+    s
+}
+
+#[test]
+fn specular_balls_agree_with_mitsuba() {
+    let ctx = common::gpu();
+    // A gold ball (published n, k at about 650, 550 and 450 nm) and solid glass of two
+    // indices: conductor Fresnel with κ > 0, Snell, dielectric Fresnel and total internal
+    // reflection along the whole specular chain.
+    let gold = Material {
+        name: "gold".into(),
+        kind: SurfaceKind::Mirror { nu: Vec3::new(0.16, 0.42, 1.37), kappa: Vec3::new(3.6, 2.35, 1.8) },
+        ..Default::default()
+    };
+    let glass =
+        |ior: f32| Material { name: format!("glass{ior}"), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() };
+    let thin = Material { name: "thin".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: true }, ..Default::default() };
+    // Measured here (48×36; the reference at 16 spp, Mitsuba at 256, both deterministic):
+    // gold 46.06 dB, glass 1.5 46.91 dB, glass 1.1 47.34 dB; the floors sit 1 dB below.
+    // Thin-walled glass differs on purpose, 37.43 dB: specula follows glTF's thin-walled
+    // model (one interface: reflect F, pass 1 − F undeviated), Mitsuba's `thindielectric` a
+    // physical slab summing its internal reflections (2F/(1 + F) reflected).
+    for (name, material, floor) in
+        [("gold", gold, 45.0), ("glass1.5", glass(1.5), 45.9), ("glass1.1", glass(1.1), 46.3), ("thin", thin, 36.4)]
+    {
+        let s = room_with(material);
+        let (r, m) = (reference(&s, 16), mitsuba(&s, name, 256, 16));
+        save(name, &r);
+        let p = psnr(&r, &m);
+        // The GPU's exact ray tracer too (4×4 supersampled, as the reference's 16 samples).
+        let mut q = Quality { depth: 16, ..Quality::default() };
+        q.set("fresnel", "exact").unwrap();
+        q.set("aa", "ssaa4").unwrap();
+        let gpu = specula::render(&ctx, &s, specula::methods::BVH, &q, SIZE, (0, 1)).unwrap().image;
+        let g = psnr(&gpu, &m);
+        println!("{name}: reference vs Mitsuba {p:.2} dB, GPU bvh vs Mitsuba {g:.2} dB");
+        assert!(p >= floor, "{name}: {p:.2} dB against Mitsuba (floor {floor} dB)");
+        assert!(g >= floor - 3.0, "{name}: GPU bvh {g:.2} dB against Mitsuba (floor {} dB)", floor - 3.0);
+    }
+    common::assert_clean(&ctx);
+}
+
+#[test]
+fn direct_light_and_shadows_agree_with_mitsuba() {
+    // A diffuse floor, a black occluder, a point light, then a tilted directional light:
+    // inverse square, cosine, the light units (W/sr, W/m²) and hard shadows.
+    for (name, light) in [
+        (
+            "point",
+            Light {
+                name: "l".into(),
+                kind: LightKind::Point,
+                position: Vec3::new(0.4, 2.0, 0.2),
+                direction: Vec3::NEG_Y,
+                intensity: Vec3::new(6.0, 5.0, 4.0),
+                range: None,
+            },
+        ),
+        (
+            "directional",
+            Light {
+                name: "l".into(),
+                kind: LightKind::Directional,
+                position: Vec3::ZERO,
+                direction: Vec3::new(0.4, -1.0, 0.3).normalize(),
+                intensity: Vec3::new(1.5, 1.2, 1.0),
+                range: None,
+            },
+        ),
+    ] {
+        let mut s = Scene::new();
+        let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::new(0.6, 0.5, 0.4), ..Default::default() }).unwrap();
+        s.add_mesh(shapes::quad("floor", Vec3::new(-2.0, 0.0, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0), 8, floor))
+            .unwrap();
+        let black = s.add_material(Material { name: "occluder".into(), base_color: Vec3::ZERO, ..Default::default() }).unwrap();
+        s.add_mesh(shapes::quad("occluder", Vec3::new(-0.4, 0.9, 0.4), Vec3::new(0.8, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.8), 1, black))
+            .unwrap();
+        s.add_light(light).unwrap();
+        s.camera = Some(Camera::look_at(Vec3::new(0.0, 2.6, 2.4), Vec3::new(0.0, 0.0, -0.2), 55f32.to_radians()));
+        let (r, m) = (reference(&s, 4), mitsuba(&s, name, 64, 4));
+        save(name, &r);
+        let p = psnr(&r, &m);
+        println!("{name}: reference vs Mitsuba {p:.2} dB");
+        // Measured 55.29 dB (point) and 50.16 dB (directional); floors 1 dB below.
+        let floor = if name == "point" { 54.3 } else { 49.2 };
+        assert!(p >= floor, "{name}: {p:.2} dB against Mitsuba (floor {floor} dB)");
+    }
+}
