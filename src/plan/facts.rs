@@ -34,6 +34,10 @@ pub struct ObjectFacts {
     /// scene's bounding box (1: the environment is a box room with nothing in it, and the
     /// proxy box of §3.2 is exact). 0 without deep facts.
     pub box_fraction: f32,
+    /// A planar mirror covers at least `MIN_COVERAGE` of its directions: cube maps show
+    /// planar mirrors as the environment (their mirrored views are the camera's), so such
+    /// an object needs rays to see the mirror's reflection.
+    pub sees_planar_mirror: bool,
     pub reference_point: Vec3,
     pub reference_note: Option<String>,
     pub triangles: usize,
@@ -400,12 +404,18 @@ impl SceneFacts {
                     visible_fraction: visible,
                     sees_specular: sees,
                     box_fraction,
+                    sees_planar_mirror: false,
                     reference_point,
                     reference_note,
                     triangles: m.triangle_count(),
                 })
             })
-            .collect();
+            .collect::<Vec<ObjectFacts>>();
+        let mut objects = objects;
+        let planar_mirrors: Vec<usize> = objects.iter().filter(|o| o.planar && o.class == ObjectClass::Mirror).map(|o| o.mesh).collect();
+        for o in &mut objects {
+            o.sees_planar_mirror = planar_mirrors.iter().any(|&m| m != o.mesh && o.sees(m));
+        }
         SceneFacts { objects }
     }
 }
