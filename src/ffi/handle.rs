@@ -151,7 +151,8 @@ impl SpeculaContext {
 
     pub(super) fn forward_validation_messages(&self) {
         for m in self.vk.validation.error_messages() {
-            self.log(SPECULA_LOG_ERROR, &m);
+            let level = if m.starts_with("warning: ") { SPECULA_LOG_WARNING } else { SPECULA_LOG_ERROR };
+            self.log(level, &m);
         }
     }
 

@@ -60,6 +60,7 @@ impl ValidationLog {
     pub fn warning_count(&self) -> u32 {
         self.warnings.load(Ordering::Relaxed)
     }
+    /// The first 64 messages: errors as the layer wrote them, warnings prefixed `warning: `.
     pub fn error_messages(&self) -> Vec<String> {
         self.messages.lock().map(|m| m.clone()).unwrap_or_default()
     }
@@ -211,6 +212,11 @@ unsafe extern "system" fn debug_callback(
     } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
         log.warnings.fetch_add(1, Ordering::Relaxed);
         eprintln!("[vulkan validation warning] {msg}");
+        if let Ok(mut m) = log.messages.lock() {
+            if m.len() < 64 {
+                m.push(format!("warning: {msg}"));
+            }
+        }
     }
     vk::FALSE
 }

@@ -11,9 +11,11 @@ pub fn gpu() -> Context {
         .expect("Vulkan context with validation (is vulkan-validationlayers installed?)")
 }
 
-/// Fails the test on any validation error.
+/// Fails the test on any validation error or warning (none is allowed: each would need a
+/// named reason here).
 pub fn assert_clean(ctx: &Context) {
     assert_eq!(ctx.validation.error_count(), 0, "validation errors: {:#?}", ctx.validation.error_messages());
+    assert_eq!(ctx.validation.warning_count(), 0, "validation warnings: {:#?}", ctx.validation.error_messages());
 }
 
 /// The emitted colour of quadrant `q` of wall `w` in `quadrant_room`: distinct for all 24.
