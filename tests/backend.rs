@@ -18,7 +18,7 @@ use specula::{plan, Quality, Renderer};
 /// created and used their devices concurrently.
 static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
-fn gpu() -> (std::sync::MutexGuard<'static, ()>, specula::vk::Context) {
+fn gpu() -> (std::sync::MutexGuard<'static, ()>, common::Gpu) {
     let guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     (guard, common::gpu())
 }

@@ -5,10 +5,37 @@ use glam::Vec3;
 use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::vk::{Context, DeviceOptions};
 
-/// A context with the Khronos validation layer on (every GPU test uses one).
-pub fn gpu() -> Context {
-    Context::new(&DeviceOptions { validation: true, device_filter: None })
-        .expect("Vulkan context with validation (is vulkan-validationlayers installed?)")
+/// A context with the Khronos validation layer on (every GPU test uses one). Dropping it
+/// fails the test if destroying the device reported errors (objects the test left alive:
+/// the layer reports them at vkDestroyDevice, after `assert_clean` ran).
+pub fn gpu() -> Gpu {
+    Gpu(Some(
+        Context::new(&DeviceOptions { validation: true, device_filter: None })
+            .expect("Vulkan context with validation (is vulkan-validationlayers installed?)"),
+    ))
+}
+
+/// A test's context (see `gpu`).
+pub struct Gpu(Option<Context>);
+
+impl std::ops::Deref for Gpu {
+    type Target = Context;
+    fn deref(&self) -> &Context {
+        self.0.as_ref().expect("context alive")
+    }
+}
+
+impl Drop for Gpu {
+    fn drop(&mut self) {
+        let before = specula::vk::process_validation_errors();
+        drop(self.0.take());
+        let after = specula::vk::process_validation_errors();
+        // Another test's device destroyed at the same moment could be the one to blame; either
+        // way an error was reported and the suite must not pass.
+        if after > before && !std::thread::panicking() {
+            panic!("destroying the device reported {} validation error(s): objects left alive (see stderr)", after - before);
+        }
+    }
 }
 
 /// Fails the test on any validation error or warning (none is allowed: each would need a
