@@ -144,6 +144,9 @@ fn glass_scene(ior: f32) -> Scene {
     s
 }
 
+/// ν = 1.0001 against the reference without the sphere: measured 41.85 dB, floor 1 dB under.
+const ALMOST_FLOOR: f64 = 40.8;
+
 /// Self refraction through the refractor map (§4.4) against the reference for ν = 1.5 and
 /// ν = 1.1, better than the single-interface distance method; total internal reflection
 /// followed inside the sphere changes the image towards the reference; ν → 1 converges
@@ -152,7 +155,10 @@ fn glass_scene(ior: f32) -> Scene {
 fn refractor_map_self_refraction() {
     let ctx = common::gpu();
     let size = 80;
-    for (ior, floor) in [(1.5f32, 27.0), (1.1, 29.0)] {
+    // Measured here: refractor-map 36.04 and 36.07 dB, image-space refraction 20.27 and
+    // 27.74 dB (its second interface is approximated by the back-face depth): floors 1 dB
+    // below.
+    for (ior, floor, wyman_floor) in [(1.5f32, 35.0, 19.3), (1.1, 35.0, 26.7)] {
         let scene = glass_scene(ior);
         let refimg = reference(&scene, &["spp=4", "depth=8", "fresnel=exact"], size);
         let q = quality(&["cube_size=128", "fresnel=exact", "internal_bounces=4", "linear_steps=16", "secant_steps=4"]);
@@ -162,6 +168,7 @@ fn refractor_map_self_refraction() {
         eprintln!("glass ν={ior}: refractor-map {rm}\n           distance {single}\n           image-space {wyman}");
         assert!(rm.psnr > floor, "ν={ior}: {rm}");
         assert!(rm.rmse < single.rmse, "ν={ior}: refractor map {rm} vs single interface {single}");
+        assert!(wyman.psnr > wyman_floor, "ν={ior}: image-space refraction {wyman}");
     }
     // Total internal reflection: in a ν = 1.5 sphere, rays hitting the far side beyond the
     // critical angle (41.8°) reflect; following them (4 bounces) instead of dropping them
@@ -182,11 +189,12 @@ fn refractor_map_self_refraction() {
     let mut empty = Scene::new();
     common::emissive_room(&mut empty, Vec3::new(0.0, 2.0, 0.0), 2.0);
     empty.camera = glass_scene(1.0001).camera;
+    // Against the reference's image of the room without the sphere (not the GPU's own).
     let q = quality(&["cube_size=128", "fresnel=exact"]);
-    let without = gpu(&ctx, &empty, specula::methods::REFRACTOR_MAP, &q, size);
+    let without = reference(&empty, &["spp=4", "depth=8", "fresnel=exact"], size);
     let almost = errors(&gpu(&ctx, &glass_scene(1.0001), specula::methods::REFRACTOR_MAP, &q, size), &without);
-    eprintln!("ν=1.0001 vs no sphere: {almost}");
-    assert!(almost.psnr > 35.0, "{almost}");
+    eprintln!("ν=1.0001 vs the reference without the sphere: {almost}");
+    assert!(almost.psnr > ALMOST_FLOOR, "{almost}");
     common::assert_clean(&ctx);
 }
 

@@ -32,7 +32,8 @@ fn every_pass_is_reported_with_positive_gpu_time() {
     assert_eq!(names, expected);
     for p in &f.passes {
         assert!(p.gpu_ms > 0.0, "{} has GPU time {}", p.name, p.gpu_ms);
-        assert!(p.cpu_ms >= 0.0);
+        // Recording a pass takes time on the CPU too (Instant's nanoseconds).
+        assert!(p.cpu_ms > 0.0 && p.cpu_ms < 1e4, "{} has CPU time {}", p.name, p.cpu_ms);
     }
     assert!(f.memory_bytes() > 0);
     let json: serde_json::Value = serde_json::from_str(&specula::profile::chrome_trace(&f.passes, &f.memory, &ctx.device_name)).unwrap();

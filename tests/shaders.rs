@@ -2,7 +2,34 @@
 
 #[test]
 fn every_embedded_module_validates() {
-    assert!(specula::shaders::ALL.len() >= 7, "shaders were embedded");
+    // Every shader source under glsl/ (not the headers in common/) and every variant it
+    // declares is embedded, and nothing else.
+    let root = std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/glsl"));
+    let mut expected = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                if p.file_name().is_some_and(|n| n != "common") {
+                    stack.push(p);
+                }
+            } else if p.extension().and_then(|x| x.to_str()).is_some_and(|x| ["vert", "frag", "comp", "geom", "tesc", "tese"].contains(&x))
+            {
+                let name = p.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+                let text = std::fs::read_to_string(&p).unwrap();
+                for v in text.lines().take(12).filter_map(|l| l.trim().strip_prefix("// variants:")).flat_map(|v| v.split_whitespace()) {
+                    expected.push(format!("{name}#{v}"));
+                }
+                expected.push(name);
+            }
+        }
+    }
+    expected.sort();
+    let mut embedded: Vec<String> = specula::shaders::ALL.iter().map(|(n, _)| n.to_string()).collect();
+    embedded.sort();
+    assert_eq!(embedded, expected, "embedded modules vs glsl/ sources");
+    assert!(embedded.len() > 40, "{} modules", embedded.len());
     let dir = std::env::temp_dir().join(format!("specula-spirv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (name, bytes) in specula::shaders::ALL {
