@@ -14,8 +14,30 @@ const F0: f32 = 0.3;
 /// centre, camera looking at it. Every pixel on the sphere is predicted on the CPU: hit the
 /// analytic sphere, reflect, take the room's colour in the reflected direction from the
 /// centre (what environment mapping assumes), weight by Schlick (eq. 2).
+/// Unpolarised reflectance of a lossless interface of index n from air at incidence cos θ,
+/// from the Fresnel equations written out here (not `specula::optics`).
+fn fresnel_equations(n: f64, cos: f64) -> f64 {
+    let sin2 = 1.0 - cos * cos;
+    let cos_t = (1.0 - sin2 / (n * n)).sqrt();
+    let rs = (cos - n * cos_t) / (cos + n * cos_t);
+    let rp = (n * cos - cos_t) / (n * cos + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
 #[test]
 fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
+    predict_the_sphere("schlick");
+}
+
+/// The same prediction with `fresnel=exact`: every pixel weighted by the Fresnel equations;
+/// at mid angles they are 0.02–0.04 above Schlick here, beyond the tolerance, so a shader
+/// that ignores the knob fails.
+#[test]
+fn exact_fresnel_follows_the_fresnel_equations_across_the_sphere() {
+    predict_the_sphere("exact");
+}
+
+fn predict_the_sphere(fresnel: &str) {
     let ctx = common::gpu();
     let mut scene = Scene::new();
     common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
@@ -26,6 +48,7 @@ fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
     scene.camera = Some(Camera::look_at(eye, Vec3::ZERO, yfov));
     let mut q = Quality::default();
     q.set("cube_size", "128").unwrap();
+    q.set("fresnel", fresnel).unwrap();
     let p = plan(&scene, specula::methods::ENVMAP, &q);
     assert_eq!(p.envmaps.len(), 1);
     assert_eq!(p.envmaps[0].reference_point, Vec3::ZERO);
@@ -33,8 +56,10 @@ fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
     let mut r = Renderer::new(&ctx, &scene, p, w, h).unwrap();
     let frame = r.render(&ctx).unwrap();
 
-    let f0 = fresnel_f0(((1.0 + F0.sqrt()) / (1.0 - F0.sqrt())) as f64, 0.0);
+    let nu = ((1.0 + F0.sqrt()) / (1.0 - F0.sqrt())) as f64;
+    let f0 = fresnel_f0(nu, 0.0);
     assert!((f0 - F0 as f64).abs() < 1e-6);
+    let mut schlick_gap: f64 = 0.0;
     let tan = (yfov as f64 * 0.5).tan();
     let (mut checked, mut bad, mut normal_seen, mut grazing_seen) = (0, 0, false, false);
     for y in 0..h {
@@ -64,7 +89,8 @@ fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
                 continue;
             }
             let (wall, quadrant) = shapes::quadrant_room_hit(rdir.as_vec3());
-            let weight = fresnel_schlick(f0, cos) as f32;
+            let weight = if fresnel == "exact" { fresnel_equations(nu, cos) } else { fresnel_schlick(f0, cos) } as f32;
+            schlick_gap = schlick_gap.max((fresnel_equations(nu, cos) - fresnel_schlick(f0, cos)).abs());
             let expected = common::quadrant_color(wall, quadrant) * weight;
             let got = frame.image.texel(0, x, y);
             let err = common::max_diff(got, expected);
@@ -82,12 +108,13 @@ fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
                 // Towards grazing incidence the weight rises towards 1.
                 grazing_seen = true;
                 let ratio = got[0] / common::quadrant_color(wall, quadrant).x;
-                assert!(ratio > 0.45 && (ratio - weight).abs() < 0.02, "grazing (cos {cos:.3}): weight {ratio}, Schlick {weight}");
+                assert!(ratio > F0 + 0.05 && (ratio - weight).abs() < 0.02, "grazing (cos {cos:.3}): weight {ratio}, {fresnel} {weight}");
             }
         }
     }
     assert!(normal_seen && grazing_seen);
     assert!(checked > 1500, "only {checked} pixels checked");
+    assert!(schlick_gap > 0.02, "the two Fresnel modes differ on this sphere by {schlick_gap}");
     // Tolerance: 1 % of the expected value + 0.002; at most 1 % of pixels outside it
     // (texel interpolation next to the skipped edges, half-float storage).
     assert!(bad * 100 <= checked, "{bad} of {checked} sphere pixels differ from the prediction");
@@ -182,9 +209,12 @@ fn lone_object_sees_the_environment_map() {
     scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.5, 64, 32, m)).unwrap();
     let (w, h) = (64u32, 32u32);
     let mut sky = Vec::new();
+    // Blue above the horizon, green below; red 0.5 in the half of azimuths u > ½ (dₓ > 0:
+    // u = ½ + atan2(dₓ, −d_z)/2π), so that a flipped azimuth shows.
     for y in 0..h {
-        for _ in 0..w {
-            sky.extend_from_slice(if y < h / 2 { &[0.0, 0.0, 1.0, 1.0] } else { &[0.0, 1.0, 0.0, 1.0] });
+        for x in 0..w {
+            let red = if x >= w / 2 { 0.5 } else { 0.0 };
+            sky.extend_from_slice(&if y < h / 2 { [red, 0.0, 1.0, 1.0] } else { [red, 1.0, 0.0, 1.0] });
         }
     }
     scene.set_environment(specula::scene::EnvironmentMap { width: w, height: h, rgba32f: sky }).unwrap();
@@ -203,5 +233,12 @@ fn lone_object_sees_the_environment_map() {
     let (top, bottom) = (px(24, 17), px(24, 31));
     assert!(top[2] >= 0.49 && top[1] < 0.01, "upper sphere reflects the blue sky: {top:?}");
     assert!(bottom[1] >= 0.49 && bottom[2] < 0.01, "lower sphere reflects the green ground: {bottom:?}");
+    // Near normal incidence the weight is near F0 = 0.5, not 1 (a missing Fresnel factor).
+    assert!(top[2] < 0.75 && bottom[1] < 0.75, "Fresnel-weighted: {top:?} {bottom:?}");
+    // Azimuth: the left background and the sphere's left side see dₓ < 0 (no red), the
+    // right ones dₓ > 0 (red 0.5, weighted on the sphere).
+    assert!(px(1, 24)[0] < 0.01 && px(46, 24)[0] > 0.49, "background azimuth: {:?} {:?}", px(1, 24), px(46, 24));
+    let (left, right) = (px(15, 24), px(33, 24));
+    assert!(left[0] < 0.01 && right[0] > 0.2 && right[0] < 0.5, "sphere azimuth: left {left:?}, right {right:?}");
     common::assert_clean(&ctx);
 }
