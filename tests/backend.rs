@@ -6,12 +6,26 @@ mod common;
 
 use ash::vk;
 use glam::Vec3;
-use specula::cube::face_st_to_direction;
 use specula::quality::CubeMode;
 use specula::scene::{shapes, Camera, Scene};
 use specula::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_image};
 use specula::vk::{read_image, Access, Image, ImageDesc, ImageKind, Profiler, Recorder};
 use specula::{plan, Quality, Renderer};
+
+/// The direction of face `face`'s texel coordinates (s, t), from the Vulkan specification's
+/// table "Cube map face selection" written out here (sc, tc per major axis, s = (sc/|ma| + 1)/2,
+/// t = (tc/|ma| + 1)/2), inverted for |ma| = 1: not the library's own face table.
+fn vulkan_face_direction(face: u32, s: f32, t: f32) -> Vec3 {
+    let (u, v) = (2.0 * s - 1.0, 2.0 * t - 1.0);
+    match face {
+        0 => Vec3::new(1.0, -v, -u),  // +X: sc = −rz, tc = −ry
+        1 => Vec3::new(-1.0, -v, u),  // −X: sc = +rz, tc = −ry
+        2 => Vec3::new(u, 1.0, v),    // +Y: sc = +rx, tc = +rz
+        3 => Vec3::new(u, -1.0, -v),  // −Y: sc = +rx, tc = −rz
+        4 => Vec3::new(u, -v, 1.0),   // +Z: sc = +rx, tc = −ry
+        _ => Vec3::new(-u, -v, -1.0), // −Z: sc = −rx, tc = −ry
+    }
+}
 
 /// One test at a time: the Khronos validation layer 1.3.239 crashed (SIGSEGV inside
 /// libVkLayer_khronos_validation.so, seen once in a fresh-clone CI run) while these tests
@@ -140,7 +154,7 @@ fn cube_faces_follow_vulkan_table(mode: &str) {
     assert_eq!(cubes.layers, 6);
     for face in 0..6u32 {
         for (s, t) in [(0.25f32, 0.25f32), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75), (0.6, 0.1), (0.1, 0.6), (0.9, 0.4)] {
-            let d = face_st_to_direction(face as usize, s, t);
+            let d = vulkan_face_direction(face, s, t);
             let (wall, quadrant) = shapes::quadrant_room_hit(d);
             assert_eq!(wall, face as usize, "the face's major axis is its wall");
             let texel = cubes.texel(face, (s * 32.0) as u32, (t * 32.0) as u32);
