@@ -927,15 +927,27 @@ fn environment_from_exr_round_trips() {
 #[test]
 fn environment_from_png_is_decoded_to_linear() {
     let dir = TempDir::new("env_png");
-    let pixels: Vec<f32> = vec![0.0, 0.5, 1.0, 1.0, 0.2, 0.04, 2.0, 1.0];
+    // Bytes written by the `image` crate (not the library's writer), decoded by the sRGB
+    // transfer function written out here (IEC 61966-2-1).
+    let bytes: [u8; 8] = [0, 64, 128, 255, 188, 10, 255, 255];
     let path = dir.join("sky.png");
-    write_png_srgb(&path, 2, 1, &pixels).unwrap();
+    image::RgbaImage::from_raw(2, 1, bytes.to_vec()).unwrap().save(&path).unwrap();
     let env = load_environment(&path).unwrap();
     assert_eq!((env.width, env.height), (2, 1));
-    let expected = [0.0, 0.5, 1.0, 1.0, 0.2, 0.04, 1.0, 1.0]; // 2.0 clamps to 1
-    for (a, b) in env.rgba32f.iter().zip(expected) {
-        assert!((a - b).abs() < 0.01, "{:?}", env.rgba32f);
+    let decode = |b: u8| {
+        let c = b as f64 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    for (i, (a, b)) in env.rgba32f.iter().zip(bytes).enumerate() {
+        // Alpha is linear already.
+        let want = if i % 4 == 3 { b as f64 / 255.0 } else { decode(b) };
+        assert!((*a as f64 - want).abs() < 1e-4, "channel {i}: {a} vs {want} ({:?})", env.rgba32f);
     }
+    assert!((env.rgba32f[1] - 0.0513).abs() < 1e-3 && (env.rgba32f[2] - 0.2159).abs() < 1e-3, "{:?}", env.rgba32f);
 }
 
 #[test]
