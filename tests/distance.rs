@@ -103,10 +103,10 @@ fn secant_steps_converge_monotonically() {
 
 /// The survey's Figure 21: a small box in the room makes the environment concave, with
 /// view-dependent occlusions a single-layer map cannot represent. The residual error is
-/// measured (and bounded, so a regression shows), and the multi-map method, which also
-/// traces the other specular object's map, does not make it worse.
+/// measured (and bounded 1 dB under it, so a regression shows). With a single specular
+/// object the multi-map method has nothing to compose and must render exactly `distance`.
 #[test]
-fn concave_occluder_residual_is_bounded_and_multi_map_no_worse() {
+fn concave_occluder_residual_is_bounded_and_one_object_needs_no_cycles() {
     let ctx = common::gpu();
     let mut scene = corner_mirror_scene();
     let m = scene.add_material(Material { name: "box".into(), emissive: Vec3::new(0.9, 0.9, 0.2), ..Default::default() }).unwrap();
@@ -121,14 +121,18 @@ fn concave_occluder_residual_is_bounded_and_multi_map_no_worse() {
     let size = 80;
     let refimg = reference(&scene, &["spp=4", "depth=2"], size);
     let q = quality(&["cube_size=128", "ref_point=0,2,0"]);
-    let single = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
-    let multi = errors(
-        &gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &quality(&["cube_size=128", "ref_point=0,2,0", "cycles=2"]), size),
-        &refimg,
-    );
-    eprintln!("concave: distance {single}\n         distance-multi {multi}");
-    assert!(single.psnr > 25.0, "{single}");
-    assert!(multi.rmse <= single.rmse * 1.02, "multi {multi} vs single {single}");
+    let single_img = gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size);
+    let single = errors(&single_img, &refimg);
+    eprintln!("concave: distance {single}");
+    // The residual of Figure 21 (what the reference point cannot see): measured 29.57 dB,
+    // floor 1 dB below; multi-layer maps (issue 10) are what removes it.
+    assert!(single.psnr > 28.5, "{single}");
+    // With one specular object there is nothing to compose: distance-multi plans no second
+    // cycle and renders the same bits as distance.
+    let mq = quality(&["cube_size=128", "ref_point=0,2,0", "cycles=2"]);
+    let multi_plan = specula::plan(&scene, specula::methods::DISTANCE_MULTI, &mq);
+    let multi_img = gpu(&ctx, &scene, specula::methods::DISTANCE_MULTI, &mq, size);
+    assert!(multi_img.data == single_img.data, "one specular object: distance-multi equals distance ({} cycles)", multi_plan.cycles);
     common::assert_clean(&ctx);
 }
 
