@@ -22,7 +22,7 @@ frame_ms() { grep -E '^frame +[0-9.]+ +[0-9.]+$' | awk '{print $2}'; }
 # The frame's stats line (the memory table has a row of the same name, in MiB).
 views_of() { awk '/^geometry.mirror_views / {v=$2} END {printf "%d", v}'; }
 errors() { $bin compare "$1" "$2" | awk '/^PSNR/ {p=$2} /^mean FLIP/ {f=$3} END {printf "%s dB | %.4f", p, f}'; }
-share() { awk '/^geometry.mirror_view +[0-9.]+ +[0-9.]+$/ {v+=$2} /^frame +[0-9.]+ +[0-9.]+$/ {f=$2} END {if (f > 0) printf "%.0f %%", 100 * v / f; else print "-"}'; }
+share() { awk '/^geometry.mirror_view( ×[0-9]+)? +[0-9.]+ +[0-9.]+$/ {v+=$(NF-1)} /^frame +[0-9.]+ +[0-9.]+$/ {f=$2} END {if (f > 0) printf "%.0f %%", 100 * v / f; else print "-"}'; }
 
 echo "## Recursion depth, $size, mirror_budget=64: GPU ms per frame"
 echo "| depth | views | frame ms | mirrored views' share | PSNR vs reference (same depth) | mean FLIP |"

@@ -32,11 +32,19 @@ pub fn median_passes(frames: &[Frame]) -> Vec<crate::vk::PassTiming> {
         .collect()
 }
 
+/// The per-pass table: one row per pass in recording order, consecutive passes of the same
+/// name summed into one row `name ×N` (a planar mirror's views, the six faces of a cube),
+/// then the frame's total and the device memory per resource.
 pub fn table(passes: &[crate::vk::PassTiming], memory: &[(String, u64)]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "{:<24} {:>10} {:>10}", "pass", "GPU ms", "CPU ms");
-    for p in passes {
-        let _ = writeln!(s, "{:<24} {:>10.3} {:>10.3}", p.name, p.gpu_ms, p.cpu_ms);
+    let mut i = 0;
+    while i < passes.len() {
+        let run = passes[i..].iter().take_while(|p| p.name == passes[i].name).count();
+        let (gpu, cpu): (f64, f64) = passes[i..i + run].iter().fold((0.0, 0.0), |(g, c), p| (g + p.gpu_ms, c + p.cpu_ms));
+        let name = if run > 1 { format!("{} ×{run}", passes[i].name) } else { passes[i].name.clone() };
+        let _ = writeln!(s, "{name:<24} {gpu:>10.3} {cpu:>10.3}");
+        i += run;
     }
     let gpu: f64 = passes.iter().map(|p| p.gpu_ms).sum();
     let cpu: f64 = passes.iter().map(|p| p.cpu_ms).sum();
@@ -73,4 +81,20 @@ pub fn chrome_trace(passes: &[crate::vk::PassTiming], memory: &[(String, u64)], 
         "otherData": {"device": device, "device_memory_bytes": mem, "device_memory_total_bytes": total},
     }))
     .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::vk::PassTiming;
+
+    #[test]
+    fn consecutive_passes_of_one_name_share_a_row() {
+        let p = |name: &str, gpu_ms: f64| PassTiming { name: name.into(), gpu_ms, cpu_ms: 0.5, gpu_start_ms: 0.0 };
+        let passes = [p("a", 1.0), p("v", 2.0), p("v", 3.0), p("b", 4.0), p("v", 5.0)];
+        let t = super::table(&passes, &[]);
+        let rows: Vec<&str> = t.lines().skip(1).take(4).collect();
+        assert!(rows[0].starts_with("a ") && rows[1].starts_with("v ×2") && rows[1].contains("5.000"), "{t}");
+        assert!(rows[2].starts_with("b ") && rows[3].starts_with("v ") && rows[3].contains("5.000"), "{t}");
+        assert!(t.lines().any(|l| l.starts_with("frame") && l.contains("15.000")), "{t}");
+    }
 }
