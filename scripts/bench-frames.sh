@@ -13,9 +13,8 @@ cd "$(dirname "$0")/.."
 out=${1:-bench-frames}
 sections=${2:-123}
 mkdir -p "$out"
-bin=./target/release/specula
+. scripts/bench-lib.sh
 scene=assets/demo/demo.gltf
-frame_ms() { grep -E '^frame +[0-9.]+ +[0-9.]+$' | awk '{print $2}'; }
 
 if [[ $sections == *1* ]]; then
 echo "## Static demo scene, 256x256: frame 1 vs frames 2-4 (map_updates=on_change), GPU ms"

@@ -16,9 +16,8 @@ cd "$(dirname "$0")/.."
 out=${1:-bench-mirrors}
 size=${2:-512x512}
 mkdir -p "$out"
-bin=./target/release/specula
+. scripts/bench-lib.sh
 scene=assets/mirrors/mirrors.gltf
-frame_ms() { grep -E '^frame +[0-9.]+ +[0-9.]+$' | awk '{print $2}'; }
 # The frame's stats line (the memory table has a row of the same name, in MiB).
 views_of() { awk '/^geometry.mirror_views / {v=$2} END {printf "%d", v}'; }
 errors() { $bin compare "$1" "$2" | awk '/^PSNR/ {p=$2} /^mean FLIP/ {f=$3} END {printf "%s dB | %.4f", p, f}'; }

@@ -141,6 +141,41 @@ pub struct Renderer {
     mirrors: Option<MirrorViews>,
 }
 
+/// The frame-wide part of what stages see, built once a frame; `io` adds one view's target.
+struct FrameShared<'a> {
+    plan: &'a Plan,
+    sets: &'a MapSets,
+    view_eyes: &'a [glam::Vec3],
+    scene_images: Vec<&'a Image>,
+}
+
+impl<'a> FrameShared<'a> {
+    /// The stages' inputs and outputs for one camera view (the camera's, or a planar
+    /// mirror's): its view table entry, target, depth and area, and per-object push flags.
+    fn io<'b>(
+        &'b self,
+        views: &'b ViewLayout,
+        target: &'b mut Image,
+        depth: &'b mut Image,
+        maps: &'b mut Maps,
+        area: vk::Rect2D,
+        object_flags: &'b [(usize, u32)],
+    ) -> FrameIo<'b> {
+        FrameIo {
+            plan: self.plan,
+            views,
+            target,
+            depth,
+            maps,
+            sets: self.sets,
+            view_eyes: self.view_eyes,
+            scene_images: self.scene_images.clone(),
+            area,
+            object_flags,
+        }
+    }
+}
+
 /// The camera target's samples for the plan's `aa` (MSAA), checked against what the
 /// device can render: the sample counts of the target's colour and depth formats, and
 /// sample-rate shading (the per-sample passes, and the ray pipelines' one ray per sample).
@@ -634,18 +669,13 @@ impl Renderer {
             vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: self.target.width, height: self.target.height } };
         // The camera-dependent stages: camera-space maps, direct light and camera passes.
         let per_view = |d: &Deps| matches!(d, Deps::EveryFrame | Deps::CameraMap);
-        let mut io = FrameIo {
+        let shared = FrameShared {
             plan: &self.plan,
-            views: &self.views,
-            target: &mut self.target,
-            depth: &mut self.depth,
-            maps: &mut self.maps,
             sets: &self.sets,
             view_eyes: &self.view_eyes,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
-            area: full,
-            object_flags: &[],
         };
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &[]);
         // The world's maps first.
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
             if per_view(deps) || !self.map_updates.iter().any(|u| u.stage == stage.name()) {
@@ -663,18 +693,8 @@ impl Renderer {
                 let v = mv.frame.views[i].clone();
                 let views = ViewLayout { camera: self.views.mirrors + i as u32, ..self.views.clone() };
                 let flags = mv.child_flags(Some(i));
-                let mut io = FrameIo {
-                    plan: &self.plan,
-                    views: &views,
-                    target: &mut mv.scratch,
-                    depth: &mut mv.depth,
-                    maps: &mut self.maps,
-                    sets: &self.sets,
-                    view_eyes: &self.view_eyes,
-                    scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
-                    area: crate::methods::geometry::views::render_area(v.rect),
-                    object_flags: &flags,
-                };
+                let area = crate::methods::geometry::views::render_area(v.rect);
+                let mut io = shared.io(&views, &mut mv.scratch, &mut mv.depth, &mut self.maps, area, &flags);
                 for (stage, _) in self.stages.iter_mut().zip(&self.deps).filter(|(_, d)| per_view(d)) {
                     stage.record(&mut rec, &f, &mut io);
                 }
@@ -686,18 +706,7 @@ impl Renderer {
             rec.scope = None;
         }
         let camera_flags = self.mirrors.as_ref().map_or_else(Vec::new, |m| m.child_flags(None));
-        let mut io = FrameIo {
-            plan: &self.plan,
-            views: &self.views,
-            target: &mut self.target,
-            depth: &mut self.depth,
-            maps: &mut self.maps,
-            sets: &self.sets,
-            view_eyes: &self.view_eyes,
-            scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
-            area: full,
-            object_flags: &camera_flags,
-        };
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &camera_flags);
         // Mirrored views re-recorded the camera-space maps from their cameras.
         let views_ran = self.mirrors.as_ref().is_some_and(|m| !m.frame.views.is_empty());
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
@@ -724,8 +733,10 @@ impl Renderer {
             unsafe { ctx.device.cmd_resolve_image(cmd, self.target.raw, s, dst.raw, d, &[region]) };
             rec.end(open);
         }
-        // Supersampling: 2×2 box steps down to the output size.
-        for i in 0..self.resolve.len() * (self.ssaa > 1) as usize {
+        // Supersampling: 2×2 box steps down to the output size (with MSAA `resolve` holds
+        // the multisample resolve's one image instead).
+        let blits = if self.ssaa > 1 { self.resolve.len() } else { 0 };
+        for i in 0..blits {
             let (done, rest) = self.resolve.split_at_mut(i);
             let src = done.last_mut().unwrap_or(&mut self.target);
             let dst = &mut rest[0];

@@ -55,16 +55,24 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                 }
             },
         };
-        let choices = Choices { method: choice, objects: c.object_methods.clone() };
-        let p = plan_with(&c.scene, &choices, &c.quality)?;
-        c.destroy_renderer();
-        let r = Renderer::new(&c.vk, &c.scene, p, d.width, d.height)?;
-        c.choice = choice;
-        c.renderer = Some(r);
-        c.renderer_version = c.scene_version;
-        c.replan = false;
+        configure(c, choice, d.width, d.height)?;
         Ok(SPECULA_SUCCESS)
     })
+}
+
+/// Plans the scene as it is now for `choice` (with the per-object methods) and replaces the
+/// renderer by one of `width`×`height`. A planning error keeps the previous renderer; a
+/// creation error leaves none.
+fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) -> FfiResult<()> {
+    let choices = Choices { method: choice, objects: c.object_methods.clone() };
+    let p = plan_with(&c.scene, &choices, &c.quality)?;
+    c.destroy_renderer();
+    let r = Renderer::new(&c.vk, &c.scene, p, width, height)?;
+    c.choice = choice;
+    c.renderer = Some(r);
+    c.renderer_version = c.scene_version;
+    c.replan = false;
+    Ok(())
 }
 
 /// Standalone mode: renders one frame, waits for it, and writes width×height pixels of
@@ -92,12 +100,7 @@ pub unsafe extern "C" fn specula_context_render(
             // An update changed the plan (specula_context_set_object_transform …): the same
             // configuration planned afresh for the scene as it is now.
             let (width, height) = c.renderer.as_ref().map_or((0, 0), |r| (r.width, r.height));
-            let choices = Choices { method: c.choice, objects: c.object_methods.clone() };
-            let p = plan_with(&c.scene, &choices, &c.quality)?;
-            c.destroy_renderer();
-            c.renderer = Some(Renderer::new(&c.vk, &c.scene, p, width, height)?);
-            c.renderer_version = c.scene_version;
-            c.replan = false;
+            configure(c, c.choice, width, height)?;
         }
         let r = c.renderer()?;
         let need = r.width as usize * r.height as usize * bpp;

@@ -22,8 +22,8 @@ use crate::scene::Scene;
 pub struct Mirror {
     pub mesh: usize,
     pub plane: Vec4,
-    /// World-space vertices.
-    pub points: Vec<Vec3>,
+    /// The largest coordinate magnitude of its vertices (the scale of their f32 rounding).
+    pub far: f32,
     /// The rectangle in its plane that bounds it (a convex polygon whose clipped
     /// projection bounds its pixels).
     pub outline: [Vec3; 4],
@@ -39,7 +39,7 @@ impl Mirror {
         if m.hidden {
             return None;
         }
-        let points: Vec<Vec3> = m.positions.clone();
+        let points = &m.positions;
         // The plane of the largest-area triangle, oriented by the mean normal.
         let mut best = (0.0f32, Vec3::ZERO, Vec3::ZERO);
         for t in m.indices.chunks_exact(3) {
@@ -61,14 +61,15 @@ impl Mirror {
         let v = n.cross(u);
         let origin = best.2;
         let (mut lo, mut hi) = (glam::Vec2::splat(f32::MAX), glam::Vec2::splat(f32::MIN));
-        for p in &points {
+        for p in points {
             let q = glam::Vec2::new((*p - origin).dot(u), (*p - origin).dot(v));
             lo = lo.min(q);
             hi = hi.max(q);
         }
         let at = |a: f32, b: f32| origin + u * a + v * b;
         let outline = [at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y)];
-        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), points, outline, size })
+        let far = points.iter().fold(0.0f32, |a, p| a.max(p.abs().max_element()));
+        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), far, outline, size })
     }
 
     fn distance(&self, p: Vec3) -> f32 {
@@ -211,8 +212,7 @@ impl MirrorFrame {
                 let plane = if m.distance(parent.eye) >= 0.0 { m.plane } else { -m.plane };
                 let r = reflection(plane);
                 let plain = parent.plain * r;
-                let far = m.points.iter().fold(0.0f32, |a, p| a.max(p.abs().max_element()));
-                let keep = plane - Vec4::new(0.0, 0.0, 0.0, (1e-4 * m.size).max(4.0 * f32::EPSILON * far));
+                let keep = plane - Vec4::new(0.0, 0.0, 0.0, (1e-4 * m.size).max(4.0 * f32::EPSILON * m.far));
                 let view = MirrorView {
                     level,
                     parent: parent.index,
