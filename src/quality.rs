@@ -102,6 +102,38 @@ pub struct Quality {
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
+    /// Caustics (§6): how photon hits are filtered into the light cube maps, or none.
+    pub caustics: Caustics,
+    /// Caustics: edge of each photon hit location image (photons per light and generator
+    /// view: `photons`²).
+    pub photons: u32,
+    /// Caustics, `splat`: radius of a photon's splat in light-cube texels.
+    pub splat_size: f32,
+    /// Caustics: radius in texels of the light cube maps' box filter before projection
+    /// (0: none).
+    pub caustic_filter: u32,
+    /// Caustics: the projection's distance test against the receiver distance map (the
+    /// shadow-map-like test that stops light leaks, §6.3.3).
+    pub caustic_distance_test: bool,
+    /// Caustics: the receiver-orientation factor cos α of the projection (off: every
+    /// receiver taken as facing the generator).
+    pub caustic_orientation: bool,
+    /// CPU reference: photons traced per light and caustic generator.
+    pub reference_photons: u32,
+    /// CPU reference: radius of the caustic density estimate (metres); `None`: 0.5 % of
+    /// the scene's bounding-box diagonal.
+    pub caustic_radius: Option<f32>,
+}
+
+/// How caustics are rendered (survey §6.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Caustics {
+    Off,
+    /// Photon splatting (§6.3.1).
+    Splat,
+    /// Caustic triangles (§6.3.2).
+    Triangles,
 }
 
 /// Anti-aliasing of the camera passes.
@@ -198,6 +230,7 @@ const MSAA_SHADING: &[(&str, bool)] = &[("sample", true), ("pixel", false)];
 const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
+const CAUSTICS: &[(&str, Caustics)] = &[("off", Caustics::Off), ("splat", Caustics::Splat), ("triangles", Caustics::Triangles)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
 
 pub const KNOBS: &[Knob] = &[
@@ -561,6 +594,100 @@ pub const KNOBS: &[Knob] = &[
         },
         get: |q| name_of(q.planner, PLANNERS),
     },
+    Knob {
+        name: "caustics",
+        values: "off|splat|triangles",
+        default: "off",
+        doc: "caustics (§6): photons from each punctual light traced through each caustic generator in its maps, stored as hits in cube-map space, then splatted (photon splatting) or meshed into caustic triangles (flux over area) into a light cube map around the generator, filtered, and projected onto diffuse surfaces with a distance test; the CPU reference adds light-traced caustics",
+        set: |q, v| {
+            q.caustics = one_of(v, CAUSTICS)?;
+            Ok(())
+        },
+        get: |q| name_of(q.caustics, CAUSTICS),
+    },
+    Knob {
+        name: "photons",
+        values: "32..=2048 texels",
+        default: "128",
+        doc: "caustics: edge of each photon hit location image (photons² per light and generator view)",
+        set: |q, v| {
+            q.photons = count(v, 32, 2048)?;
+            Ok(())
+        },
+        get: |q| q.photons.to_string(),
+    },
+    Knob {
+        name: "splat_size",
+        values: "0.5..=16 texels",
+        default: "2",
+        doc: "caustics=splat: radius of each photon's splat (an Epanechnikov kernel normalised to the photon's power) in light-cube texels",
+        set: |q, v| {
+            q.splat_size = real(v, 0.5, 16.0)?;
+            Ok(())
+        },
+        get: |q| q.splat_size.to_string(),
+    },
+    Knob {
+        name: "caustic_filter",
+        values: "0..=8 texels",
+        default: "1",
+        doc: "caustics: radius of the box filter over each light cube face before projection (0: none)",
+        set: |q, v| {
+            q.caustic_filter = count(v, 0, 8)?;
+            Ok(())
+        },
+        get: |q| q.caustic_filter.to_string(),
+    },
+    Knob {
+        name: "caustic_distance_test",
+        values: "on|off",
+        default: "on",
+        doc: "caustics: a diffuse point takes the light cube map's irradiance only where its distance from the generator matches the receiver distance map (off: light leaks behind occluders, for comparison)",
+        set: |q, v| {
+            q.caustic_distance_test = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.caustic_distance_test, ON_OFF),
+    },
+    Knob {
+        name: "caustic_orientation",
+        values: "on|off",
+        default: "on",
+        doc: "caustics: the receiver-orientation factor of the projection, E = J·cos α/D² (off: cos α = 1, every receiver taken as facing the generator; wrong at grazing angles)",
+        set: |q, v| {
+            q.caustic_orientation = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.caustic_orientation, ON_OFF),
+    },
+    Knob {
+        name: "reference_photons",
+        values: "1000..=100000000 photons",
+        default: "1000000",
+        doc: "CPU reference: photons traced from each punctual light into each caustic generator's bounding cone for its caustics",
+        set: |q, v| {
+            q.reference_photons = count(v, 1000, 100_000_000)?;
+            Ok(())
+        },
+        get: |q| q.reference_photons.to_string(),
+    },
+    Knob {
+        name: "caustic_radius",
+        values: "auto|metres",
+        default: "auto",
+        doc: "CPU reference: radius of the caustics' density estimate on the receivers (Epanechnikov kernel); auto: 0.5 % of the scene's bounding-box diagonal",
+        set: |q, v| {
+            q.caustic_radius = match v {
+                "auto" => None,
+                v => match v.trim().parse::<f32>() {
+                    Ok(r) if r > 0.0 && r.is_finite() => Some(r),
+                    _ => return Err(format!("'{}' is not auto or a radius > 0 in metres", clip(v))),
+                },
+            };
+            Ok(())
+        },
+        get: |q| q.caustic_radius.map_or("auto".into(), |r| r.to_string()),
+    },
 ];
 
 impl Default for Quality {
@@ -597,6 +724,14 @@ impl Default for Quality {
             aa: Aa::Off,
             msaa_per_sample: true,
             mirror_budget: 8,
+            caustics: Caustics::Off,
+            photons: 128,
+            splat_size: 2.0,
+            caustic_filter: 1,
+            caustic_distance_test: true,
+            caustic_orientation: true,
+            reference_photons: 1_000_000,
+            caustic_radius: None,
         }
     }
 }
