@@ -420,7 +420,7 @@ impl Renderer {
                 StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
                 StageSpec::Shadows => Deps::Shadows,
                 StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
-                StageSpec::Map(_) => Deps::World,
+                StageSpec::Map(_) | StageSpec::Caustics => Deps::World,
             });
             let stage: Box<dyn Stage> = match spec {
                 // The scene records its own upload (first frame only).
@@ -431,6 +431,7 @@ impl Renderer {
                 StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
                 StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout, self.multisample)?),
                 StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
+                StageSpec::Caustics => crate::methods::caustics::stage::CausticsStage::create(&init, &mut self.maps)?,
                 StageSpec::Camera(c) => match c.pass.create {
                     Some(create) => create(&init, c)?,
                     None => Box::new(CameraShade::new(ctx, self.layout, c, self.multisample)?),
@@ -616,6 +617,23 @@ impl Renderer {
         self.maps.refractor.as_ref()
     }
 
+    /// Caustics (§6): the light cube maps (radiant intensity seen from each generator's
+    /// reference point, one cube per generator, after filtering), if planned.
+    pub fn caustic_maps(&self) -> Option<&Image> {
+        self.maps.caustic_maps.as_ref()
+    }
+
+    /// Caustics: the receiver distance cubes, one per generator.
+    pub fn caustic_distances(&self) -> Option<&Image> {
+        self.maps.caustic_distances.as_ref()
+    }
+
+    /// Caustics: the photon hit location images (xyz hit relative to the reference point,
+    /// w 1 for a photon) and the photons' power, one layer per light view.
+    pub fn photon_images(&self) -> Option<(&Image, &Image)> {
+        self.maps.photon_hits.as_ref().zip(self.maps.photon_power.as_ref())
+    }
+
     /// The shadow cube array (one cube per `plan.shadow_cubes` entry), if planned.
     pub fn shadow_cubes(&self) -> Option<&Image> {
         self.maps.shadow_cubes.as_ref()
@@ -640,7 +658,10 @@ impl Renderer {
             m.plan_frame(&self.cpu, vp, self.camera.position, cos_corner);
         }
         let mirror_views = self.mirrors.as_ref().map_or(&[][..], |m| &m.frame.views[..]);
-        let views = views::view_table(&self.plan, &self.views, &self.light_table, vp, self.camera.position, mirror_views);
+        let photons = self.plan.caustics.as_ref().map_or_else(Vec::new, |c| {
+            crate::methods::caustics::photon_views(c, &self.cpu, &self.light_table, &self.plan.quality, self.plan.cube_near)
+        });
+        let views = views::view_table(&self.plan, &self.views, &self.light_table, vp, self.camera.position, mirror_views, &photons);
         self.view_eyes = views.iter().map(|v| glam::Vec3::from_slice(&v.eye[..3])).collect();
         self.view_buffer.write(bytemuck::cast_slice(&views))
     }

@@ -5,6 +5,7 @@
 #include "common/scene.glsl"
 #include "common/optics.glsl"
 #include "common/sky.glsl"
+#include "caustics/project.glsl"
 
 // Compute shaders have no derivatives: they define SHADING_LOD0 and sample level 0 (the
 // only level: textures have no mip chain, so the result is the same).
@@ -77,7 +78,8 @@ vec3 light_irradiance(Light l, vec3 p, out vec3 wi, out float dist) {
     return e;
 }
 
-// Emission + Σ albedo/π · E_i · visibility (radiance towards any direction).
+// Emission + albedo/π · (Σ E_i · visibility + the caustics' E) (radiance towards any
+// direction).
 vec3 shade_diffuse(Material m, vec3 p, vec3 n, vec3 eye, vec2 uv) {
     vec3 albedo = material_base_color(m, uv);
     vec3 v = normalize(eye - p);
@@ -92,6 +94,7 @@ vec3 shade_diffuse(Material m, vec3 p, vec3 n, vec3 eye, vec2 uv) {
         if (cos_t <= 0.0) continue;
         l_sum += e * cos_t * light_visibility(l, p, n);
     }
+    l_sum += caustic_irradiance(p, n);  // caustics (§6): light through specular objects
     return material_emission(m, uv) + albedo / PI * l_sum;
 }
 

@@ -4,12 +4,14 @@
 #define TRACED_GLSL
 #include "common/scene.glsl"
 
-// Which map SEARCH_DISTANCE reads: 0 the environment's distance map, 1 a refractor map.
+// Which map SEARCH_DISTANCE reads: 0 the environment's distance map, 1 a refractor map,
+// 2 a caustic generator's receiver distance map (§6).
 int search_map = 0;
 float search_layer = 0.0;
 
 float search_lookup(vec3 dir) {
     if (search_map == 1) return textureLod(refractor_maps, vec4(dir, search_layer), 0.0).w;
+    if (search_map == 2) return textureLod(caustic_distances, vec4(dir, search_layer), 0.0).r;
     return textureLod(distance_maps, vec4(dir, search_layer), 0.0).a;
 }
 #define SEARCH_DISTANCE(dir) search_lookup(dir)

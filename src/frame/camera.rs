@@ -41,6 +41,7 @@ impl CameraShade {
                 view_mask: 0,
                 cull: vk::CullModeFlags::NONE,
                 multisample,
+                blend: crate::vk::pipeline::Blend::Replace,
             },
         )?;
         Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone() })

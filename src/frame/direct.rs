@@ -44,6 +44,7 @@ pub fn sky_and_direct(
             view_mask,
             cull: vk::CullModeFlags::NONE,
             multisample,
+            blend: crate::vk::pipeline::Blend::Replace,
         },
     )?;
     let direct = graphics_pipeline(
@@ -61,6 +62,7 @@ pub fn sky_and_direct(
             view_mask,
             cull: vk::CullModeFlags::NONE,
             multisample,
+            blend: crate::vk::pipeline::Blend::Replace,
         },
     );
     match direct {

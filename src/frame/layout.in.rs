@@ -182,6 +182,34 @@ gpu_structs! {
         pad: uint,
     }
 
+    /// One caustic generator (survey §6): a specular object that a light sees. Its light cube
+    /// map and its receiver distance map are cubes around its reference point, in layer
+    /// `index` of `caustic_maps` and `caustic_distances`.
+    struct GpuCausticGenerator => struct CausticGenerator {
+        /// xyz: the reference point; w: unused
+        reference_point: vec4,
+        /// the generator's mesh (its `objects` entry)
+        mesh: uint,
+        pad: [uint; 3],
+    }
+
+    /// What the caustic passes and the projection share (the header of `Caustics`).
+    struct GpuCausticParams => struct CausticParams {
+        /// generators in `generators` (0: the scene has no caustics)
+        generator_count: uint,
+        /// edge of the photon hit location images
+        photon_size: uint,
+        /// edge of each face of the light cube and receiver distance maps
+        cube_size: uint,
+        /// CAUSTIC_* flags
+        flags: uint,
+        /// photon splatting: the splat's radius in light-cube texels
+        splat_size: float,
+        /// box filter radius in texels
+        filter_radius: uint,
+        pad: [uint; 2],
+    }
+
     /// Push constants of every scene-drawing shader.
     struct Push => push_constant Push push {
         /// first view of this draw (multiview adds gl_ViewIndex)
@@ -236,6 +264,18 @@ gpu_consts! {
     FLAG_MIRROR_VIEW: uint = 32;
     MIRROR_LAYER_SHIFT: uint = 16;
 
+    /// `CausticParams.flags`: the projection's distance test (§6.3.3).
+    CAUSTIC_DISTANCE_TEST: uint = 1;
+    /// `CausticParams.flags`: the receiver-orientation factor cos α of the projection.
+    CAUSTIC_ORIENTATION: uint = 2;
+    /// `Push.flags` of the photon pass: the generator's index `(flags >> CAUSTIC_GENERATOR_SHIFT)
+    /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
+    CAUSTIC_GENERATOR_SHIFT: uint = 8;
+    CAUSTIC_LIGHT_SHIFT: uint = 20;
+    /// Caustic triangles whose corners' distances from the reference point differ by more
+    /// than this fraction land on different surfaces (§6.3.2) and are dropped.
+    CAUSTIC_GAP: float = 0.1;
+
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
     RAY_NO_TRIANGLE: uint = 4294967295;
     /// `RayQuery.flags`: any hit will do (shadow rays).
@@ -265,6 +305,21 @@ descriptor_sets! {
         /// renders into a scratch target while it samples its children here, and is copied
         /// into its layer afterwards.
         MIRROR_VIEWS = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views";
+        /// Caustics (§6): per generator, the distance of the nearest receiver (everything but
+        /// the generator) from its reference point, the terminal hits' search map and the
+        /// projection's distance test.
+        CAUSTIC_DISTANCES = 10: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_distances";
+        /// Caustics: per generator, the light cube map: radiant intensity J (W/sr) of the
+        /// caustic as seen from the reference point, the projection's input.
+        CAUSTIC_MAPS = 11: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_maps";
+        /// Caustics: photon hit location images, one layer per light view of a generator:
+        /// xyz the hit relative to the reference point (cube-map space), w 1 for a photon.
+        PHOTON_HITS = 12: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_hits";
+        /// Caustics: the photons' power (rgb, W).
+        PHOTON_POWER = 13: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_power";
+        CAUSTICS = 14: STORAGE_BUFFER => "readonly buffer Caustics { CausticParams caustic; CausticGenerator generators[]; }";
+        /// Caustics: the light cube maps before filtering (the filter pass reads them).
+        CAUSTIC_RAW = 15: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_raw";
     }
 
     /// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.

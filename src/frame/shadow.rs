@@ -49,6 +49,7 @@ impl ShadowMaps {
             view_mask,
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
+            blend: crate::vk::pipeline::Blend::Replace,
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };

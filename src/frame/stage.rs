@@ -20,6 +20,9 @@ pub mod order {
     /// Maps that depend on geometry alone (refractor maps): before the radiance maps, whose
     /// generation may search them.
     pub const GEOMETRY_MAPS: u32 = 15;
+    /// Caustics (§6): after the refractor maps their photons search, before every pass
+    /// that shades diffuse surfaces (which projects them).
+    pub const CAUSTICS: u32 = 17;
     pub const ENVIRONMENT_MAPS: u32 = 20;
     pub const DIRECT: u32 = 30;
     /// Camera-space maps (image-space refraction's back faces).
@@ -76,6 +79,17 @@ pub struct Maps {
     pub thickness: Option<Buffer>,
     /// Set 0, binding 9: planar mirrors' views (§5), one layer per view of a frame.
     pub mirror_views: Option<Image>,
+    /// Set 0, binding 10: caustic generators' receiver distance cubes (§6).
+    pub caustic_distances: Option<Image>,
+    /// Set 0, binding 11: caustic generators' light cube maps (filtered, when filtering).
+    pub caustic_maps: Option<Image>,
+    /// Set 0, binding 15: the light cube maps before filtering (only with a filter).
+    pub caustic_raw: Option<Image>,
+    /// Set 0, bindings 12 and 13: photon hit location images and the photons' power.
+    pub photon_hits: Option<Image>,
+    pub photon_power: Option<Image>,
+    /// Set 0, binding 14: the caustics' parameters and generator table.
+    pub caustics: Option<Buffer>,
 }
 
 impl Maps {
@@ -91,23 +105,23 @@ impl Maps {
     }
 
     /// How many set-1 descriptor sets the maps need: per distance image one for map
-    /// generation and one for the camera passes, and an all-null one; none without set-1
-    /// maps.
+    /// generation and one for the camera passes, an all-null one and one of the refractor
+    /// maps alone; none without set-1 maps.
     pub fn set_count(&self) -> usize {
         if self.distance.is_empty() && self.refractor.is_none() && self.backfaces.is_none() {
             0
         } else {
-            2 * self.distance.len() + 1
+            2 * self.distance.len() + 2
         }
     }
 
     /// Assigns `set_count()` allocated sets to their roles.
     pub fn sets(&self, sets: &[vk::DescriptorSet]) -> MapSets {
         let n = self.distance.len();
-        if sets.len() < 2 * n + 1 {
+        if sets.len() < 2 * n + 2 {
             return MapSets::default();
         }
-        MapSets { generate: sets[..n].to_vec(), camera: sets[n..2 * n].to_vec(), empty: sets[2 * n] }
+        MapSets { generate: sets[..n].to_vec(), camera: sets[n..2 * n].to_vec(), empty: sets[2 * n], geometry: sets[2 * n + 1] }
     }
 
     /// Writes every map slot's descriptors: set 0's shadow and radiance maps into `frame`,
@@ -125,6 +139,12 @@ impl Maps {
         write_image(ctx, frame, binding::SHADOW_PLANES, 0, cis, view(self.shadow_planes.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::ENVMAPS, 0, cis, view(self.radiance.as_ref()), linear, ro);
         write_image(ctx, frame, binding::MIRROR_VIEWS, 0, cis, view(self.mirror_views.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::CAUSTIC_DISTANCES, 0, cis, view(self.caustic_distances.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::CAUSTIC_MAPS, 0, cis, view(self.caustic_maps.as_ref()), linear, ro);
+        write_image(ctx, frame, binding::CAUSTIC_RAW, 0, cis, view(self.caustic_raw.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::PHOTON_HITS, 0, cis, view(self.photon_hits.as_ref()), nearest, ro);
+        write_image(ctx, frame, binding::PHOTON_POWER, 0, cis, view(self.photon_power.as_ref()), nearest, ro);
+        write_buffer(ctx, frame, binding::CAUSTICS, sb, self.caustics.as_ref().map_or(vk::Buffer::null(), |b| b.raw));
         let refractor = view(self.refractor.as_ref());
         let backfaces = view(self.backfaces.as_ref());
         let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
@@ -137,6 +157,9 @@ impl Maps {
         if sets.empty != vk::DescriptorSet::null() {
             all.push((sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
         }
+        if sets.geometry != vk::DescriptorSet::null() {
+            all.push((sets.geometry, null_image, refractor, null_image, vk::Buffer::null()));
+        }
         for (set, distance, refractor, backfaces, thickness) in all {
             write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, linear, ro);
             write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, linear, ro);
@@ -145,8 +168,10 @@ impl Maps {
         }
     }
 
+    /// What shading a diffuse surface samples: the shadow maps, and the caustics'
+    /// receiver distances and light cube maps (§6.3.3).
     pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
-        self.shadow_cubes.iter().chain(self.shadow_planes.iter())
+        self.shadow_cubes.iter().chain(self.shadow_planes.iter()).chain(self.caustic_distances.iter()).chain(self.caustic_maps.iter())
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -158,7 +183,13 @@ impl Maps {
         {
             i.destroy(ctx);
         }
-        for b in self.thickness.iter_mut() {
+        for i in [&mut self.caustic_distances, &mut self.caustic_maps, &mut self.caustic_raw, &mut self.photon_hits, &mut self.photon_power]
+            .into_iter()
+            .flatten()
+        {
+            i.destroy(ctx);
+        }
+        for b in self.thickness.iter_mut().chain(self.caustics.iter_mut()) {
             b.destroy(ctx);
         }
         *self = Maps::default();
@@ -172,6 +203,8 @@ pub struct MapSets {
     pub generate: Vec<vk::DescriptorSet>,
     pub camera: Vec<vk::DescriptorSet>,
     pub empty: vk::DescriptorSet,
+    /// The refractor maps alone (caustic photons search them, §6).
+    pub geometry: vk::DescriptorSet,
 }
 
 /// Indices into the frame's view table.
@@ -184,6 +217,10 @@ pub struct ViewLayout {
     pub envmaps: Vec<u32>,
     /// First of the planar mirrors' views (§5): view `mirrors + i` is the frame's i-th.
     pub mirrors: u32,
+    /// Caustics (§6): the first of each generator's six cube views around its reference
+    /// point, and the first photon view (one per photon image layer).
+    pub caustic_cubes: Vec<u32>,
+    pub photons: u32,
     pub count: u32,
 }
 

@@ -30,6 +30,14 @@ impl ViewLayout {
         }
         v.mirrors = v.count;
         v.count += plan.mirror_layers;
+        if let Some(c) = &plan.caustics {
+            for _ in &c.generators {
+                v.caustic_cubes.push(v.count);
+                v.count += 6;
+            }
+            v.photons = v.count;
+            v.count += c.photon_layers;
+        }
         v
     }
 }
@@ -53,6 +61,7 @@ pub fn view_table(
     camera_view_proj: Mat4,
     eye: Vec3,
     mirrors: &[crate::methods::geometry::mirror::MirrorView],
+    photon_views: &[GpuView],
 ) -> Vec<GpuView> {
     let mut views = vec![GpuView::zeroed(); layout.count as usize];
     views[layout.camera as usize] = view(camera_view_proj, eye.extend(0.0), Vec4::ZERO);
@@ -87,6 +96,19 @@ pub fn view_table(
                 dir: [0.0; 4],
                 clip: m.clip.to_array(),
             };
+        }
+    }
+    if let Some(c) = &plan.caustics {
+        for (g, &base) in c.generators.iter().zip(&layout.caustic_cubes) {
+            for f in 0..6 {
+                views[(base + f) as usize] =
+                    view(face_view_proj(f as usize, g.reference_point, near), g.reference_point.extend(0.0), Vec4::ZERO);
+            }
+        }
+        for (i, v) in photon_views.iter().enumerate() {
+            if let Some(slot) = views.get_mut(layout.photons as usize + i) {
+                *slot = *v;
+            }
         }
     }
     views

@@ -6,6 +6,7 @@
 //! Adding a method: its descriptor and passes in its family's folder, its shaders in
 //! `glsl/<family>/`, its tests, and one line below.
 
+pub mod caustics;
 pub mod distance;
 pub mod envmap;
 pub mod geometry;

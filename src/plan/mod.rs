@@ -98,6 +98,8 @@ pub enum StageSpec {
     /// `scene.direct`.
     Direct,
     Map(MapPlan),
+    /// The caustics stage (§6; `Plan::caustics` says what it renders).
+    Caustics,
     Camera(CameraPlan),
 }
 
@@ -108,6 +110,7 @@ impl StageSpec {
             StageSpec::Shadows => "shadow.generate",
             StageSpec::Direct => "scene.direct",
             StageSpec::Map(m) => m.name,
+            StageSpec::Caustics => "caustics",
             StageSpec::Camera(c) => c.name,
         }
     }
@@ -117,6 +120,7 @@ impl StageSpec {
             StageSpec::Shadows => order::SHADOWS,
             StageSpec::Direct => order::DIRECT,
             StageSpec::Map(m) => m.info.order,
+            StageSpec::Caustics => order::CAUSTICS,
             StageSpec::Camera(c) => c.pass.order,
         }
     }
@@ -155,6 +159,8 @@ pub struct Plan {
     /// (within `mirror_budget`): the layers of their views' image.
     pub mirrors: Vec<usize>,
     pub mirror_layers: u32,
+    /// Caustics (§6): the generators and their lights, when the scene has caustics.
+    pub caustics: Option<crate::methods::caustics::CausticsPlan>,
 }
 
 impl Plan {
@@ -192,6 +198,7 @@ impl Plan {
                 && fresh.shadow_planes == self.shadow_planes
                 && methods(fresh) == methods(self)
                 && fresh.envmaps.iter().map(|e| e.mesh).eq(self.envmaps.iter().map(|e| e.mesh))
+                && fresh.caustics == self.caustics
         };
         // The plan a fresh renderer would get; if the planner would now choose otherwise for
         // some object, the same plan with every object kept on its method.
@@ -220,6 +227,7 @@ impl Plan {
         for (e, f) in self.envmaps.iter_mut().zip(&fresh.envmaps) {
             e.reference_point = f.reference_point;
         }
+        crate::methods::caustics::refresh(self);
         self.cube_near = fresh.cube_near;
         self.proxy_radius = fresh.proxy_radius;
         self.proxy_box = fresh.proxy_box;
@@ -228,7 +236,8 @@ impl Plan {
 
     /// Device memory the plan's maps will hold (bytes), excluding the frame's own images.
     pub fn map_bytes(&self) -> u64 {
-        self.stages.iter().map(|s| if let StageSpec::Map(m) = s { m.bytes } else { 0 }).sum()
+        let caustics = self.caustics.as_ref().map_or(0, |c| c.bytes);
+        caustics + self.stages.iter().map(|s| if let StageSpec::Map(m) = s { m.bytes } else { 0 }).sum::<u64>()
     }
 }
 
@@ -288,6 +297,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         proxy_box: (Vec3::ZERO, Vec3::ZERO),
         mirrors: Vec::new(),
         mirror_layers: 0,
+        caustics: None,
     }
 }
 
@@ -440,6 +450,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
         proxy_box: (bounds.min, bounds.max),
         mirrors: Vec::new(),
         mirror_layers: 0,
+        caustics: None,
     };
     if !p.is_gpu() {
         p.stages.clear();
@@ -527,6 +538,42 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         }
         o.passes.push(cam.name);
     }
+    // Caustics (§6): generators that a light sees; a solid dielectric among them needs its
+    // refractor map for the photons' paths inside it, whatever its own method.
+    p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q, traced_everywhere);
+    if let Some(c) = &p.caustics {
+        let refractor = crate::methods::distance::REFRACTOR_CUBES;
+        for g in &c.generators {
+            let solid =
+                matches!(scene.materials[scene.meshes[g.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. });
+            let o = p.objects.iter_mut().find(|o| o.mesh == g.mesh).expect("generator is a planned object");
+            if !solid || o.maps.iter().any(|m| m.pass == refractor.name) {
+                continue;
+            }
+            let k = match maps.iter().position(|m| m.name == refractor.name) {
+                Some(k) => k,
+                None => {
+                    maps.push(MapPlan { info: refractor, name: refractor.name, objects: Vec::new(), bytes: 0 });
+                    maps.len() - 1
+                }
+            };
+            o.maps.push(ObjectMap {
+                pass: refractor.name,
+                layer: maps[k].objects.len() as u32,
+                layer_field: refractor.layer_field,
+                what: (refractor.describe)(&q, (0, 0)) + " for its caustics",
+                bytes: 0,
+            });
+            maps[k].objects.push(o.mesh);
+            o.passes.push(refractor.name);
+        }
+        stages.push(StageSpec::Caustics);
+        for o in &mut p.objects {
+            if c.generators.iter().any(|g| g.mesh == o.mesh) {
+                o.passes.extend(c.passes(&q));
+            }
+        }
+    }
     // The cube-mapped objects and their views.
     for o in &p.objects {
         let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.info.cube));
@@ -550,7 +597,13 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.
     stages.sort_by_key(|s| s.order());
-    p.passes = stages.iter().map(|s| s.name()).collect();
+    p.passes = stages
+        .iter()
+        .flat_map(|s| match (s, &p.caustics) {
+            (StageSpec::Caustics, Some(c)) => c.passes(&q),
+            _ => vec![s.name()],
+        })
+        .collect();
     p.stages = stages;
 }
 
@@ -581,6 +634,9 @@ pub fn table(p: &Plan, scene: &Scene) -> String {
         let _ = writeln!(s, "  passes     {}", o.passes.join(", "));
         let knobs: Vec<String> = o.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect();
         let _ = writeln!(s, "  knobs      {}", if knobs.is_empty() { "-".into() } else { knobs.join(" ") });
+    }
+    if let Some(c) = &p.caustics {
+        let _ = writeln!(s, "\n{}", crate::methods::caustics::describe(c, &p.quality, scene));
     }
     let _ = writeln!(s, "\nmaps: {:.2} MiB", p.map_bytes() as f64 / (1 << 20) as f64);
     s

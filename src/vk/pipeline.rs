@@ -133,6 +133,17 @@ pub struct GraphicsDesc<'a> {
     /// Samples per pixel of the attachments, and whether every sample runs the fragment
     /// shader (sample-rate shading).
     pub multisample: Multisample,
+    /// How fragments combine with the attachments' contents.
+    pub blend: Blend,
+}
+
+/// Colour blending of a pipeline's attachments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Blend {
+    /// The fragment replaces what is there.
+    Replace,
+    /// Additive (ONE, ONE): accumulation, e.g. photon splats into a light cube map.
+    Add,
 }
 
 /// The rasteriser's samples per pixel for a pipeline.
@@ -211,7 +222,20 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
     let blend: Vec<_> = desc
         .color_formats
         .iter()
-        .map(|_| vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA))
+        .map(|_| {
+            let b = vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA);
+            match desc.blend {
+                Blend::Replace => b,
+                Blend::Add => b
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ONE)
+                    .dst_color_blend_factor(vk::BlendFactor::ONE)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(vk::BlendOp::ADD),
+            }
+        })
         .collect();
     let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
     let dyn_states = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];

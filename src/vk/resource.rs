@@ -131,6 +131,8 @@ pub enum Access {
     DepthAttachment,
     /// Sampled in fragment shaders.
     FragmentSampled,
+    /// Sampled in vertex shaders.
+    VertexSampled,
     /// Sampled in compute shaders.
     ComputeSampled,
     /// Written (and read) as a storage image in compute shaders.
@@ -152,6 +154,7 @@ impl Access {
                 L::DEPTH_ATTACHMENT_OPTIMAL,
             ),
             Access::FragmentSampled => (S::FRAGMENT_SHADER, A::SHADER_SAMPLED_READ, L::SHADER_READ_ONLY_OPTIMAL),
+            Access::VertexSampled => (S::VERTEX_SHADER, A::SHADER_SAMPLED_READ, L::SHADER_READ_ONLY_OPTIMAL),
             Access::ComputeSampled => (S::COMPUTE_SHADER, A::SHADER_SAMPLED_READ, L::SHADER_READ_ONLY_OPTIMAL),
             Access::ComputeStorage => (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE | A::SHADER_STORAGE_READ, L::GENERAL),
             // Every transfer stage: copies, blits (host-format conversion, the supersampling
@@ -162,7 +165,7 @@ impl Access {
         ImageState { stage, access, layout }
     }
     fn writes(self) -> bool {
-        !matches!(self, Access::FragmentSampled | Access::ComputeSampled | Access::TransferSrc)
+        !matches!(self, Access::FragmentSampled | Access::VertexSampled | Access::ComputeSampled | Access::TransferSrc)
     }
 }
 

@@ -96,6 +96,7 @@ impl Backfaces {
                     view_mask: 0,
                     cull: vk::CullModeFlags::FRONT,
                     multisample: Multisample::OFF,
+                    blend: crate::vk::pipeline::Blend::Replace,
                 },
             )?;
             Ok(())

@@ -58,6 +58,7 @@ impl RefractorMaps {
                     view_mask: view_mask(q.cube_mode),
                     cull: vk::CullModeFlags::NONE,
                     multisample: Multisample::OFF,
+                    blend: crate::vk::pipeline::Blend::Replace,
                 },
             )?;
             Ok(())

@@ -126,6 +126,7 @@ impl CubeMaps {
             view_mask: view_mask(q.cube_mode),
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
+            blend: crate::vk::pipeline::Blend::Replace,
         };
         self.sky = graphics_pipeline(
             ctx,

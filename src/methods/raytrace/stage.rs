@@ -351,6 +351,7 @@ impl RayTrace {
             view_mask: 0,
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
+            blend: crate::vk::pipeline::Blend::Replace,
         };
         self.p.primary_raster = graphics_pipeline(
             ctx,

@@ -1,0 +1,100 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// caustics.photons: the photon hit location image (survey §6.1.2, SKALP05/UPSK08). The
+// generator is rasterised from the light; each texel is one photon that follows its path
+// through the generator in the sampled geometry (§4): reflected by a mirror, or refracted
+// in, searched in the refractor map (§4.4, total internal reflection included) and
+// refracted out, then searched in the generator's receiver distance map to its terminal
+// hit, which is stored in cube-map space (relative to the reference point) with the
+// photon's power: the light's intensity × the texel's solid angle (its area for a
+// directional light) × the Fresnel transmittances along the path.
+#include "common/specular.glsl"
+#include "common/traced.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_hit;
+layout(location = 1) out vec4 out_power;
+
+void main() {
+    out_hit = vec4(0.0);
+    out_power = vec4(0.0);
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    uint g = (push.flags >> CAUSTIC_GENERATOR_SHIFT) & 0xffu;
+    Light l = lights[push.flags >> CAUSTIC_LIGHT_SHIFT];
+    View v = views[in_view];
+    vec3 p = in_position;
+    // Where the photon comes from, and what it carries (light_irradiance's E times d² is
+    // the intensity in this direction, spot cone and range window included).
+    vec3 wi;
+    float dist;
+    vec3 e = light_irradiance(l, p, wi, dist);
+    vec3 i = -wi;
+    vec3 power;
+    if (uint(l.direction_kind.w) == LIGHT_DIRECTIONAL) {
+        power = e * v.dir.w;  // irradiance × the texel's area
+    } else {
+        float c = max(dot(i, v.dir.xyz), 0.0);
+        power = e * dist * dist * v.dir.w * c * c * c;  // intensity × the texel's solid angle
+    }
+    vec3 n = normalize(in_normal);
+    if (dot(n, i) > 0.0) n = -n;  // the side the photon arrives on
+    power *= light_visibility(l, p, n);
+    if (all(lessThanEqual(power, vec3(0.0)))) return;
+
+    SpecularSplit s = specular_split(m, p, n, p - i);
+    vec3 ref = generators[g].reference_point.xyz;
+    vec3 pos = p;
+    vec3 dir;
+    vec3 w;
+    if (m.kind == KIND_MIRROR || m.thin != 0u) {
+        // A mirror reflects; a thin-walled dielectric lets the photon through undeviated.
+        bool mirror = m.kind == KIND_MIRROR;
+        dir = mirror ? s.r : s.t;
+        w = mirror ? s.fr : s.ft;
+    } else {
+        // A solid dielectric: refracted in, then out where the refractor map says, or
+        // reflected inside on total internal reflection; the internally reflected share of
+        // a partial reflection is not followed (the stronger branch, 1 − F, is).
+        if (all(lessThanEqual(s.ft, vec3(0.0)))) return;
+        w = s.ft;
+        dir = s.t;
+        float ior = m.nu.x;
+        vec3 oref = o.reference_point.xyz;
+        bool out_of_it = false;
+        search_map = 1;
+        search_layer = float(o.refractor_layer);
+        for (uint bounce = 0u; bounce <= push.internal_bounces; ++bounce) {
+            float eps = 1e-2 * length(pos - oref);
+            SearchResult h = search_ray(pos + dir * eps - oref, dir);
+            if (h.escaped) {  // an open refractor: the photon is out
+                out_of_it = true;
+                break;
+            }
+            vec3 hit = pos + dir * (eps + h.d);
+            vec3 n2 = normalize(textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0).xyz);
+            if (dot(n2, dir) < 0.0) n2 = -n2;
+            vec3 out_dir;
+            pos = hit;
+            if (refract_dir(dir, -n2, ior, out_dir)) {
+                w *= 1.0 - material_fresnel(m, dot(dir, n2), 1.0 / ior);
+                dir = out_dir;
+                out_of_it = true;
+                break;
+            }
+            dir = reflect_dir(dir, -n2);  // total internal reflection
+        }
+        if (!out_of_it) return;  // still inside after internal_bounces reflections
+    }
+    // The terminal hit on the receivers: the §4 search in the receiver distance map.
+    search_map = 2;
+    search_layer = float(g);
+    vec3 x = pos - ref;
+    SearchResult h = search_ray(x, dir);
+    if (h.escaped) return;
+    out_hit = vec4(x + dir * h.d, 1.0);
+    out_power = vec4(w * power, 0.0);
+}

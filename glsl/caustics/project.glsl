@@ -1,0 +1,35 @@
+// caustics.project (survey §6.3.3): the caustic irradiance at a diffuse point, looked up in
+// each generator's light cube map in the point's direction from the reference point. The
+// map holds radiant intensity J seen from there, so a receiver at distance D whose normal
+// makes the angle α with that direction receives E = J cos α / D². The shadow-map-like
+// distance test stops light leaks: the point takes the caustic only if it is the surface
+// the receiver distance map holds in that direction. Receivers facing away from the
+// generator (back faces) take none.
+#ifndef CAUSTICS_PROJECT_GLSL
+#define CAUSTICS_PROJECT_GLSL
+
+// n: the receiver's normal on the side it is seen from.
+vec3 caustic_irradiance(vec3 p, vec3 n) {
+    vec3 e = vec3(0.0);
+    uint count = caustic.generator_count;
+    if (count == 0u) return e;
+    float texel = 2.0 / float(caustic.cube_size);
+    for (uint g = 0u; g < count; ++g) {
+        vec3 w = p - generators[g].reference_point.xyz;
+        float d = length(w);
+        if (!(d > 0.0)) continue;
+        vec3 dir = w / d;
+        float cos_a = -dot(n, dir);
+        if (cos_a <= 0.0) continue;
+        if ((caustic.flags & CAUSTIC_DISTANCE_TEST) != 0u) {
+            // Within a texel the receiver's distance varies by about D·texel/cos α.
+            float stored = textureLod(caustic_distances, vec4(dir, float(g)), 0.0).r;
+            if (abs(d - stored) > d * texel * (2.0 + 1.0 / max(cos_a, 0.05))) continue;
+        }
+        vec3 j = textureLod(caustic_maps, vec4(dir, float(g)), 0.0).rgb;
+        float cos_factor = (caustic.flags & CAUSTIC_ORIENTATION) != 0u ? cos_a : 1.0;
+        e += j * cos_factor / (d * d);
+    }
+    return e;
+}
+#endif

@@ -1,0 +1,252 @@
+//! Caustics (survey §6): light focused by specular objects onto diffuse surfaces. They are
+//! an effect added to whatever method renders the camera view: the plan gets one caustics
+//! stage over every *generator* (a specular object that a punctual light sees) and its
+//! lights, and every pass that shades diffuse surfaces projects the result
+//! (glsl/caustics/project.glsl, called by `shade_diffuse`), so caustics appear in the
+//! camera, in mirrors and through glass.
+//!
+//! Per generator, around its reference point:
+//! - `caustics.receivers`: the receiver distance map, everything but the generator;
+//! - `caustics.photons`: per light a photon hit location image (the generator seen from the
+//!   light through its bounding cone, a cube of six views when the light is inside that
+//!   cone's sphere, an orthographic view for a directional light), each texel a photon
+//!   traced through the generator in the sampled geometry to its terminal hit;
+//! - `caustics.splat` (photon splatting, §6.3.1) or `caustics.triangles` (§6.3.2): the
+//!   photons into the light cube map, radiant intensity seen from the reference point;
+//! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0).
+
+pub mod stage;
+
+use glam::{Mat4, Vec3, Vec4};
+
+use crate::gpu_scene::{GpuLight, GpuView};
+use crate::plan::{ObjectPlan, Plan};
+use crate::quality::{Caustics, Quality};
+use crate::scene::{LightKind, Scene};
+
+/// One light's views of a generator: layers `first_layer ..` of the photon images.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LightViews {
+    pub light: usize,
+    pub first_layer: u32,
+    /// 1 (a cone or an orthographic view), or 6 (a cube around a light inside the
+    /// generator's bounding sphere).
+    pub faces: u32,
+}
+
+/// One caustic generator.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Generator {
+    pub mesh: usize,
+    pub name: String,
+    /// Its light cube map's and receiver distance map's centre: the object's reference point.
+    pub reference_point: Vec3,
+    pub lights: Vec<LightViews>,
+}
+
+/// The structure of a generator (what it renders), not where it is.
+impl PartialEq for Generator {
+    fn eq(&self, o: &Generator) -> bool {
+        self.mesh == o.mesh && self.lights == o.lights
+    }
+}
+
+/// The caustics stage of a plan.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CausticsPlan {
+    /// `Splat` or `Triangles`.
+    pub filter: Caustics,
+    pub generators: Vec<Generator>,
+    /// Layers of the photon images: Σ faces over every generator's lights.
+    pub photon_layers: u32,
+    /// Device memory of its images.
+    pub bytes: u64,
+}
+
+impl CausticsPlan {
+    /// The profiled passes it records, in order.
+    pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
+        let mut v = vec!["caustics.receivers", "caustics.photons"];
+        v.push(if self.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" });
+        if q.caustic_filter > 0 {
+            v.push("caustics.filter");
+        }
+        v
+    }
+}
+
+/// Whether the light can send photons into the sphere (centre, radius): a spot light's cone
+/// must reach it; point and directional lights reach everything (occluders between the
+/// light and the generator are the shadow maps' business, per photon).
+fn light_sees(kind: LightKind, position: Vec3, direction: Vec3, centre: Vec3, radius: f32) -> bool {
+    match kind {
+        LightKind::Spot { outer_cone, .. } => {
+            let to = centre - position;
+            let d = to.length();
+            if d <= radius {
+                return true;
+            }
+            let angle = direction.normalize().dot(to / d).clamp(-1.0, 1.0).acos();
+            angle <= outer_cone + (radius / d).asin()
+        }
+        _ => true,
+    }
+}
+
+/// A mesh's bounding sphere: its box's centre, and the farthest vertex from it (tighter
+/// than the half diagonal: a sphere's photon cone then holds the sphere, not its box).
+pub fn bounding_sphere(scene: &Scene, mesh: usize) -> (Vec3, f32) {
+    let m = &scene.meshes[mesh];
+    let c = m.bounds().center();
+    let r = m.positions.iter().map(|p| (*p - c).length()).fold(0.0f32, f32::max);
+    (c, (r * 1.0001).max(1e-6))
+}
+
+/// Whether a light at `position` lies inside (or at the rim of) the sphere, so that no cone
+/// from it bounds the sphere: it then sees the generator through a cube of six views.
+fn light_inside(position: Vec3, centre: Vec3, radius: f32) -> bool {
+    (position - centre).length() <= radius * 1.05
+}
+
+/// The caustics stage the scene needs under `q`, or none: caustics are off, no diffuse
+/// surface receives them, no punctual light, or no specular object a light sees.
+/// A whole-scene ray tracer (§2) shades its pixels by shadow rays in compute kernels that
+/// do not project caustics: it gets none.
+pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality, traced_everywhere: bool) -> Option<CausticsPlan> {
+    if q.caustics == Caustics::Off || traced_everywhere || scene.lights.is_empty() {
+        return None;
+    }
+    if !scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular()) {
+        return None;
+    }
+    let mut generators = Vec::new();
+    let mut layers = 0;
+    for o in objects {
+        let (centre, radius) = bounding_sphere(scene, o.mesh);
+        let mut lights = Vec::new();
+        for (i, l) in scene.lights.iter().enumerate() {
+            if !light_sees(l.kind, l.position, l.direction, centre, radius) {
+                continue;
+            }
+            let faces = if l.kind != LightKind::Directional && light_inside(l.position, centre, radius) { 6 } else { 1 };
+            lights.push(LightViews { light: i, first_layer: layers, faces });
+            layers += faces;
+        }
+        if !lights.is_empty() {
+            generators.push(Generator { mesh: o.mesh, name: o.name.clone(), reference_point: o.reference_point, lights });
+        }
+    }
+    if generators.is_empty() {
+        return None;
+    }
+    let mut p = CausticsPlan { filter: q.caustics, generators, photon_layers: layers, bytes: 0 };
+    p.bytes = bytes(&p, q);
+    Some(p)
+}
+
+/// Device memory: per generator a receiver distance cube (R32F) and a light cube map
+/// (RGBA32F, two with filtering), the photon images (two RGBA32F layers per view and a
+/// depth buffer), the receivers' depth buffer.
+pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
+    let s = q.cube_size as u64;
+    let n = q.photons as u64;
+    let g = p.generators.len() as u64;
+    let light_cubes = if q.caustic_filter > 0 { 2 } else { 1 };
+    let depth_layers = if q.cube_mode == crate::quality::CubeMode::Multiview { 6 } else { 1 };
+    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + depth_layers * s * s * 4
+}
+
+/// What `specula plan` says of it.
+pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
+    let mut s = format!(
+        "caustics ({}): {} photons² per light view, light cubes 6×{}² RGBA32F{}, {:.2} MiB",
+        if p.filter == Caustics::Splat { format!("splat, splat_size {}", q.splat_size) } else { "triangles".into() },
+        q.photons,
+        q.cube_size,
+        if q.caustic_filter > 0 { format!(", box filter radius {}", q.caustic_filter) } else { String::new() },
+        p.bytes as f64 / (1 << 20) as f64
+    );
+    for g in &p.generators {
+        let lights: Vec<String> = g
+            .lights
+            .iter()
+            .map(|l| {
+                let name = &scene.lights[l.light].name;
+                if l.faces == 6 {
+                    format!("'{name}' (inside its bounding sphere: 6 views)")
+                } else {
+                    format!("'{name}'")
+                }
+            })
+            .collect();
+        s += &format!("\n  generator  {} lit by {}", g.name, lights.join(", "));
+    }
+    s
+}
+
+/// The photon views of this frame, one per photon image layer: where each light sees its
+/// generator from. `eye` is the light (w 0) or, for a directional light, the view's origin
+/// (w 1); `dir` is the view's axis and, in w, one texel's solid angle on the axis
+/// ((2 tan θ / N)², θ the half angle) or, orthographic, one texel's area (m²).
+pub fn photon_views(p: &CausticsPlan, scene: &Scene, lights: &[GpuLight], q: &Quality, near_scale: f32) -> Vec<GpuView> {
+    let n = q.photons as f32;
+    let mut views = Vec::with_capacity(p.photon_layers as usize);
+    for g in &p.generators {
+        let (centre, radius) = bounding_sphere(scene, g.mesh);
+        for lv in &g.lights {
+            let l = &lights[lv.light];
+            let pos = Vec3::from_slice(&l.position_range[..3]);
+            let kind = scene.lights[lv.light].kind;
+            if kind == LightKind::Directional {
+                let dir = Vec3::from_slice(&l.direction_kind[..3]).normalize();
+                let vp = crate::frame::views::directional_view_proj(dir, centre, radius);
+                let texel = 2.0 * radius / n;
+                views.push(view(vp, (centre - dir * radius).extend(1.0), dir.extend(texel * texel)));
+                continue;
+            }
+            if lv.faces == 6 {
+                for f in 0..6 {
+                    let vp = crate::cube::face_view_proj(f, pos, near_scale);
+                    let axis = crate::cube::FACE_AXES[f][2];
+                    views.push(view(vp, pos.extend(0.0), axis.extend((2.0 / n).powi(2))));
+                }
+                continue;
+            }
+            let to = centre - pos;
+            let d = to.length();
+            let axis = to / d;
+            // The bounding cone, a little wider so that the silhouette's texels are whole.
+            let half = ((radius / d).min(1.0).asin() * 1.02).min(1.5);
+            let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+            let near = ((d - radius) * 0.5).max(near_scale);
+            let mut proj = Mat4::perspective_infinite_reverse_rh(2.0 * half, 1.0, near);
+            proj.y_axis.y = -proj.y_axis.y;
+            let vp = proj * Mat4::look_to_rh(pos, axis, up);
+            let t = half.tan();
+            views.push(view(vp, pos.extend(0.0), axis.extend((2.0 * t / n).powi(2))));
+        }
+    }
+    views
+}
+
+fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
+    GpuView {
+        view_proj: view_proj.to_cols_array_2d(),
+        inv_view_proj: view_proj.inverse().to_cols_array_2d(),
+        eye: eye.to_array(),
+        dir: dir.to_array(),
+        clip: [0.0, 0.0, 0.0, 1.0],
+    }
+}
+
+/// After objects moved: the generators' reference points follow their objects'.
+pub fn refresh(p: &mut Plan) {
+    let refs: Vec<(usize, Vec3)> = p.objects.iter().map(|o| (o.mesh, o.reference_point)).collect();
+    if let Some(c) = p.caustics.as_mut() {
+        for g in &mut c.generators {
+            if let Some((_, r)) = refs.iter().find(|(m, _)| *m == g.mesh) {
+                g.reference_point = *r;
+            }
+        }
+    }
+}

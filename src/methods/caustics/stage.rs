@@ -1,0 +1,311 @@
+//! The caustics stage: its passes (`caustics.receivers`, `caustics.photons`,
+//! `caustics.splat` or `caustics.triangles`, `caustics.filter`), their pipelines and
+//! images. The images the other passes sample (receiver distances, light cube maps, the
+//! generator table) live in the frame's `Maps`; the photon images too, since the splat and
+//! triangle shaders read them through the frame's set.
+
+use ash::vk;
+
+use super::CausticsPlan;
+use crate::frame::direct::DEPTH_FORMAT;
+use crate::frame::layout::{GpuCausticGenerator, GpuCausticParams};
+use crate::frame::layout::{CAUSTIC_DISTANCE_TEST, CAUSTIC_GENERATOR_SHIFT, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION};
+use crate::frame::shadow::FAR;
+use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
+use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
+use crate::quality::{Caustics, CubeMode, Quality};
+use crate::vk::pipeline::{graphics_pipeline, Blend, GraphicsDesc, Multisample, VertexInput};
+use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
+use crate::Result;
+
+const HIT_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const LIGHT_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+pub struct CausticsStage {
+    plan: CausticsPlan,
+    photons: u32,
+    filter: u32,
+    mode: CubeMode,
+    /// Depth of the receiver cubes (also attached, untested, to the light cube passes).
+    cube_depth: Image,
+    photon_depth: Image,
+    receivers: vk::Pipeline,
+    photon: vk::Pipeline,
+    accumulate: vk::Pipeline,
+    box_filter: vk::Pipeline,
+}
+
+/// The generator table the shaders read (`Caustics`, set 0).
+pub fn table(plan: &CausticsPlan, q: &Quality) -> (GpuCausticParams, Vec<GpuCausticGenerator>) {
+    let flags =
+        if q.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 } | if q.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 };
+    let params = GpuCausticParams {
+        generator_count: plan.generators.len() as u32,
+        photon_size: q.photons,
+        cube_size: q.cube_size,
+        flags,
+        splat_size: q.splat_size,
+        filter_radius: q.caustic_filter,
+        pad: [0; 2],
+    };
+    let gens = plan
+        .generators
+        .iter()
+        .map(|g| GpuCausticGenerator { reference_point: g.reference_point.extend(0.0).to_array(), mesh: g.mesh as u32, pad: [0; 3] })
+        .collect();
+    (params, gens)
+}
+
+fn table_bytes(plan: &CausticsPlan, q: &Quality) -> Vec<u8> {
+    let (params, gens) = table(plan, q);
+    let mut bytes = bytemuck::bytes_of(&params).to_vec();
+    bytes.extend_from_slice(bytemuck::cast_slice(&gens));
+    bytes
+}
+
+impl CausticsStage {
+    pub fn create(init: &StageInit, maps: &mut Maps) -> Result<Box<dyn Stage>> {
+        let plan = init.plan.caustics.clone().expect("a caustics stage is planned with its generators");
+        let q = &init.plan.quality;
+        let me = CausticsStage {
+            plan,
+            photons: q.photons,
+            filter: q.caustic_filter,
+            mode: q.cube_mode,
+            cube_depth: Image::placeholder(),
+            photon_depth: Image::placeholder(),
+            receivers: vk::Pipeline::null(),
+            photon: vk::Pipeline::null(),
+            accumulate: vk::Pipeline::null(),
+            box_filter: vk::Pipeline::null(),
+        };
+        Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
+    }
+
+    fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
+        let (s, n) = (q.cube_size, q.photons);
+        let cubes = self.plan.generators.len() as u32;
+        let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
+        let cube = |name, format| {
+            Image::new(ctx, &ImageDesc { name, format, width: s, height: s, kind: ImageKind::CubeArray { cubes }, usage: attach })
+        };
+        maps.caustic_distances = Some(cube("caustics.receivers", vk::Format::R32_SFLOAT)?);
+        maps.caustic_maps = Some(cube("caustics.light_cubes", LIGHT_FORMAT)?);
+        if self.filter > 0 {
+            maps.caustic_raw = Some(cube("caustics.light_cubes.unfiltered", LIGHT_FORMAT)?);
+        }
+        let layers = ImageKind::D2Array { layers: self.plan.photon_layers };
+        let photon = |name| Image::new(ctx, &ImageDesc { name, format: HIT_FORMAT, width: n, height: n, kind: layers, usage: attach });
+        maps.photon_hits = Some(photon("caustics.photon_hits")?);
+        maps.photon_power = Some(photon("caustics.photon_power")?);
+        let bytes = table_bytes(&self.plan, q);
+        maps.caustics = Some(Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
+        self.cube_depth = cube_depth(ctx, "caustics.depth", s, self.mode)?;
+        self.photon_depth = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "caustics.photon_depth",
+                format: DEPTH_FORMAT,
+                width: n,
+                height: n,
+                kind: ImageKind::D2,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            },
+        )?;
+        let mask = view_mask(self.mode);
+        let desc = |name, vertex, fragment, vertex_input, formats, depth_test, view_mask, blend| GraphicsDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input,
+            color_formats: formats,
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test,
+            depth_write: depth_test,
+            view_mask,
+            cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
+            blend,
+        };
+        let r32 = [vk::Format::R32_SFLOAT];
+        let light = [LIGHT_FORMAT];
+        let hits = [HIT_FORMAT, HIT_FORMAT];
+        self.receivers = graphics_pipeline(
+            ctx,
+            layout,
+            &desc("caustics.receivers", "scene/mesh.vert", "shadow/distance.frag", VertexInput::Mesh, &r32, true, mask, Blend::Replace),
+        )?;
+        self.photon = graphics_pipeline(
+            ctx,
+            layout,
+            &desc("caustics.photons", "scene/mesh.vert", "caustics/photons.frag", VertexInput::Mesh, &hits, true, 0, Blend::Replace),
+        )?;
+        let (vs, fs) = match self.plan.filter {
+            Caustics::Splat => ("caustics/splat.vert", "caustics/splat.frag"),
+            _ => ("caustics/triangles.vert", "caustics/triangles.frag"),
+        };
+        self.accumulate =
+            graphics_pipeline(ctx, layout, &desc("caustics.accumulate", vs, fs, VertexInput::None, &light, false, mask, Blend::Add))?;
+        if self.filter > 0 {
+            self.box_filter = graphics_pipeline(
+                ctx,
+                layout,
+                &desc("caustics.filter", "scene/sky.vert", "caustics/filter.frag", VertexInput::None, &light, false, mask, Blend::Replace),
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Vertices of one photon layer's accumulation draw.
+    fn vertices(&self) -> u32 {
+        let n = self.photons;
+        match self.plan.filter {
+            Caustics::Splat => 6 * n * n,
+            _ => 6 * (n - 1) * (n - 1),
+        }
+    }
+}
+
+impl Stage for CausticsStage {
+    fn name(&self) -> &'static str {
+        "caustics"
+    }
+
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        vec![
+            ("caustics.generators".into(), self.plan.generators.len() as f64),
+            ("caustics.photon_layers".into(), self.plan.photon_layers as f64),
+        ]
+    }
+
+    /// Reference points follow their objects; the table is rewritten before the frame.
+    fn update(&mut self, init: &StageInit, _changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
+        if let Some(p) = init.plan.caustics.as_ref() {
+            for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
+                g.reference_point = fresh.reference_point;
+            }
+        }
+        if let Some(b) = maps.caustics.as_mut() {
+            b.write(&table_bytes(&self.plan, &init.plan.quality))?;
+        }
+        Ok(())
+    }
+
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let ctx = rec.ctx;
+        let maps = &mut *io.maps;
+        let (Some(distances), Some(hits), Some(power)) =
+            (maps.caustic_distances.as_mut(), maps.photon_hits.as_mut(), maps.photon_power.as_mut())
+        else {
+            return;
+        };
+        let cube_views = &io.views.caustic_cubes;
+
+        // The receivers: everything but the generator, from its reference point.
+        let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
+        for (g, gen) in self.plan.generators.iter().enumerate() {
+            render_cube_faces(rec, distances, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [FAR, 0.0, 0.0, 0.0], |cmd, v| {
+                f.bind(ctx, cmd, self.receivers);
+                for d in f.scene.draws.iter().filter(|d| d.mesh as usize != gen.mesh && d.index_count > 0) {
+                    f.draw(ctx, cmd, v, d);
+                }
+            });
+        }
+        rec.end(open);
+
+        // The photon hit location images.
+        let mut pass = rec.pass("caustics.photons").writes(hits, Access::ColorAttachment).writes(power, Access::ColorAttachment);
+        pass = pass.reads(distances, Access::FragmentSampled);
+        for img in
+            io.scene_images.iter().copied().chain(maps.shadow_cubes.iter()).chain(maps.shadow_planes.iter()).chain(maps.refractor.iter())
+        {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        let cmd = rec.cmd;
+        for (g, gen) in self.plan.generators.iter().enumerate() {
+            for lv in &gen.lights {
+                for face in 0..lv.faces {
+                    let layer = lv.first_layer + face;
+                    rec.barrier(&mut self.photon_depth, Access::DepthAttachment);
+                    let colors = [hits.layer_view(layer), power.layer_view(layer)];
+                    let t = Target {
+                        color: &colors,
+                        depth: Some(self.photon_depth.view),
+                        width: self.photons,
+                        height: self.photons,
+                        view_mask: 0,
+                        layer_count: 1,
+                        clear_color: [0.0; 4],
+                        clear: true,
+                    };
+                    begin_rendering(ctx, cmd, &t);
+                    f.bind(ctx, cmd, self.photon);
+                    f.bind_maps(ctx, cmd, io.sets.geometry);
+                    let flags = f.flags | ((g as u32) << CAUSTIC_GENERATOR_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
+                    for d in f.scene.draws.iter().filter(|d| d.mesh as usize == gen.mesh && d.index_count > 0) {
+                        f.push_flags(ctx, cmd, io.views.photons + layer, d.mesh, flags);
+                        unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+                    }
+                    unsafe { ctx.device.cmd_end_rendering(cmd) };
+                }
+            }
+        }
+        rec.end(open);
+
+        // Splats or triangles into the light cube maps (the unfiltered ones with a filter).
+        let name = if self.plan.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" };
+        let filtering = self.filter > 0;
+        let (light, raw) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_mut());
+        let Some(light) = light else { return };
+        let target: &mut Image = match raw {
+            Some(r) if filtering => r,
+            _ => light,
+        };
+        let open = rec
+            .pass(name)
+            .writes(target, Access::ColorAttachment)
+            .reads(hits, Access::VertexSampled)
+            .reads(power, Access::VertexSampled)
+            .begin();
+        let vertices = self.vertices();
+        for (g, gen) in self.plan.generators.iter().enumerate() {
+            render_cube_faces(rec, target, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [0.0; 4], |cmd, v| {
+                f.bind(ctx, cmd, self.accumulate);
+                for lv in &gen.lights {
+                    for face in 0..lv.faces {
+                        f.push(ctx, cmd, v, lv.first_layer + face);
+                        unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
+                    }
+                }
+            });
+        }
+        rec.end(open);
+
+        if filtering {
+            let (Some(light), Some(raw)) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_ref()) else { return };
+            let open = rec.pass("caustics.filter").writes(light, Access::ColorAttachment).reads(raw, Access::FragmentSampled).begin();
+            for g in 0..self.plan.generators.len() {
+                render_cube_faces(rec, light, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [0.0; 4], |cmd, v| {
+                    f.bind(ctx, cmd, self.box_filter);
+                    f.push(ctx, cmd, v, g as u32);
+                    unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
+                });
+            }
+            rec.end(open);
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.cube_depth.destroy(ctx);
+        self.photon_depth.destroy(ctx);
+        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter]);
+    }
+}
+
+impl Owner for CausticsStage {
+    fn destroy(&mut self, ctx: &Context) {
+        Stage::destroy(self, ctx)
+    }
+}
