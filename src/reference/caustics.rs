@@ -75,6 +75,21 @@ fn r2(i: u32) -> DVec2 {
     DVec2::new(0.5 + i as f64 / G, 0.5 + i as f64 / (G * G)).fract()
 }
 
+/// Shirley and Chiu's concentric map of [0, 1)² onto the unit disk: area-preserving and
+/// continuous, the square's centre at the disk's, so that low-discrepancy points stay
+/// well spread near the cone's axis (where a ball's focus lies) as everywhere else.
+fn concentric(u: DVec2) -> DVec2 {
+    let (a, b) = (2.0 * u.x - 1.0, 2.0 * u.y - 1.0);
+    let (r, phi) = if a == 0.0 && b == 0.0 {
+        return DVec2::ZERO;
+    } else if a.abs() > b.abs() {
+        (a, PI / 4.0 * b / a)
+    } else {
+        (b, PI / 2.0 - PI / 4.0 * a / b)
+    };
+    DVec2::from_angle(phi) * r
+}
+
 /// Where a light's photons towards one generator start: origin and unit direction of
 /// sample `u`, and the solid angle (point, spot) or area (directional) they share.
 struct Emitter<'l> {
@@ -101,16 +116,20 @@ impl<'l> Emitter<'l> {
         Emitter { light, centre, axis, frame: axis.any_orthonormal_pair(), radius, extent, measure }
     }
 
+    /// The photon of `u` ∈ [0, 1)²: the square mapped onto the unit disk preserving area
+    /// (`concentric`), the disk onto the cone's spherical cap (area again: 1 − cos θ ∝ ρ²)
+    /// or onto the directional light's disk.
     fn ray(&self, u: DVec2) -> (DVec3, DVec3) {
         let (t1, t2) = self.frame;
-        let (s, c) = (TAU * u.y).sin_cos();
+        let q = concentric(u);
+        let across = t1 * q.x + t2 * q.y;
         if self.light.kind == LightKind::Directional {
-            let rho = self.radius * u.x.sqrt();
-            (self.centre + (t1 * c + t2 * s) * rho - self.axis * self.extent, self.axis)
+            (self.centre + across * self.radius - self.axis * self.extent, self.axis)
         } else {
-            let cos_t = 1.0 - u.x * (1.0 - self.extent);
-            let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
-            (self.light.position, ((t1 * c + t2 * s) * sin_t + self.axis * cos_t).normalize())
+            let rho2 = q.length_squared();
+            let cos_t = 1.0 - rho2 * (1.0 - self.extent);
+            let sin_over_rho = if rho2 > 0.0 { ((1.0 - cos_t * cos_t).max(0.0) / rho2).sqrt() } else { 0.0 };
+            (self.light.position, (across * sin_over_rho + self.axis * cos_t).normalize())
         }
     }
 }
@@ -234,8 +253,8 @@ impl Tracer<'_> {
             let split = shade::specular_split(m, self.fresnel, d, s.normal);
             let mean = |f: DVec3| f.element_sum() / 3.0;
             let (pr, pt) = (mean(split.fr), mean(split.ft));
-            if !(pr + pt > 0.0) {
-                return None;
+            if pr + pt <= 0.0 || (pr + pt).is_nan() {
+                return None; // a black mirror absorbs the photon
             }
             let p = pr / (pr + pt);
             let u = hash(i, bounces, seed) as f64 / 4_294_967_296.0;
@@ -284,7 +303,8 @@ mod tests {
     fn ball_over_floor(ior: f32, segments: u32, light: Vec3, intensity: Vec3) -> Scene {
         let mut s = Scene::new();
         let (floor, glass) = (diffuse(&mut s), glass(&mut s, ior));
-        s.add_mesh(shapes::quad("floor", Vec3::new(-3.0, 0.0, 3.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), 4, floor)).unwrap();
+        s.add_mesh(shapes::quad("floor", Vec3::new(-3.0, 0.0, 3.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), 4, floor))
+            .unwrap();
         s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.0, 1.0, 0.0), 0.5, segments, segments / 2, glass)).unwrap();
         s.add_light(point_light(light, intensity)).unwrap();
         s
@@ -311,7 +331,7 @@ mod tests {
     /// interactions is lost; every other photon reaches a wall). Tolerance 0.5 %: the ball
     /// is a 128×64 polygon with interpolated normals (its silhouette and hit angles differ
     /// from the sphere's by ~1e-3); the emission noise is far below that.
-    /// Measured: T T 0.99 of the closed form, all paths 0.99 (see the final report).
+    /// Measured: T T 0.9984 of the closed form, all paths 0.9993.
     #[test]
     fn glass_ball_transmits_the_fresnel_closed_form() {
         let mut s = Scene::new();
@@ -336,17 +356,16 @@ mod tests {
 
     /// A flat mirror tilted 45° under a point light 2 m above it sends the light sideways
     /// onto a wall 3 m away: the reflected spot is lit by the light's virtual image, 5 m
-    /// away along the unfolded path, E = F(45°) I / 25 per channel. Tolerance 2 %: emission
-    /// noise of ~1200 photons per kernel disk (low-discrepancy, well under 1 %) and the
-    /// kernel's bias (r²/L² ≈ 4e-4). Outside the reflected beam the wall gets nothing.
+    /// away along the unfolded path, E = F(45°) I / 25 per channel. Tolerance 1 %: emission
+    /// noise of ~1200 photons per kernel disk (low-discrepancy) and the kernel's bias
+    /// (r²/L² ≈ 4e-4). Measured: 1.0015 (0.99984 with 1.6e6 photons). Outside the reflected
+    /// beam the wall gets nothing.
     #[test]
     fn tilted_mirror_images_the_light_onto_a_wall() {
         let mut s = Scene::new();
         let wall = diffuse(&mut s);
-        let mirror = Material {
-            kind: SurfaceKind::Mirror { nu: Vec3::new(0.15, 0.5, 1.2), kappa: Vec3::new(3.5, 2.8, 2.2) },
-            ..Default::default()
-        };
+        let mirror =
+            Material { kind: SurfaceKind::Mirror { nu: Vec3::new(0.15, 0.5, 1.2), kappa: Vec3::new(3.5, 2.8, 2.2) }, ..Default::default() };
         let f = shade::material_fresnel(&mirror, FresnelMode::Exact, 0.5f64.sqrt(), 1.0);
         let mirror = s.add_material(mirror).unwrap();
         let (u, v) = (Vec3::Z, Vec3::new(1.0, -1.0, 0.0) / 2f32.sqrt()); // faces (1, 1, 0)/√2
@@ -358,15 +377,16 @@ mod tests {
         let e = t.caustic_irradiance(DVec3::new(3.0, 0.0, 0.0), DVec3::NEG_X);
         let expected = f * intensity.as_dvec3() / 25.0;
         println!("mirror: {e} vs {expected}, ratio {}", e / expected);
-        assert!(((e / expected) - 1.0).abs().max_element() < 0.02, "{e} vs {expected}");
+        assert!(((e / expected) - 1.0).abs().max_element() < 0.01, "{e} vs {expected}");
         assert_eq!(t.caustic_irradiance(DVec3::new(3.0, 0.0, 1.8), DVec3::NEG_X), DVec3::ZERO);
         // Seen from behind the wall (its normal away from the photons' side): nothing.
         assert_eq!(t.caustic_irradiance(DVec3::new(3.0, 0.0, 0.0), DVec3::X), DVec3::ZERO);
     }
 
     /// The estimate converges: RMSE over a 9×9 grid across the ball's caustic on the floor
-    /// against 1.28e6 photons falls with the photon count (r = 3 cm).
-    /// Measured (this machine): see the final report and the printout.
+    /// against 1.28e6 photons falls with the photon count (r = 3 cm). Measured: RMSE 0.0497,
+    /// 0.0345, 0.0073 W/m² at 1e4, 4e4, 1.6e5 photons (6.8 %, 4.7 %, 1.0 % of the mean
+    /// 0.73 W/m²); the 1.28e6-photon map takes 0.6 s to build on 2 cores.
     #[test]
     fn caustic_estimate_converges_with_photons() {
         let s = ball_over_floor(1.5, 64, Vec3::new(0.0, 3.0, 0.0), Vec3::ONE);
@@ -392,18 +412,32 @@ mod tests {
     }
 
     /// ν → 1: the ball is invisible to light, so the caustic under it is the unshadowed
-    /// direct irradiance I cos θ / d² (the shadow ray, which sees the ball as opaque, misses
-    /// exactly that). Tolerance 3 %: emission noise of ~800 photons per disk.
+    /// direct irradiance E cos θ of `ShadeLight::incident` (the shadow ray, which sees the
+    /// ball as opaque, misses exactly that), for a point light, a spot light whose ramp
+    /// falls across the ball (its falloff carried by the photons) and a slanted directional
+    /// light. Tolerance 1 %: emission noise of several hundred photons per disk
+    /// (low-discrepancy) and the kernel's blur of the spot's ramp. Measured: within 0.6 %.
     #[test]
     fn index_near_one_gives_the_unshadowed_direct_light() {
-        let s = ball_over_floor(1.0001, 32, Vec3::new(0.0, 3.0, 0.0), Vec3::splat(2.0));
-        let t = Tracer::new(&s, &quality(400_000, 0.06)).unwrap();
-        for x in [0.0, 0.2, 0.4] {
-            let e = t.caustic_irradiance(DVec3::new(x, 0.0, 0.1), DVec3::Y).x;
-            let d = DVec3::new(x, -3.0, 0.1).length();
-            let direct = 2.0 * (3.0 / d) / (d * d);
-            println!("ν → 1 at x = {x}: {e:.5} vs {direct:.5} ({:.4})", e / direct);
-            assert!((e / direct - 1.0).abs() < 0.03, "x = {x}: {e} vs {direct}");
+        let top = Vec3::new(0.0, 3.0, 0.0);
+        let spot = LightKind::Spot { inner_cone: 0.1, outer_cone: 0.35 };
+        let slanted = Vec3::new(0.3, -1.0, 0.0);
+        for (kind, position, direction, shift) in
+            [(LightKind::Point, top, Vec3::NEG_Y, 0.0), (spot, top, Vec3::NEG_Y, 0.0), (LightKind::Directional, top, slanted, 0.3)]
+        {
+            let mut s = ball_over_floor(1.0001, 32, top, Vec3::ONE);
+            s.lights.clear();
+            s.add_light(Light { kind, position, direction, intensity: Vec3::splat(2.0), ..point_light(top, Vec3::ONE) }).unwrap();
+            let light = ShadeLight::new(&s.lights[0]);
+            let t = Tracer::new(&s, &quality(400_000, 0.06)).unwrap();
+            for x in [-0.3, 0.0, 0.2, 0.4] {
+                let p = DVec3::new(x + shift, 0.0, 0.1);
+                let e = t.caustic_irradiance(p, DVec3::Y).x;
+                let (wi, direct, _) = light.incident(p);
+                let direct = direct.x * wi.y;
+                println!("ν → 1, {kind:?} at x = {x}: {e:.5} vs {direct:.5} ({:.4})", e / direct);
+                assert!((e / direct - 1.0).abs() < 0.01, "{kind:?} at x = {x}: {e} vs {direct}");
+            }
         }
     }
 
@@ -428,7 +462,10 @@ mod tests {
         let t = Tracer::new(&s, &Quality::default()).unwrap();
         assert!(t.photon_map().is_none());
         assert_eq!(t.caustic_irradiance(DVec3::ZERO, DVec3::Y), DVec3::ZERO);
-        assert_ne!(image_hash(&Quality { caustics: Caustics::Splat, reference_photons: 20_000, ..Default::default() }), 0xd946_45ca_2b44_3afc);
+        assert_ne!(
+            image_hash(&Quality { caustics: Caustics::Splat, reference_photons: 20_000, ..Default::default() }),
+            0xd946_45ca_2b44_3afc
+        );
     }
 
     /// Without a specular object or without a light there are no photons.
