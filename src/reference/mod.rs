@@ -16,9 +16,13 @@
 //!   spanning [x, x+1]×[y, y+1] with row 0 at the top. `Quality::spp` samples per pixel on a
 //!   k×k stratified grid with a fixed hash jitter (1 sample = the pixel centre, as the GPU's
 //!   single sample), averaged (box filter).
+//! - Caustics (paths L S+ D, survey §6) only with `Quality::caustics` other than off:
+//!   light-traced photons and a density estimate (`caustics`), added to the diffuse
+//!   shading.
 //! - Rows are rendered in parallel (rayon), the result is deterministic.
 
 pub mod bvh;
+pub mod caustics;
 pub mod shade;
 
 use glam::{DVec2, DVec3};
@@ -26,9 +30,10 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::image::ImageData;
-use crate::quality::{FresnelMode, Quality};
+use crate::quality::{Caustics, FresnelMode, Quality};
 use crate::scene::{Camera, Scene, SurfaceKind};
 use bvh::{Bvh, Hit};
+use caustics::PhotonMap;
 use shade::{ShadeLight, Sky, Textures};
 
 /// The exact CPU reference as a registered method: it has no GPU passes (`Renderer::new`
@@ -62,6 +67,8 @@ pub struct Tracer<'a> {
     /// Secondary and shadow rays start this far from the surface they leave (and skip its
     /// triangle): a fixed fraction of the scene's size, so scaling the scene scales it.
     epsilon: f64,
+    /// The caustic photons, built only when `Quality::caustics` is not off.
+    caustics: Option<PhotonMap>,
 }
 
 /// What one camera ray sees, pre-computed per pixel sample.
@@ -141,7 +148,7 @@ impl<'a> Tracer<'a> {
             return Err(Error::invalid("knob depth", format!("{} is outside 1..=64", quality.depth)));
         }
         let diag = scene.bounds().diagonal() as f64;
-        Ok(Tracer {
+        let mut tracer = Tracer {
             scene,
             bvh: Bvh::new(scene),
             textures: Textures::new(&scene.textures),
@@ -150,7 +157,23 @@ impl<'a> Tracer<'a> {
             fresnel: quality.fresnel,
             depth: quality.depth,
             epsilon: diag.max(f64::MIN_POSITIVE) * 1e-9,
-        })
+            caustics: None,
+        };
+        if quality.caustics != Caustics::Off {
+            tracer.caustics = Some(PhotonMap::build(&tracer, quality)?);
+        }
+        Ok(tracer)
+    }
+
+    /// The caustic photon map, `None` with caustics off.
+    pub fn photon_map(&self) -> Option<&PhotonMap> {
+        self.caustics.as_ref()
+    }
+
+    /// Caustic irradiance at `p` on a surface of unit normal `n` (towards the viewer):
+    /// the photon map's density estimate, zero with caustics off.
+    pub fn caustic_irradiance(&self, p: DVec3, n: DVec3) -> DVec3 {
+        self.caustics.as_ref().map_or(DVec3::ZERO, |m| m.irradiance(p, n))
     }
 
     /// Radiance arriving at `o` from direction `-d` (d a unit vector): what the ray
@@ -205,7 +228,8 @@ impl<'a> Tracer<'a> {
     }
 
     /// `shade_diffuse` of glsl/common/shading.glsl, seen along `d`: emission +
-    /// albedo/π Σ E cos θ · visibility, visibility by an exact shadow ray.
+    /// albedo/π Σ E cos θ · visibility, visibility by an exact shadow ray, plus the caustic
+    /// irradiance when caustics are on.
     fn shade_diffuse(&self, s: &Surface, triangle: u32, d: DVec3) -> DVec3 {
         let m = &self.scene.materials[s.material];
         let albedo = shade::base_color(m, &self.textures, s.uv);
@@ -221,6 +245,9 @@ impl<'a> Tracer<'a> {
             if !self.bvh.occluded(s.position, wi, self.epsilon, t_max, Some(triangle)) {
                 sum += e * cos_t;
             }
+        }
+        if let Some(map) = &self.caustics {
+            sum += map.irradiance(s.position, n);
         }
         shade::emission(m, &self.textures, s.uv) + albedo / std::f64::consts::PI * sum
     }
