@@ -118,6 +118,9 @@ pub struct Quality {
     /// Caustics: the receiver-orientation factor cos α of the projection (off: every
     /// receiver taken as facing the generator).
     pub caustic_orientation: bool,
+    /// Caustics: dielectric generators also send their reflected photons (else only the
+    /// refracted ones, the stronger branch).
+    pub caustic_reflections: bool,
     /// CPU reference: photons traced per light and caustic generator.
     pub reference_photons: u32,
     /// CPU reference: radius of the caustic density estimate (metres); `None`: 0.5 % of
@@ -231,6 +234,7 @@ const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
 const CAUSTICS: &[(&str, Caustics)] = &[("off", Caustics::Off), ("splat", Caustics::Splat), ("triangles", Caustics::Triangles)];
+const CAUSTIC_PATHS: &[(&str, bool)] = &[("both", true), ("refracted", false)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
 
 pub const KNOBS: &[Knob] = &[
@@ -661,6 +665,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.caustic_orientation, ON_OFF),
     },
     Knob {
+        name: "caustic_paths",
+        values: "both|refracted",
+        default: "both",
+        doc: "caustics: a dielectric generator's photons follow both Fresnel branches, each its own photon image (the reflected one is weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way",
+        set: |q, v| {
+            q.caustic_reflections = one_of(v, CAUSTIC_PATHS)?;
+            Ok(())
+        },
+        get: |q| name_of(q.caustic_reflections, CAUSTIC_PATHS),
+    },
+    Knob {
         name: "reference_photons",
         values: "1000..=100000000 photons",
         default: "1000000",
@@ -730,6 +745,7 @@ impl Default for Quality {
             caustic_filter: 1,
             caustic_distance_test: true,
             caustic_orientation: true,
+            caustic_reflections: true,
             reference_photons: 1_000_000,
             caustic_radius: None,
         }

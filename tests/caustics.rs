@@ -121,7 +121,7 @@ fn caustic_power_matches_the_fresnel_transmittances() {
     // Lost: triangles across the silhouette (a photon missing) and across distance gaps,
     // texels of the photon cone's rim; a few per cent, less with more photons.
     for (filter, photons, lo) in [("splat", 64, 0.98), ("splat", 128, 0.98), ("triangles", 64, 0.93), ("triangles", 128, 0.96)] {
-        let q = quality(&[&format!("caustics={filter}"), &format!("photons={photons}")]);
+        let q = quality(&[&format!("caustics={filter}"), &format!("photons={photons}"), "caustic_paths=refracted"]);
         let (power, passes) = caustic_power(&ctx, &scene, &q);
         let ratio = power / expected;
         eprintln!("{filter} photons={photons}: power {power:.4} W, closed form {expected:.4} W, ratio {ratio:.4}");
@@ -131,6 +131,40 @@ fn caustic_power_matches_the_fresnel_transmittances() {
             assert!(passes.iter().any(|p| p == name), "{name} in {passes:?}");
         }
     }
+    common::assert_clean(&ctx);
+}
+
+#[test]
+fn the_reflected_branch_adds_the_glass_surface_reflection() {
+    // caustic_paths=both adds the photons the sphere's surface reflects: ∫ I F(θ_i) dΩ over
+    // the directions whose reflection goes down to the (wide) floor.
+    let ctx = common::gpu();
+    let mut scene = sphere_over_floor(1.5);
+    scene.meshes[0].positions.iter_mut().for_each(|p| *p *= 8.0);
+    let (l, c, r) = (LIGHT.as_dvec3(), C.as_dvec3(), R as f64);
+    let psi_max = (r / (l - c).length()).asin();
+    let n = 20000;
+    let mut expected = 0.0;
+    for k in 0..n {
+        let psi = (k as f64 + 0.5) / n as f64 * psi_max;
+        let d = DVec3::new(psi.sin(), -psi.cos(), 0.0);
+        // First intersection of the ray l + t d with the sphere.
+        let oc = l - c;
+        let b = oc.dot(d);
+        let t = -b - (b * b - oc.length_squared() + r * r).max(0.0).sqrt();
+        let normal = (l + d * t - c) / r;
+        let cos_i = -d.dot(normal);
+        let reflected = d + normal * (2.0 * cos_i);
+        if reflected.y < -0.05 {
+            let f = specula::optics::fresnel_dielectric(cos_i, 1.5);
+            expected += INTENSITY as f64 * f * 2.0 * std::f64::consts::PI * psi.sin() * (psi_max / n as f64);
+        }
+    }
+    let (both, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128"]));
+    let (refracted, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128", "caustic_paths=refracted"]));
+    let added = both - refracted;
+    eprintln!("reflected branch: {added:.4} W, quadrature {expected:.4} W, ratio {:.4}", added / expected);
+    assert!((0.9..=1.1).contains(&(added / expected)), "{added} vs {expected}");
     common::assert_clean(&ctx);
 }
 
@@ -176,7 +210,7 @@ fn directional_and_grazing_light_keep_the_power() {
             intensity: Vec3::splat(e as f32),
             range: None,
         };
-        let (power, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128"]));
+        let (power, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128", "caustic_paths=refracted"]));
         eprintln!("directional at {degrees}°: {power:.4} W, quadrature {expected:.4} W, ratio {:.4}", power / expected);
         assert!((0.96..=1.01).contains(&(power / expected)), "{degrees}°: {power} vs {expected}");
     }
@@ -189,12 +223,13 @@ fn spot_lights_send_photons_only_where_their_cone_reaches() {
     let mut scene = sphere_over_floor(1.5);
     // A spot whose inner cone holds the sphere: the point light's caustic.
     scene.lights[0].kind = LightKind::Spot { inner_cone: 0.4, outer_cone: 0.5 };
-    let (power, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat"]));
+    let refracted = quality(&["caustics=splat", "caustic_paths=refracted"]);
+    let (power, _) = caustic_power(&ctx, &scene, &refracted);
     let expected = two_refraction_power(1.5);
     assert!((0.98..=1.005).contains(&(power / expected)), "{power} vs {expected}");
     // Narrower than the sphere: only its cone's share (less than half at these angles).
     scene.lights[0].kind = LightKind::Spot { inner_cone: 0.05, outer_cone: 0.1 };
-    let (narrow, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat"]));
+    let (narrow, _) = caustic_power(&ctx, &scene, &refracted);
     assert!(narrow > 0.0 && narrow < 0.5 * expected, "{narrow}");
     // Aimed away: the light sees no generator, the plan has no caustics.
     scene.lights[0].direction = Vec3::Y;
@@ -209,7 +244,7 @@ fn only_scenes_with_lit_generators_and_receivers_get_caustics() {
     let scene = sphere_over_floor(1.5);
     let p = plan(&scene, specula::methods::DISTANCE, &q);
     let c = p.caustics.as_ref().expect("a lit glass sphere over a floor");
-    assert_eq!((c.generators.len(), c.photon_layers), (1, 1));
+    assert_eq!((c.generators.len(), c.photon_layers), (1, 2), "one view, both branches");
     assert!(c.bytes > 0 && p.map_bytes() >= c.bytes);
     // A solid refractor's photons search its refractor map, whatever its method.
     assert!(p.passes.contains(&"refractor.generate"), "{:?}", p.passes);
@@ -232,7 +267,7 @@ fn only_scenes_with_lit_generators_and_receivers_get_caustics() {
     // A light inside the generator's bounding sphere sees it through six views.
     let mut inside = scene.clone();
     inside.lights[0].position = C + Vec3::new(0.0, 0.3, 0.0);
-    assert_eq!(plan(&inside, specula::methods::DISTANCE, &q).caustics.unwrap().photon_layers, 6);
+    assert_eq!(plan(&inside, specula::methods::DISTANCE, &q).caustics.unwrap().photon_layers, 12);
 }
 
 #[test]
@@ -315,5 +350,74 @@ fn the_caustic_is_seen_through_the_glass() {
     let (a, b): (f64, f64) = (sphere.iter().map(|&i| luminance(&off, i)).sum(), sphere.iter().map(|&i| luminance(&on, i)).sum());
     eprintln!("sphere pixels {}: off {a:.3}, with caustics {b:.3}", sphere.len());
     assert!(b > a * 1.05, "{b} vs {a}");
+    common::assert_clean(&ctx);
+}
+
+/// The caustic's share of an image: each pixel's radiance minus the caustic-less one's.
+fn caustic_part(with: &specula::image::ImageData, without: &specula::image::ImageData) -> Vec<f64> {
+    (0..(with.width * with.height) as usize).map(|i| luminance(with, i) - luminance(without, i)).collect()
+}
+
+/// (centroid x, y) of a non-negative weight image.
+fn centroid(w: &[f64], width: usize) -> (f64, f64) {
+    let (mut sx, mut sy, mut s) = (0.0, 0.0, 0.0);
+    for (i, &v) in w.iter().enumerate() {
+        let v = v.max(0.0);
+        sx += v * (i % width) as f64;
+        sy += v * (i / width) as f64;
+        s += v;
+    }
+    (sx / s, sy / s)
+}
+
+#[test]
+fn caustics_match_the_cpu_light_tracer() {
+    let ctx = common::gpu();
+    let mut scene = sphere_over_floor(1.5);
+    // Close to the caustic, beside the sphere.
+    scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.9, 1.2), Vec3::ZERO, 40f32.to_radians()));
+    let size = (64, 64);
+    let base = ["cube_size=128", "spp=4", "caustic_radius=0.03"];
+    let mut q = quality(&base);
+    let off = specula::reference::render_reference(&scene, &q, size).unwrap();
+    q.set("caustics", "triangles").unwrap();
+    let exact = specula::reference::render_reference(&scene, &q, size).unwrap();
+    let truth = caustic_part(&exact, &off);
+    let region: Vec<usize> = (0..truth.len()).filter(|&i| truth[i] > 0.01).collect();
+    assert!(region.len() > 30, "the reference has a caustic of {} pixels", region.len());
+    let peak = truth.iter().cloned().fold(0.0, f64::max);
+    let (cx, cy) = centroid(&truth, 64);
+    let mut errors = Vec::new();
+    for filter in ["splat", "triangles"] {
+        for photons in [32, 64, 128] {
+            let q = quality(&["cube_size=128", &format!("caustics={filter}"), &format!("photons={photons}")]);
+            let gpu = image(&ctx, &scene, &q);
+            let gpu_off = image(&ctx, &scene, &quality(&["cube_size=128"]));
+            let part = caustic_part(&gpu, &gpu_off);
+            let (gx, gy) = centroid(&part, 64);
+            let mse = region.iter().map(|&i| (part[i] - truth[i]).powi(2)).sum::<f64>() / region.len() as f64;
+            let psnr = 10.0 * (peak * peak / mse).log10();
+            let l1: f64 = region.iter().map(|&i| (part[i] - truth[i]).abs()).sum::<f64>() / region.iter().map(|&i| truth[i]).sum::<f64>();
+            eprintln!("   relative L1 {l1:.4}, region {} px", region.len());
+            let shift = ((gx - cx).powi(2) + (gy - cy).powi(2)).sqrt();
+            eprintln!("{filter} photons={photons}: caustic PSNR {psnr:.2} dB (peak {peak:.3}), centroid off by {shift:.2} px");
+            errors.push((filter, photons, psnr, shift, l1));
+        }
+    }
+    // Measured (lavapipe): relative L1 splat 0.33 / 0.23 / 0.20, triangles 0.18 / 0.13 / 0.10
+    // at 32² / 64² / 128² photons; PSNR over the peak splat 39.9, triangles 45.5 dB; the
+    // centroid within 0.9 px. What remains: the light cube's texels and filter (the focus
+    // is sharper in the reference) and the paths the photon pass does not follow (internal
+    // reflections, a dim halo).
+    for filter in ["splat", "triangles"] {
+        let e: Vec<_> = errors.iter().filter(|e| e.0 == filter).collect();
+        assert!(e[0].4 > e[1].4 && e[1].4 > e[2].4, "{filter}: the error falls as photons grow: {e:?}");
+        for x in &e {
+            assert!(x.3 < 1.5, "{filter} {}: centroid {} px off", x.1, x.3);
+            assert!(x.2 > if filter == "splat" { 38.5 } else { 44.0 }, "{filter} {}: {} dB", x.1, x.2);
+        }
+    }
+    let l1 = |f: &str| errors.iter().find(|e| e.0 == f && e.1 == 128).unwrap().4;
+    assert!(l1("triangles") < l1("splat"), "triangles beat splats at equal photons (survey §6.3.2)");
     common::assert_clean(&ctx);
 }

@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // caustics.photons: the photon hit location image (survey §6.1.2, SKALP05/UPSK08). The
 // generator is rasterised from the light; each texel is one photon that follows its path
-// through the generator in the sampled geometry (§4): reflected by a mirror, or refracted
+// through the generator in the sampled geometry (§4): reflected by a mirror (or by a
+// dielectric, in the layers of its reflected branch: caustic_paths=both), or refracted
 // in, searched in the refractor map (§4.4, total internal reflection included) and
 // refracted out, then searched in the generator's receiver distance map to its terminal
 // hit, which is stored in cube-map space (relative to the reference point) with the
@@ -42,7 +43,10 @@ void main() {
     }
     vec3 n = normalize(in_normal);
     if (dot(n, i) > 0.0) n = -n;  // the side the photon arrives on
-    power *= light_visibility(l, p, n);
+    // Occluders between the light and the generator: the shadow map, offset towards the
+    // light (not along the normal: at the silhouette, grazing, the generator would shadow
+    // its own photons).
+    power *= light_visibility(l, p, -i);
     if (all(lessThanEqual(power, vec3(0.0)))) return;
 
     SpecularSplit s = specular_split(m, p, n, p - i);
@@ -50,11 +54,14 @@ void main() {
     vec3 pos = p;
     vec3 dir;
     vec3 w;
-    if (m.kind == KIND_MIRROR || m.thin != 0u) {
-        // A mirror reflects; a thin-walled dielectric lets the photon through undeviated.
-        bool mirror = m.kind == KIND_MIRROR;
-        dir = mirror ? s.r : s.t;
-        w = mirror ? s.fr : s.ft;
+    if (m.kind == KIND_MIRROR || (push.flags & CAUSTIC_REFLECTED) != 0u) {
+        // A mirror reflects, and so does a dielectric in its reflected-branch layer.
+        dir = s.r;
+        w = s.fr;
+    } else if (m.thin != 0u) {
+        // A thin-walled dielectric lets the photon through undeviated.
+        dir = s.t;
+        w = s.ft;
     } else {
         // A solid dielectric: refracted in, then out where the refractor map says, or
         // reflected inside on total internal reflection; the internally reflected share of

@@ -271,6 +271,9 @@ gpu_consts! {
     /// `Push.flags` of the photon pass: the generator's index `(flags >> CAUSTIC_GENERATOR_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_GENERATOR_SHIFT: uint = 8;
+    /// `Push.flags` of the photon pass: this layer's photons take the reflected branch at a
+    /// dielectric generator's surface (else the refracted one).
+    CAUSTIC_REFLECTED: uint = 64;
     CAUSTIC_LIGHT_SHIFT: uint = 20;
     /// Caustic triangles whose corners' distances from the reference point differ by more
     /// than this fraction land on different surfaces (§6.3.2) and are dropped.

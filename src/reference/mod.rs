@@ -45,7 +45,7 @@ pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::met
     family: "reference",
     summary: "the exact CPU reference (f64, SAH BVH, Möller–Trumbore): Whitted recursion through both the reflected and the refracted branch weighted by Fresnel, up to `depth` bounces, the GPU's non-specular shading with exact shadow rays, `spp` stratified samples per pixel, both cores (rayon). Ground truth for the tests and `specula tradeoff`",
     serves: crate::methods::EVERY_CLASS,
-    knobs: &["depth", "spp", "fresnel"],
+    knobs: &["depth", "spp", "fresnel", "caustics", "reference_photons", "caustic_radius"],
     gpu: None,
     fallback: None,
     shape: crate::methods::registry::Shape::Any,

@@ -32,6 +32,9 @@ pub struct LightViews {
     /// 1 (a cone or an orthographic view), or 6 (a cube around a light inside the
     /// generator's bounding sphere).
     pub faces: u32,
+    /// 1, or 2 for a dielectric with `caustic_paths=both`: layers `first_layer + b·faces ..`
+    /// hold branch b (0 refracted, 1 reflected).
+    pub branches: u32,
 }
 
 /// One caustic generator.
@@ -123,14 +126,16 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality, traced_everywher
     let mut layers = 0;
     for o in objects {
         let (centre, radius) = bounding_sphere(scene, o.mesh);
+        let dielectric = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
+        let branches = if dielectric && q.caustic_reflections { 2 } else { 1 };
         let mut lights = Vec::new();
         for (i, l) in scene.lights.iter().enumerate() {
             if !light_sees(l.kind, l.position, l.direction, centre, radius) {
                 continue;
             }
             let faces = if l.kind != LightKind::Directional && light_inside(l.position, centre, radius) { 6 } else { 1 };
-            lights.push(LightViews { light: i, first_layer: layers, faces });
-            layers += faces;
+            lights.push(LightViews { light: i, first_layer: layers, faces, branches });
+            layers += faces * branches;
         }
         if !lights.is_empty() {
             generators.push(Generator { mesh: o.mesh, name: o.name.clone(), reference_point: o.reference_point, lights });
@@ -194,39 +199,45 @@ pub fn photon_views(p: &CausticsPlan, scene: &Scene, lights: &[GpuLight], q: &Qu
     for g in &p.generators {
         let (centre, radius) = bounding_sphere(scene, g.mesh);
         for lv in &g.lights {
-            let l = &lights[lv.light];
-            let pos = Vec3::from_slice(&l.position_range[..3]);
-            let kind = scene.lights[lv.light].kind;
-            if kind == LightKind::Directional {
-                let dir = Vec3::from_slice(&l.direction_kind[..3]).normalize();
-                let vp = crate::frame::views::directional_view_proj(dir, centre, radius);
-                let texel = 2.0 * radius / n;
-                views.push(view(vp, (centre - dir * radius).extend(1.0), dir.extend(texel * texel)));
-                continue;
+            let v = light_views(lv, scene.lights[lv.light].kind, &lights[lv.light], n, near_scale, (centre, radius));
+            // The reflected branch looks from the same place.
+            for _ in 0..lv.branches {
+                views.extend_from_slice(&v);
             }
-            if lv.faces == 6 {
-                for f in 0..6 {
-                    let vp = crate::cube::face_view_proj(f, pos, near_scale);
-                    let axis = crate::cube::FACE_AXES[f][2];
-                    views.push(view(vp, pos.extend(0.0), axis.extend((2.0 / n).powi(2))));
-                }
-                continue;
-            }
-            let to = centre - pos;
-            let d = to.length();
-            let axis = to / d;
-            // The bounding cone, a little wider so that the silhouette's texels are whole.
-            let half = ((radius / d).min(1.0).asin() * 1.02).min(1.5);
-            let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-            let near = ((d - radius) * 0.5).max(near_scale);
-            let mut proj = Mat4::perspective_infinite_reverse_rh(2.0 * half, 1.0, near);
-            proj.y_axis.y = -proj.y_axis.y;
-            let vp = proj * Mat4::look_to_rh(pos, axis, up);
-            let t = half.tan();
-            views.push(view(vp, pos.extend(0.0), axis.extend((2.0 * t / n).powi(2))));
         }
     }
     views
+}
+
+/// The views from which light `lv` sees the sphere (centre, radius): one per face.
+fn light_views(lv: &LightViews, kind: LightKind, l: &GpuLight, n: f32, near_scale: f32, (centre, radius): (Vec3, f32)) -> Vec<GpuView> {
+    let pos = Vec3::from_slice(&l.position_range[..3]);
+    if kind == LightKind::Directional {
+        let dir = Vec3::from_slice(&l.direction_kind[..3]).normalize();
+        let vp = crate::frame::views::directional_view_proj(dir, centre, radius);
+        let texel = 2.0 * radius / n;
+        return vec![view(vp, (centre - dir * radius).extend(1.0), dir.extend(texel * texel))];
+    }
+    if lv.faces == 6 {
+        return (0..6)
+            .map(|f| {
+                let axis = crate::cube::FACE_AXES[f][2];
+                view(crate::cube::face_view_proj(f, pos, near_scale), pos.extend(0.0), axis.extend((2.0 / n).powi(2)))
+            })
+            .collect();
+    }
+    let to = centre - pos;
+    let d = to.length();
+    let axis = to / d;
+    // The bounding cone, a little wider so that the silhouette's texels are whole.
+    let half = ((radius / d).min(1.0).asin() * 1.02).min(1.5);
+    let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let near = ((d - radius) * 0.5).max(near_scale);
+    let mut proj = Mat4::perspective_infinite_reverse_rh(2.0 * half, 1.0, near);
+    proj.y_axis.y = -proj.y_axis.y;
+    let vp = proj * Mat4::look_to_rh(pos, axis, up);
+    let t = half.tan();
+    vec![view(vp, pos.extend(0.0), axis.extend((2.0 * t / n).powi(2)))]
 }
 
 fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {

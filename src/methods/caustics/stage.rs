@@ -9,7 +9,7 @@ use ash::vk;
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticGenerator, GpuCausticParams};
-use crate::frame::layout::{CAUSTIC_DISTANCE_TEST, CAUSTIC_GENERATOR_SHIFT, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION};
+use crate::frame::layout::{CAUSTIC_DISTANCE_TEST, CAUSTIC_GENERATOR_SHIFT, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_REFLECTED};
 use crate::frame::shadow::FAR;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
@@ -226,8 +226,8 @@ impl Stage for CausticsStage {
         let cmd = rec.cmd;
         for (g, gen) in self.plan.generators.iter().enumerate() {
             for lv in &gen.lights {
-                for face in 0..lv.faces {
-                    let layer = lv.first_layer + face;
+                for (branch, face) in (0..lv.branches).flat_map(|b| (0..lv.faces).map(move |f| (b, f))) {
+                    let layer = lv.first_layer + branch * lv.faces + face;
                     rec.barrier(&mut self.photon_depth, Access::DepthAttachment);
                     let colors = [hits.layer_view(layer), power.layer_view(layer)];
                     let t = Target {
@@ -243,7 +243,8 @@ impl Stage for CausticsStage {
                     begin_rendering(ctx, cmd, &t);
                     f.bind(ctx, cmd, self.photon);
                     f.bind_maps(ctx, cmd, io.sets.geometry);
-                    let flags = f.flags | ((g as u32) << CAUSTIC_GENERATOR_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
+                    let reflected = if branch == 1 { CAUSTIC_REFLECTED } else { 0 };
+                    let flags = f.flags | reflected | ((g as u32) << CAUSTIC_GENERATOR_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
                     for d in f.scene.draws.iter().filter(|d| d.mesh as usize == gen.mesh && d.index_count > 0) {
                         f.push_flags(ctx, cmd, io.views.photons + layer, d.mesh, flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
@@ -274,8 +275,8 @@ impl Stage for CausticsStage {
             render_cube_faces(rec, target, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [0.0; 4], |cmd, v| {
                 f.bind(ctx, cmd, self.accumulate);
                 for lv in &gen.lights {
-                    for face in 0..lv.faces {
-                        f.push(ctx, cmd, v, lv.first_layer + face);
+                    for layer in lv.first_layer..lv.first_layer + lv.faces * lv.branches {
+                        f.push(ctx, cmd, v, layer);
                         unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
                     }
                 }
