@@ -11,6 +11,9 @@
 #include "common/scene.glsl"
 
 layout(location = 0) flat out vec3 out_intensity;
+// Small triangles: the centroid in framebuffer texels, and 1 (a tent around it).
+layout(location = 1) flat out vec2 out_centre;
+layout(location = 2) flat out float out_tent;
 
 // Corners of the two triangles of a block, as (dx, dy).
 const ivec2 CORNERS[6] = ivec2[](ivec2(0, 0), ivec2(1, 0), ivec2(0, 1), ivec2(1, 0), ivec2(1, 1), ivec2(0, 1));
@@ -48,6 +51,8 @@ void main() {
     float omega = solid_angle(h[0], h[1], h[2]);
     ok = ok && hi <= lo * (1.0 + CAUSTIC_GAP) && omega > 0.0;
     View v = views[push.view + gl_ViewIndex];
+    out_centre = vec2(0.0);
+    out_tent = 0.0;
     if (!ok) {
         out_intensity = vec3(0.0);
         gl_Position = vec4(0.0, 0.0, 0.0, -1.0);
@@ -55,24 +60,30 @@ void main() {
     }
     out_intensity = flux / (6.0 * omega);
     gl_Position = v.view_proj * vec4(v.eye.xyz + h[k], 1.0);
-    // A triangle smaller than a texel would be drawn into one texel or none, depending on
-    // whether it covers a texel centre: it goes whole into the texel of its centroid
-    // instead (in the face that holds the centroid), so every triangle keeps its flux.
+    // A triangle under a few texels would be drawn into the texels whose centres it covers,
+    // one, two or none: at the photon spacing of a light cube texel that aliases into a
+    // pattern of holes. Such a triangle goes into the 2×2 texels around its centroid
+    // instead, with bilinear (tent) weights that sum to 1 wherever the centroid lies: its
+    // flux is kept, and smoothly. The face that holds the centroid draws it, and a face
+    // whose edge is within a texel of it draws its share.
     vec3 mid = (h[0] + h[1] + h[2]) / 3.0;
     float size = float(caustic.cube_size);
     vec3 ad = abs(mid);
     float major = max(ad.x, max(ad.y, ad.z));
     float texel_omega = (4.0 / (size * size)) * pow(major / length(mid), 3.0);
-    if (omega < texel_omega) {
+    out_tent = 0.0;
+    if (omega < 4.0 * texel_omega) {
         vec4 c = v.view_proj * vec4(v.eye.xyz + mid, 1.0);
         vec2 ndc = c.xy / c.w;
-        if (c.w <= 0.0 || any(greaterThan(abs(ndc), vec2(1.0)))) {
+        if (c.w <= 0.0 || any(greaterThan(abs(ndc), vec2(1.0 + 2.0 / size)))) {
             gl_Position = vec4(0.0, 0.0, 0.0, -1.0);
             return;
         }
-        vec2 texel = (floor((ndc * 0.5 + 0.5) * size) + 0.5) / size * 2.0 - 1.0;  // its centre
-        const vec2 AROUND[3] = vec2[](vec2(-0.4, -0.4), vec2(0.4, -0.4), vec2(0.0, 0.45));
+        // A triangle of legs 4.2 texels holds the 2×2 texels' square around the centroid.
+        const vec2 AROUND[3] = vec2[](vec2(-1.0, -1.0), vec2(3.2, -1.0), vec2(-1.0, 3.2));
+        out_centre = (ndc * 0.5 + 0.5) * size;
+        out_tent = 1.0;
         out_intensity = flux / (6.0 * texel_omega);
-        gl_Position = vec4(texel + AROUND[k] * (2.0 / size), c.z / c.w, 1.0);
+        gl_Position = vec4(ndc + AROUND[k] * (2.0 / size), c.z / c.w, 1.0);
     }
 }
