@@ -531,3 +531,37 @@ fn a_light_inside_the_generators_bounds_sees_it_through_six_views() {
     assert!((ratio - (1.0 - f0)).abs() < 0.02, "{ratio}");
     common::assert_clean(&ctx);
 }
+
+#[test]
+fn every_method_shows_the_caustic() {
+    // The caustic is an effect of the frame, not of the generator's method: the ray tracers'
+    // shading kernels project it like the rasterised passes.
+    let ctx = common::gpu();
+    let mut scene = sphere_over_floor(1.5);
+    scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.9, 1.2), Vec3::ZERO, 40f32.to_radians()));
+    let mut q = quality(&["spp=1", "caustic_radius=0.03"]);
+    let off = specula::reference::render_reference(&scene, &q, (48, 48)).unwrap();
+    q.set("caustics", "triangles").unwrap();
+    let exact = specula::reference::render_reference(&scene, &q, (48, 48)).unwrap();
+    let truth = caustic_part(&exact, &off);
+    let region: Vec<usize> = (0..truth.len()).filter(|&i| truth[i] > 0.01).collect();
+    for m in [
+        specula::methods::ENVMAP,
+        specula::methods::DISTANCE,
+        specula::methods::REFRACTOR_MAP,
+        specula::methods::BVH,
+        specula::methods::RAY_ENGINE,
+    ] {
+        let render = |c: &str| {
+            let q = quality(&["cube_size=128", &format!("caustics={c}")]);
+            let p = plan(&scene, m, &q);
+            assert_eq!(p.caustics.is_some(), c != "off", "{}: {:?}", m.name, p.passes);
+            specula::render_plan(&ctx, &scene, p, (48, 48), (0, 1)).unwrap().image
+        };
+        let part = caustic_part(&render("triangles"), &render("off"));
+        let l1 = region.iter().map(|&i| (part[i] - truth[i]).abs()).sum::<f64>() / region.iter().map(|&i| truth[i]).sum::<f64>();
+        eprintln!("{}: caustic relative L1 {l1:.4}", m.name);
+        assert!(l1 < 0.25, "{}: {l1}", m.name);
+    }
+    common::assert_clean(&ctx);
+}

@@ -25,6 +25,8 @@ void main() {
     accumulate(pl.pixel, w * material_emission(m, s.uv));
     vec3 albedo = material_base_color(m, s.uv);
     vec3 n = dot(s.n, -d) < 0.0 ? -s.n : s.n;  // two-sided
+    // Caustics (§6.3.3): light through specular objects, from their light cube maps.
+    accumulate(pl.pixel, w * albedo / PI * caustic_irradiance(s.p, n));
     for (uint k = 0u; k < push.light_count; ++k) {
         vec3 wi;
         float dist;

@@ -477,9 +477,11 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         stages.push(StageSpec::Upload);
     }
     // Shadows matter only where a diffuse surface receives light, and not at all where a
-    // whole-scene ray tracer shades every pixel with exact shadow rays (survey §2).
+    // whole-scene ray tracer shades every pixel with exact shadow rays (survey §2), unless
+    // caustic photons need them (occluders between a light and a generator).
     let traced_everywhere = matches!(p.choice, Choice::Method(m) if m.family == "raytrace");
-    if has_diffuse && !traced_everywhere {
+    p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q);
+    if has_diffuse && (!traced_everywhere || p.caustics.is_some()) {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),
@@ -540,7 +542,6 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     }
     // Caustics (§6): generators that a light sees; a solid dielectric among them needs its
     // refractor map for the photons' paths inside it, whatever its own method.
-    p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q, traced_everywhere);
     if let Some(c) = &p.caustics {
         let refractor = crate::methods::distance::REFRACTOR_CUBES;
         for g in &c.generators {

@@ -112,11 +112,10 @@ fn light_inside(position: Vec3, centre: Vec3, radius: f32) -> bool {
 }
 
 /// The caustics stage the scene needs under `q`, or none: caustics are off, no diffuse
-/// surface receives them, no punctual light, or no specular object a light sees.
-/// A whole-scene ray tracer (§2) shades its pixels by shadow rays in compute kernels that
-/// do not project caustics: it gets none.
-pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality, traced_everywhere: bool) -> Option<CausticsPlan> {
-    if q.caustics == Caustics::Off || traced_everywhere || scene.lights.is_empty() {
+/// surface receives them, no punctual light, or no specular object a light sees. Every
+/// method's diffuse shading projects them, the ray tracers' (§2) shading kernels too.
+pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<CausticsPlan> {
+    if q.caustics == Caustics::Off || scene.lights.is_empty() {
         return None;
     }
     if !scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular()) {

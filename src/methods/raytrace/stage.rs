@@ -677,13 +677,13 @@ impl Stage for RayTrace {
         let compute = vk::PipelineBindPoint::COMPUTE;
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
 
-        // 1. Primary hits by rasterisation, then the first queue.
-        let open = rec
-            .pass("raytrace.primary")
-            .after_buffer_writes()
-            .writes(vis, Access::ColorAttachment)
-            .writes(vis_depth, Access::DepthAttachment)
-            .begin();
+        // 1. Primary hits by rasterisation, then the first queue. The shading kernels
+        // project the caustics (§6.3.3): their maps are read by compute.
+        let mut pass = rec.pass("raytrace.primary");
+        for img in [io.maps.caustic_distances.as_ref(), io.maps.caustic_maps.as_ref()].into_iter().flatten() {
+            pass = pass.reads(img, Access::ComputeSampled);
+        }
+        let open = pass.after_buffer_writes().writes(vis, Access::ColorAttachment).writes(vis_depth, Access::DepthAttachment).begin();
         unsafe {
             ctx.device.cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0);
             ctx.device.cmd_fill_buffer(cmd, self.accum.raw, 0, vk::WHOLE_SIZE, 0);
