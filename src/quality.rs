@@ -264,7 +264,7 @@ pub const KNOBS: &[Knob] = &[
         name: "cube_mode",
         values: "six|multiview",
         default: "six",
-        doc: "cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md)",
+        doc: "cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md; lavapipe's multiview puts large clipped triangles on wrong faces: use six there); the caustics' cubes always take six passes",
         set: |q, v| {
             q.cube_mode = one_of(v, CUBE_MODES)?;
             Ok(())
@@ -601,7 +601,7 @@ pub const KNOBS: &[Knob] = &[
     Knob {
         name: "caustics",
         values: "off|splat|triangles",
-        default: "off",
+        default: "triangles",
         doc: "caustics (§6): photons from each punctual light traced through each caustic generator in its maps, stored as hits in cube-map space, then splatted (photon splatting) or meshed into caustic triangles (flux over area) into a light cube map around the generator, filtered, and projected onto diffuse surfaces with a distance test; the CPU reference adds light-traced caustics",
         set: |q, v| {
             q.caustics = one_of(v, CAUSTICS)?;
@@ -739,7 +739,7 @@ impl Default for Quality {
             aa: Aa::Off,
             msaa_per_sample: true,
             mirror_budget: 8,
-            caustics: Caustics::Off,
+            caustics: Caustics::Triangles,
             photons: 128,
             splat_size: 2.0,
             caustic_filter: 1,

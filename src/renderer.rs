@@ -59,6 +59,11 @@ enum Deps {
     EveryFrame,
     /// Shadow maps: the geometry and the lights (not materials, not the camera).
     Shadows,
+    /// Maps of the geometry alone (refractor maps): what moved.
+    Geometry,
+    /// Caustics (§6): the geometry, the lights and the generators' materials (the
+    /// receivers' albedo is applied when they are shaded).
+    Caustics,
     /// Maps around objects (environment, distance, refractor): everything they see, which
     /// is the whole scene's geometry, materials and lights, but not the camera.
     World,
@@ -420,7 +425,9 @@ impl Renderer {
                 StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
                 StageSpec::Shadows => Deps::Shadows,
                 StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
-                StageSpec::Map(_) | StageSpec::Caustics => Deps::World,
+                StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
+                StageSpec::Caustics => Deps::Caustics,
+                StageSpec::Map(_) => Deps::World,
             });
             let stage: Box<dyn Stage> = match spec {
                 // The scene records its own upload (first frame only).
@@ -544,6 +551,9 @@ impl Renderer {
         let materials = names(&c.materials, &|i| format!("'{}'", self.cpu.materials[i].name));
         let lights = names(&c.lights, &|i| format!("'{}'", self.cpu.lights[i].name));
         let q = &self.plan.quality;
+        let generators: Vec<usize> =
+            self.plan.caustics.as_ref().map_or_else(Vec::new, |p| p.generators.iter().map(|g| self.cpu.meshes[g.mesh].material).collect());
+        let generator_materials = c.materials.iter().any(|m| generators.contains(m));
         for (i, deps) in self.deps.iter().enumerate() {
             let mut why = Vec::new();
             if self.first_frame {
@@ -555,6 +565,8 @@ impl Renderer {
                 let (g, m, l, cam) = match deps {
                     Deps::EveryFrame => continue,
                     Deps::Shadows => (geometry, false, !c.lights.is_empty(), false),
+                    Deps::Geometry => (geometry, false, false, false),
+                    Deps::Caustics => (geometry, generator_materials, !c.lights.is_empty(), false),
                     Deps::World => (geometry, !c.materials.is_empty(), !c.lights.is_empty(), false),
                     Deps::CameraMap => (geometry, false, false, c.camera),
                 };

@@ -191,7 +191,21 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     q.set("cube_size", "64").unwrap();
     let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
-    assert_eq!(names, ["shadow.generate", "envmap.generate", "scene.direct", "envmap.shade", "frame.readback"]);
+    // The lit mirror over the floor is a caustic generator (§6): its four passes.
+    assert_eq!(
+        names,
+        [
+            "shadow.generate",
+            "caustics.receivers",
+            "caustics.photons",
+            "caustics.triangles",
+            "caustics.filter",
+            "envmap.generate",
+            "scene.direct",
+            "envmap.shade",
+            "frame.readback"
+        ]
+    );
     let cubes = f.memory.iter().find(|(n, _)| n == "envmap.cubes").unwrap().1;
     assert!(cubes >= 64 * 64 * 6 * 8, "RGBA16F cube of 64²×6: {cubes} bytes");
     assert!(cubes < 2 * 64 * 64 * 6 * 8);

@@ -135,7 +135,8 @@ fn only_what_changed_is_rebuilt() {
     r.update(&scene).unwrap();
     let f = r.render(&ctx).unwrap();
     let rebuilt: Vec<(&str, &str)> = f.map_updates.iter().map(|u| (u.stage, u.reason.as_str())).collect();
-    assert_eq!(rebuilt, vec![("shadow.generate", "light 'light'"), ("distance.generate", "light 'light'")]);
+    // The caustics too (they are lit); not the refractor maps (geometry alone).
+    assert_eq!(rebuilt, vec![("shadow.generate", "light 'light'"), ("caustics", "light 'light'"), ("distance.generate", "light 'light'")]);
     assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::DISTANCE, &q));
 
     // A material: the maps that see it, not the shadow maps.
@@ -232,7 +233,9 @@ fn cube_faces_draw_only_what_they_see() {
     })
     .unwrap();
     s.camera = Some(specula::scene::Camera::look_at(Vec3::new(0.0, 1.5, 4.0), Vec3::new(1.0, 1.0, 0.0), 1.0));
-    let q = quality();
+    // Caustics off: lavapipe's multiview rasterises the mirror ball's caustic triangles to
+    // within 1e-4 of six passes, not bit for bit (tests/caustics.rs compares the two modes).
+    let q = Quality { caustics: specula::quality::Caustics::Off, ..quality() };
     let mut r = renderer(&ctx, &s, specula::methods::ENVMAP, &q);
     let f = r.render(&ctx).unwrap();
     let stat = |name: &str| {

@@ -108,7 +108,8 @@ impl Maps {
     /// generation and one for the camera passes, an all-null one and one of the refractor
     /// maps alone; none without set-1 maps.
     pub fn set_count(&self) -> usize {
-        if self.distance.is_empty() && self.refractor.is_none() && self.backfaces.is_none() {
+        // Caustic photons bind set 1 (a refractor map, or nothing for a mirror).
+        if self.distance.is_empty() && self.refractor.is_none() && self.backfaces.is_none() && self.caustic_distances.is_none() {
             0
         } else {
             2 * self.distance.len() + 2

@@ -156,8 +156,8 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
     let n = q.photons as u64;
     let g = p.generators.len() as u64;
     let light_cubes = if q.caustic_filter > 0 { 2 } else { 1 };
-    let depth_layers = if q.cube_mode == crate::quality::CubeMode::Multiview { 6 } else { 1 };
-    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + depth_layers * s * s * 4
+    // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
+    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4
 }
 
 /// What `specula plan` says of it.
