@@ -290,8 +290,8 @@ impl Stage for CausticsStage {
         if filtering {
             let (Some(light), Some(raw)) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_ref()) else { return };
             let open = rec.pass("caustics.filter").writes(light, Access::ColorAttachment).reads(raw, Access::FragmentSampled).begin();
-            for g in 0..self.plan.generators.len() {
-                render_cube_faces(rec, light, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [0.0; 4], |cmd, v| {
+            for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.generators.len()) {
+                render_cube_faces(rec, light, &mut self.cube_depth, g as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                     f.bind(ctx, cmd, self.box_filter);
                     f.push(ctx, cmd, v, g as u32);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
