@@ -121,11 +121,24 @@ pub struct Quality {
     /// Caustics: dielectric generators also send their reflected photons (else only the
     /// refracted ones, the stronger branch).
     pub caustic_reflections: bool,
+    /// Caustics: where the photon hits and the light cube maps live (survey §6.1.2).
+    pub caustic_space: CausticSpace,
     /// CPU reference: photons traced per light and caustic generator.
     pub reference_photons: u32,
     /// CPU reference: radius of the caustic density estimate (metres); `None`: 0.5 % of
     /// the scene's bounding-box diagonal.
     pub caustic_radius: Option<f32>,
+}
+
+/// Where caustic photon hits are stored and projected from (survey §6.1.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CausticSpace {
+    /// Cube-map space (UPSK08): one cube per generator, around its reference point.
+    Cube,
+    /// Light space (the shadow-map space of SP07): one cube per generator and point or spot
+    /// light, around the light; directional lights stay in cube-map space.
+    Light,
 }
 
 /// How caustics are rendered (survey §6.3).
@@ -234,6 +247,7 @@ const MAP_UPDATES: &[(&str, bool)] = &[("on_change", false), ("always", true)];
 const KD_TRAVERSALS: &[(&str, bool)] = &[("short-stack", false), ("restart", true)];
 const BVH_TRAVERSALS: &[(&str, bool)] = &[("stack", false), ("stackless", true)];
 const CAUSTICS: &[(&str, Caustics)] = &[("off", Caustics::Off), ("splat", Caustics::Splat), ("triangles", Caustics::Triangles)];
+const CAUSTIC_SPACES: &[(&str, CausticSpace)] = &[("cube", CausticSpace::Cube), ("light", CausticSpace::Light)];
 const CAUSTIC_PATHS: &[(&str, bool)] = &[("both", true), ("refracted", false)];
 const PLANNERS: &[(&str, Planner)] = &[("accuracy", Planner::Accuracy), ("speed", Planner::Speed)];
 
@@ -665,6 +679,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.caustic_orientation, ON_OFF),
     },
     Knob {
+        name: "caustic_space",
+        values: "cube|light",
+        default: "cube",
+        doc: "caustics: photon hits stored and projected in cube-map space, one light cube map per generator around its reference point (UPSK08), or in light space, one per generator and point or spot light around the light (the shadow-map space of SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md)",
+        set: |q, v| {
+            q.caustic_space = one_of(v, CAUSTIC_SPACES)?;
+            Ok(())
+        },
+        get: |q| name_of(q.caustic_space, CAUSTIC_SPACES),
+    },
+    Knob {
         name: "caustic_paths",
         values: "both|refracted",
         default: "both",
@@ -746,6 +771,7 @@ impl Default for Quality {
             caustic_distance_test: true,
             caustic_orientation: true,
             caustic_reflections: true,
+            caustic_space: CausticSpace::Cube,
             reference_photons: 1_000_000,
             caustic_radius: None,
         }

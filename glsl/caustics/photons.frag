@@ -6,7 +6,8 @@
 // dielectric, in the layers of its reflected branch: caustic_paths=both), or refracted
 // in, searched in the refractor map (§4.4, total internal reflection included) and
 // refracted out, then searched in the generator's receiver distance map to its terminal
-// hit, which is stored in cube-map space (relative to the reference point) with the
+// hit, which is stored relative to its caustic cube's centre (the generator's reference point
+// in cube-map space, UPSK08; the light in light space, SP07) with the
 // photon's power: the light's intensity × the texel's solid angle (its area for a
 // directional light) × the Fresnel transmittances along the path.
 #include "common/specular.glsl"
@@ -24,7 +25,7 @@ void main() {
     out_power = vec4(0.0);
     Object o = objects[push.object];
     Material m = materials[o.material];
-    uint g = (push.flags >> CAUSTIC_GENERATOR_SHIFT) & 0xffu;
+    uint cube = (push.flags >> CAUSTIC_CUBE_SHIFT) & 0xffu;
     Light l = lights[push.flags >> CAUSTIC_LIGHT_SHIFT];
     View v = views[in_view];
     vec3 p = in_position;
@@ -50,7 +51,7 @@ void main() {
     if (all(lessThanEqual(power, vec3(0.0)))) return;
 
     SpecularSplit s = specular_split(m, p, n, p - i);
-    vec3 ref = generators[g].reference_point.xyz;
+    vec3 centre = cubes[cube].centre.xyz;
     vec3 pos = p;
     vec3 dir;
     vec3 w;
@@ -98,8 +99,8 @@ void main() {
     }
     // The terminal hit on the receivers: the §4 search in the receiver distance map.
     search_map = 2;
-    search_layer = float(g);
-    vec3 x = pos - ref;
+    search_layer = float(cube);
+    vec3 x = pos - centre;
     SearchResult h = search_ray(x, dir);
     if (h.escaped) return;
     out_hit = vec4(x + dir * h.d, 1.0);

@@ -1,6 +1,6 @@
 // caustics.project (survey §6.3.3): the caustic irradiance at a diffuse point, looked up in
-// each generator's light cube map in the point's direction from the reference point. The
-// map holds radiant intensity J seen from there, so a receiver at distance D whose normal
+// each caustic cube's light cube map in the point's direction from the cube's centre (a
+// generator's reference point, or a light). The map holds radiant intensity J seen from there, so a receiver at distance D whose normal
 // makes the angle α with that direction receives E = J cos α / D². The shadow-map-like
 // distance test stops light leaks: the point takes the caustic only if it is the surface
 // the receiver distance map holds in that direction. Receivers facing away from the
@@ -11,11 +11,11 @@
 // n: the receiver's normal on the side it is seen from.
 vec3 caustic_irradiance(vec3 p, vec3 n) {
     vec3 e = vec3(0.0);
-    uint count = caustic.generator_count;
+    uint count = caustic.cube_count;
     if (count == 0u) return e;
     float texel = 2.0 / float(caustic.cube_size);
     for (uint g = 0u; g < count; ++g) {
-        vec3 w = p - generators[g].reference_point.xyz;
+        vec3 w = p - cubes[g].centre.xyz;
         float d = length(w);
         if (!(d > 0.0)) continue;
         vec3 dir = w / d;

@@ -4,7 +4,7 @@
 // caustics.splat: photon splatting (survey §6.3.1). One quad per texel of the photon hit
 // location image (layer push.object), placed by this shader from the image: no readback.
 // Drawn into each face of the generator's light cube map (view push.view + gl_ViewIndex:
-// the face's view around the reference point), so a splat near an edge reaches both faces.
+// the face's view around the cube's centre), so a splat near an edge reaches both faces.
 #include "common/scene.glsl"
 
 layout(location = 0) out vec2 out_offset;

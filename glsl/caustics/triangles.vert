@@ -5,8 +5,8 @@
 // photons of the hit location image (layer push.object) makes two triangles on the
 // receivers; a triangle carries a sixth of each corner's power (each photon belongs to six
 // triangles of the grid) and its radiant intensity is that flux over the triangle's solid
-// angle seen from the reference point (flux conservation). Triangles with a missing
-// corner, or whose corners lie at distances from the reference point more than CAUSTIC_GAP
+// angle seen from the cube's centre (flux conservation). Triangles with a missing
+// corner, or whose corners lie at distances from the centre more than CAUSTIC_GAP
 // apart (different surfaces), are dropped. Drawn into each face of the light cube map.
 #include "common/scene.glsl"
 

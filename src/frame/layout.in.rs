@@ -182,12 +182,12 @@ gpu_structs! {
         pad: uint,
     }
 
-    /// One caustic generator (survey §6): a specular object that a light sees. Its light cube
-    /// map and its receiver distance map are cubes around its reference point, in layer
-    /// `index` of `caustic_maps` and `caustic_distances`.
-    struct GpuCausticGenerator => struct CausticGenerator {
-        /// xyz: the reference point; w: unused
-        reference_point: vec4,
+    /// One caustic cube (survey §6): a light cube map and its receiver distance map, cube
+    /// `index` of `caustic_maps` and `caustic_distances`, around a centre: a generator's
+    /// reference point (`caustic_space=cube`), or a light (`caustic_space=light`).
+    struct GpuCausticCube => struct CausticCube {
+        /// xyz: the centre; w: unused
+        centre: vec4,
         /// the generator's mesh (its `objects` entry)
         mesh: uint,
         pad: [uint; 3],
@@ -195,8 +195,8 @@ gpu_structs! {
 
     /// What the caustic passes and the projection share (the header of `Caustics`).
     struct GpuCausticParams => struct CausticParams {
-        /// generators in `generators` (0: the scene has no caustics)
-        generator_count: uint,
+        /// cubes in `cubes` (0: the scene has no caustics)
+        cube_count: uint,
         /// edge of the photon hit location images
         photon_size: uint,
         /// edge of each face of the light cube and receiver distance maps
@@ -268,9 +268,9 @@ gpu_consts! {
     CAUSTIC_DISTANCE_TEST: uint = 1;
     /// `CausticParams.flags`: the receiver-orientation factor cos α of the projection.
     CAUSTIC_ORIENTATION: uint = 2;
-    /// `Push.flags` of the photon pass: the generator's index `(flags >> CAUSTIC_GENERATOR_SHIFT)
+    /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
-    CAUSTIC_GENERATOR_SHIFT: uint = 8;
+    CAUSTIC_CUBE_SHIFT: uint = 8;
     /// `Push.flags` of the photon pass: this layer's photons take the reflected branch at a
     /// dielectric generator's surface (else the refracted one).
     CAUSTIC_REFLECTED: uint = 64;
@@ -308,19 +308,19 @@ descriptor_sets! {
         /// renders into a scratch target while it samples its children here, and is copied
         /// into its layer afterwards.
         MIRROR_VIEWS = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views";
-        /// Caustics (§6): per generator, the distance of the nearest receiver (everything but
-        /// the generator) from its reference point, the terminal hits' search map and the
-        /// projection's distance test.
+        /// Caustics (§6): per caustic cube, the distance of the nearest receiver (everything but
+        /// the generator) from its centre, the terminal hits' search map and the projection's
+        /// distance test.
         CAUSTIC_DISTANCES = 10: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_distances";
-        /// Caustics: per generator, the light cube map: radiant intensity J (W/sr) of the
-        /// caustic as seen from the reference point, the projection's input.
+        /// Caustics: per caustic cube, the light cube map: radiant intensity J (W/sr) of the
+        /// caustic as seen from its centre, the projection's input.
         CAUSTIC_MAPS = 11: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_maps";
         /// Caustics: photon hit location images, one layer per light view of a generator:
-        /// xyz the hit relative to the reference point (cube-map space), w 1 for a photon.
+        /// xyz the hit relative to its cube's centre, w 1 for a photon.
         PHOTON_HITS = 12: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_hits";
         /// Caustics: the photons' power (rgb, W).
         PHOTON_POWER = 13: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_power";
-        CAUSTICS = 14: STORAGE_BUFFER => "readonly buffer Caustics { CausticParams caustic; CausticGenerator generators[]; }";
+        CAUSTICS = 14: STORAGE_BUFFER => "readonly buffer Caustics { CausticParams caustic; CausticCube cubes[]; }";
         /// Caustics: the light cube maps before filtering (the filter pass reads them).
         CAUSTIC_RAW = 15: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_raw";
     }

@@ -31,7 +31,7 @@ impl ViewLayout {
         v.mirrors = v.count;
         v.count += plan.mirror_layers;
         if let Some(c) = &plan.caustics {
-            for _ in &c.generators {
+            for _ in &c.cubes {
                 v.caustic_cubes.push(v.count);
                 v.count += 6;
             }
@@ -99,10 +99,10 @@ pub fn view_table(
         }
     }
     if let Some(c) = &plan.caustics {
-        for (g, &base) in c.generators.iter().zip(&layout.caustic_cubes) {
+        for (k, &base) in layout.caustic_cubes.iter().enumerate() {
+            let centre = c.centre(k, lights);
             for f in 0..6 {
-                views[(base + f) as usize] =
-                    view(face_view_proj(f as usize, g.reference_point, near), g.reference_point.extend(0.0), Vec4::ZERO);
+                views[(base + f) as usize] = view(face_view_proj(f as usize, centre, near), centre.extend(0.0), Vec4::ZERO);
             }
         }
         for (i, v) in photon_views.iter().enumerate() {

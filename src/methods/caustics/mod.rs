@@ -21,7 +21,7 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::gpu_scene::{GpuLight, GpuView};
 use crate::plan::{ObjectPlan, Plan};
-use crate::quality::{Caustics, Quality};
+use crate::quality::{CausticSpace, Caustics, Quality};
 use crate::scene::{LightKind, Scene};
 
 /// One light's views of a generator: layers `first_layer ..` of the photon images.
@@ -35,6 +35,18 @@ pub struct LightViews {
     /// 1, or 2 for a dielectric with `caustic_paths=both`: layers `first_layer + b·faces ..`
     /// hold branch b (0 refracted, 1 reflected).
     pub branches: u32,
+    /// The caustic cube its photons land in (`CausticsPlan::cubes`).
+    pub cube: u32,
+}
+
+/// One caustic cube: a receiver distance cube and a light cube map around a centre.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CausticCube {
+    /// Index into `CausticsPlan::generators`.
+    pub generator: usize,
+    /// `Some(light)`: centred at that light (light space); `None`: at the generator's
+    /// reference point (cube-map space).
+    pub light: Option<usize>,
 }
 
 /// One caustic generator.
@@ -60,6 +72,9 @@ pub struct CausticsPlan {
     /// `Splat` or `Triangles`.
     pub filter: Caustics,
     pub generators: Vec<Generator>,
+    /// The caustic cubes, in layer order of the cube arrays.
+    pub cubes: Vec<CausticCube>,
+    pub space: CausticSpace,
     /// Layers of the photon images: Σ faces over every generator's lights.
     pub photon_layers: u32,
     /// Device memory of its images.
@@ -67,6 +82,15 @@ pub struct CausticsPlan {
 }
 
 impl CausticsPlan {
+    /// Where cube `c` is this frame: its light's position, or its generator's reference point.
+    pub fn centre(&self, c: usize, lights: &[GpuLight]) -> Vec3 {
+        let cube = &self.cubes[c];
+        match cube.light {
+            Some(l) => Vec3::from_slice(&lights[l].position_range[..3]),
+            None => self.generators[cube.generator].reference_point,
+        }
+    }
+
     /// The profiled passes it records, in order.
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
@@ -122,18 +146,31 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
         return None;
     }
     let mut generators = Vec::new();
+    let mut cubes: Vec<CausticCube> = Vec::new();
     let mut layers = 0;
     for o in objects {
         let (centre, radius) = bounding_sphere(scene, o.mesh);
         let dielectric = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
         let branches = if dielectric && q.caustic_reflections { 2 } else { 1 };
         let mut lights = Vec::new();
+        let g = generators.len();
+        let first_cube = cubes.len();
         for (i, l) in scene.lights.iter().enumerate() {
             if !light_sees(l.kind, l.position, l.direction, centre, radius) {
                 continue;
             }
             let faces = if l.kind != LightKind::Directional && light_inside(l.position, centre, radius) { 6 } else { 1 };
-            lights.push(LightViews { light: i, first_layer: layers, faces, branches });
+            // Light space centres a cube at each point or spot light; everything else shares
+            // the generator's cube around its reference point.
+            let light = (q.caustic_space == CausticSpace::Light && l.kind != LightKind::Directional).then_some(i);
+            let cube = match cubes[first_cube..].iter().position(|c| c.light == light) {
+                Some(k) => first_cube + k,
+                None => {
+                    cubes.push(CausticCube { generator: g, light });
+                    cubes.len() - 1
+                }
+            };
+            lights.push(LightViews { light: i, first_layer: layers, faces, branches, cube: cube as u32 });
             layers += faces * branches;
         }
         if !lights.is_empty() {
@@ -143,18 +180,18 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
     if generators.is_empty() {
         return None;
     }
-    let mut p = CausticsPlan { filter: q.caustics, generators, photon_layers: layers, bytes: 0 };
+    let mut p = CausticsPlan { filter: q.caustics, generators, cubes, space: q.caustic_space, photon_layers: layers, bytes: 0 };
     p.bytes = bytes(&p, q);
     Some(p)
 }
 
-/// Device memory: per generator a receiver distance cube (R32F) and a light cube map
+/// Device memory: per caustic cube a receiver distance cube (R32F) and a light cube map
 /// (RGBA32F, two with filtering), the photon images (two RGBA32F layers per view and a
 /// depth buffer), the receivers' depth buffer.
 pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
     let s = q.cube_size as u64;
     let n = q.photons as u64;
-    let g = p.generators.len() as u64;
+    let g = p.cubes.len() as u64;
     let light_cubes = if q.caustic_filter > 0 { 2 } else { 1 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
     g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4
@@ -163,9 +200,11 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
 /// What `specula plan` says of it.
 pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
     let mut s = format!(
-        "caustics ({}): {} photons² per light view, light cubes 6×{}² RGBA32F{}, {:.2} MiB",
+        "caustics ({}, {} space): {} photons² per light view, {} light cube(s) 6×{}² RGBA32F{}, {:.2} MiB",
         if p.filter == Caustics::Splat { format!("splat, splat_size {}", q.splat_size) } else { "triangles".into() },
+        if p.space == CausticSpace::Light { "light" } else { "cube-map" },
         q.photons,
+        p.cubes.len(),
         q.cube_size,
         if q.caustic_filter > 0 { format!(", box filter radius {}", q.caustic_filter) } else { String::new() },
         p.bytes as f64 / (1 << 20) as f64

@@ -8,8 +8,8 @@ use ash::vk;
 
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
-use crate::frame::layout::{GpuCausticGenerator, GpuCausticParams};
-use crate::frame::layout::{CAUSTIC_DISTANCE_TEST, CAUSTIC_GENERATOR_SHIFT, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_REFLECTED};
+use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
+use crate::frame::layout::{CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_REFLECTED};
 use crate::frame::shadow::FAR;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
@@ -35,12 +35,12 @@ pub struct CausticsStage {
     box_filter: vk::Pipeline,
 }
 
-/// The generator table the shaders read (`Caustics`, set 0).
-pub fn table(plan: &CausticsPlan, q: &Quality) -> (GpuCausticParams, Vec<GpuCausticGenerator>) {
+/// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
+pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (GpuCausticParams, Vec<GpuCausticCube>) {
     let flags =
         if q.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 } | if q.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 };
     let params = GpuCausticParams {
-        generator_count: plan.generators.len() as u32,
+        cube_count: plan.cubes.len() as u32,
         photon_size: q.photons,
         cube_size: q.cube_size,
         flags,
@@ -48,18 +48,21 @@ pub fn table(plan: &CausticsPlan, q: &Quality) -> (GpuCausticParams, Vec<GpuCaus
         filter_radius: q.caustic_filter,
         pad: [0; 2],
     };
-    let gens = plan
-        .generators
+    let cubes = plan
+        .cubes
         .iter()
-        .map(|g| GpuCausticGenerator { reference_point: g.reference_point.extend(0.0).to_array(), mesh: g.mesh as u32, pad: [0; 3] })
+        .map(|c| {
+            let centre = c.light.map_or(plan.generators[c.generator].reference_point, |l| scene.lights[l].position);
+            GpuCausticCube { centre: centre.extend(0.0).to_array(), mesh: plan.generators[c.generator].mesh as u32, pad: [0; 3] }
+        })
         .collect();
-    (params, gens)
+    (params, cubes)
 }
 
-fn table_bytes(plan: &CausticsPlan, q: &Quality) -> Vec<u8> {
-    let (params, gens) = table(plan, q);
+fn table_bytes(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> Vec<u8> {
+    let (params, cubes) = table(plan, q, scene);
     let mut bytes = bytemuck::bytes_of(&params).to_vec();
-    bytes.extend_from_slice(bytemuck::cast_slice(&gens));
+    bytes.extend_from_slice(bytemuck::cast_slice(&cubes));
     bytes
 }
 
@@ -88,7 +91,7 @@ impl CausticsStage {
     fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
         let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
         let (s, n) = (q.cube_size, q.photons);
-        let cubes = self.plan.generators.len() as u32;
+        let cubes = self.plan.cubes.len() as u32;
         let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let cube = |name, format| {
             Image::new(ctx, &ImageDesc { name, format, width: s, height: s, kind: ImageKind::CubeArray { cubes }, usage: attach })
@@ -102,7 +105,7 @@ impl CausticsStage {
         let photon = |name| Image::new(ctx, &ImageDesc { name, format: HIT_FORMAT, width: n, height: n, kind: layers, usage: attach });
         maps.photon_hits = Some(photon("caustics.photon_hits")?);
         maps.photon_power = Some(photon("caustics.photon_power")?);
-        let bytes = table_bytes(&self.plan, q);
+        let bytes = table_bytes(&self.plan, q, init.scene);
         maps.caustics = Some(Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         self.cube_depth = cube_depth(ctx, "caustics.depth", s, self.mode)?;
         self.photon_depth = Image::new(
@@ -178,6 +181,7 @@ impl Stage for CausticsStage {
     fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
         vec![
             ("caustics.generators".into(), self.plan.generators.len() as f64),
+            ("caustics.cubes".into(), self.plan.cubes.len() as f64),
             ("caustics.photon_layers".into(), self.plan.photon_layers as f64),
         ]
     }
@@ -190,7 +194,7 @@ impl Stage for CausticsStage {
             }
         }
         if let Some(b) = maps.caustics.as_mut() {
-            b.write(&table_bytes(&self.plan, &init.plan.quality))?;
+            b.write(&table_bytes(&self.plan, &init.plan.quality, init.scene))?;
         }
         Ok(())
     }
@@ -207,10 +211,11 @@ impl Stage for CausticsStage {
 
         // The receivers: everything but the generator, from its reference point.
         let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
-        for (g, gen) in self.plan.generators.iter().enumerate() {
-            render_cube_faces(rec, distances, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [FAR, 0.0, 0.0, 0.0], |cmd, v| {
+        for (k, cube) in self.plan.cubes.iter().enumerate() {
+            let mesh = self.plan.generators[cube.generator].mesh;
+            render_cube_faces(rec, distances, &mut self.cube_depth, k as u32, cube_views[k], self.mode, [FAR, 0.0, 0.0, 0.0], |cmd, v| {
                 f.bind(ctx, cmd, self.receivers);
-                for d in f.scene.draws.iter().filter(|d| d.mesh as usize != gen.mesh && d.index_count > 0) {
+                for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh && d.index_count > 0) {
                     f.draw(ctx, cmd, v, d);
                 }
             });
@@ -227,7 +232,7 @@ impl Stage for CausticsStage {
         }
         let open = pass.begin();
         let cmd = rec.cmd;
-        for (g, gen) in self.plan.generators.iter().enumerate() {
+        for gen in &self.plan.generators {
             for lv in &gen.lights {
                 for (branch, face) in (0..lv.branches).flat_map(|b| (0..lv.faces).map(move |f| (b, f))) {
                     let layer = lv.first_layer + branch * lv.faces + face;
@@ -247,7 +252,7 @@ impl Stage for CausticsStage {
                     f.bind(ctx, cmd, self.photon);
                     f.bind_maps(ctx, cmd, io.sets.geometry);
                     let reflected = if branch == 1 { CAUSTIC_REFLECTED } else { 0 };
-                    let flags = f.flags | reflected | ((g as u32) << CAUSTIC_GENERATOR_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
+                    let flags = f.flags | reflected | (lv.cube << CAUSTIC_CUBE_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
                     for d in f.scene.draws.iter().filter(|d| d.mesh as usize == gen.mesh && d.index_count > 0) {
                         f.push_flags(ctx, cmd, io.views.photons + layer, d.mesh, flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
@@ -274,10 +279,11 @@ impl Stage for CausticsStage {
             .reads(power, Access::VertexSampled)
             .begin();
         let vertices = self.vertices();
-        for (g, gen) in self.plan.generators.iter().enumerate() {
-            render_cube_faces(rec, target, &mut self.cube_depth, g as u32, cube_views[g], self.mode, [0.0; 4], |cmd, v| {
+        let plan = &self.plan;
+        for (k, &first_view) in cube_views.iter().enumerate().take(plan.cubes.len()) {
+            render_cube_faces(rec, target, &mut self.cube_depth, k as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                 f.bind(ctx, cmd, self.accumulate);
-                for lv in &gen.lights {
+                for lv in plan.generators.iter().flat_map(|g| &g.lights).filter(|lv| lv.cube as usize == k) {
                     for layer in lv.first_layer..lv.first_layer + lv.faces * lv.branches {
                         f.push(ctx, cmd, v, layer);
                         unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
@@ -290,7 +296,7 @@ impl Stage for CausticsStage {
         if filtering {
             let (Some(light), Some(raw)) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_ref()) else { return };
             let open = rec.pass("caustics.filter").writes(light, Access::ColorAttachment).reads(raw, Access::FragmentSampled).begin();
-            for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.generators.len()) {
+            for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.cubes.len()) {
                 render_cube_faces(rec, light, &mut self.cube_depth, g as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                     f.bind(ctx, cmd, self.box_filter);
                     f.push(ctx, cmd, v, g as u32);
