@@ -422,7 +422,7 @@ impl Renderer {
         };
         for spec in &self.plan.stages {
             self.deps.push(match spec {
-                StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
+                StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) | StageSpec::CausticsProject => Deps::EveryFrame,
                 StageSpec::Shadows => Deps::Shadows,
                 StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
                 StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
@@ -439,6 +439,7 @@ impl Renderer {
                 StageSpec::Direct => Box::new(SceneDirect::new(ctx, self.layout, self.multisample)?),
                 StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
                 StageSpec::Caustics => crate::methods::caustics::stage::CausticsStage::create(&init, &mut self.maps)?,
+                StageSpec::CausticsProject => crate::methods::caustics::project::CausticsProject::create(&init)?,
                 StageSpec::Camera(c) => match c.pass.create {
                     Some(create) => create(&init, c)?,
                     None => Box::new(CameraShade::new(ctx, self.layout, c, self.multisample)?),

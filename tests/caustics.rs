@@ -128,7 +128,7 @@ fn caustic_power_matches_the_fresnel_transmittances() {
         eprintln!("{filter} photons={photons}: power {power:.4} W, closed form {expected:.4} W, ratio {ratio:.4}");
         assert!((lo..=1.005).contains(&ratio), "{filter} {photons}: {ratio}");
         let accumulate = if filter == "splat" { "caustics.splat" } else { "caustics.triangles" };
-        for name in ["caustics.receivers", "caustics.photons", accumulate, "caustics.filter"] {
+        for name in ["caustics.receivers", "caustics.photons", accumulate, "caustics.filter", "caustics.project"] {
             assert!(passes.iter().any(|p| p == name), "{name} in {passes:?}");
         }
     }

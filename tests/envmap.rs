@@ -202,6 +202,7 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
             "caustics.filter",
             "envmap.generate",
             "scene.direct",
+            "caustics.project",
             "envmap.shade",
             "frame.readback"
         ]

@@ -94,7 +94,8 @@ vec3 shade_diffuse(Material m, vec3 p, vec3 n, vec3 eye, vec2 uv) {
         if (cos_t <= 0.0) continue;
         l_sum += e * cos_t * light_visibility(l, p, n);
     }
-    l_sum += caustic_irradiance(p, n);  // caustics (§6): light through specular objects
+    // Caustics (§6): light through specular objects; the camera has a pass for them.
+    if ((push.flags & FLAG_CAUSTICS_APART) == 0u) l_sum += caustic_irradiance(p, n);
     return material_emission(m, uv) + albedo / PI * l_sum;
 }
 

@@ -42,6 +42,7 @@ impl CameraShade {
                 cull: vk::CullModeFlags::NONE,
                 multisample,
                 blend: crate::vk::pipeline::Blend::Replace,
+                depth_op: crate::vk::pipeline::DepthOp::Nearer,
             },
         )?;
         Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone() })

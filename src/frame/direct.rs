@@ -45,6 +45,7 @@ pub fn sky_and_direct(
             cull: vk::CullModeFlags::NONE,
             multisample,
             blend: crate::vk::pipeline::Blend::Replace,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         },
     )?;
     let direct = graphics_pipeline(
@@ -63,6 +64,7 @@ pub fn sky_and_direct(
             cull: vk::CullModeFlags::NONE,
             multisample,
             blend: crate::vk::pipeline::Blend::Replace,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         },
     );
     match direct {
@@ -101,8 +103,12 @@ impl Stage for SceneDirect {
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);
+        // With a caustics.project pass the camera's surfaces get their caustics there.
+        let apart = io.plan.stages.contains(&crate::plan::StageSpec::CausticsProject);
+        let flags = f.flags | if apart { crate::frame::layout::FLAG_CAUSTICS_APART } else { 0 };
         for d in f.scene.draws.iter().filter(|d| !d.specular) {
-            f.draw(ctx, cmd, view, d);
+            f.push_flags(ctx, cmd, view, d.mesh, flags);
+            unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
         }
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         rec.end(open);

@@ -262,6 +262,9 @@ gpu_consts! {
     /// `flags >> MIRROR_LAYER_SHIFT` of `mirror_views`; without the flag, the budget's
     /// fallback (the environment along the reflected ray).
     FLAG_MIRROR_VIEW: uint = 32;
+    /// `Push.flags` of the camera's `scene.direct`: the caustics are projected by their own
+    /// pass (`caustics.project`), not inside `shade_diffuse`.
+    FLAG_CAUSTICS_APART: uint = 128;
     MIRROR_LAYER_SHIFT: uint = 16;
 
     /// `CausticParams.flags`: the projection's distance test (§6.3.3).

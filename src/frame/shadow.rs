@@ -50,6 +50,7 @@ impl ShadowMaps {
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend: crate::vk::pipeline::Blend::Replace,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };

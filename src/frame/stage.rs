@@ -25,6 +25,8 @@ pub mod order {
     pub const CAUSTICS: u32 = 17;
     pub const ENVIRONMENT_MAPS: u32 = 20;
     pub const DIRECT: u32 = 30;
+    /// The caustics' projection onto the camera's diffuse surfaces, over `scene.direct`.
+    pub const CAUSTICS_PROJECT: u32 = 35;
     /// Camera-space maps (image-space refraction's back faces).
     pub const CAMERA_MAPS: u32 = 40;
     pub const CAMERA: u32 = 50;

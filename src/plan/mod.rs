@@ -100,6 +100,8 @@ pub enum StageSpec {
     Map(MapPlan),
     /// The caustics stage (§6; `Plan::caustics` says what it renders).
     Caustics,
+    /// `caustics.project`: the caustics on the camera's diffuse surfaces.
+    CausticsProject,
     Camera(CameraPlan),
 }
 
@@ -111,6 +113,7 @@ impl StageSpec {
             StageSpec::Direct => "scene.direct",
             StageSpec::Map(m) => m.name,
             StageSpec::Caustics => "caustics",
+            StageSpec::CausticsProject => "caustics.project",
             StageSpec::Camera(c) => c.name,
         }
     }
@@ -121,6 +124,7 @@ impl StageSpec {
             StageSpec::Direct => order::DIRECT,
             StageSpec::Map(m) => m.info.order,
             StageSpec::Caustics => order::CAUSTICS,
+            StageSpec::CausticsProject => order::CAUSTICS_PROJECT,
             StageSpec::Camera(c) => c.pass.order,
         }
     }
@@ -569,9 +573,16 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
             o.passes.push(refractor.name);
         }
         stages.push(StageSpec::Caustics);
+        // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
+        if !traced_everywhere {
+            stages.push(StageSpec::CausticsProject);
+        }
         for o in &mut p.objects {
             if c.generators.iter().any(|g| g.mesh == o.mesh) {
                 o.passes.extend(c.passes(&q));
+                if !traced_everywhere {
+                    o.passes.push("caustics.project");
+                }
             }
         }
     }

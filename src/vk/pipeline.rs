@@ -135,6 +135,17 @@ pub struct GraphicsDesc<'a> {
     pub multisample: Multisample,
     /// How fragments combine with the attachments' contents.
     pub blend: Blend,
+    /// Which fragments the depth test keeps (reversed-Z).
+    pub depth_op: DepthOp,
+}
+
+/// The depth test's comparison, reversed-Z (greater is nearer).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthOp {
+    /// Strictly nearer than what is there.
+    Nearer,
+    /// Nearer or at the same depth: a second pass over the same surfaces (caustics.project).
+    NearerOrEqual,
 }
 
 /// Colour blending of a pipeline's attachments.
@@ -218,7 +229,10 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(desc.depth_test)
         .depth_write_enable(desc.depth_write)
-        .depth_compare_op(vk::CompareOp::GREATER);
+        .depth_compare_op(match desc.depth_op {
+            DepthOp::Nearer => vk::CompareOp::GREATER,
+            DepthOp::NearerOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
+        });
     let blend: Vec<_> = desc
         .color_formats
         .iter()

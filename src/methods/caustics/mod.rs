@@ -15,6 +15,7 @@
 //!   photons into the light cube map, radiant intensity seen from the reference point;
 //! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0).
 
+pub mod project;
 pub mod stage;
 
 use glam::{Mat4, Vec3, Vec4};

@@ -133,6 +133,7 @@ impl CausticsStage {
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         };
         let r32 = [vk::Format::R32_SFLOAT];
         let light = [LIGHT_FORMAT];

@@ -97,6 +97,7 @@ impl Backfaces {
                     cull: vk::CullModeFlags::FRONT,
                     multisample: Multisample::OFF,
                     blend: crate::vk::pipeline::Blend::Replace,
+                    depth_op: crate::vk::pipeline::DepthOp::Nearer,
                 },
             )?;
             Ok(())

@@ -59,6 +59,7 @@ impl RefractorMaps {
                     cull: vk::CullModeFlags::NONE,
                     multisample: Multisample::OFF,
                     blend: crate::vk::pipeline::Blend::Replace,
+                    depth_op: crate::vk::pipeline::DepthOp::Nearer,
                 },
             )?;
             Ok(())

@@ -127,6 +127,7 @@ impl CubeMaps {
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend: crate::vk::pipeline::Blend::Replace,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         };
         self.sky = graphics_pipeline(
             ctx,

@@ -352,6 +352,7 @@ impl RayTrace {
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend: crate::vk::pipeline::Blend::Replace,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
         };
         self.p.primary_raster = graphics_pipeline(
             ctx,

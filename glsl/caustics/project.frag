@@ -1,0 +1,20 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// caustics.project (survey §6.3.3): the camera's diffuse surfaces again, at the depth
+// scene.direct left, adding the caustics' radiance albedo/π · E (blended additively). The
+// map-generation passes project inside their own shading (common/shading.glsl).
+#include "common/shading.glsl"
+
+layout(location = 0) in vec3 in_position;
+layout(location = 1) in vec3 in_normal;
+layout(location = 2) in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Material m = materials[objects[push.object].material];
+    vec3 n = normalize(in_normal);
+    vec3 v = views[in_view].eye.xyz - in_position;
+    if (dot(n, v) < 0.0) n = -n;  // two-sided, as shade_diffuse
+    out_color = vec4(material_base_color(m, in_uv) / PI * caustic_irradiance(in_position, n), 0.0);
+}
