@@ -330,7 +330,8 @@ impl Renderer {
         let (pool, set) = allocate_set(ctx, "frame.set", self.set_layout, BINDINGS)?;
         (self.pool, self.set) = (pool, set);
         self.maps_layout = descriptor_set_layout(ctx, "maps.set_layout", MAP_BINDINGS, set_stages)?;
-        self.layout = pipeline_layout(ctx, "frame.layout", &[self.set_layout, self.maps_layout], PUSH_BYTES, stages)?;
+        // Push constants reach compute too: the caustic triangles' set-up kernel reads them.
+        self.layout = pipeline_layout(ctx, "frame.layout", &[self.set_layout, self.maps_layout], PUSH_BYTES, set_stages)?;
         self.linear_repeat = sampler(ctx, "sampler.linear_repeat", vk::Filter::LINEAR, vk::SamplerAddressMode::REPEAT)?;
         self.nearest_clamp = sampler(ctx, "sampler.nearest_clamp", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
 

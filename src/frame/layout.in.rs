@@ -207,7 +207,11 @@ gpu_structs! {
         splat_size: float,
         /// box filter radius in texels
         filter_radius: uint,
-        pad: [uint; 2],
+        /// caustic triangles: triangles of every photon layer (`caustic_faces` holds six
+        /// flags of each)
+        triangle_count: uint,
+        /// caustic triangles: triangles per photon layer, 2 (photon_size − 1)²
+        layer_triangles: uint,
     }
 
     /// Push constants of every scene-drawing shader.
@@ -326,6 +330,13 @@ descriptor_sets! {
         CAUSTICS = 14: STORAGE_BUFFER => "readonly buffer Caustics { CausticParams caustic; CausticCube cubes[]; }";
         /// Caustics: the light cube maps before filtering (the filter pass reads them).
         CAUSTIC_RAW = 15: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_raw";
+        /// Caustic triangles, set up once (caustics/setup.comp): per triangle of a photon layer
+        /// four vec4: its corners relative to the cube's centre with J's r, g, b in w, and
+        /// (1: a tent around the centroid, 0: the triangle itself).
+        CAUSTIC_TRIANGLES = 16: STORAGE_BUFFER => "buffer CausticTriangles { vec4 caustic_triangles[]; }";
+        /// Caustic triangles: per cube face f and triangle i, `caustic_faces[f · triangle_count
+        /// + i]` is 1 when the face draws it (its frustum may hold it).
+        CAUSTIC_FACES = 17: STORAGE_BUFFER => "buffer CausticFaces { uint caustic_faces[]; }";
     }
 
     /// Maps of ray tracing in the sampled geometry (survey §4), bound per pass as set 1.

@@ -79,7 +79,7 @@ impl FrameInputs<'_> {
             ctx.device.cmd_push_constants(
                 cmd,
                 self.layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE,
                 0,
                 bytemuck::bytes_of(&p),
             )

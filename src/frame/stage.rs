@@ -90,8 +90,12 @@ pub struct Maps {
     /// Set 0, bindings 12 and 13: photon hit location images and the photons' power.
     pub photon_hits: Option<Image>,
     pub photon_power: Option<Image>,
-    /// Set 0, binding 14: the caustics' parameters and generator table.
+    /// Set 0, binding 14: the caustics' parameters and cube table.
     pub caustics: Option<Buffer>,
+    /// Set 0, bindings 16 and 17: caustic triangles set up once, and per face which of them
+    /// it draws.
+    pub caustic_triangles: Option<Buffer>,
+    pub caustic_faces: Option<Buffer>,
 }
 
 impl Maps {
@@ -147,7 +151,10 @@ impl Maps {
         write_image(ctx, frame, binding::CAUSTIC_RAW, 0, cis, view(self.caustic_raw.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::PHOTON_HITS, 0, cis, view(self.photon_hits.as_ref()), nearest, ro);
         write_image(ctx, frame, binding::PHOTON_POWER, 0, cis, view(self.photon_power.as_ref()), nearest, ro);
-        write_buffer(ctx, frame, binding::CAUSTICS, sb, self.caustics.as_ref().map_or(vk::Buffer::null(), |b| b.raw));
+        let raw = |b: &Option<Buffer>| b.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
+        write_buffer(ctx, frame, binding::CAUSTICS, sb, raw(&self.caustics));
+        write_buffer(ctx, frame, binding::CAUSTIC_TRIANGLES, sb, raw(&self.caustic_triangles));
+        write_buffer(ctx, frame, binding::CAUSTIC_FACES, sb, raw(&self.caustic_faces));
         let refractor = view(self.refractor.as_ref());
         let backfaces = view(self.backfaces.as_ref());
         let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
@@ -192,7 +199,13 @@ impl Maps {
         {
             i.destroy(ctx);
         }
-        for b in self.thickness.iter_mut().chain(self.caustics.iter_mut()) {
+        for b in self
+            .thickness
+            .iter_mut()
+            .chain(self.caustics.iter_mut())
+            .chain(self.caustic_triangles.iter_mut())
+            .chain(self.caustic_faces.iter_mut())
+        {
             b.destroy(ctx);
         }
         *self = Maps::default();

@@ -33,6 +33,9 @@ pub struct CausticsStage {
     photon: vk::Pipeline,
     accumulate: vk::Pipeline,
     box_filter: vk::Pipeline,
+    /// Caustic triangles: the set-up kernel (caustics/setup.comp).
+    setup: vk::Pipeline,
+    layout: vk::PipelineLayout,
 }
 
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
@@ -46,7 +49,8 @@ pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (
         flags,
         splat_size: q.splat_size,
         filter_radius: q.caustic_filter,
-        pad: [0; 2],
+        triangle_count: plan.photon_layers * 2 * (q.photons - 1) * (q.photons - 1),
+        layer_triangles: 2 * (q.photons - 1) * (q.photons - 1),
     };
     let cubes = plan
         .cubes
@@ -57,6 +61,15 @@ pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (
         })
         .collect();
     (params, cubes)
+}
+
+/// The photon layers whose photons land in cube `c`.
+pub fn cube_layers(plan: &CausticsPlan, c: usize) -> impl Iterator<Item = u32> + '_ {
+    plan.generators
+        .iter()
+        .flat_map(|g| &g.lights)
+        .filter(move |lv| lv.cube as usize == c)
+        .flat_map(|lv| lv.first_layer..lv.first_layer + lv.faces * lv.branches)
 }
 
 fn table_bytes(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> Vec<u8> {
@@ -84,6 +97,8 @@ impl CausticsStage {
             photon: vk::Pipeline::null(),
             accumulate: vk::Pipeline::null(),
             box_filter: vk::Pipeline::null(),
+            setup: vk::Pipeline::null(),
+            layout: init.layout,
         };
         Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
     }
@@ -154,6 +169,15 @@ impl CausticsStage {
         };
         self.accumulate =
             graphics_pipeline(ctx, layout, &desc("caustics.accumulate", vs, fs, VertexInput::None, &light, false, mask, Blend::Add))?;
+        if self.plan.filter == Caustics::Triangles {
+            // Per photon layer 2 (n − 1)² triangles of four vec4, and six face flags each.
+            let count = self.plan.photon_layers as u64 * 2 * (n as u64 - 1) * (n as u64 - 1);
+            let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            let gpu = crate::vk::MemoryLocation::GpuOnly;
+            maps.caustic_triangles = Some(Buffer::new(ctx, "caustics.triangles", count * 64, storage, gpu)?);
+            maps.caustic_faces = Some(Buffer::new(ctx, "caustics.triangle_faces", count * 6 * 4, storage, gpu)?);
+            self.setup = crate::vk::pipeline::compute_pipeline(ctx, layout, "caustics/setup.comp")?;
+        }
         if self.filter > 0 {
             self.box_filter = graphics_pipeline(
                 ctx,
@@ -164,13 +188,33 @@ impl CausticsStage {
         Ok(())
     }
 
-    /// Vertices of one photon layer's accumulation draw.
+    /// Vertices of one photon layer's splat draw (a quad per photon).
     fn vertices(&self) -> u32 {
-        let n = self.photons;
-        match self.plan.filter {
-            Caustics::Splat => 6 * n * n,
-            _ => 6 * (n - 1) * (n - 1),
+        6 * self.photons * self.photons
+    }
+
+    /// Caustic triangles (§6.3.2): sets up every photon layer's triangles once, each flagged
+    /// for the faces of its cube it may reach. (The previous frame's reads of the buffers
+    /// are behind the pass's opening barrier.)
+    fn setup_triangles(&self, rec: &mut Recorder, f: &FrameInputs, views: &crate::frame::stage::ViewLayout) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.setup);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
         }
+        let per_layer = 2 * (self.photons - 1) * (self.photons - 1);
+        for (c, &first_view) in views.caustic_cubes.iter().enumerate().take(self.plan.cubes.len()) {
+            for layer in cube_layers(&self.plan, c) {
+                f.push_flags(ctx, cmd, first_view, layer, 0);
+                unsafe { ctx.device.cmd_dispatch(cmd, per_layer.div_ceil(64), 1, 1) };
+            }
+        }
+        let barrier = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+            .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_SHADER)
+            .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ)];
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
     }
 }
 
@@ -273,22 +317,24 @@ impl Stage for CausticsStage {
             Some(r) if filtering => r,
             _ => light,
         };
-        let open = rec
-            .pass(name)
-            .writes(target, Access::ColorAttachment)
-            .reads(hits, Access::VertexSampled)
-            .reads(power, Access::VertexSampled)
-            .begin();
-        let vertices = self.vertices();
+        // The splats' vertex shader reads the photon images; triangles read them once, in
+        // their set-up kernel.
+        let photon_access = if self.plan.filter == Caustics::Splat { Access::VertexSampled } else { Access::ComputeSampled };
+        let open = rec.pass(name).writes(target, Access::ColorAttachment).reads(hits, photon_access).reads(power, photon_access).begin();
+        let triangles = self.plan.filter == Caustics::Triangles;
+        if triangles {
+            self.setup_triangles(rec, f, io.views);
+        }
+        // A photon layer's quads (splat) or triangles (the faces skip those not flagged).
+        let vertices = if triangles { 6 * (self.photons - 1) * (self.photons - 1) } else { self.vertices() };
         let plan = &self.plan;
         for (k, &first_view) in cube_views.iter().enumerate().take(plan.cubes.len()) {
             render_cube_faces(rec, target, &mut self.cube_depth, k as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                 f.bind(ctx, cmd, self.accumulate);
-                for lv in plan.generators.iter().flat_map(|g| &g.lights).filter(|lv| lv.cube as usize == k) {
-                    for layer in lv.first_layer..lv.first_layer + lv.faces * lv.branches {
-                        f.push(ctx, cmd, v, layer);
-                        unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
-                    }
+                for layer in cube_layers(plan, k) {
+                    // Triangles: the face's index in push.flags, for its flags.
+                    f.push_flags(ctx, cmd, v, layer, if triangles { v - first_view } else { f.flags });
+                    unsafe { ctx.device.cmd_draw(cmd, vertices, 1, 0, 0) };
                 }
             });
         }
@@ -311,7 +357,7 @@ impl Stage for CausticsStage {
     fn destroy(&mut self, ctx: &Context) {
         self.cube_depth.destroy(ctx);
         self.photon_depth.destroy(ctx);
-        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter]);
+        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
     }
 }
 
