@@ -627,7 +627,7 @@ pub const KNOBS: &[Knob] = &[
         name: "photons",
         values: "32..=2048 texels",
         default: "128",
-        doc: "caustics: edge of each photon hit location image (photons² per light and generator view)",
+        doc: "caustics: edge of each photon hit location image (photons² per light and generator view); caustic triangles keep 64 bytes per triangle in one storage buffer, within the device's maxStorageBufferRange (lavapipe's 128 MiB: 1024² photons for one photon layer, 592² for three)",
         set: |q, v| {
             q.photons = count(v, 32, 2048)?;
             Ok(())

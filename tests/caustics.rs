@@ -708,3 +708,27 @@ fn light_space_caustics_keep_the_power_and_compare_with_cube_space() {
     assert!(l1s[0] < 0.2 && l1s[1] < 1.0 && l1s[0] < l1s[1], "{l1s:?}");
     common::assert_clean(&ctx);
 }
+
+#[test]
+fn triangles_beyond_the_storage_buffer_range_are_refused_by_name() {
+    // Caustic triangles live in one storage buffer of 64 bytes each: a photon image whose
+    // triangles exceed the device's maxStorageBufferRange (lavapipe: 128 MiB, 1024² photons
+    // for one layer) is refused naming the knob, before anything is allocated for it.
+    let ctx = common::gpu();
+    let scene = sphere_over_floor(1.5);
+    let q = quality(&["caustics=triangles", "photons=2048", "caustic_paths=refracted"]);
+    let need = 2u64 * 2047 * 2047 * 64;
+    let limit = ctx.properties.limits.max_storage_buffer_range as u64;
+    let r = Renderer::new(&ctx, &scene, plan(&scene, specula::methods::REFRACTOR_MAP, &q), 16, 16);
+    match r {
+        Err(e) => {
+            let msg = e.to_string();
+            assert!(need > limit && msg.contains("knob photons") && msg.contains("caustics=splat"), "{msg}");
+        }
+        Ok(mut r) => {
+            assert!(need <= limit, "{need} bytes accepted beyond the range {limit}");
+            r.destroy(&ctx);
+        }
+    }
+    common::assert_clean(&ctx);
+}

@@ -188,14 +188,16 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
 
 /// Device memory: per caustic cube a receiver distance cube (R32F) and a light cube map
 /// (RGBA32F, two with filtering), the photon images (two RGBA32F layers per view and a
-/// depth buffer), the receivers' depth buffer.
+/// depth buffer), the receivers' depth buffer, and for caustic triangles their set-up
+/// buffers (64 bytes and six face flags per triangle).
 pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
     let s = q.cube_size as u64;
     let n = q.photons as u64;
     let g = p.cubes.len() as u64;
     let light_cubes = if q.caustic_filter > 0 { 2 } else { 1 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
-    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4
+    let triangles = if p.filter == Caustics::Triangles { p.photon_layers as u64 * 2 * (n - 1) * (n - 1) * (64 + 24) } else { 0 };
+    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles
 }
 
 /// What `specula plan` says of it.

@@ -174,6 +174,19 @@ impl CausticsStage {
             let count = self.plan.photon_layers as u64 * 2 * (n as u64 - 1) * (n as u64 - 1);
             let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
             let gpu = crate::vk::MemoryLocation::GpuOnly;
+            // One storage-buffer descriptor must reach every triangle.
+            let limit = ctx.properties.limits.max_storage_buffer_range as u64;
+            if count * 64 > limit {
+                return Err(crate::Error::invalid(
+                    "knob photons",
+                    format!(
+                        "{n}: caustic triangles for {} photon layers need {} bytes in one storage buffer, beyond {}'s {limit} (fewer photons, or caustics=splat)",
+                        self.plan.photon_layers,
+                        count * 64,
+                        ctx.device_name
+                    ),
+                ));
+            }
             maps.caustic_triangles = Some(Buffer::new(ctx, "caustics.triangles", count * 64, storage, gpu)?);
             maps.caustic_faces = Some(Buffer::new(ctx, "caustics.triangle_faces", count * 6 * 4, storage, gpu)?);
             self.setup = crate::vk::pipeline::compute_pipeline(ctx, layout, "caustics/setup.comp")?;
