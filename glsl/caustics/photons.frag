@@ -10,8 +10,7 @@
 // in cube-map space, UPSK08; the light in light space, SP07) with the
 // photon's power: the light's intensity × the texel's solid angle (its area for a
 // directional light) × the Fresnel transmittances along the path.
-#include "common/specular.glsl"
-#include "common/traced.glsl"
+#include "distance/refractor/trace.glsl"
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -71,20 +70,13 @@ void main() {
         w = s.ft;
         dir = s.t;
         float ior = m.nu.x;
-        vec3 oref = o.reference_point.xyz;
         bool out_of_it = false;
-        search_map = 1;
-        search_layer = float(o.refractor_layer);
         for (uint bounce = 0u; bounce <= push.internal_bounces; ++bounce) {
-            float eps = 1e-2 * length(pos - oref);
-            SearchResult h = search_ray(pos + dir * eps - oref, dir);
-            if (h.escaped) {  // an open refractor: the photon is out
+            vec3 hit, n2;
+            if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the photon is out
                 out_of_it = true;
                 break;
             }
-            vec3 hit = pos + dir * (eps + h.d);
-            vec3 n2 = normalize(textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0).xyz);
-            if (dot(n2, dir) < 0.0) n2 = -n2;
             vec3 out_dir;
             pos = hit;
             if (refract_dir(dir, -n2, ior, out_dir)) {

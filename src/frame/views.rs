@@ -42,7 +42,9 @@ impl ViewLayout {
     }
 }
 
-fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
+/// A view-table entry for `view_proj` from `eye` (w: 0 radial, 1 planar distance) with
+/// `dir`, clipping nothing.
+pub fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
     GpuView {
         view_proj: view_proj.to_cols_array_2d(),
         inv_view_proj: view_proj.inverse().to_cols_array_2d(),

@@ -8,6 +8,25 @@
 #include "common/specular.glsl"
 #include "common/traced.glsl"
 
+// The surface the ray (pos, dir) inside solid refractor o meets next, searched in its
+// refractor map: false when there is none (an open refractor: the ray is out), else the hit
+// and the outward normal there (along the leaving ray). Shared by the camera's self
+// refraction below and the caustic photons (glsl/caustics/photons.frag).
+bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
+    vec3 ref = o.reference_point.xyz;
+    search_map = 1;
+    search_layer = float(o.refractor_layer);
+    // The ray starts on the refractor's own surface, where |l| = |l'|: start the search
+    // just inside, so that the surface it leaves is not mistaken for the one it meets.
+    float eps = 1e-2 * length(pos - ref);
+    SearchResult h = search_ray(pos + dir * eps - ref, dir);
+    if (h.escaped) return false;
+    hit = pos + dir * (eps + h.d);
+    n2 = normalize(textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0).xyz);
+    if (dot(n2, dir) < 0.0) n2 = -n2;
+    return true;
+}
+
 // Radiance leaving point p of solid refractor o (material m, interpolated normal n)
 // towards eye.
 vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
@@ -17,22 +36,13 @@ vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     vec3 pos = p;
     vec3 dir = s.t;
     float ior = m.nu.x;
-    vec3 ref = o.reference_point.xyz;
     for (uint bounce = 0u; bounce <= push.internal_bounces && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
-        search_map = 1;
-        search_layer = float(o.refractor_layer);
-        // The ray starts on the refractor's own surface, where |l| = |l'|: start the search
-        // just inside, so that the surface it leaves is not mistaken for the one it meets.
-        float eps = 1e-2 * length(pos - ref);
-        SearchResult h = search_ray(pos + dir * eps - ref, dir);
-        if (h.escaped) {  // an open refractor: the ray is out
+        vec3 hit, n2;
+        if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
             c += weight * traced_radiance(o, pos, dir);
             weight = vec3(0.0);
             break;
         }
-        vec3 hit = pos + dir * (eps + h.d);
-        vec3 n2 = normalize(textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0).xyz);
-        if (dot(n2, dir) < 0.0) n2 = -n2;       // the outward normal, along the leaving ray
         float cos_i = dot(dir, n2);
         vec3 out_dir;
         // Leaving the object: ν_i/ν_t = ior, the normal faces the inside (−n2).

@@ -18,7 +18,9 @@
 pub mod project;
 pub mod stage;
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
+
+use crate::frame::views::view;
 
 use crate::gpu_scene::{GpuLight, GpuView};
 use crate::plan::{ObjectPlan, Plan};
@@ -279,16 +281,6 @@ fn light_views(lv: &LightViews, kind: LightKind, l: &GpuLight, n: f32, near_scal
     let vp = proj * Mat4::look_to_rh(pos, axis, up);
     let t = half.tan();
     vec![view(vp, pos.extend(0.0), axis.extend((2.0 * t / n).powi(2)))]
-}
-
-fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
-    GpuView {
-        view_proj: view_proj.to_cols_array_2d(),
-        inv_view_proj: view_proj.inverse().to_cols_array_2d(),
-        eye: eye.to_array(),
-        dir: dir.to_array(),
-        clip: [0.0, 0.0, 0.0, 1.0],
-    }
 }
 
 /// After objects moved: the generators' reference points follow their objects'.
