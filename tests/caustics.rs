@@ -732,3 +732,43 @@ fn triangles_beyond_the_storage_buffer_range_are_refused_by_name() {
     }
     common::assert_clean(&ctx);
 }
+
+#[test]
+fn the_receiver_orientation_factor_matches_the_light_tracer() {
+    // E = J cos α / D²: a directional light at 60° puts the caustic on the floor 1.7 m from
+    // the sphere, where the floor is seen from the sphere's centre at about 60°. Without
+    // cos α (caustic_orientation=off) it is about twice too bright; with it, it matches the
+    // light tracer.
+    let ctx = common::gpu();
+    let mut scene = sphere_over_floor(1.5);
+    scene.meshes[0].positions.iter_mut().for_each(|p| *p *= 8.0);
+    let a = 60f32.to_radians();
+    scene.lights[0] = Light {
+        name: "sun".into(),
+        kind: LightKind::Directional,
+        position: Vec3::ZERO,
+        direction: Vec3::new(a.sin(), -a.cos(), 0.0),
+        intensity: Vec3::splat(2.0),
+        range: None,
+    };
+    scene.camera = Some(Camera::look_at(Vec3::new(1.7, 1.2, 1.6), Vec3::new(1.7, 0.0, 0.0), 50f32.to_radians()));
+    let mut r = quality(&["spp=1", "caustic_radius=0.03"]);
+    let off = specula::reference::render_reference(&scene, &r, (48, 48)).unwrap();
+    r.set("caustics", "triangles").unwrap();
+    let truth = caustic_part(&specula::reference::render_reference(&scene, &r, (48, 48)).unwrap(), &off);
+    let base = image48(&ctx, &scene, &["cube_size=128"]);
+    let sum = |o: &str| -> f64 {
+        caustic_part(&image48(&ctx, &scene, &["cube_size=128", "caustics=triangles", &format!("caustic_orientation={o}")]), &base)
+            .iter()
+            .sum()
+    };
+    let (exact, on, no) = (truth.iter().sum::<f64>(), sum("on"), sum("off"));
+    eprintln!("caustic in view: light tracer {exact:.3}, orientation on {on:.3}, off {no:.3}");
+    assert!(exact > 1.0, "the caustic is in view: {exact}");
+    assert!((on / exact - 1.0).abs() < 0.15 && no > 1.5 * on, "{exact} {on} {no}");
+    common::assert_clean(&ctx);
+}
+
+fn image48(ctx: &specula::vk::Context, scene: &Scene, pairs: &[&str]) -> specula::image::ImageData {
+    specula::render(ctx, scene, specula::methods::REFRACTOR_MAP, &quality(pairs), (48, 48), (0, 1)).unwrap().image
+}
