@@ -128,7 +128,18 @@ pub struct Quality {
     /// CPU reference: radius of the caustic density estimate (metres); `None`: 0.5 % of
     /// the scene's bounding-box diagonal.
     pub caustic_radius: Option<f32>,
+    /// Layered distance maps (§4.5): the most layers peeled; `None` (auto): as many as the
+    /// scene's depth complexity from the map's reference point, measured on the GPU, up to
+    /// `MAX_LAYERS`.
+    pub layers: Option<u32>,
+    /// Layered maps: a dielectric hit in the layers continues along both Fresnel branches
+    /// while the ray stack has room (else the stronger one carrying both weights), or always
+    /// along the stronger one only.
+    pub layered_both: bool,
 }
+
+/// The most layers a layered distance map (§4.5) peels.
+pub const MAX_LAYERS: u32 = 16;
 
 /// Where caustic photon hits are stored and projected from (survey §6.1.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -728,7 +739,31 @@ pub const KNOBS: &[Knob] = &[
         },
         get: |q| q.caustic_radius.map_or("auto".into(), |r| r.to_string()),
     },
+    Knob {
+        name: "layers",
+        values: "auto|1..=16",
+        default: "auto",
+        doc: "layered maps (§4.5): depth-peeled layers; auto = the scene's depth complexity from the map's reference point, measured on the GPU (at most 16)",
+        set: |q, v| {
+            q.layers = if v == "auto" { None } else { Some(count(v, 1, MAX_LAYERS)?) };
+            Ok(())
+        },
+        get: |q| q.layers.map_or("auto".into(), |l| l.to_string()),
+    },
+    Knob {
+        name: "layered_branches",
+        values: "both|strongest",
+        default: "both",
+        doc: "layered maps: a dielectric hit follows both Fresnel branches while the shader's ray stack (8 rays) has room, else the stronger one carrying both weights; strongest: always the stronger one",
+        set: |q, v| {
+            q.layered_both = one_of(v, LAYERED_BRANCHES)?;
+            Ok(())
+        },
+        get: |q| name_of(q.layered_both, LAYERED_BRANCHES),
+    },
 ];
+
+const LAYERED_BRANCHES: &[(&str, bool)] = &[("both", true), ("strongest", false)];
 
 impl Default for Quality {
     fn default() -> Self {
@@ -774,6 +809,8 @@ impl Default for Quality {
             caustic_space: CausticSpace::Cube,
             reference_photons: 1_000_000,
             caustic_radius: None,
+            layers: None,
+            layered_both: true,
         }
     }
 }

@@ -321,7 +321,8 @@ impl Renderer {
             self.lights = Some(Buffer::with_data(ctx, "scene.lights", &self.light_table, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         }
         self.flags = if plan.quality.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
-            | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 };
+            | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 }
+            | if plan.quality.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST };
 
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         // The sets are visible to compute too: the ray pipeline's kernels shade with them.
@@ -546,6 +547,10 @@ impl Renderer {
             for s in &mut self.stages {
                 s.update(&init, c, &mut self.maps)?;
             }
+            // A stage may have reallocated its maps (the layered maps' layer count).
+            if !c.moved.is_empty() && self.maps.layered.is_some() {
+                self.write_descriptors(ctx);
+            }
         }
         self.map_updates.clear();
         let names = |ids: &[usize], name: &dyn Fn(usize) -> String| ids.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ");
@@ -699,6 +704,7 @@ impl Renderer {
             search: SearchKnobs::of(q),
             tolerance: q.search_tolerance,
             internal_bounces: q.internal_bounces,
+            depth: q.depth,
         };
         let full =
             vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: self.target.width, height: self.target.height } };

@@ -145,32 +145,120 @@ pub fn linear_search(
     if d_p < 0.0 {
         return search_result(x, r, 0.0, true, lookups);
     }
-    // One refinement probe at d: done within tolerance, else it replaces the bracket end
-    // of its kind (false position keeps one undershooting and one overshooting guess).
-    let mut probe = |d: f64, d_l: &mut f64, a_l: &mut f64, d_p: &mut f64, a_p: &mut f64| {
-        let a = search_ratio(map, x, r, d, &mut lookups);
-        if (a - 1.0).abs() <= tolerance {
-            return true;
-        }
-        if a < 1.0 {
-            (*d_l, *a_l) = (d, a);
-        } else {
-            (*d_p, *a_p) = (d, a);
-        }
-        false
-    };
+    let (d, _) = search_refine(map, x, r, [(d_l, a_l), (d_p, a_p)], binary_steps, secant_steps, tolerance, &mut lookups);
+    search_result(x, r, d, false, lookups)
+}
+
+/// Refinement of a bracket whose ratios lie on either side of 1: `binary_steps` halvings
+/// (§4.1.4), then `secant_steps` false-position steps (survey eq. 5). A probe within
+/// tolerance is the answer, else it replaces the bracket end on its side; at the end, the
+/// better end of the bracket. Also returns the final bracket.
+type Bracket = [(f64, f64); 2];
+#[allow(clippy::too_many_arguments)]
+fn search_refine(
+    map: &impl DistanceMap,
+    x: DVec3,
+    r: DVec3,
+    [(mut d_l, mut a_l), (mut d_p, mut a_p)]: Bracket,
+    binary_steps: u32,
+    secant_steps: u32,
+    tolerance: f64,
+    lookups: &mut u32,
+) -> (f64, Bracket) {
     for i in 0..binary_steps + secant_steps {
+        let den = a_p - a_l;
         let d = if i < binary_steps {
             0.5 * (d_l + d_p)
         } else {
-            d_l + (d_p - d_l) * (1.0 - a_l) / (a_p - a_l).max(1e-300) // survey eq. 5
+            d_l + (d_p - d_l) * (1.0 - a_l) / if den.abs() > 1e-300 { den } else { 1e-300 }
+            // survey eq. 5
         };
-        if probe(d, &mut d_l, &mut a_l, &mut d_p, &mut a_p) {
-            return search_result(x, r, d, false, lookups);
+        let a = search_ratio(map, x, r, d, lookups);
+        if (a - 1.0).abs() <= tolerance {
+            return (d, [(d_l, a_l), (d_p, a_p)]);
+        }
+        if (a < 1.0) == (a_l < 1.0) {
+            (d_l, a_l) = (d, a);
+        } else {
+            (d_p, a_p) = (d, a);
         }
     }
     let d = if (a_l - 1.0).abs() < (a_p - 1.0).abs() { d_l } else { d_p };
-    search_result(x, r, d, false, lookups)
+    (d, [(d_l, a_l), (d_p, a_p)])
+}
+
+/// One layer of a multi-layer map (survey §4.5): the first crossing of the layer's surface
+/// in either direction, on the linear search's steps; `start_side` (+1 behind the surface,
+/// −1 in front, 0 measured) for a ray that starts on this layer's surface; a bracket is a
+/// hit only if the refined point, or else the false-position point of the final bracket,
+/// lies within `gap` of the surface (silhouettes are gaps, the march goes on). Twin of
+/// `layer_search` in glsl/common/search.glsl.
+#[allow(clippy::too_many_arguments)]
+pub fn layer_search(
+    map: &impl DistanceMap,
+    x: DVec3,
+    r: DVec3,
+    steps: u32,
+    binary_steps: u32,
+    secant_steps: u32,
+    tolerance: f64,
+    gap: f64,
+    start_side: i32,
+) -> SearchResult {
+    let mut lookups = 1;
+    let len_x = x.length();
+    let far_stored = map.distance(r);
+    if len_x <= 1e-6 * far_stored.min(1e30) {
+        if search_is_sky(far_stored) || start_side != 0 {
+            return search_result(x, r, 0.0, true, lookups);
+        }
+        return search_result(x, r, far_stored, false, lookups);
+    }
+    let (mut d_l, mut a_l) = (0.0, search_ratio(map, x, r, 0.0, &mut lookups));
+    if start_side != 0 {
+        a_l = if start_side > 0 { 2.0 } else { 0.0 };
+    }
+    let steps = steps.max(1);
+    for i in 1..=steps {
+        let (d, a);
+        if i < steps {
+            let t = i as f64 / steps as f64;
+            d = len_x * t / (1.0 - t);
+            a = search_ratio(map, x, r, d, &mut lookups);
+        } else {
+            if search_is_sky(far_stored) || a_l >= 1.0 {
+                return search_result(x, r, 0.0, true, lookups);
+            }
+            let mut dd = (far_stored - r.dot(x)).max(d_l);
+            let mut aa = search_ratio(map, x, r, dd, &mut lookups);
+            let mut k = 0;
+            while k < 8 && aa < 1.0 {
+                d_l = dd;
+                a_l = aa;
+                dd = 2.0 * dd + len_x + far_stored;
+                aa = search_ratio(map, x, r, dd, &mut lookups);
+                k += 1;
+            }
+            if aa < 1.0 {
+                return search_result(x, r, 0.0, true, lookups);
+            }
+            (d, a) = (dd, aa);
+        }
+        if (a < 1.0) != (a_l < 1.0) {
+            let (h, [(e0, b0), (e1, b1)]) =
+                search_refine(map, x, r, [(d_l, a_l), (d, a)], binary_steps, secant_steps, tolerance, &mut lookups);
+            if (search_ratio(map, x, r, h, &mut lookups) - 1.0).abs() <= gap {
+                return search_result(x, r, h, false, lookups);
+            }
+            let den = b1 - b0;
+            let at = if den.abs() > 1e-30 { e0 + (e1 - e0) * (1.0 - b0) / den } else { h };
+            if (search_ratio(map, x, r, at, &mut lookups) - 1.0).abs() <= gap {
+                return search_result(x, r, at, false, lookups);
+            }
+        }
+        (d_l, a_l) = (d, a);
+    }
+    search_result(x, r, 0.0, true, lookups)
 }
 
 /// The distance map of an axis-aligned box room seen from `center` (inside it).

@@ -65,6 +65,23 @@ SearchResult parallax_search(vec3 x, vec3 R, int iterations) {
     return search_result(x, R, d, false, lookups);
 }
 
+// Refinement of a bracket (d_l, a_l), (d_p, a_p) whose ratios lie on either side of 1:
+// `binary_steps` halvings (§4.1.4), then `secant_steps` false-position steps (survey eq. 5:
+// the ray meets the segment between the overshooting and the undershooting surface
+// points). A probe within tolerance is the answer, else it replaces the bracket end on its
+// side. Returns the ray parameter found, or the better end of the final bracket.
+float search_refine(vec3 x, vec3 R, inout float d_l, inout float a_l, inout float d_p, inout float a_p,
+                    int binary_steps, int secant_steps, float tolerance, inout int lookups) {
+    for (int i = 0; i < binary_steps + secant_steps; ++i) {
+        float den = a_p - a_l;
+        float d = i < binary_steps ? 0.5 * (d_l + d_p) : d_l + (d_p - d_l) * (1.0 - a_l) / (abs(den) > 1e-30 ? den : 1e-30);
+        float a = search_ratio(x, R, d, lookups);
+        if (abs(a - 1.0) <= tolerance) return d;
+        if ((a < 1.0) == (a_l < 1.0)) { d_l = d; a_l = a; } else { d_p = d; a_p = a; }
+    }
+    return abs(a_l - 1.0) < abs(a_p - 1.0) ? d_l : d_p;
+}
+
 // Two-level search: linear search for the first undershoot/overshoot pair, marching
 // uniformly on the segment between the projections of the ray's start and end on the unit
 // sphere, d(t) = |x|/|R| · t/(1−t) (§4.1.2); then `binary_steps` halvings (§4.1.4) and
@@ -117,18 +134,64 @@ SearchResult linear_search(vec3 x, vec3 R, int steps, int binary_steps, int seca
         a_l = a;
     }
     if (d_p < 0.0) return search_result(x, R, 0.0, true, lookups);
-    // Refinement: binary halvings, then secant steps (survey eq. 5: the ray meets the segment
-    // between the overshooting and the undershooting surface points). Each probe is done
-    // within tolerance, else replaces the bracket end of its kind (false position).
-    for (int i = 0; i < binary_steps + secant_steps; ++i) {
-        float d = i < binary_steps ? 0.5 * (d_l + d_p) : d_l + (d_p - d_l) * (1.0 - a_l) / max(a_p - a_l, 1e-30);
-        float a = search_ratio(x, R, d, lookups);
-        if (abs(a - 1.0) <= tolerance) return search_result(x, R, d, false, lookups);
-        if (a < 1.0) { d_l = d; a_l = a; } else { d_p = d; a_p = a; }
+    return search_result(x, R, search_refine(x, R, d_l, a_l, d_p, a_p, binary_steps, secant_steps, tolerance, lookups), false, lookups);
+}
+
+// One layer of a multi-layer map (survey §4.5, UPSK07): SEARCH_DISTANCE reads that layer.
+// A ray may start anywhere (in front of the layer's surface or behind it) and cross it
+// either way, so the linear search looks for the first sign change of |l|/|l'| − 1 on the
+// same projected-segment steps; `start_side` (+1 behind, −1 in front, 0 measure it) says
+// on which side the ray leaves when it starts on this layer's surface. A bracket is a hit
+// only where the ray meets the surface: the refined point, or else the false-position
+// point of the final bracket, must be within `gap` of it (else the bracket spans the gap
+// between two surfaces of the layer, a silhouette, and the march goes on). Not escaped:
+// `d` is the hit.
+SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secant_steps, float tolerance, float gap, int start_side) {
+    int lookups = 0;
+    float len_x = length(x);
+    float far_stored = SEARCH_DISTANCE(R);
+    lookups++;
+    if (len_x <= 1e-6 * min(far_stored, 1e30)) {
+        // From the reference point the layer answers exactly (its own surface excluded).
+        if (search_is_sky(far_stored) || start_side != 0) return search_result(x, R, 0.0, true, lookups);
+        return search_result(x, R, far_stored, false, lookups);
     }
-    // The better end of the bracket.
-    float d = abs(a_l - 1.0) < abs(a_p - 1.0) ? d_l : d_p;
-    return search_result(x, R, d, false, lookups);
+    float d_l = 0.0;
+    float a_l = search_ratio(x, R, 0.0, lookups);
+    if (start_side != 0) a_l = start_side > 0 ? 2.0 : 0.0;
+    steps = max(steps, 1);
+    for (int i = 1; i <= steps; ++i) {
+        float d, a;
+        if (i < steps) {
+            float t = float(i) / float(steps);
+            d = len_x * t / (1.0 - t);
+            a = search_ratio(x, R, d, lookups);
+        } else {
+            // The ray's end at infinity is behind the layer's surface in direction R, if it
+            // has one there; from in front, bracket with the parallax estimate pushed out.
+            if (search_is_sky(far_stored) || a_l >= 1.0) return search_result(x, R, 0.0, true, lookups);
+            d = max(far_stored - dot(R, x), d_l);
+            a = search_ratio(x, R, d, lookups);
+            for (int k = 0; k < 8 && a < 1.0; ++k) {
+                d_l = d;
+                a_l = a;
+                d = 2.0 * d + len_x + far_stored;
+                a = search_ratio(x, R, d, lookups);
+            }
+            if (a < 1.0) return search_result(x, R, 0.0, true, lookups);
+        }
+        if ((a < 1.0) != (a_l < 1.0)) {
+            float e0 = d_l, b0 = a_l, e1 = d, b1 = a;
+            float h = search_refine(x, R, e0, b0, e1, b1, binary_steps, secant_steps, tolerance, lookups);
+            if (abs(search_ratio(x, R, h, lookups) - 1.0) <= gap) return search_result(x, R, h, false, lookups);
+            float den = b1 - b0;
+            float at = abs(den) > 1e-30 ? e0 + (e1 - e0) * (1.0 - b0) / den : h;
+            if (abs(search_ratio(x, R, at, lookups) - 1.0) <= gap) return search_result(x, R, at, false, lookups);
+        }
+        d_l = d;
+        a_l = a;
+    }
+    return search_result(x, R, 0.0, true, lookups);
 }
 
 #endif

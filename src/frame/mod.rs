@@ -44,6 +44,7 @@ pub struct FrameInputs<'a> {
     pub search: SearchKnobs,
     pub tolerance: f32,
     pub internal_bounces: u32,
+    pub depth: u32,
 }
 
 impl FrameInputs<'_> {
@@ -73,7 +74,8 @@ impl FrameInputs<'_> {
             search: self.search,
             tolerance: self.tolerance,
             internal_bounces: self.internal_bounces,
-            pad: [0; 2],
+            depth: self.depth,
+            pad: 0,
         };
         unsafe {
             ctx.device.cmd_push_constants(

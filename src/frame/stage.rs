@@ -96,6 +96,10 @@ pub struct Maps {
     /// it draws.
     pub caustic_triangles: Option<Buffer>,
     pub caustic_faces: Option<Buffer>,
+    /// Set 1, bindings 4 and 5: the layered distance map of the whole scene (§4.5), one cube
+    /// per layer: radiance and distance, normal and material.
+    pub layered: Option<Image>,
+    pub layered_normals: Option<Image>,
 }
 
 impl Maps {
@@ -107,7 +111,15 @@ impl Maps {
         v.extend(self.refractor.iter());
         v.extend(self.backfaces.iter());
         v.extend(self.mirror_views.iter());
+        v.extend(self.layered.iter());
+        v.extend(self.layered_normals.iter());
         v
+    }
+
+    /// Distance-image slots of the set-1 sets: one per distance image, or one (holding no
+    /// distance map) for the layered maps alone.
+    fn map_slots(&self) -> usize {
+        self.distance.len().max(usize::from(self.layered.is_some()))
     }
 
     /// How many set-1 descriptor sets the maps need: per distance image one for map
@@ -115,16 +127,16 @@ impl Maps {
     /// maps alone; none without set-1 maps.
     pub fn set_count(&self) -> usize {
         // Caustic photons bind set 1 (a refractor map, or nothing for a mirror).
-        if self.distance.is_empty() && self.refractor.is_none() && self.backfaces.is_none() && self.caustic_distances.is_none() {
+        if self.map_slots() == 0 && self.refractor.is_none() && self.backfaces.is_none() && self.caustic_distances.is_none() {
             0
         } else {
-            2 * self.distance.len() + 2
+            2 * self.map_slots() + 2
         }
     }
 
     /// Assigns `set_count()` allocated sets to their roles.
     pub fn sets(&self, sets: &[vk::DescriptorSet]) -> MapSets {
-        let n = self.distance.len();
+        let n = self.map_slots();
         if sets.len() < 2 * n + 2 {
             return MapSets::default();
         }
@@ -159,22 +171,31 @@ impl Maps {
         let backfaces = view(self.backfaces.as_ref());
         let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
         let null_image = vk::ImageView::null();
+        let (layered, layered_normals) = (view(self.layered.as_ref()), view(self.layered_normals.as_ref()));
+        let none = (null_image, null_image);
         let mut all = Vec::new();
-        for (i, d) in self.distance.iter().enumerate() {
-            all.push((sets.generate[i], d.view, refractor, null_image, vk::Buffer::null()));
-            all.push((sets.camera[i], d.view, refractor, backfaces, thickness));
+        for i in 0..self.map_slots() {
+            let d = self.distance.get(i).map_or(null_image, |d| d.view);
+            if i < sets.generate.len() {
+                all.push((sets.generate[i], d, refractor, null_image, vk::Buffer::null(), none));
+                all.push((sets.camera[i], d, refractor, backfaces, thickness, (layered, layered_normals)));
+            }
         }
         if sets.empty != vk::DescriptorSet::null() {
-            all.push((sets.empty, null_image, null_image, null_image, vk::Buffer::null()));
+            all.push((sets.empty, null_image, null_image, null_image, vk::Buffer::null(), none));
         }
         if sets.geometry != vk::DescriptorSet::null() {
-            all.push((sets.geometry, null_image, refractor, null_image, vk::Buffer::null()));
+            all.push((sets.geometry, null_image, refractor, null_image, vk::Buffer::null(), none));
         }
-        for (set, distance, refractor, backfaces, thickness) in all {
+        // The layered maps hold materials and silhouettes: sampled nearest, never blended.
+        for (set, distance, refractor, backfaces, thickness, (lm, ln)) in all {
             write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, linear, ro);
             write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, linear, ro);
             write_image(ctx, set, binding::BACKFACE_MAP, 0, cis, backfaces, nearest, ro);
             write_buffer(ctx, set, binding::THICKNESS, sb, thickness);
+            write_image(ctx, set, binding::LAYERED_MAPS, 0, cis, lm, nearest, ro);
+            write_image(ctx, set, binding::LAYERED_NORMALS, 0, cis, ln, nearest, ro);
+            write_image(ctx, set, binding::LAYERED_PREVIOUS, 0, cis, null_image, nearest, ro);
         }
     }
 
@@ -193,9 +214,17 @@ impl Maps {
         {
             i.destroy(ctx);
         }
-        for i in [&mut self.caustic_distances, &mut self.caustic_maps, &mut self.caustic_raw, &mut self.photon_hits, &mut self.photon_power]
-            .into_iter()
-            .flatten()
+        for i in [
+            &mut self.caustic_distances,
+            &mut self.caustic_maps,
+            &mut self.caustic_raw,
+            &mut self.photon_hits,
+            &mut self.photon_power,
+            &mut self.layered,
+            &mut self.layered_normals,
+        ]
+        .into_iter()
+        .flatten()
         {
             i.destroy(ctx);
         }

@@ -10,6 +10,7 @@ pub mod caustics;
 pub mod distance;
 pub mod envmap;
 pub mod geometry;
+pub mod layered;
 pub mod raytrace;
 pub mod registry;
 
@@ -17,6 +18,7 @@ pub use crate::reference::REFERENCE;
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
 pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
 pub use geometry::PLANAR_MIRROR;
+pub use layered::LAYERED;
 pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{Choice, Method, MethodInfo, ObjectClass};
 
@@ -30,6 +32,7 @@ pub const ALL: &[Method] = &[
     DISTANCE_MULTI,
     REFRACTOR_MAP,
     IMAGE_SPACE_REFRACTION,
+    LAYERED,
     BVH,
     KD_TREE,
     GRID,

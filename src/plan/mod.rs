@@ -468,6 +468,8 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     let self_refracting = |o: &ObjectPlan| o.method.gpu.is_some_and(|g| g.map_shading == MapShading::Refractor);
     let composes =
         !whole_scene && p.objects.iter().filter(|o| self_refracting(o)).any(|o| scene_facts.objects.iter().any(|f| f.sees(o.mesh)));
+    // Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
+    crate::methods::layered::share_centre(scene, &mut p);
     stages(scene, &mut p, composes);
     Ok(p)
 }

@@ -112,6 +112,8 @@ pub enum VertexInput {
     None,
     /// position vec3, normal vec3, uv vec2: 32 bytes.
     Mesh,
+    /// The same buffer, positions only (passes that need nothing else: `layered.count`).
+    Positions,
 }
 
 /// Everything that distinguishes one graphics pipeline of this library from another.
@@ -210,6 +212,9 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
         VertexInput::Mesh => {
             vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&bindings).vertex_attribute_descriptions(&attrs)
         }
+        VertexInput::Positions => vk::PipelineVertexInputStateCreateInfo::default()
+            .vertex_binding_descriptions(&bindings)
+            .vertex_attribute_descriptions(&attrs[..1]),
     };
     let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
     let vp = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);

@@ -509,7 +509,8 @@ impl RayTrace {
             search: f.search,
             tolerance: f.tolerance,
             internal_bounces: f.internal_bounces,
-            pad: [0; 2],
+            depth: f.depth,
+            pad: 0,
         };
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };

@@ -1,0 +1,127 @@
+//! Ray tracing in layered distance maps (survey §4.5, UPSK07): one multi-layer cube map of
+//! the whole scene around one reference point, made by depth peeling (`layered.peel`), in
+//! which the camera pass traces every specular object's rays recursively
+//! (`layered.search`): each layer searched with the combined linear + secant search, the
+//! nearest hit over the layers wins, specular hits continue the ray. Self reflections of
+//! concave mirrors, non-convex refractors and surfaces hidden from the reference point,
+//! which single-layer maps miss (Figures 21, 28), come from the same loop.
+//!
+//! The objects that take this method share the one map (Table 1: one map for the whole
+//! scene, O(N·L) to build, O(L) per lookup): its reference point is the centre of their
+//! bounding box (or the `ref_point` knob), the number of layers L the scene's depth
+//! complexity from there (`layers=auto`, counted on the GPU) or the `layers` knob.
+
+pub mod peel;
+
+use glam::Vec3;
+
+use crate::frame::stage::{order, MapInfo};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Shape, Verdict};
+use crate::methods::EVERY_CLASS;
+use crate::plan::facts::ObjectFacts;
+use crate::plan::Plan;
+use crate::quality::{Quality, MAX_LAYERS};
+
+/// `layered.peel`: the layers of the whole scene's map (see `peel`).
+pub const LAYERED_CUBES: MapInfo = MapInfo {
+    name: "layered.peel",
+    order: order::ENVIRONMENT_MAPS + 1,
+    cube: true,
+    layer_field: None,
+    create: peel::create,
+    bytes: |p, objects, _| if objects == 0 { 0 } else { peel::bytes(&p.quality, planned_layers(&p.quality)) },
+    describe: |q, _| {
+        let layers = q
+            .layers
+            .map_or(format!("auto (the depth complexity, at most {MAX_LAYERS}; memory counted at {MAX_LAYERS})"), |l| l.to_string());
+        format!("one map of the whole scene, shared: layers {layers}, each {}", peel::describe_layer(q))
+    },
+};
+
+/// The layers the plan budgets: the knob, or for `auto` the most there can be (the stage
+/// allocates what it measured; `layered.layers` in the frame's stats).
+pub fn planned_layers(q: &Quality) -> u32 {
+    q.layers.unwrap_or(MAX_LAYERS)
+}
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+pub const SEARCH: CameraPass = CameraPass {
+    name: "layered.search",
+    vertex: "scene/mesh.vert",
+    fragment: "layered/search.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+};
+
+pub const LAYERED: Method = Method(&MethodInfo {
+    name: "layered",
+    abi: 13,
+    section: "§4.5",
+    family: "layered",
+    summary: "layered distance maps of the whole scene by depth peeling (layers = its depth complexity from one reference point); recursive ray tracing in the fragment shader: every layer searched (linear + secant), the nearest hit wins, specular hits reflected and refracted with Fresnel up to depth",
+    serves: EVERY_CLASS,
+    knobs: &[
+        "layers", "layered_branches", "depth", "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "search_tolerance",
+    ],
+    gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one }),
+    fallback: None,
+    shape: Shape::Any,
+    rule: layered_rule,
+});
+
+/// Below this visible fraction from its own reference point an object is not convex from
+/// there: it sees itself (a concave mirror) or hides part of itself (a non-convex
+/// refractor), which a single layer cannot hold.
+pub const CONVEX_FRACTION: f32 = 0.98;
+
+fn layered_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
+    if f.visible_fraction >= CONVEX_FRACTION {
+        return None;
+    }
+    Some(Verdict {
+        score: if q.planner.speed() { 2.5 } else { 4.5 },
+        reason: format!(
+            "{} {:.0} % visible from its reference point (concave or non-convex: it sees or hides part of itself): layered maps of the whole scene, traced recursively (§4.5)",
+            f.class.label(),
+            100.0 * f.visible_fraction
+        ),
+    })
+}
+
+/// The layered map's reference point: the `ref_point` knob, else the centre of the
+/// bounding box of the objects that take the method (`meshes`).
+pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec3 {
+    if let Some(p) = q.ref_point {
+        return p;
+    }
+    let mut b = crate::scene::Aabb::EMPTY;
+    for &m in meshes {
+        b = b.union(&scene.meshes[m].bounds());
+    }
+    if b.is_empty() {
+        Vec3::ZERO
+    } else {
+        b.center()
+    }
+}
+
+/// Gives every layered object of the plan the shared map's reference point.
+pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
+    let meshes = p.objects_with(LAYERED);
+    if meshes.is_empty() {
+        return;
+    }
+    let c = centre(scene, &p.quality, &meshes);
+    for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
+        o.reference_point = c;
+        o.reference_note = Some(if p.quality.ref_point.is_some() {
+            "the layered map's, set by the ref_point knob".into()
+        } else {
+            "the layered map's: the centre of its objects' bounding box".into()
+        });
+    }
+}

@@ -1,0 +1,404 @@
+//! `layered.peel` (survey §4.5): the layered distance map of the whole scene around one
+//! reference point, by depth peeling (Everitt): layer k is rendered with the depth test
+//! keeping the nearest fragment *behind* layer k−1's depth at the same texel (two depth
+//! buffers, ping-pong: one is written, the other sampled), so that it holds the k-th
+//! surface along each texel's ray. Per texel: radiance and Euclidean distance
+//! (`layered_maps`), normal and material (`layered_normals`), as `peel.frag` writes them.
+//!
+//! The number of layers is the `layers` knob, or (`auto`) the scene's depth complexity
+//! from the reference point: `layered.count` renders every surface into the six faces with
+//! additive blending and the largest count is read back (on the library's own queue; a
+//! host's device without one is counted on the CPU along the same texel rays). A scene
+//! that needs 3 layers allocates 3; the count is taken again when objects move, and the
+//! layers are reallocated when it changes.
+
+use ash::vk;
+use glam::{DVec3, Vec3};
+
+use crate::frame::direct::DEPTH_FORMAT;
+use crate::frame::layout::{LAYERED_FACE_SHIFT, LAYERED_FIRST};
+use crate::frame::stage::{cube_texel_bytes, describe_cube, FrameIo, Maps, Stage, StageInit};
+use crate::frame::{destroy_pipelines, FrameInputs};
+use crate::methods::envmap::generate::radiance_format;
+use crate::quality::{CubeMode, Precision, Quality, MAX_LAYERS};
+use crate::vk::pipeline::{allocate_set, graphics_pipeline, sampler, write_image, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
+use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
+use crate::Result;
+
+/// Device memory of `layers` layers (both images) and the two peeling depth buffers.
+pub fn bytes(q: &Quality, layers: u32) -> u64 {
+    let face = q.cube_size as u64 * q.cube_size as u64;
+    layers as u64 * 6 * face * 2 * cube_texel_bytes(q) + 2 * 6 * face * 4
+}
+
+/// What one layer is, for `specula plan`.
+pub fn describe_layer(q: &Quality) -> String {
+    format!(
+        "{} (radiance, distance) + {} (normal, material), {:.2} MiB",
+        describe_cube(q),
+        describe_cube(q),
+        (bytes(q, 1) - bytes(q, 0)) as f64 / (1 << 20) as f64
+    )
+}
+
+/// Half-precision normals hold material indices exactly up to 2048.
+const HALF_MATERIALS: usize = 2048;
+
+pub struct LayeredMaps {
+    /// The objects that take the method (they share the map; the first one's cube views
+    /// are the map's).
+    objects: Vec<usize>,
+    layers: u32,
+    /// The depth complexity counted (`layers=auto`), and whether the GPU counted it.
+    measured: Option<(u32, bool)>,
+    depth: Vec<Image>,
+    peel: vk::Pipeline,
+    nearest: vk::Sampler,
+    /// Set-1 sets sampling depth buffer 0 and 1 as the previous layer.
+    sets: Vec<(vk::DescriptorPool, vk::DescriptorSet)>,
+    mode: CubeMode,
+}
+
+pub fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    let me = LayeredMaps {
+        objects: objects.to_vec(),
+        layers: 0,
+        measured: None,
+        depth: Vec::new(),
+        peel: vk::Pipeline::null(),
+        nearest: vk::Sampler::null(),
+        sets: Vec::new(),
+        mode: init.plan.quality.cube_mode,
+    };
+    Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
+}
+
+impl LayeredMaps {
+    fn centre(&self, init: &StageInit) -> Vec3 {
+        self.objects.first().and_then(|&m| init.plan.object(m)).map_or(Vec3::ZERO, |o| o.reference_point)
+    }
+
+    fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let (ctx, q) = (init.ctx, &init.plan.quality);
+        self.layers = self.layer_count(init)?;
+        self.allocate(init, maps)?;
+        for i in 0..2 {
+            let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+            let name = format!("layered.depth.{}", ["ping", "pong"][i]);
+            let desc = ImageDesc {
+                name: &name,
+                format: DEPTH_FORMAT,
+                width: q.cube_size,
+                height: q.cube_size,
+                kind: ImageKind::D2Array { layers: 6 },
+                usage,
+            };
+            self.depth.push(Image::new(ctx, &desc)?);
+        }
+        self.nearest = sampler(ctx, "layered.previous_sampler", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
+        use crate::frame::layout::{binding, MAP_BINDINGS};
+        for i in 0..2 {
+            let (pool, set) = allocate_set(ctx, &format!("layered.peel_set{i}"), init.set_layouts[1], MAP_BINDINGS)?;
+            self.sets.push((pool, set));
+            let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+            write_image(
+                ctx,
+                set,
+                binding::LAYERED_PREVIOUS,
+                0,
+                cis,
+                self.depth[i].view,
+                self.nearest,
+                vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+            );
+            for b in
+                [binding::DISTANCE_MAPS, binding::REFRACTOR_MAPS, binding::BACKFACE_MAP, binding::LAYERED_MAPS, binding::LAYERED_NORMALS]
+            {
+                write_image(ctx, set, b, 0, cis, vk::ImageView::null(), self.nearest, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+            }
+            crate::vk::pipeline::write_buffer(ctx, set, binding::THICKNESS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
+        }
+        let formats = [radiance_format(q.cube_precision), normal_format(q, init.scene.materials.len())];
+        self.peel = graphics_pipeline(
+            ctx,
+            init.layout,
+            &GraphicsDesc {
+                name: "layered.peel",
+                vertex: "scene/mesh.vert",
+                fragment: "layered/peel.frag",
+                vertex_input: VertexInput::Mesh,
+                color_formats: &formats,
+                depth_format: Some(DEPTH_FORMAT),
+                depth_test: true,
+                depth_write: true,
+                view_mask: crate::frame::view_mask(q.cube_mode),
+                cull: vk::CullModeFlags::NONE,
+                multisample: Multisample::OFF,
+                blend: Blend::Replace,
+                depth_op: DepthOp::Nearer,
+            },
+        )?;
+        Ok(())
+    }
+
+    /// The knob, or the depth complexity counted now (at least one layer).
+    fn layer_count(&mut self, init: &StageInit) -> Result<u32> {
+        let q = &init.plan.quality;
+        if let Some(l) = q.layers {
+            self.measured = None;
+            return Ok(l);
+        }
+        let centre = self.centre(init);
+        let (count, gpu) = if init.ctx.queue.is_some() {
+            (count_on_gpu(init, centre)?, true)
+        } else {
+            (count_on_cpu(init.scene, centre, q.cube_size.min(64)), false)
+        };
+        self.measured = Some((count, gpu));
+        Ok(count.clamp(1, MAX_LAYERS))
+    }
+
+    /// The layers' two images, `layers` cubes each, into the frame's maps.
+    fn allocate(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let (ctx, q) = (init.ctx, &init.plan.quality);
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
+        let kind = ImageKind::CubeArray { cubes: self.layers };
+        let s = q.cube_size;
+        let radiance = ImageDesc { name: "layered.cubes", format: radiance_format(q.cube_precision), width: s, height: s, kind, usage };
+        maps.layered = Some(Image::new(ctx, &radiance)?);
+        let normals =
+            ImageDesc { name: "layered.normals", format: normal_format(q, init.scene.materials.len()), width: s, height: s, kind, usage };
+        maps.layered_normals = Some(Image::new(ctx, &normals)?);
+        Ok(())
+    }
+}
+
+fn normal_format(q: &Quality, materials: usize) -> vk::Format {
+    match q.cube_precision {
+        Precision::Half if materials <= HALF_MATERIALS => vk::Format::R16G16B16A16_SFLOAT,
+        _ => vk::Format::R32G32B32A32_SFLOAT,
+    }
+}
+
+/// `layered.count`: every surface rendered into the six faces around `centre` with
+/// additive blending (one per surface along each texel's ray), read back, the maximum.
+fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
+    let ctx = init.ctx;
+    let size = init.plan.quality.cube_size;
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let desc = ImageDesc {
+        name: "layered.count",
+        format: vk::Format::R32_SFLOAT,
+        width: size,
+        height: size,
+        kind: ImageKind::D2Array { layers: 6 },
+        usage,
+    };
+    let mut target = Image::new(ctx, &desc)?;
+    let mut layout = vk::PipelineLayout::null();
+    let mut pipeline = vk::Pipeline::null();
+    let result = (|| {
+        layout = crate::vk::pipeline::pipeline_layout(ctx, "layered.count_layout", &[], 64, vk::ShaderStageFlags::VERTEX)?;
+        let formats = [vk::Format::R32_SFLOAT];
+        pipeline = graphics_pipeline(
+            ctx,
+            layout,
+            &GraphicsDesc {
+                name: "layered.count",
+                vertex: "layered/count.vert",
+                fragment: "layered/count.frag",
+                vertex_input: VertexInput::Positions,
+                color_formats: &formats,
+                depth_format: None,
+                depth_test: false,
+                depth_write: false,
+                view_mask: 0,
+                cull: vk::CullModeFlags::NONE,
+                multisample: Multisample::OFF,
+                blend: Blend::Add,
+                depth_op: DepthOp::Nearer,
+            },
+        )?;
+        ctx.one_shot(|cmd| {
+            if let Some(b) = target.transition(Access::ColorAttachment) {
+                unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().image_memory_barriers(&[b])) };
+            }
+            for face in 0..6 {
+                let colors = [target.layer_view(face)];
+                let t = Target {
+                    color: &colors,
+                    depth: None,
+                    width: size,
+                    height: size,
+                    view_mask: 0,
+                    layer_count: 1,
+                    clear_color: [0.0; 4],
+                    clear: true,
+                };
+                begin_rendering(ctx, cmd, &t);
+                let vp = crate::cube::face_view_proj(face as usize, centre, init.plan.cube_near);
+                unsafe {
+                    ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                    ctx.device.cmd_push_constants(cmd, layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::bytes_of(&vp.to_cols_array()));
+                }
+                init.gpu.bind_geometry(ctx, cmd);
+                for d in init.gpu.draws.iter().filter(|d| d.index_count > 0) {
+                    unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
+            Ok(())
+        })?;
+        let counts = crate::vk::read_image(ctx, &target)?;
+        Ok(counts.data.iter().fold(0.0f32, |m, &c| m.max(c)).round() as u32)
+    })();
+    destroy_pipelines(ctx, &mut [pipeline]);
+    if layout != vk::PipelineLayout::null() {
+        unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+    }
+    target.destroy(ctx);
+    result
+}
+
+/// The depth complexity along the rays through the texel centres of six `size`² faces
+/// around `centre`, by the reference's BVH (every surface crossed counts).
+pub fn count_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> u32 {
+    let bvh = crate::reference::bvh::Bvh::new(scene);
+    let o = centre.as_dvec3();
+    let mut most = 0;
+    for face in 0..6 {
+        for j in 0..size {
+            for i in 0..size {
+                let (s, t) = ((i as f32 + 0.5) / size as f32, (j as f32 + 0.5) / size as f32);
+                let d: DVec3 = crate::cube::face_st_to_direction(face, s, t).as_dvec3().normalize();
+                let (mut t_min, mut skip, mut n) = (0.0, None, 0);
+                while let Some(h) = bvh.intersect(o, d, t_min, f64::INFINITY, skip) {
+                    n += 1;
+                    t_min = h.t;
+                    skip = Some(h.triangle);
+                    if n >= 64 {
+                        break;
+                    }
+                }
+                most = most.max(n);
+            }
+        }
+    }
+    most
+}
+
+impl Stage for LayeredMaps {
+    fn name(&self) -> &'static str {
+        "layered.peel"
+    }
+
+    /// Peels the layers: layer k tests against layer k−1's depth (sampled from the other
+    /// depth buffer); six passes per layer, or one multiview pass.
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let (Some(mut radiance), Some(mut normals)) = (io.maps.layered.take(), io.maps.layered_normals.take()) else { return };
+        let Some(view) = self.objects.first().and_then(|&m| io.views.cube_of(io.plan, m)) else {
+            (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
+            return;
+        };
+        let mut pass =
+            rec.pass("layered.peel").writes(&mut radiance, Access::ColorAttachment).writes(&mut normals, Access::ColorAttachment);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()) {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let size = radiance.width;
+        let six = self.mode == CubeMode::SixPasses;
+        let eyes = io.view_eyes;
+        for k in 0..self.layers {
+            let (cur, prev) = ((k % 2) as usize, ((k + 1) % 2) as usize);
+            rec.barrier(&mut self.depth[cur], Access::DepthAttachment);
+            // Layer 0 samples nothing, but its set names the other buffer all the same.
+            rec.barrier(&mut self.depth[prev], Access::FragmentSampled);
+            let first = if k == 0 { LAYERED_FIRST } else { 0 };
+            let faces: &[u32] = if six { &[0, 1, 2, 3, 4, 5] } else { &[0] };
+            for &face in faces {
+                let (colors, depth, mask) = if six {
+                    ([radiance.layer_view(6 * k + face), normals.layer_view(6 * k + face)], self.depth[cur].layer_view(face), 0)
+                } else {
+                    ([radiance.group_view(k), normals.group_view(k)], self.depth[cur].group_view(0), 0x3F)
+                };
+                let t = Target {
+                    color: &colors,
+                    depth: Some(depth),
+                    width: size,
+                    height: size,
+                    view_mask: mask,
+                    layer_count: 1,
+                    clear_color: [0.0, 0.0, 0.0, 1e30],
+                    clear: true,
+                };
+                begin_rendering(ctx, cmd, &t);
+                f.bind(ctx, cmd, self.peel);
+                f.bind_maps(ctx, cmd, self.sets[prev].1);
+                let v = view + face;
+                let eye = eyes.get(v as usize).copied().unwrap_or_default();
+                let flags = f.flags | first | if six { face << LAYERED_FACE_SHIFT } else { 0 };
+                for d in f
+                    .scene
+                    .draws
+                    .iter()
+                    .filter(|d| d.index_count > 0 && (!six || crate::cube::face_sees_box(face as usize, eye, d.lo, d.hi)))
+                {
+                    f.push_flags(ctx, cmd, v, d.mesh, flags);
+                    unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
+        }
+        rec.end(open);
+        (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
+    }
+
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        let mut s = vec![("layered.layers".to_string(), self.layers as f64)];
+        if let Some((count, gpu)) = self.measured {
+            s.push(("layered.depth_complexity".into(), count as f64));
+            s.push(("layered.counted_on_gpu".into(), if gpu { 1.0 } else { 0.0 }));
+        }
+        s
+    }
+
+    /// Objects moved: with `layers=auto` the depth complexity is counted again, and the
+    /// layers are reallocated when it changed (the renderer rewrites the descriptors).
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
+        if changes.moved.is_empty() || init.plan.quality.layers.is_some() {
+            return Ok(());
+        }
+        let layers = self.layer_count(init)?;
+        if layers != self.layers {
+            for i in [maps.layered.take(), maps.layered_normals.take()].iter_mut().flatten() {
+                i.destroy(init.ctx);
+            }
+            self.layers = layers;
+            self.allocate(init, maps)?;
+        }
+        Ok(())
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        destroy_pipelines(ctx, &mut [self.peel]);
+        for d in &mut self.depth {
+            d.destroy(ctx);
+        }
+        self.depth.clear();
+        for (pool, _) in self.sets.drain(..) {
+            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+        }
+        if self.nearest != vk::Sampler::null() {
+            unsafe { ctx.device.destroy_sampler(self.nearest, None) };
+            self.nearest = vk::Sampler::null();
+        }
+    }
+}
+
+impl Owner for LayeredMaps {
+    fn destroy(&mut self, ctx: &Context) {
+        Stage::destroy(self, ctx)
+    }
+}
