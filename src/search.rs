@@ -208,7 +208,8 @@ pub fn layer_search(
     let mut lookups = 1;
     let len_x = x.length();
     let far_stored = map.distance(r);
-    if len_x <= 1e-6 * far_stored.min(1e30) {
+    // A sparse layer is empty in many directions: an empty far end does not end the march.
+    if len_x <= 0.0 || (!search_is_sky(far_stored) && len_x <= 1e-6 * far_stored) {
         if search_is_sky(far_stored) || start_side != 0 {
             return search_result(x, r, 0.0, true, lookups);
         }

@@ -151,7 +151,8 @@ SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secan
     float len_x = length(x);
     float far_stored = SEARCH_DISTANCE(R);
     lookups++;
-    if (len_x <= 1e-6 * min(far_stored, 1e30)) {
+    // (A sparse layer is empty in many directions: an empty far end does not end the march.)
+    if (len_x <= 0.0 || (!search_is_sky(far_stored) && len_x <= 1e-6 * far_stored)) {
         // From the reference point the layer answers exactly (its own surface excluded).
         if (search_is_sky(far_stored) || start_side != 0) return search_result(x, R, 0.0, true, lookups);
         return search_result(x, R, far_stored, false, lookups);

@@ -299,7 +299,7 @@ gpu_consts! {
     /// A crossing of a layer's surface found by the search is a hit only if the ray meets
     /// the surface there within this fraction of the distance (else it is the gap between
     /// two surfaces of one layer, and the search goes on).
-    LAYERED_GAP: float = 0.1;
+    LAYERED_GAP: float = 0.05;
     /// Rays the layered trace keeps pending (both Fresnel branches while there is room).
     LAYERED_STACK: uint = 8;
     /// `Push.flags`: a dielectric hit in the layered maps follows only its stronger Fresnel

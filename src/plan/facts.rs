@@ -38,6 +38,9 @@ pub struct ObjectFacts {
     /// planar mirrors as the environment (their mirrored views are the camera's), so such
     /// an object needs rays to see the mirror's reflection.
     pub sees_planar_mirror: bool,
+    /// Area fraction of the surface whose normal faces the reference point (0: convex
+    /// around it; a concave mirror that reflects itself, such as a bowl, faces it).
+    pub self_facing: f32,
     pub reference_point: Vec3,
     pub reference_note: Option<String>,
     pub triangles: usize,
@@ -312,6 +315,29 @@ fn visible_fraction(m: &Mesh, x: Vec3) -> f32 {
     }
 }
 
+/// Area fraction of mesh `m`'s triangles whose interpolated normal at the centroid faces
+/// `x` (by more than 1 % of the distance: a plane through `x` faces it nowhere).
+fn self_facing(m: &Mesh, x: Vec3) -> f32 {
+    let (mut facing, mut total) = (0.0f64, 0.0f64);
+    for t in m.indices.chunks_exact(3) {
+        let p = |k: usize| m.positions[t[k] as usize];
+        let area = ((p(1) - p(0)).cross(p(2) - p(0)).length() * 0.5) as f64;
+        let n = m.normals.get(t[0] as usize).copied().unwrap_or_default()
+            + m.normals.get(t[1] as usize).copied().unwrap_or_default()
+            + m.normals.get(t[2] as usize).copied().unwrap_or_default();
+        let to = (p(0) + p(1) + p(2)) / 3.0 - x;
+        total += area;
+        if n.normalize_or_zero().dot(to) < -0.01 * to.length() {
+            facing += area;
+        }
+    }
+    if total > 0.0 {
+        (facing / total) as f32
+    } else {
+        0.0
+    }
+}
+
 /// What rays from `x` (2048 directions of a Fibonacci sphere, stepping through the object
 /// itself) reach first: the other specular objects with the fraction of directions that
 /// reach each, and the fraction of directions whose hit lies on the scene's bounding box
@@ -405,6 +431,7 @@ impl SceneFacts {
                     sees_specular: sees,
                     box_fraction,
                     sees_planar_mirror: false,
+                    self_facing: self_facing(m, reference_point),
                     reference_point,
                     reference_note,
                     triangles: m.triangle_count(),

@@ -78,17 +78,29 @@ pub const LAYERED: Method = Method(&MethodInfo {
 /// refractor), which a single layer cannot hold.
 pub const CONVEX_FRACTION: f32 = 0.98;
 
+/// Above this area fraction of its surface facing its reference point an object is
+/// concave there (a bowl): its reflections see itself.
+pub const SELF_FACING: f32 = 0.02;
+
 fn layered_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    if f.visible_fraction >= CONVEX_FRACTION {
+    let hides = f.visible_fraction < CONVEX_FRACTION;
+    let faces = f.self_facing > SELF_FACING;
+    if !(hides || faces) || f.planar {
         return None;
+    }
+    let mut why = Vec::new();
+    if hides {
+        why.push(format!(
+            "only {:.0} % of it is visible from its reference point (non-convex: it hides part of itself)",
+            100.0 * f.visible_fraction
+        ));
+    }
+    if faces {
+        why.push(format!("{:.0} % of its surface faces its reference point (concave: it sees itself)", 100.0 * f.self_facing));
     }
     Some(Verdict {
         score: if q.planner.speed() { 2.5 } else { 4.5 },
-        reason: format!(
-            "{} {:.0} % visible from its reference point (concave or non-convex: it sees or hides part of itself): layered maps of the whole scene, traced recursively (§4.5)",
-            f.class.label(),
-            100.0 * f.visible_fraction
-        ),
+        reason: format!("{}: {}; layered maps of the whole scene, traced recursively (§4.5)", f.class.label(), why.join(", ")),
     })
 }
 
