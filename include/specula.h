@@ -53,6 +53,8 @@
 #define SPECULA_METHOD_REFRACTOR_MAP 5
 /* image-space-refraction (§4.4) */
 #define SPECULA_METHOD_IMAGE_SPACE_REFRACTION 6
+/* layered (§4.5) */
+#define SPECULA_METHOD_LAYERED 13
 /* bvh (§2.3.5) */
 #define SPECULA_METHOD_BVH 7
 /* kd-tree (§2.3.3) */

@@ -385,4 +385,29 @@ mod tests {
         assert!(s.escaped && s.dir == DVec3::Y);
         assert!(parallax_search(&sky, DVec3::X, DVec3::Y, 3).escaped);
     }
+
+    /// Two layers of nested spheres around the origin (radius 1 and 2): a ray from inside
+    /// the inner one hits it (layer 0) and, continuing, the outer one (layer 1); a ray
+    /// starting on the inner sphere, told it leaves outwards, does not find it again; a
+    /// ray from outside crosses the inner sphere inwards (behind → in front).
+    #[test]
+    fn layer_search_crosses_either_way_and_skips_its_origin() {
+        let inner = |_: DVec3| 1.0;
+        let outer = |_: DVec3| 2.0;
+        let x = DVec3::new(0.3, 0.1, 0.0);
+        let r = DVec3::new(0.2, 1.0, 0.4).normalize();
+        let exit = |radius: f64| -x.dot(r) + (x.dot(r).powi(2) - x.length_squared() + radius * radius).sqrt();
+        for (map, radius) in [(&inner as &dyn Fn(DVec3) -> f64, 1.0), (&outer, 2.0)] {
+            let h = layer_search(&map, x, r, 16, 0, 8, 1e-6, 0.05, 0);
+            assert!(!h.escaped && (h.d - exit(radius)).abs() < 1e-4, "{h:?} vs {}", exit(radius));
+        }
+        // Leaving the inner sphere outwards from its surface: no second hit on it.
+        let on = DVec3::new(0.0, 1.0, 0.0);
+        let out = DVec3::new(0.3, 1.0, 0.0).normalize();
+        assert!(layer_search(&inner, on, out, 16, 0, 8, 1e-6, 0.05, 1).escaped);
+        // From outside, inwards: the crossing from behind the layer's surface to in front.
+        let o = DVec3::new(0.0, 1.5, 0.0);
+        let h = layer_search(&inner, o, DVec3::NEG_Y, 16, 0, 8, 1e-6, 0.05, 0);
+        assert!(!h.escaped && (h.d - 0.5).abs() < 1e-4, "{h:?}");
+    }
 }
