@@ -115,22 +115,8 @@ pub fn linear_search(
             d = len_x * t / (1.0 - t);
             a = search_ratio(map, x, r, d, &mut lookups);
         } else {
-            if search_is_sky(far_stored) {
-                return search_result(x, r, 0.0, true, lookups);
-            }
-            let mut dd = (far_stored - r.dot(x)).max(d_l);
-            let mut aa = search_ratio(map, x, r, dd, &mut lookups);
-            let mut k = 0;
-            while k < 8 && aa < 1.0 {
-                d_l = dd;
-                a_l = aa;
-                dd = 2.0 * dd + len_x + far_stored;
-                aa = search_ratio(map, x, r, dd, &mut lookups);
-                k += 1;
-            }
-            if aa < 1.0 {
-                return search_result(x, r, 0.0, true, lookups);
-            }
+            let far = (!search_is_sky(far_stored)).then(|| search_far_end(map, x, r, far_stored, &mut d_l, &mut a_l, &mut lookups));
+            let Some(Some((dd, aa))) = far else { return search_result(x, r, 0.0, true, lookups) };
             (d, a) = (dd, aa);
         }
         if (a - 1.0).abs() <= tolerance {
@@ -147,6 +133,31 @@ pub fn linear_search(
     }
     let (d, _) = search_refine(map, x, r, [(d_l, a_l), (d_p, a_p)], binary_steps, secant_steps, tolerance, &mut lookups);
     search_result(x, r, d, false, lookups)
+}
+
+/// The ray's end at infinity with something seen there: the parallax estimate pushed out
+/// until it overshoots, moving the undershooting end along; `None`: it never does. Twin of
+/// `search_far_end` in glsl/common/search.glsl.
+fn search_far_end(
+    map: &impl DistanceMap,
+    x: DVec3,
+    r: DVec3,
+    far_stored: f64,
+    d_l: &mut f64,
+    a_l: &mut f64,
+    lookups: &mut u32,
+) -> Option<(f64, f64)> {
+    let len_x = x.length();
+    let mut d = (far_stored - r.dot(x)).max(*d_l);
+    let mut a = search_ratio(map, x, r, d, lookups);
+    let mut k = 0;
+    while k < 8 && a < 1.0 {
+        (*d_l, *a_l) = (d, a);
+        d = 2.0 * d + len_x + far_stored;
+        a = search_ratio(map, x, r, d, lookups);
+        k += 1;
+    }
+    (a >= 1.0).then_some((d, a))
 }
 
 /// Refinement of a bracket whose ratios lie on either side of 1: `binary_steps` halvings
@@ -227,22 +238,9 @@ pub fn layer_search(
             d = len_x * t / (1.0 - t);
             a = search_ratio(map, x, r, d, &mut lookups);
         } else {
-            if search_is_sky(far_stored) || a_l >= 1.0 {
-                return search_result(x, r, 0.0, true, lookups);
-            }
-            let mut dd = (far_stored - r.dot(x)).max(d_l);
-            let mut aa = search_ratio(map, x, r, dd, &mut lookups);
-            let mut k = 0;
-            while k < 8 && aa < 1.0 {
-                d_l = dd;
-                a_l = aa;
-                dd = 2.0 * dd + len_x + far_stored;
-                aa = search_ratio(map, x, r, dd, &mut lookups);
-                k += 1;
-            }
-            if aa < 1.0 {
-                return search_result(x, r, 0.0, true, lookups);
-            }
+            let far =
+                (!search_is_sky(far_stored) && a_l < 1.0).then(|| search_far_end(map, x, r, far_stored, &mut d_l, &mut a_l, &mut lookups));
+            let Some(Some((dd, aa))) = far else { return search_result(x, r, 0.0, true, lookups) };
             (d, a) = (dd, aa);
         }
         if (a < 1.0) != (a_l < 1.0) {

@@ -65,6 +65,23 @@ SearchResult parallax_search(vec3 x, vec3 R, int iterations) {
     return search_result(x, R, d, false, lookups);
 }
 
+// The ray's end at infinity, seen in direction R with something there (far_stored): the
+// parallax estimate of it (§4.1.3: pairing the ray's end with parallax correction), pushed
+// out until it overshoots; the pushes move the undershooting end (d_l, a_l) along. False:
+// it never overshoots (the ray escapes).
+bool search_far_end(vec3 x, vec3 R, float far_stored, inout float d_l, inout float a_l, out float d, out float a, inout int lookups) {
+    float len_x = length(x);
+    d = max(far_stored - dot(R, x), d_l);
+    a = search_ratio(x, R, d, lookups);
+    for (int k = 0; k < 8 && a < 1.0; ++k) {
+        d_l = d;
+        a_l = a;
+        d = 2.0 * d + len_x + far_stored;
+        a = search_ratio(x, R, d, lookups);
+    }
+    return a >= 1.0;
+}
+
 // Refinement of a bracket (d_l, a_l), (d_p, a_p) whose ratios lie on either side of 1:
 // `binary_steps` halvings (§4.1.4), then `secant_steps` false-position steps (survey eq. 5:
 // the ray meets the segment between the overshooting and the undershooting surface
@@ -113,16 +130,8 @@ SearchResult linear_search(vec3 x, vec3 R, int steps, int binary_steps, int seca
             // t = 1 is the ray's end at infinity, seen in direction R. If something is
             // there, bracket with the parallax estimate of it (§4.1.3: pairing the ray's end
             // with parallax correction), pushed out until it overshoots.
-            if (search_is_sky(far_stored)) return search_result(x, R, 0.0, true, lookups);
-            d = max(far_stored - dot(R, x), d_l);
-            a = search_ratio(x, R, d, lookups);
-            for (int k = 0; k < 8 && a < 1.0; ++k) {
-                d_l = d;
-                a_l = a;
-                d = 2.0 * d + len_x + far_stored;
-                a = search_ratio(x, R, d, lookups);
-            }
-            if (a < 1.0) return search_result(x, R, 0.0, true, lookups);
+            if (search_is_sky(far_stored) || !search_far_end(x, R, far_stored, d_l, a_l, d, a, lookups))
+                return search_result(x, R, 0.0, true, lookups);
         }
         if (abs(a - 1.0) <= tolerance) return search_result(x, R, d, false, lookups);
         if (a > 1.0) {
@@ -170,16 +179,8 @@ SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secan
         } else {
             // The ray's end at infinity is behind the layer's surface in direction R, if it
             // has one there; from in front, bracket with the parallax estimate pushed out.
-            if (search_is_sky(far_stored) || a_l >= 1.0) return search_result(x, R, 0.0, true, lookups);
-            d = max(far_stored - dot(R, x), d_l);
-            a = search_ratio(x, R, d, lookups);
-            for (int k = 0; k < 8 && a < 1.0; ++k) {
-                d_l = d;
-                a_l = a;
-                d = 2.0 * d + len_x + far_stored;
-                a = search_ratio(x, R, d, lookups);
-            }
-            if (a < 1.0) return search_result(x, R, 0.0, true, lookups);
+            if (search_is_sky(far_stored) || a_l >= 1.0 || !search_far_end(x, R, far_stored, d_l, a_l, d, a, lookups))
+                return search_result(x, R, 0.0, true, lookups);
         }
         if ((a < 1.0) != (a_l < 1.0)) {
             float e0 = d_l, b0 = a_l, e1 = d, b1 = a;
