@@ -90,6 +90,47 @@ fn spot_light_follows_the_gltf_falloff_on_the_gpu_and_in_the_reference() {
     common::assert_clean(&ctx);
 }
 
+/// KHR_lights_punctual's recommended range window, written out as the extension states it
+/// (not from the library's code): max(min(1 − (d/range)⁴, 1), 0) / d².
+fn gltf_range_window(d: f32, range: f32) -> f32 {
+    (1.0 - (d / range).powi(4)).clamp(0.0, 1.0)
+}
+
+/// A point light 1 m above the floor with range 2.2 m: floor points from its foot (window
+/// ≈ 0.96) across the window to beyond the range (0) follow the extension's window on the
+/// GPU and in the reference, so a window that is ignored, squared or cut off hard fails.
+#[test]
+fn point_light_range_follows_the_gltf_window_on_the_gpu_and_in_the_reference() {
+    let ctx = common::gpu();
+    let range = 2.2f32;
+    let position = Vec3::new(0.0, 1.0, 0.0);
+    let mut s = floor_scene(false);
+    s.add_light(Light { range: Some(range), ..light(LightKind::Point, position, Vec3::NEG_Y, 4.0) }).unwrap();
+    let gpu = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap().image;
+    let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
+    let (mut window_points, mut beyond) = (0, 0);
+    for x in [32, 36, 40, 44, 48, 52, 56, 60, 63] {
+        for y in [32, 44, 56, 63] {
+            let p = floor_point(x, y);
+            let d = position - p;
+            let window = gltf_range_window(d.length(), range);
+            window_points += (window > 0.05 && window < 0.8) as usize;
+            beyond += (window == 0.0) as usize;
+            let expected = ALBEDO / std::f32::consts::PI * 4.0 * (d.y / d.length()) / d.length_squared() * window;
+            for (name, img) in [("gpu", &gpu), ("reference", &reference)] {
+                let got = img.texel(0, x, y)[0];
+                assert!(
+                    (got - expected).abs() <= 0.01 * expected + 1e-5,
+                    "{name}: floor point {p} at {:.3} m (window {window:.4}): {got} vs {expected}",
+                    d.length()
+                );
+            }
+        }
+    }
+    assert!(window_points >= 4 && beyond >= 2, "the points sample the window ({window_points}) and beyond the range ({beyond})");
+    common::assert_clean(&ctx);
+}
+
 #[test]
 fn occluder_casts_a_shadow_from_point_spot_and_directional_lights() {
     let ctx = common::gpu();

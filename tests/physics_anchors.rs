@@ -190,3 +190,27 @@ fn slabs_displace_and_balls_focus_where_geometric_optics_says() {
         assert!((-z - f).abs() < 0.01 * f, "h {h}: focus at {} m, paraxial {f} m", -z);
     }
 }
+
+#[test]
+fn khr_materials_specular_scales_f0_by_its_colour_and_the_lobe_by_its_factor() {
+    use specula::quality::FresnelMode;
+    use specula::scene::{Material, SurfaceKind};
+    // The extension's dielectric Fresnel, written out as its specification states it:
+    // f0 = min(((ν − 1)/(ν + 1))² · specularColor, 1) · specular, f90 = specular,
+    // F = mix(f0, f90, (1 − cos θ)⁵). For ν 1.5, factor 0.5, colour (1, 0.5, 0.2):
+    // at normal incidence 0.02, 0.01, 0.004; at 60° (cos ½) each + 0.5 · (1 − F0c)/32.
+    let m = Material {
+        name: "spec".into(),
+        kind: SurfaceKind::Dielectric { ior: 1.5, thin: false },
+        specular_factor: 0.5,
+        specular_color: glam::Vec3::new(1.0, 0.5, 0.2),
+        ..Default::default()
+    };
+    let f0c = [0.04, 0.02, 0.008];
+    for (cos, expected) in [(1.0, [0.02, 0.01, 0.004]), (0.5, f0c.map(|f: f64| 0.5 * (f + (1.0 - f) / 32.0)))] {
+        let f = specula::reference::shade::material_fresnel(&m, FresnelMode::Schlick, cos, 1.5);
+        for k in 0..3 {
+            assert!((f[k] - expected[k]).abs() < 1e-6, "cos {cos}, channel {k}: {} vs {}", f[k], expected[k]);
+        }
+    }
+}

@@ -64,9 +64,9 @@ vec3 light_irradiance(Light l, vec3 p, out vec3 wi, out float dist) {
     wi = d / dist;
     vec3 e = l.intensity.rgb / d2;
     float range = l.position_range.w;
-    if (range > 0.0) {  // glTF's recommended smooth window
+    if (range > 0.0) {  // KHR_lights_punctual's recommended window (not squared)
         float r = dist / range;
-        e *= pow(clamp(1.0 - r * r * r * r, 0.0, 1.0), 2.0);
+        e *= clamp(1.0 - r * r * r * r, 0.0, 1.0);
     }
     if (kind == LIGHT_SPOT) {
         // KHR_lights_punctual's recommended falloff: the ramp linear in cos θ between the

@@ -131,9 +131,10 @@ impl ShadeLight {
         let wi = d / dist;
         let mut e = self.intensity / d2;
         if self.range > 0.0 {
-            // glTF's recommended smooth window.
+            // KHR_lights_punctual's recommended window, max(min(1 − (d/range)⁴, 1), 0) (the
+            // shader's `light_irradiance` is its twin; not squared as some engines do).
             let r = dist / self.range;
-            e *= (1.0 - r * r * r * r).clamp(0.0, 1.0).powi(2);
+            e *= (1.0 - r * r * r * r).clamp(0.0, 1.0);
         }
         if matches!(self.kind, LightKind::Spot { .. }) {
             // KHR_lights_punctual's recommended falloff (the ramp in cos θ, squared), as the
