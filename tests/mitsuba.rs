@@ -50,8 +50,19 @@ fn write_obj(path: &Path, m: &specula::scene::Mesh) {
     for n in &m.normals {
         let _ = writeln!(s, "vn {} {} {}", n.x, n.y, n.z);
     }
+    // Texture coordinates flipped in v (glTF's v = 0 is the image's top row, Mitsuba's
+    // bitmap puts it at v = 1: render.py states it).
+    for t in &m.uvs {
+        let _ = writeln!(s, "vt {} {}", t.x, 1.0 - t.y);
+    }
+    let uv = m.uvs.len() == m.positions.len();
     for t in m.indices.chunks_exact(3) {
-        let _ = writeln!(s, "f {0}//{0} {1}//{1} {2}//{2}", t[0] + 1, t[1] + 1, t[2] + 1);
+        let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
+        if uv {
+            let _ = writeln!(s, "f {a}/{a}/{a} {b}/{b}/{b} {c}/{c}/{c}");
+        } else {
+            let _ = writeln!(s, "f {a}//{a} {b}//{b} {c}//{c}");
+        }
     }
     std::fs::write(path, s).unwrap();
 }
@@ -76,6 +87,15 @@ fn describe(s: &Scene, name: &str, spp: u32, depth: u32) -> serde_json::Value {
         if mat.emissive != Vec3::ZERO {
             e["radiance"] = v(mat.emissive);
         }
+        if let Some(t) = mat.emissive_texture {
+            // The texture's sRGB bytes as a PNG (Mitsuba decodes sRGB to linear as the
+            // reference does); the factor must be 1 (Mitsuba's bitmap has no scale).
+            assert_eq!(mat.emissive, Vec3::ONE, "render.py takes an emissive texture with factor 1");
+            let t = &s.textures[t];
+            let png = d.join(format!("{name}_{i}.png"));
+            image::RgbaImage::from_raw(t.width, t.height, t.rgba8.clone()).unwrap().save(&png).unwrap();
+            e["radiance_texture"] = json!(png.to_str().unwrap());
+        }
         meshes.push(e);
     }
     let lights: Vec<_> = s
@@ -86,7 +106,12 @@ fn describe(s: &Scene, name: &str, spp: u32, depth: u32) -> serde_json::Value {
             LightKind::Directional => {
                 json!({ "type": "directional", "direction": l.direction.to_array(), "irradiance": l.intensity.to_array() })
             }
-            LightKind::Spot { .. } => panic!("spot lights differ on purpose (the glTF falloff): not cross-checked"),
+            // Mitsuba's spot ramps between beam_width and cutoff_angle by its own curve, not
+            // glTF's squared ramp in cos θ: the test compares outside the ramp.
+            LightKind::Spot { inner_cone, outer_cone } => json!({
+                "type": "spot", "position": l.position.to_array(), "direction": l.direction.to_array(),
+                "intensity": l.intensity.to_array(), "beam_deg": inner_cone.to_degrees(), "cutoff_deg": outer_cone.to_degrees(),
+            }),
         })
         .collect();
     let cam = s.camera_or_default();
@@ -161,13 +186,20 @@ fn specular_balls_agree_with_mitsuba() {
         |ior: f32| Material { name: format!("glass{ior}"), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() };
     let thin = Material { name: "thin".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: true }, ..Default::default() };
     // Measured here (48×36; the reference at 16 spp, Mitsuba at 256, both deterministic):
-    // gold 46.06 dB, glass 1.5 46.91 dB, glass 1.1 47.34 dB; the floors sit 1 dB below.
+    // mirror (F0 0.8, κ 0) 45.13 dB, gold 46.06 dB, glass 1.5 46.91 dB, glass 1.1 47.34 dB;
+    // the floors sit 1 dB below. The GPU's bvh measured 1.2–2.3 dB above the reference
+    // (its 4×4 grid is Mitsuba's stratified pattern more nearly than the reference's jitter).
     // Thin-walled glass differs on purpose, 37.43 dB: specula follows glTF's thin-walled
     // model (one interface: reflect F, pass 1 − F undeviated), Mitsuba's `thindielectric` a
     // physical slab summing its internal reflections (2F/(1 + F) reflected).
-    for (name, material, floor) in
-        [("gold", gold, 45.0), ("glass1.5", glass(1.5), 45.9), ("glass1.1", glass(1.1), 46.3), ("thin", thin, 36.4)]
-    {
+    // GPU measured 47.18, 48.31, 48.92, 49.60 and 37.50 dB: floors 1 dB below.
+    for (name, material, floor, gpu_floor) in [
+        ("mirror", common::mirror(0.8), 44.1, 46.2),
+        ("gold", gold, 45.1, 47.3),
+        ("glass1.5", glass(1.5), 45.9, 47.9),
+        ("glass1.1", glass(1.1), 46.3, 48.6),
+        ("thin", thin, 36.4, 36.5),
+    ] {
         let s = room_with(material);
         let (r, m) = (reference(&s, 16), mitsuba(&s, name, 256, 16));
         save(name, &r);
@@ -180,7 +212,7 @@ fn specular_balls_agree_with_mitsuba() {
         let g = psnr(&gpu, &m);
         println!("{name}: reference vs Mitsuba {p:.2} dB, GPU bvh vs Mitsuba {g:.2} dB");
         assert!(p >= floor, "{name}: {p:.2} dB against Mitsuba (floor {floor} dB)");
-        assert!(g >= floor - 3.0, "{name}: GPU bvh {g:.2} dB against Mitsuba (floor {} dB)", floor - 3.0);
+        assert!(g >= gpu_floor, "{name}: GPU bvh {g:.2} dB against Mitsuba (floor {gpu_floor} dB)");
     }
     common::assert_clean(&ctx);
 }
@@ -213,21 +245,118 @@ fn direct_light_and_shadows_agree_with_mitsuba() {
             },
         ),
     ] {
-        let mut s = Scene::new();
-        let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::new(0.6, 0.5, 0.4), ..Default::default() }).unwrap();
-        s.add_mesh(shapes::quad("floor", Vec3::new(-2.0, 0.0, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0), 8, floor))
-            .unwrap();
-        let black = s.add_material(Material { name: "occluder".into(), base_color: Vec3::ZERO, ..Default::default() }).unwrap();
-        s.add_mesh(shapes::quad("occluder", Vec3::new(-0.4, 0.9, 0.4), Vec3::new(0.8, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.8), 1, black))
-            .unwrap();
-        s.add_light(light).unwrap();
-        s.camera = Some(Camera::look_at(Vec3::new(0.0, 2.6, 2.4), Vec3::new(0.0, 0.0, -0.2), 55f32.to_radians()));
+        let s = lit_floor(light);
         let (r, m) = (reference(&s, 4), mitsuba(&s, name, 64, 4));
         save(name, &r);
         let p = psnr(&r, &m);
         println!("{name}: reference vs Mitsuba {p:.2} dB");
-        // Measured 55.29 dB (point) and 50.16 dB (directional); floors 1 dB below.
-        let floor = if name == "point" { 54.3 } else { 49.2 };
+        // Measured 55.24 dB (point) and 50.31 dB (directional); floors 1 dB below.
+        let floor = if name == "point" { 54.3 } else { 49.3 };
         assert!(p >= floor, "{name}: {p:.2} dB against Mitsuba (floor {floor} dB)");
     }
+}
+
+/// The floor, the occluder and the camera of the direct-light scenes.
+fn lit_floor(light: Light) -> Scene {
+    let mut s = Scene::new();
+    let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::new(0.6, 0.5, 0.4), ..Default::default() }).unwrap();
+    s.add_mesh(shapes::quad("floor", Vec3::new(-2.0, 0.0, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0), 8, floor)).unwrap();
+    let black = s.add_material(Material { name: "occluder".into(), base_color: Vec3::ZERO, ..Default::default() }).unwrap();
+    s.add_mesh(shapes::quad("occluder", Vec3::new(-0.4, 0.9, 0.4), Vec3::new(0.8, 0.0, 0.0), Vec3::new(0.0, 0.0, -0.8), 1, black)).unwrap();
+    s.add_light(light).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 2.6, 2.4), Vec3::new(0.0, 0.0, -0.2), 55f32.to_radians()));
+    s
+}
+
+/// A spot light on the floor with the occluder's shadow inside its inner cone. The two
+/// renderers' falloffs differ on purpose inside the ramp (render.py): the pixels whose floor
+/// point lies within the ramp (between the inner and the outer cone, widened by 2°) are
+/// compared apart and their difference stated; everywhere else, inside the inner cone and
+/// outside the outer, the images must agree.
+#[test]
+fn spot_light_agrees_with_mitsuba_outside_its_ramp() {
+    let (inner, outer) = (0.55f32, 0.7f32);
+    let position = Vec3::new(0.3, 2.0, 0.1);
+    let direction = Vec3::new(-0.1, -1.0, -0.1).normalize();
+    let s = lit_floor(Light {
+        name: "l".into(),
+        kind: LightKind::Spot { inner_cone: inner, outer_cone: outer },
+        position,
+        direction,
+        intensity: Vec3::new(6.0, 5.0, 4.0),
+        range: None,
+    });
+    let (r, m) = (reference(&s, 4), mitsuba(&s, "spot", 64, 4));
+    save("spot", &r);
+    // Each pixel's floor point (y = 0) through its centre, and its angle off the spot's axis.
+    let rays = specula::reference::CameraRays::new(&s.camera_or_default(), SIZE.0, SIZE.1);
+    let margin = 2f64.to_radians();
+    let (mut outside, mut ramp) = ((0.0, 0usize, 0.0f64), (0.0, 0usize));
+    for y in 0..SIZE.1 {
+        for x in 0..SIZE.0 {
+            let (o, d, _) = rays.ray(x as f64 + 0.5, y as f64 + 0.5);
+            let t = -o.y / d.y;
+            let angle = if t > 0.0 {
+                let p = o + d * t;
+                (p - position.as_dvec3()).normalize().dot(direction.as_dvec3()).clamp(-1.0, 1.0).acos()
+            } else {
+                std::f64::consts::PI
+            };
+            let i = ((y * SIZE.0 + x) * 4) as usize;
+            let se: f64 = (0..3).map(|c| ((r.data[i + c] - m.data[i + c]) as f64).powi(2)).sum::<f64>() / 3.0;
+            if angle > inner as f64 - margin && angle < outer as f64 + margin {
+                ramp = (ramp.0 + se, ramp.1 + 1);
+            } else {
+                outside = (outside.0 + se, outside.1 + 1, outside.2.max(r.data[i] as f64));
+            }
+        }
+    }
+    let db = |se: f64, n: usize| -10.0 * (se / n as f64).log10();
+    let (p_out, p_ramp) = (db(outside.0, outside.1), db(ramp.0, ramp.1));
+    println!("spot: outside the ramp ({} px) {p_out:.2} dB, inside it ({} px) {p_ramp:.2} dB", outside.1, ramp.1);
+    assert!(outside.1 > 1000 && ramp.1 > 50 && outside.2 > 0.2, "the pixels sample the lit cone, the ramp and the dark");
+    // Measured 54.94 dB outside the ramp (36.30 dB inside it); the floor 1 dB below.
+    assert!(p_out >= 53.9, "spot outside its ramp: {p_out:.2} dB against Mitsuba");
+}
+
+/// A wall whose emission is a texture (4 × 4 texels of distinct colours, sampled bilinearly
+/// with repeat), seen straight and in a mirror ball: texture orientation (u, v and their
+/// flips), sRGB decoding and filtering against Mitsuba's bitmap emitter.
+#[test]
+fn emissive_textured_wall_agrees_with_mitsuba() {
+    let mut s = Scene::new();
+    let mut rgba8 = Vec::new();
+    for k in 0..16u32 {
+        rgba8.extend_from_slice(&[(k * 53 % 256) as u8, (k * 97 % 256) as u8, (255 - k * 16) as u8, 255]);
+    }
+    let t = s.add_texture(specula::scene::Texture { name: "checker".into(), width: 4, height: 4, rgba8 }).unwrap();
+    let wall = s
+        .add_material(Material {
+            name: "wall".into(),
+            base_color: Vec3::ZERO,
+            emissive: Vec3::ONE,
+            emissive_texture: Some(t),
+            ..Default::default()
+        })
+        .unwrap();
+    // A 3 × 2 m wall facing +z, towards the camera (Mitsuba's area emitters emit on their
+    // front only): u along −x, v down (glTF's image rows top to bottom).
+    s.add_mesh(shapes::quad("wall", Vec3::new(1.5, 2.0, -1.0), Vec3::new(-3.0, 0.0, 0.0), Vec3::new(0.0, -2.0, 0.0), 1, wall)).unwrap();
+    let m = s.add_material(common::mirror(0.8)).unwrap();
+    s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.6, 0.5, 0.2), 0.35, 64, 32, m)).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(0.2, 1.0, 2.2), Vec3::new(0.0, 1.0, -1.0), 60f32.to_radians()));
+    let (r, mi) = (reference(&s, 4), mitsuba(&s, "textured", 64, 4));
+    save("textured", &r);
+    let p = psnr(&r, &mi);
+    // The GPU's texture sampling too, 4×4 supersampled (2×2 measured 39.6 dB: the wall's and
+    // the ball's edges, not the texels).
+    let ctx = common::gpu();
+    let q = Quality { depth: 4, aa: specula::quality::Aa::Ssaa(4), ..Quality::default() };
+    let gpu = specula::render(&ctx, &s, specula::methods::BVH, &q, SIZE, (0, 1)).unwrap().image;
+    let g = psnr(&gpu, &mi);
+    println!("textured wall: reference vs Mitsuba {p:.2} dB, GPU bvh vs Mitsuba {g:.2} dB");
+    // Measured 47.03 dB (the reference) and 44.48 dB (the GPU); the floors 1 dB below.
+    assert!(p >= 46.0, "textured wall: {p:.2} dB against Mitsuba");
+    assert!(g >= 43.5, "textured wall: GPU bvh {g:.2} dB against Mitsuba");
+    common::assert_clean(&ctx);
 }

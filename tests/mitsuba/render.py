@@ -11,8 +11,15 @@ The conventions mapping, written down once (the Rust side writes the JSON in the
   diffuse {reflectance}, conductor {eta, k} (per channel, the glTF/specula ν, κ),
   dielectric {ior} (solid, from air), thindielectric {ior}, black (emitters: reflectance 0);
   an optional `radiance` makes the mesh an area emitter (specula's emission is radiance).
+  An optional `radiance_texture` (a PNG of sRGB bytes, the glTF emissive texture with
+  factor 1) makes the radiance a bilinear, repeating bitmap; glTF's uv has v = 0 at the
+  image's top row, Mitsuba's bitmap at its bottom row: the OBJ's `vt` carry 1 − v
+  (measured: without the flip the textured wall of tests/mitsuba.rs falls to 15.7 dB).
 - lights: point {position, intensity} (W/sr, specula's glTF intensity 1:1), directional
-  {direction, irradiance} (W/m²).
+  {direction, irradiance} (W/m²), spot {position, direction, intensity, beam_deg,
+  cutoff_deg}: glTF's inner and outer cone angles as Mitsuba's beam width and cutoff. The
+  two differ on purpose inside the ramp (Mitsuba's own curve against glTF's squared ramp
+  in cos θ, which specula follows): the test compares outside it.
 - integrator: path tracing to `max_depth` (specula's `depth` + 1: Mitsuba counts the camera
   segment), no Russian roulette before that depth.
 """
@@ -67,7 +74,9 @@ def main():
     }
     for i, m in enumerate(desc["meshes"]):
         shape = {"type": "obj", "filename": m["obj"], "face_normals": False, "bsdf": bsdf(m["bsdf"])}
-        if "radiance" in m:
+        if "radiance_texture" in m:
+            shape["emitter"] = {"type": "area", "radiance": {"type": "bitmap", "filename": m["radiance_texture"], "filter_type": "bilinear", "wrap_mode": "repeat"}}
+        elif "radiance" in m:
             shape["emitter"] = {"type": "area", "radiance": rgb(m["radiance"])}
         scene[f"mesh{i}"] = shape
     for i, l in enumerate(desc.get("lights", [])):
@@ -75,6 +84,16 @@ def main():
             scene[f"light{i}"] = {"type": "point", "position": l["position"], "intensity": rgb(l["intensity"])}
         elif l["type"] == "directional":
             scene[f"light{i}"] = {"type": "directional", "direction": l["direction"], "irradiance": rgb(l["irradiance"])}
+        elif l["type"] == "spot":
+            p, d = l["position"], l["direction"]
+            up = [0.0, 0.0, 1.0] if abs(d[1]) > 0.9 else [0.0, 1.0, 0.0]
+            scene[f"light{i}"] = {
+                "type": "spot",
+                "to_world": mi.ScalarTransform4f().look_at(origin=p, target=[p[k] + d[k] for k in range(3)], up=up),
+                "intensity": rgb(l["intensity"]),
+                "beam_width": float(l["beam_deg"]),
+                "cutoff_angle": float(l["cutoff_deg"]),
+            }
         else:
             raise ValueError(f"unknown light {l['type']}")
     image = mi.render(mi.load_dict(scene))
