@@ -32,6 +32,22 @@ fn errors(test: &ImageData, reference: &ImageData) -> ImageErrors {
     metrics::compare(test, reference).unwrap()
 }
 
+/// RMSE of `distance` against `refimg` for each value of one knob over fixed `base` knobs,
+/// printed as `label value: errors`.
+fn knob_sweep(ctx: &Context, scene: &Scene, refimg: &ImageData, base: &[&str], knob: &str, values: &[u32], label: &str) -> Vec<f64> {
+    let size = refimg.width;
+    values
+        .iter()
+        .map(|v| {
+            let pair = format!("{knob}={v}");
+            let q = quality(&base.iter().copied().chain(std::iter::once(pair.as_str())).collect::<Vec<_>>());
+            let e = errors(&gpu(ctx, scene, specula::methods::DISTANCE, &q, size), refimg);
+            eprintln!("{label} {v:2}: {e}");
+            e.rmse
+        })
+        .collect()
+}
+
 /// The quadrant room (half-size 2 around (0, 2, 0), 24 distinct emissive colours) with a
 /// mirror sphere of radius 0.5 moved into a corner: the survey's Figure 14/20 situation.
 fn corner_mirror_scene() -> Scene {
@@ -85,13 +101,8 @@ fn secant_steps_converge_monotonically() {
     let scene = corner_mirror_scene();
     let size = 80;
     let refimg = reference(&scene, &["spp=4", "depth=1"], size);
-    let mut rmse = Vec::new();
-    for secant in [0, 1, 2, 4, 8, 16] {
-        let q = quality(&["cube_size=128", "ref_point=0,2,0", "linear_steps=4", "search_tolerance=0", &format!("secant_steps={secant}")]);
-        let e = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
-        eprintln!("secant {secant:2}: {e}");
-        rmse.push(e.rmse);
-    }
+    let base = ["cube_size=128", "ref_point=0,2,0", "linear_steps=4", "search_tolerance=0"];
+    let rmse = knob_sweep(&ctx, &scene, &refimg, &base, "secant_steps", &[0, 1, 2, 4, 8, 16], "secant");
     for w in rmse.windows(2) {
         assert!(w[1] <= w[0] * 1.02, "error rose: {rmse:?}");
     }
@@ -103,27 +114,16 @@ fn secant_steps_converge_monotonically() {
 
 /// Binary refinement (§4.1.4) after a coarse 4-step linear search, no secant: the error falls
 /// with the halvings and 8 of them beat none by a wide margin (measured RMSE 0.0556,
-/// 0.0237, 0.0201, 0.0195 for 0, 2, 4, 8 steps; the floor is 1 dB above the last), so a knob that is ignored or halves the wrong side fails.
+/// 0.0237, 0.0201, 0.0195 for 0, 2, 4, 8 steps; the floor is 1 dB above the last), so a
+/// knob that is ignored or halves the wrong side fails.
 #[test]
 fn binary_steps_refine_the_linear_search() {
     let ctx = common::gpu();
     let scene = corner_mirror_scene();
     let size = 64;
     let refimg = reference(&scene, &["spp=4", "depth=1"], size);
-    let mut rmse = Vec::new();
-    for binary in [0, 2, 4, 8] {
-        let q = quality(&[
-            "cube_size=128",
-            "ref_point=0,2,0",
-            "linear_steps=4",
-            "secant_steps=0",
-            "search_tolerance=0",
-            &format!("binary_steps={binary}"),
-        ]);
-        let e = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
-        eprintln!("binary {binary}: {e}");
-        rmse.push(e.rmse);
-    }
+    let base = ["cube_size=128", "ref_point=0,2,0", "linear_steps=4", "secant_steps=0", "search_tolerance=0"];
+    let rmse = knob_sweep(&ctx, &scene, &refimg, &base, "binary_steps", &[0, 2, 4, 8], "binary");
     for w in rmse.windows(2) {
         assert!(w[1] < w[0], "each halving lowers the error: {rmse:?}");
     }
@@ -144,13 +144,8 @@ fn parallax_iterations_converge_when_there_is_no_linear_search() {
     let scene = corner_mirror_scene();
     let size = 64;
     let refimg = reference(&scene, &["spp=4", "depth=1"], size);
-    let mut rmse = Vec::new();
-    for it in [1, 2, 4] {
-        let q = quality(&["cube_size=128", "ref_point=0,2,0", "linear_steps=0", &format!("parallax_iterations={it}")]);
-        let e = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &q, size), &refimg);
-        eprintln!("parallax {it}: {e}");
-        rmse.push(e.rmse);
-    }
+    let base = ["cube_size=128", "ref_point=0,2,0", "linear_steps=0"];
+    let rmse = knob_sweep(&ctx, &scene, &refimg, &base, "parallax_iterations", &[1, 2, 4], "parallax");
     let linear = errors(&gpu(&ctx, &scene, specula::methods::DISTANCE, &quality(&["cube_size=128", "ref_point=0,2,0"]), size), &refimg);
     eprintln!("linear 16: {linear}");
     for w in rmse.windows(2) {
