@@ -7,12 +7,51 @@ use glam::Vec3;
 use specula::scene::{shapes, Camera, Light, LightKind, Material, Scene};
 use specula::Quality;
 
-const ALBEDO: f32 = 0.5;
+/// The floor's albedo and the lights' colour, a different value per channel, so that a bug
+/// on one channel's path (a channel dropped, swapped or taken from another) shows: every
+/// closed form below is checked on red, green and blue.
+const ALBEDO: Vec3 = Vec3::new(0.5, 0.3, 0.7);
+const COLOUR: Vec3 = Vec3::new(1.0, 0.6, 0.3);
+
+/// The largest relative error over the three channels of `got` against `expected` (whose
+/// channels are all > 0).
+fn rel_err(got: &[f32], expected: Vec3) -> f32 {
+    (0..3).map(|k| (got[k] - expected[k]).abs() / expected[k]).fold(0.0, f32::max)
+}
+
+/// The relative error over the channels of a lit point (`expected` > 0), or the absolute
+/// error of an unlit one (`expected` = 0): (relative, absolute).
+fn errors(got: &[f32], expected: Vec3) -> (f32, f32) {
+    if expected.min_element() > 0.0 {
+        (rel_err(got, expected), 0.0)
+    } else {
+        (0.0, (0..3).map(|k| (got[k] - expected[k]).abs()).fold(0.0, f32::max))
+    }
+}
+
+/// Relative tolerance of the closed forms at a point or directional light's lit points:
+/// the f32 rounding of the shader's arithmetic and of this test's (the interpolated floor
+/// position, the inverse square and cosine), 10× the worst measured: 1.5e-7 (point light),
+/// 1.5e-7 (directional, shadow test).
+const TOL: f32 = 2e-6;
+/// The same where a spot ramp or a range window multiplies in: their f32 rounding is
+/// amplified by the cancellation in cos θ·scale + offset and 1 − (d/range)⁴ near the cone's
+/// edge and the range; 10× the worst measured: 2.8e-6 (spot, reference), 2.6e-6 (range
+/// window, GPU).
+const TOL_RAMP: f32 = 3e-5;
+/// Outside the spot's outer cone and beyond the range, both clamp the factor to exactly 0:
+/// measured 0 on the GPU and in the reference.
+const ABS_TOL: f32 = 0.0;
+
+/// Lambert's BRDF times the light's colour: the radiance per unit irradiance, per channel.
+fn lambert() -> Vec3 {
+    ALBEDO * COLOUR / std::f32::consts::PI
+}
 
 /// A 4 m floor at y = 0 seen from straight above, an optional 0.4 m occluder at y = 1.
 fn floor_scene(occluder: bool) -> Scene {
     let mut s = Scene::new();
-    let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::splat(ALBEDO), ..Default::default() }).unwrap();
+    let floor = s.add_material(Material { name: "floor".into(), base_color: ALBEDO, ..Default::default() }).unwrap();
     s.add_mesh(shapes::quad("floor", Vec3::new(-2.0, 0.0, 2.0), Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -4.0), 4, floor)).unwrap();
     if occluder {
         let m = s.add_material(Material { name: "occluder".into(), base_color: Vec3::ZERO, ..Default::default() }).unwrap();
@@ -25,7 +64,7 @@ fn floor_scene(occluder: bool) -> Scene {
 }
 
 fn light(kind: LightKind, position: Vec3, direction: Vec3, intensity: f32) -> Light {
-    Light { name: "l".into(), kind, position, direction, intensity: Vec3::splat(intensity), range: None }
+    Light { name: "l".into(), kind, position, direction, intensity: COLOUR * intensity, range: None }
 }
 
 /// Radiance of the floor point under pixel (x, y) of a 64² render from 3 m above.
@@ -43,14 +82,18 @@ fn point_light_follows_inverse_square_and_cosine() {
     let mut s = floor_scene(false);
     s.add_light(light(LightKind::Point, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 10.0)).unwrap();
     let f = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap();
+    let mut worst = 0.0f32;
     for (x, y) in [(32, 32), (10, 20), (50, 40), (5, 60)] {
         let p = floor_point(x, y);
         let d = Vec3::new(0.0, 2.0, 0.0) - p;
         let e = 10.0 * (d.y / d.length()) / d.length_squared();
-        let expected = ALBEDO / std::f32::consts::PI * e;
-        let got = f.image.texel(0, x, y)[0];
-        assert!((got - expected).abs() < 0.01 * expected, "pixel ({x},{y}) at {p}: {got} vs {expected}");
+        let expected = lambert() * e;
+        let got = f.image.texel(0, x, y);
+        let err = rel_err(got, expected);
+        worst = worst.max(err);
+        assert!(err < TOL, "pixel ({x},{y}) at {p}: {got:?} vs {expected}");
     }
+    eprintln!("point light: worst relative error {worst:.3e} (tolerance {TOL:e})");
     common::assert_clean(&ctx);
 }
 
@@ -74,18 +117,28 @@ fn spot_light_follows_the_gltf_falloff_on_the_gpu_and_in_the_reference() {
     let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
     // Floor points inside the inner cone, across the ramp, and outside the outer cone.
     let mut ramp_points = 0;
+    let mut worst = [(0.0f32, 0.0f32); 2];
     for x in [32, 40, 44, 46, 48, 50, 52, 54, 60] {
         let p = floor_point(x, 32);
         let d = Vec3::new(0.0, 2.0, 0.0) - p;
         let cd = d.y / d.length();
         let att = gltf_spot_attenuation(cd, inner, outer);
         ramp_points += (att > 0.05 && att < 0.95) as usize;
-        let expected = ALBEDO / std::f32::consts::PI * 10.0 * cd / d.length_squared() * att;
-        for (name, img) in [("gpu", &gpu), ("reference", &reference)] {
-            let got = img.texel(0, x, 32)[0];
-            assert!((got - expected).abs() <= 0.01 * expected + 1e-5, "{name}: floor point {p} (cos θ {cd:.4}): {got} vs {expected}");
+        let expected = lambert() * 10.0 * cd / d.length_squared() * att;
+        for (k, (name, img)) in [("gpu", &gpu), ("reference", &reference)].into_iter().enumerate() {
+            let got = img.texel(0, x, 32);
+            let (rel, abs) = errors(got, expected);
+            worst[k] = (worst[k].0.max(rel), worst[k].1.max(abs));
+            assert!(
+                (0..3).all(|c| (got[c] - expected[c]).abs() <= TOL_RAMP * expected[c] + ABS_TOL),
+                "{name}: floor point {p} (cos θ {cd:.4}): {got:?} vs {expected}"
+            );
         }
     }
+    eprintln!(
+        "spot light: worst relative error (lit points) gpu {:.3e} reference {:.3e}; worst absolute error (unlit) gpu {:e} reference {:e}",
+        worst[0].0, worst[1].0, worst[0].1, worst[1].1
+    );
     assert!(ramp_points >= 3, "the points sample the ramp: {ramp_points}");
     common::assert_clean(&ctx);
 }
@@ -109,6 +162,7 @@ fn point_light_range_follows_the_gltf_window_on_the_gpu_and_in_the_reference() {
     let gpu = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap().image;
     let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
     let (mut window_points, mut beyond) = (0, 0);
+    let mut worst = [(0.0f32, 0.0f32); 2];
     for x in [32, 36, 40, 44, 48, 52, 56, 60, 63] {
         for y in [32, 44, 56, 63] {
             let p = floor_point(x, y);
@@ -116,17 +170,20 @@ fn point_light_range_follows_the_gltf_window_on_the_gpu_and_in_the_reference() {
             let window = gltf_range_window(d.length(), range);
             window_points += (window > 0.05 && window < 0.8) as usize;
             beyond += (window == 0.0) as usize;
-            let expected = ALBEDO / std::f32::consts::PI * 4.0 * (d.y / d.length()) / d.length_squared() * window;
-            for (name, img) in [("gpu", &gpu), ("reference", &reference)] {
-                let got = img.texel(0, x, y)[0];
+            let expected = lambert() * 4.0 * (d.y / d.length()) / d.length_squared() * window;
+            for (k, (name, img)) in [("gpu", &gpu), ("reference", &reference)].into_iter().enumerate() {
+                let got = img.texel(0, x, y);
+                let (rel, abs) = errors(got, expected);
+                worst[k] = (worst[k].0.max(rel), worst[k].1.max(abs));
                 assert!(
-                    (got - expected).abs() <= 0.01 * expected + 1e-5,
-                    "{name}: floor point {p} at {:.3} m (window {window:.4}): {got} vs {expected}",
+                    (0..3).all(|c| (got[c] - expected[c]).abs() <= TOL_RAMP * expected[c] + ABS_TOL),
+                    "{name}: floor point {p} at {:.3} m (window {window:.4}): {got:?} vs {expected}",
                     d.length()
                 );
             }
         }
     }
+    eprintln!("range window: worst relative error (lit points) gpu {:.3e} reference {:.3e}; worst absolute error (beyond the range) gpu {:e} reference {:e}", worst[0].0, worst[1].0, worst[0].1, worst[1].1);
     assert!(window_points >= 4 && beyond >= 2, "the points sample the window ({window_points}) and beyond the range ({beyond})");
     common::assert_clean(&ctx);
 }
@@ -148,20 +205,23 @@ fn occluder_casts_a_shadow_from_point_spot_and_directional_lights() {
         // spot, one inside its inner cone (0.5 rad: 1.09 m from its foot), so that a spot
         // that emits nothing fails.
         let (lx, ly) = if matches!(kind, LightKind::Spot { .. }) { (46, 32) } else { (8, 8) };
-        let lit = f.image.texel(0, lx, ly)[0];
+        let lit = f.image.texel(0, lx, ly);
         let p = floor_point(lx, ly);
         let expected = match kind {
-            LightKind::Directional => ALBEDO / std::f32::consts::PI * 2.0 * -tilted.y,
+            LightKind::Directional => lambert() * 2.0 * -tilted.y,
             _ => {
                 let d = Vec3::new(0.0, 2.0, 0.0) - p;
                 if let LightKind::Spot { inner_cone, .. } = kind {
                     assert!((d.y / d.length()) > inner_cone.cos(), "{p} lies inside the inner cone");
                 }
-                ALBEDO / std::f32::consts::PI * 2.0 * (d.y / d.length()) / d.length_squared()
+                lambert() * 2.0 * (d.y / d.length()) / d.length_squared()
             }
         };
-        assert!(expected > 0.02, "{kind:?}: the lit point is lit ({expected})");
-        assert!((lit - expected).abs() < 0.01 * expected, "{kind:?}: lit {lit} vs {expected}");
+        assert!(expected.min_element() > 0.01, "{kind:?}: the lit point is lit ({expected})");
+        // Measured: 0 (point), 1.5e-7 (directional), 0 (spot); TOL 2e-6.
+        let err = rel_err(lit, expected);
+        eprintln!("{kind:?}: lit point relative error {err:.3e}");
+        assert!(err < TOL, "{kind:?}: lit {lit:?} vs {expected}");
         // A floor point outside the occluder's silhouette (0.3 m from the centre, seen from
         // 3 m) but inside its shadow.
         let (x, y) = match kind {
@@ -178,11 +238,16 @@ fn occluder_casts_a_shadow_from_point_spot_and_directional_lights() {
             _ => p.x > 0.31 && p.x < 0.39,
         };
         assert!(in_shadow, "{kind:?}: {p}");
-        assert_eq!(f.image.texel(0, x, y)[0], 0.0, "{kind:?}: shadowed floor point {p}");
+        assert_eq!(&f.image.texel(0, x, y)[..3], &[0.0; 3], "{kind:?}: shadowed floor point {p}");
         // Its mirror image across the occluder is lit for the tilted sun (the shadow is
         // where the light says, not all around).
         if kind == LightKind::Directional {
-            assert!(f.image.texel(0, 63 - x, y)[0] > 0.5 * expected, "{kind:?}: floor at {} is lit", floor_point(63 - x, y));
+            // The sun lights the whole floor alike: the mirror point gets the lit point's
+            // radiance (measured relative error 1.5e-7; TOL 2e-6).
+            let mirror = f.image.texel(0, 63 - x, y);
+            let err = rel_err(mirror, expected);
+            eprintln!("{kind:?}: mirror image of the shadowed point, relative error {err:.3e}");
+            assert!(err < TOL, "{kind:?}: floor at {} is lit: {mirror:?} vs {expected}", floor_point(63 - x, y));
         }
     }
     common::assert_clean(&ctx);

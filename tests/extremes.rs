@@ -58,11 +58,14 @@ fn errors(test: &ImageData, reference: &ImageData) -> ImageErrors {
 /// wide band of grazing angles for every ν ≠ 1 and would show a rim) the scene renders as
 /// the scene without it:
 /// - on the reference, inside the emissive quadrant room (exact refraction through the
-///   sphere): measured RMSE 5.6e-4, p99 1e-6; asserted RMSE ≤ 2e-3, p99 ≤ 1e-4 (the few
-///   pixels that differ sit on quadrant edges shifted by the bending, or at grazing);
+///   sphere): measured RMSE 5.64e-4 (the few pixels that differ sit on quadrant edges
+///   shifted by the bending, or at grazing: samples that flip), asserted ≤ 6.3e-4, a factor
+///   1.122 over; p99 6.6e-7 (f32 rounding), asserted ≤ 7e-6, 20 dB over. The same sphere at
+///   ν = 1.5 is plainly visible (measured RMSE 0.109, floor 0.097, a factor 1.122 under);
 /// - on the GPU's environment mapping, under a distant sky (where the method's missing
-///   parallax costs nothing): measured PSNR 75.8 dB, p99 4.5e-4 against the bare sky;
-///   asserted ≥ 60 dB and p99 ≤ 2e-3 (half-float cube maps round to ~1e-3 relative).
+///   parallax costs nothing): measured PSNR 75.8 dB against the bare sky, asserted ≥ 60 dB
+///   (tests/README.md rule 2); p99 4.46e-4, asserted ≤ 5e-4: half-float cube maps round
+///   radiances up to 0.9 by up to 0.9·2⁻¹¹ = 4.4e-4.
 #[test]
 fn glass_of_index_almost_one_is_invisible() {
     let mut q = quality(&["fresnel=exact", "spp=4", "cube_size=128"]);
@@ -75,12 +78,13 @@ fn glass_of_index_almost_one_is_invisible() {
     room.add_mesh(shapes::uv_sphere("glass", Vec3::ZERO, 0.5, 96, 48, g)).unwrap();
     let with = render_reference(&room, &q, (64, 64)).unwrap();
     let e = errors(&with, &without);
-    println!("reference, ν = 1.0001 sphere vs none: {e}");
-    assert!(e.rmse <= 2e-3 && e.p99_abs <= 1e-4, "{e}");
+    println!("reference, ν = 1.0001 sphere vs none: {e} (RMSE {:e}, p99 {:e})", e.rmse, e.p99_abs);
+    assert!(e.rmse <= 6.3e-4 && e.p99_abs <= 7e-6, "{e}");
     // The same sphere at ν = 1.5 is plainly visible: the test can tell.
     room.materials[g] = glass(1.5);
     let visible = errors(&render_reference(&room, &q, (64, 64)).unwrap(), &without);
-    assert!(visible.rmse > 10.0 * e.rmse.max(1e-3), "ν = 1.5: {visible}");
+    println!("reference, ν = 1.5 sphere vs none: {visible}");
+    assert!(visible.rmse > 0.097, "ν = 1.5: {visible}");
 
     // The GPU under a sky.
     let ctx = common::gpu();
@@ -99,9 +103,9 @@ fn glass_of_index_almost_one_is_invisible() {
     bare.add_mesh(shapes::quad("speck", Vec3::new(0.3, 0.5, 5.0), Vec3::new(0.01, 0.0, 0.0), Vec3::new(0.0, 0.01, 0.0), 1, speck)).unwrap();
     let sky_only = specula::render(&ctx, &bare, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap().image;
     let e = errors(&gpu.image, &sky_only);
-    println!("GPU envmap, ν = 1.0001 sphere vs the bare sky: {e}");
+    println!("GPU envmap, ν = 1.0001 sphere vs the bare sky: {e} (p99 {:e})", e.p99_abs);
     assert!(all_finite(&gpu.image));
-    assert!(e.psnr >= 60.0 && e.p99_abs <= 2e-3, "{e}");
+    assert!(e.psnr >= 60.0 && e.p99_abs <= 5e-4, "{e}");
     common::assert_clean(&ctx);
 }
 
@@ -110,10 +114,11 @@ fn glass_of_index_almost_one_is_invisible() {
 /// stays the same) must render the same image: nothing in either renderer may depend on
 /// absolute size (ray epsilons, cube-map near planes, shadow biases are all relative).
 /// The demo scene at s = 1e-3 and 1e3, 64², compared with s = 1:
-/// - GPU environment mapping: measured PSNR 111.6 dB (1e-3) and 108.1 dB (1e3), mean
-///   FLIP 1.2e-5; asserted ≥ 80 dB and ≤ 1e-3;
-/// - reference (1 spp): measured RMSE 3e-7 and 1e-6 (f32 rounding of the scaled vertices);
-///   asserted ≤ 1e-5.
+/// - GPU environment mapping (caustics on, the default): measured PSNR 91.87 dB (1e-3) and
+///   90.30 dB (1e3); asserted ≥ 80 dB (a mean FLIP bound beside it could not fail while
+///   this holds, and was dropped);
+/// - reference (1 spp): measured RMSE 3.9e-7 and 9.0e-7 (f32 rounding of the scaled
+///   vertices); asserted ≤ 1e-5 (100 dB, 20 dB under the measured 121 dB).
 #[test]
 fn scaled_scenes_render_the_same_image() {
     let ctx = common::gpu();
@@ -127,10 +132,10 @@ fn scaled_scenes_render_the_same_image() {
         let e = errors(&gpu.image, &gpu1.image);
         println!("GPU, scale {s:e}: {e}");
         assert!(all_finite(&gpu.image));
-        assert!(e.psnr >= 80.0 && e.flip <= 1e-3, "GPU at scale {s:e}: {e}");
+        assert!(e.psnr >= 80.0, "GPU at scale {s:e}: {e}");
         let cpu = render_reference(&scaled, &q, (64, 64)).unwrap();
         let e = errors(&cpu, &ref1);
-        println!("reference, scale {s:e}: {e}");
+        println!("reference, scale {s:e}: {e} (RMSE {:e})", e.rmse);
         assert!(e.rmse <= 1e-5, "reference at scale {s:e}: {e}");
     }
     common::assert_clean(&ctx);
@@ -164,8 +169,8 @@ fn scale_scene(scene: &Scene, s: f32) -> Scene {
 /// 1e-3) under a sky. Proves: no NaN anywhere, the Fresnel weight runs to 1 at grazing
 /// incidence (survey eq. 2) on both renderers, and environment mapping, whose reference
 /// point (the mirror's box centre) lies on the mirror's own surface, still reflects the
-/// sky correctly: measured PSNR 76.7 dB, mean FLIP 0.0025 against the reference; asserted
-/// ≥ 60 dB and ≤ 0.01.
+/// sky correctly: measured PSNR 76.7 dB, mean FLIP 0.00248 against the reference; asserted
+/// ≥ 60 dB (tests/README.md rule 2) and FLIP ≤ 0.0028 (a factor 1.122 over).
 #[test]
 fn grazing_incidence_on_a_planar_mirror() {
     let ctx = common::gpu();
@@ -185,20 +190,27 @@ fn grazing_incidence_on_a_planar_mirror() {
     assert!(all_finite(&gpu.image) && all_finite(&cpu));
     let e = errors(&gpu.image, &cpu);
     println!("grazing mirror, envmap vs reference: {e}");
-    assert!(e.psnr >= 60.0 && e.flip <= 0.01, "{e}");
+    assert!(e.psnr >= 60.0 && e.flip <= 0.0028, "{e}");
 
     // Row 33 sees the mirror 0.29° below the horizon (cos θ = 5e-3, Schlick F = 0.976):
     // its reflection is the sky 0.29° above it, which row 30 (0.18° above) sees directly
-    // (the sky changes by ~1e-3 over that 0.1°).
+    // (the sky changes by ~1e-3 over that 0.1°). Tolerances: the reflected / direct ratio
+    // within 1.5e-3 of 0.976 (the sky's change, and 0.976's rounding: 2.4e-4), measured
+    // 8.6e-4; the GPU's pixel within 1e-3 relative of the reference's (half-float cube map
+    // texels: 2⁻¹¹ = 4.9e-4, and their bilinear resampling), measured 6.4e-4.
+    let (mut worst_ratio, mut worst_gpu) = (0.0f32, 0.0f32);
     for x in [8u32, 32, 56] {
         let (reflected, direct) = (cpu.texel(0, x, 33), cpu.texel(0, x, 30));
         for k in 0..3 {
             let ratio = reflected[k] / direct[k];
-            assert!((ratio - 0.976).abs() < 0.01, "column {x}: reflected {reflected:?} vs sky {direct:?}");
+            let gpu_px = gpu.image.texel(0, x, 33);
+            worst_ratio = worst_ratio.max((ratio - 0.976).abs());
+            worst_gpu = worst_gpu.max((gpu_px[k] / reflected[k] - 1.0).abs());
+            assert!((ratio - 0.976).abs() < 1.5e-3, "column {x}: reflected {reflected:?} vs sky {direct:?}");
+            assert!((gpu_px[k] / reflected[k] - 1.0).abs() < 1e-3, "GPU column {x}: {gpu_px:?} vs {reflected:?}");
         }
-        let gpu_px = gpu.image.texel(0, x, 33);
-        assert!((gpu_px[1] / reflected[1] - 1.0).abs() < 0.02, "GPU column {x}: {gpu_px:?} vs {reflected:?}");
     }
+    println!("worst |reflected / direct − 0.976| {worst_ratio:e}, worst |GPU / CPU − 1| {worst_gpu:e}");
     common::assert_clean(&ctx);
 }
 
@@ -207,7 +219,8 @@ fn grazing_incidence_on_a_planar_mirror() {
 /// at the surface, and half of what the map sees lies right at its origin. Proves: no NaN
 /// and no validation error, and the image stays a usable environment-mapped reflection
 /// whose error against the reference is of the same order as with the centre (measured
-/// PSNR 23.90 dB centre, 23.18 dB pole; asserted pole ≥ 20 dB and within 2 dB of the centre).
+/// PSNR 23.90 dB centre, 23.18 dB pole, 0.72 dB under; floors 1 dB under each: centre
+/// ≥ 22.90 dB, pole ≥ 22.18 dB and within 1.72 dB of the centre).
 #[test]
 fn reference_point_on_the_surface() {
     let ctx = common::gpu();
@@ -224,7 +237,7 @@ fn reference_point_on_the_surface() {
     assert!(all_finite(&pole.image));
     let (ec, ep) = (errors(&centre.image, &reference), errors(&pole.image, &reference));
     println!("reference point at the centre: {ec}\nreference point on the surface: {ep}");
-    assert!(ep.psnr >= 20.0 && ep.psnr >= ec.psnr - 2.0, "centre {ec} / pole {ep}");
+    assert!(ec.psnr >= 22.90 && ep.psnr >= 22.18 && ep.psnr >= ec.psnr - 1.72, "centre {ec} / pole {ep}");
     assert_ne!(centre.image.data, pole.image.data, "the reference point is used");
     common::assert_clean(&ctx);
 }
@@ -232,9 +245,9 @@ fn reference_point_on_the_surface() {
 /// Half- and single-precision radiance cube maps (RGBA16F / RGBA32F), where the device
 /// offers both as filterable colour attachments. Proves: half precision costs nothing
 /// visible here: the two images differ by at most 2⁻¹⁰ relative (half's rounding, 1e-3)
-/// plus 1e-4 and their errors against the reference agree within 0.05 dB (measured:
-/// largest |Δ|/(|single| + 0.1) 7.3e-4, PSNR 16.75 vs 16.74 dB), and single precision
-/// takes twice the memory.
+/// plus 1e-4 and their errors against the reference agree within 0.05 dB (measured: the
+/// largest difference 0.75 of that tolerance, PSNR 16.70 vs 16.69 dB, 0.007 dB apart), and
+/// single precision takes twice the memory.
 #[test]
 fn half_and_single_precision_cube_maps() {
     let ctx = common::gpu();
@@ -257,14 +270,16 @@ fn half_and_single_precision_cube_maps() {
     assert_eq!(cube_bytes(&single), 2 * cube_bytes(&half));
     let mut worst = 0.0f32;
     for (a, b) in half.image.data.iter().zip(&single.image.data) {
-        let rel = (a - b).abs() / (b.abs() + 0.1);
-        worst = worst.max(rel);
+        worst = worst.max((a - b).abs() / (b.abs() / 1024.0 + 1e-4));
         assert!((a - b).abs() <= b.abs() / 1024.0 + 1e-4, "half {a} vs single {b}");
     }
     assert_ne!(half.image.data, single.image.data, "the precision knob reaches the maps");
     let reference = render_reference(&scene, &quality(&["spp=4"]), (64, 64)).unwrap();
     let (eh, es) = (errors(&half.image, &reference), errors(&single.image, &reference));
-    println!("max relative difference {worst:e}\nhalf:   {eh}\nsingle: {es}");
+    println!(
+        "largest |half − single| / (|single|/1024 + 1e-4) {worst}\nhalf:   {eh}\nsingle: {es}; half − single {:.4} dB",
+        eh.psnr - es.psnr
+    );
     assert!((eh.psnr - es.psnr).abs() <= 0.05, "half {eh} / single {es}");
     common::assert_clean(&ctx);
 }

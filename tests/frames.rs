@@ -261,7 +261,8 @@ fn cube_faces_draw_only_what_they_see() {
 }
 
 /// A hidden object disappears from every map, the camera passes and the rays: the image
-/// equals a fresh render of the scene without it (to 4 ulps); shown again, the first image
+/// equals a fresh render of the scene without it (bit for bit, as measured; the buffers and
+/// map layers are laid out differently); shown again, the first image
 /// returns bit for bit.
 #[test]
 fn a_hidden_object_disappears_everywhere() {
@@ -271,7 +272,10 @@ fn a_hidden_object_disappears_everywhere() {
     let mut without = base.clone();
     without.meshes.remove(i);
     let q = quality();
-    for m in [specula::methods::DISTANCE, specula::methods::BVH] {
+    // Per method, the largest ulp difference measured against the scene without the object:
+    // 0 (bit for bit) with distance maps and with the BVH (an earlier commit saw 1 value of
+    // 4800 one ulp apart with distance maps; the bound was 4 ulps).
+    for (m, ulps_measured) in [(specula::methods::DISTANCE, 0), (specula::methods::BVH, 0)] {
         let mut scene = base.clone();
         let mut r = renderer(&ctx, &scene, m, &q);
         let shown = bits(&r.render(&ctx).unwrap());
@@ -279,11 +283,21 @@ fn a_hidden_object_disappears_everywhere() {
         let c = r.update(&scene).unwrap();
         assert_eq!(c.moved, vec![i]);
         let hidden = bits(&r.render(&ctx).unwrap());
-        // Within 4 ulps per value: the scene without the object lays out its buffers and map
-        // layers differently (seen: 1 value of 4800 one ulp apart with distance maps).
+        // Within the measured ulps per value, although the scene without the object lays out
+        // its buffers and map layers differently.
         let without = fresh(&ctx, &without, m, &q);
         let ulps = hidden.iter().zip(&without).map(|(a, b)| (*a as i64 - *b as i64).unsigned_abs()).max().unwrap();
-        assert!(ulps <= 4, "{}: hidden differs from a scene without the object by {ulps} ulps", m.name());
+        let differing = hidden.iter().zip(&without).filter(|(a, b)| a != b).count();
+        let visible = shown.iter().zip(&without).filter(|(a, b)| a != b).count();
+        eprintln!(
+            "{}: hidden vs a scene without the object: {differing} of {} values differ, by at most {ulps} ulps; shown: {visible} differ",
+            m.name(),
+            hidden.len()
+        );
+        assert!(ulps <= ulps_measured, "{}: hidden differs from a scene without the object by {ulps} ulps", m.name());
+        // The object shows (measured: 3402 of 4800 values differ from the scene without it,
+        // both methods), so that a hide that changes nothing fails the comparison above.
+        assert!(visible as f64 >= 3402.0 / 1.122, "{}: the object changes only {visible} values", m.name());
         scene.set_object_visible(i, true).unwrap();
         r.update(&scene).unwrap();
         assert!(bits(&r.render(&ctx).unwrap()) == shown, "{}: shown again differs", m.name());

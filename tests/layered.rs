@@ -146,21 +146,37 @@ fn a_concave_mirror_reflects_itself_in_the_layers() {
     let ctx = common::gpu();
     let s = bowl_scene();
     let mut rows = Vec::new();
+    let mut prev: Option<ImageData> = None;
     for depth in [1, 2, 3, 4] {
         let d = format!("depth={depth}");
         let r = reference(&s, &["spp=1", &d, "caustics=off"], SIZE);
         let knobs = [d.as_str(), "caustics=off", "cube_size=128"];
         let (l, stats) = gpu(&ctx, &s, specula::methods::LAYERED, &knobs, SIZE);
         let (dm, _) = gpu(&ctx, &s, specula::methods::DISTANCE, &knobs, SIZE);
-        let (l, dm) = (errors(&l, &r), errors(&dm, &r));
+        let l_img = l;
+        let (l, dm) = (errors(&l_img, &r), errors(&dm, &r));
         eprintln!("bowl depth {depth}: layered {l}\n              distance {dm}");
+        // Each depth is closer to its reference than the previous depth's image: the layers
+        // are searched again for every bounce (a search that stops early fails).
+        let over_prev = prev.as_ref().map(|p| {
+            let pe = errors(p, &r);
+            eprintln!("              previous depth's image {pe}");
+            l.psnr - pe.psnr
+        });
+        prev = Some(l_img);
         assert_eq!(stat(&stats, "layered.layers"), 4.0, "ball front and back, bowl, floor");
-        rows.push((depth, l.psnr, dm.psnr));
+        rows.push((depth, l.psnr, dm.psnr, over_prev));
     }
-    // Measured: layered 23.44 / 23.48 / 23.7 / 23.83 dB, distance 10.9–13.9 dB (depth 1…4).
-    for (depth, l, d) in &rows {
-        assert!(*l > 22.5, "depth {depth}: layered {l:.2} dB");
-        assert!(l - d > 9.0, "depth {depth}: layered {l:.2} vs distance {d:.2} dB");
+    // Measured (depth 1, 2, 3, 4): layered 23.44, 23.48, 23.50, 23.83 dB; over distance
+    // 12.60, 11.04, 10.28, 10.15 dB; over the previous depth's image 9.93, 4.14, 1.31 dB.
+    // Floors 1 dB under each.
+    let floors = [(22.44, 11.60, 0.0), (22.48, 10.04, 8.93), (22.50, 9.28, 3.14), (22.83, 9.15, 0.31)];
+    for ((depth, l, d, over_prev), (floor, over_distance, prev_floor)) in rows.iter().zip(floors) {
+        assert!(*l > floor, "depth {depth}: layered {l:.2} dB");
+        assert!(l - d > over_distance, "depth {depth}: layered {l:.2} vs distance {d:.2} dB");
+        if let Some(m) = over_prev {
+            assert!(*m > prev_floor, "depth {depth}: layered {l:.2} dB, {m:.2} dB over the previous depth's image");
+        }
     }
     // distance-multi has no other specular object to cycle through: it is distance.
     let q = ["depth=4", "caustics=off", "cube_size=128"];
@@ -185,12 +201,14 @@ fn a_non_convex_glass_torus_refracts_through_both_sides_of_its_tube() {
     let (l, rm, strongest) = (errors(&l, &r), errors(&rm, &r), errors(&strongest, &r));
     eprintln!("torus: layered {l}\n       refractor-map {rm}\n       layered, strongest branch only {strongest}");
     assert_eq!(stat(&stats, "layered.layers"), 3.0);
-    // Measured: layered 25.11 dB, refractor-map 12.69 dB, strongest branch 24.6 dB.
-    assert!(l.psnr > 24.1, "layered {l}");
-    assert!(l.psnr - rm.psnr > 11.0, "layered {l} vs refractor-map {rm}");
+    // Measured: layered 25.11 dB, refractor-map 12.69 dB (12.42 dB under), strongest
+    // branch 24.16 dB; floors 1 dB under.
+    assert!(l.psnr > 24.11, "layered {l}");
+    assert!(l.psnr - rm.psnr > 11.42, "layered {l} vs refractor-map {rm}");
     // Both Fresnel branches beat the stronger one carrying both weights (the reflections
-    // of the room in the glass are lost), by a measured margin.
-    assert!(l.psnr > strongest.psnr, "both {l} vs strongest {strongest}");
+    // of the room in the glass are lost): measured by 0.95 dB; under 1 dB, so asserted at
+    // half of it (a knob that is ignored gives 0).
+    assert!(l.psnr - strongest.psnr > 0.47, "both {l} vs strongest {strongest}");
     common::assert_clean(&ctx);
 }
 
@@ -217,12 +235,16 @@ fn figure_28_thin_objects_need_fine_steps_and_hidden_surfaces_need_layers() {
         (errors(&img, &r), img, stats)
     };
     // Coarse linear steps jump over the thin rod (and the ball's edges): the error falls
-    // as the steps grow.
+    // as the steps grow. Measured RMSE 0.1147, 0.0961, 0.0710 for 2, 8, 32 steps (PSNR
+    // 18.81, 20.35, 22.98 dB): ratios 1.194 and 1.353, bounds a factor 1.122 under; the
+    // floor on 32 steps 1 dB under.
     let steps: Vec<(u32, ImageErrors)> = [2u32, 8, 32].iter().map(|&n| (n, run(&[&format!("linear_steps={n}")]).0)).collect();
     for (n, e) in &steps {
         eprintln!("rod: linear_steps {n}: {e}");
     }
-    assert!(steps[0].1.rmse > steps[1].1.rmse && steps[1].1.rmse > steps[2].1.rmse, "error falls with linear_steps: {steps:?}");
+    assert!(steps[0].1.rmse > steps[1].1.rmse * 1.065, "2 → 8 linear steps: {steps:?}");
+    assert!(steps[1].1.rmse > steps[2].1.rmse * 1.206, "8 → 32 linear steps: {steps:?}");
+    assert!(steps[2].1.psnr > 21.98, "32 linear steps: {steps:?}");
     // Layers below the depth complexity lose what the missing layers hold (the rod, the
     // bowl and the floor behind the ball); at the full count the error is gone.
     let (full, full_img, stats) = run(&[]);
@@ -235,9 +257,14 @@ fn figure_28_thin_objects_need_fine_steps_and_hidden_surfaces_need_layers() {
         by_layers.push(e);
     }
     eprintln!("rod: layers auto ({l}): {full}");
-    assert!(by_layers.windows(2).all(|w| w[0].rmse > w[1].rmse), "error falls with layers: {by_layers:?}");
-    // Measured: RMSE 0.1267 / 0.0971 / 0.0853 at 1 / 2 / 3 layers, 0.0814 at 4.
-    assert!(by_layers.last().unwrap().rmse > full.rmse * 1.03, "the last layer matters: {by_layers:?} vs {full}");
+    // Measured: RMSE 0.1267 / 0.0971 / 0.0853 at 1 / 2 / 3 layers, 0.0814 at 4 (PSNR
+    // 21.79 dB): ratios 1.305, 1.138, 1.049, bounds a factor 1.122 under (the last, under
+    // 1.122, at 1.03); the floor at 4 layers 1 dB under.
+    assert_eq!(by_layers.len(), 3, "the rod scene has 4 layers");
+    assert!(by_layers[0].rmse > by_layers[1].rmse * 1.164, "1 → 2 layers: {by_layers:?}");
+    assert!(by_layers[1].rmse > by_layers[2].rmse * 1.015, "2 → 3 layers: {by_layers:?}");
+    assert!(by_layers[2].rmse > full.rmse * 1.03, "the last layer matters: {by_layers:?} vs {full}");
+    assert!(full.psnr > 20.79, "all layers: {full}");
     let (_, exact_img, _) = run(&[&format!("layers={l}")]);
     assert_eq!(exact_img.data, full_img.data, "layers=auto is layers={l}");
     common::assert_clean(&ctx);
@@ -303,6 +330,7 @@ fn layered_maps_hold_at_1_km_and_1_mm_and_in_half_precision() {
     let base = bowl_scene();
     let knobs = ["depth=2", "caustics=off", "cube_size=128"];
     let mut psnr = Vec::new();
+    let mut half_img = None;
     for k in [1.0f32, 1000.0, 1e-3] {
         let s = scale_scene(&base, k);
         let r = reference(&s, &["spp=1", "depth=2", "caustics=off"], SIZE);
@@ -310,15 +338,22 @@ fn layered_maps_hold_at_1_km_and_1_mm_and_in_half_precision() {
         let e = errors(&l, &r);
         eprintln!("bowl ×{k}: {e}");
         psnr.push(e.psnr);
+        half_img.get_or_insert(l);
     }
-    // Measured: 23.48 dB at 1 m, 23.47 dB at 1 km, 22.46 dB at 1 mm (the millimetre scene
-    // loses 1 dB: left as a finding).
-    assert!(psnr.iter().all(|p| (p - psnr[0]).abs() < 1.3), "{psnr:?}");
+    // Measured: 23.48 dB at 1 m, 23.47 dB at 1 km (0.012 dB apart), 22.46 dB at 1 mm (the
+    // millimetre scene loses 1.02 dB: left as a finding). Floors 1 dB under each; the
+    // kilometre scene within 0.1 dB of the metre one.
+    assert!(psnr[0] > 22.48 && psnr[1] > 22.47 && psnr[2] > 21.46, "{psnr:?}");
+    assert!((psnr[1] - psnr[0]).abs() < 0.1, "1 km vs 1 m: {psnr:?}");
+    assert!((psnr[2] - psnr[0]).abs() < 1.3, "1 mm vs 1 m: {psnr:?}");
+    let half_img = half_img.unwrap();
     let r = reference(&base, &["spp=1", "depth=2", "caustics=off"], SIZE);
-    let (single, _) =
+    let (single_img, _) =
         gpu(&ctx, &base, specula::methods::LAYERED, &["depth=2", "caustics=off", "cube_size=128", "cube_precision=single"], SIZE);
-    let single = errors(&single, &r);
-    eprintln!("bowl, single precision: {single}");
-    assert!((single.psnr - psnr[0]).abs() < 0.5, "half {:.2} vs single {single}", psnr[0]);
+    let single = errors(&single_img, &r);
+    eprintln!("bowl, single precision: {single}; half - single {:.3} dB", psnr[0] - single.psnr);
+    assert_ne!(single_img.data, half_img.data, "cube_precision reaches the layers");
+    // Half precision costs 0.07 dB here (measured 0.068): bound 0.15 dB.
+    assert!((single.psnr - psnr[0]).abs() < 0.15, "half {:.2} vs single {single}", psnr[0]);
     common::assert_clean(&ctx);
 }

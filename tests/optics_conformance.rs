@@ -547,9 +547,16 @@ fn check_expected(e: &Entry, g: &GpuResult, f: &mut Vec<String>) {
         }
     }
     if e.case.op[0] == OP_DIELECTRIC && w.contains("critical exactly") {
-        // At the critical angle exactly, within rounding: F within √δ-scale of 1.
-        if (g.r0[0] as f64) < 0.99 {
-            fail(f, e, format!("at the critical angle F must be ≈ 1, GPU {}", g.r0[0]));
+        // At the critical angle exactly, within rounding: F within √δ-scale of 1. Leaving
+        // ν = 1.5 and ν = 1 + 1e-6 the GPU gives F = 1 (measured 1 − F = 0); leaving ν = 4
+        // the nearest f32 to the critical cosine lies 2.7e-8 inside it, where F, falling as
+        // the square root of that, is short of 1 already (measured 1 − F = 8.51e-3 on the
+        // GPU, 8.03e-3 on the CPU): the bound is the measured 1 − F × 1.122.
+        let measured = if w.contains("eta=0.25") { 8.51e-3 } else { 0.0 };
+        let short = 1.0 - g.r0[0] as f64;
+        eprintln!("{w}: GPU F {} (1 − F {short:e}), CPU F {}", g.r0[0], fresnel_dielectric(e.case.c[0] as f64, e.case.c[1] as f64));
+        if !(short <= 1.122 * measured) {
+            fail(f, e, format!("at the critical angle F must be ≈ 1, GPU {} (1 − F {short:e} > 1.122 × {measured:e})", g.r0[0]));
         }
     }
 }
@@ -576,6 +583,10 @@ fn optics_and_ray_triangle_match_their_f64_twins_on_the_gpu() {
         }
     }
     let names = ["reflect_dir", "refract_dir", "fresnel_f0", "fresnel_schlick", "fresnel_dielectric", "fresnel_conductor", "ray_triangle"];
+    // Measured on lavapipe (the bounds above are rounding analyses, not fitted, so these
+    // ratios show how much of each the driver uses): reflect_dir 0.165, refract_dir 0.053,
+    // fresnel_f0 0.130, fresnel_schlick 0.201, fresnel_dielectric 0.035,
+    // fresnel_conductor 0.273, ray_triangle 0.084.
     for (op, (ratio, what)) in &worst {
         println!("{:<20} worst |Δ|/bound {ratio:.3} at {what}", names[*op as usize]);
     }
@@ -586,5 +597,8 @@ fn optics_and_ray_triangle_match_their_f64_twins_on_the_gpu() {
     }
     let hits = table.iter().zip(&results).filter(|(e, g)| e.case.op[0] == OP_RAY_TRIANGLE && g.r0[3] == 1.0).count();
     let rays = table.iter().filter(|e| e.case.op[0] == OP_RAY_TRIANGLE).count();
-    assert!(hits > rays / 4 && hits < rays * 3 / 4, "{hits} hits of {rays} rays");
+    // Measured 1017 hits of 2083 rays (48.8 %); the share within a factor 1.122 of that.
+    let share = hits as f64 / rays as f64;
+    eprintln!("{hits} hits of {rays} rays ({:.1} %)", 100.0 * share);
+    assert!(share > 0.488 / 1.122 && share < 0.488 * 1.122, "{hits} hits of {rays} rays");
 }

@@ -60,12 +60,21 @@ fn dielectric_fresnel_matches_the_tabulated_values_of_crown_glass() {
     // ν = 1.5 from air: 4 % at normal incidence; Brewster's angle atan 1.5 = 56.31°, where
     // R_p = 0 and the unpolarised reflectance is R_s / 2 = 0.0740; 0.0502 at 45° (Hecht,
     // Optics, Fig. 4.49: R_s 0.092, R_p 0.0085).
+    // The table's four decimals round by up to 5e-5: that is the tolerance against it
+    // (measured |code − table| 0, 4.0e-5, 3.5e-5, 4.3e-5, 3.5e-7). Against the textbook
+    // formula, the two f64 evaluations differ by rounding alone: 1e-12 (measured ≤ 8.3e-17).
     let cases = [(0.0, 0.04), (45.0, 0.0502), (56.31, 0.0740), (70.0, 0.1710), (85.0, 0.6128)];
     for (theta, tabulated) in cases {
         let code = optics::fresnel_dielectric(deg(theta).cos(), 1.5);
         let textbook = fresnel_textbook(deg(theta), 1.5, 0.0);
-        assert!((textbook - tabulated).abs() < 5e-4, "the test's own formula at {theta}°: {textbook} vs {tabulated}");
-        assert!((code - tabulated).abs() < 5e-4, "fresnel_dielectric at {theta}°: {code}, tabulated {tabulated}");
+        eprintln!(
+            "dielectric {theta}°: code {code:.6}, tabulated {tabulated}: |Δ| {:.2e}; |code − textbook| {:.2e}",
+            (code - tabulated).abs(),
+            (code - textbook).abs()
+        );
+        assert!((textbook - tabulated).abs() <= 5e-5, "the test's own formula at {theta}°: {textbook} vs {tabulated}");
+        assert!((code - tabulated).abs() <= 5e-5, "fresnel_dielectric at {theta}°: {code}, tabulated {tabulated}");
+        assert!((code - textbook).abs() < 1e-12, "fresnel_dielectric at {theta}°: {code}, textbook {textbook}");
     }
     // At Brewster's angle the p-polarised part vanishes: R = R_s/2 exactly, which an
     // s-only (or p-only) formula cannot give.
@@ -81,13 +90,20 @@ fn total_internal_reflection_starts_at_the_critical_angle() {
     let critical = (1.0f64 / 1.5).asin();
     assert!((critical.to_degrees() - 41.81).abs() < 0.01);
     let eta = 1.0 / 1.5; // ν_t / ν_i
-    for (theta, total) in [(critical - 1e-3, false), (critical + 1e-3, true), (deg(60.0), true), (deg(20.0), false)] {
+                         // Below the critical angle, R is the textbook's to f64 rounding, amplified near the
+                         // critical angle (1e-12; measured 5.7e-15 there, 6.9e-18 at 20°), and short of total:
+                         // below the measured R (0.7636 just below the critical angle, 0.0417 at 20°) × 1.122.
+    for (theta, total, measured) in
+        [(critical - 1e-3, false, 0.7636), (critical + 1e-3, true, 1.0), (deg(60.0), true, 1.0), (deg(20.0), false, 0.0417)]
+    {
         let r = optics::fresnel_dielectric(theta.cos(), eta);
         if total {
             assert_eq!(r, 1.0, "{}°", theta.to_degrees());
         } else {
-            assert!(r < 0.9, "{}°: {r}", theta.to_degrees());
-            assert!((r - fresnel_textbook(theta, eta, 0.0)).abs() < 1e-6, "{}°", theta.to_degrees());
+            let textbook = fresnel_textbook(theta, eta, 0.0);
+            eprintln!("leaving glass at {:.4}°: R {r:.6}, |code − textbook| {:.2e}", theta.to_degrees(), (r - textbook).abs());
+            assert!(r < 1.122 * measured, "{}°: {r}", theta.to_degrees());
+            assert!((r - textbook).abs() < 1e-12, "{}°", theta.to_degrees());
         }
         // Snell's law agrees: no refracted direction beyond the critical angle.
         let i = DVec3::new(theta.sin(), -theta.cos(), 0.0);
@@ -105,14 +121,26 @@ fn conductor_fresnel_matches_the_complex_fresnel_equations() {
     // their normal-incidence reflectances ((n − 1)² + k²)/((n + 1)² + k²) are 0.88, 0.98
     // and 0.92 (the metals' published visible reflectances), and at every angle the
     // exact conductor formula equals the complex Fresnel equations written above.
-    for (metal, nu, kappa, r0) in [("gold", 0.27, 2.78, 0.88), ("silver", 0.05, 3.6, 0.98), ("aluminium", 0.96, 6.69, 0.92)] {
+    // The published reflectances have two decimals and come from other measurements than
+    // the (n, k) pairs: each is bounded within a factor 1.122 of its measured gap (0.0044,
+    // 0.0058, 0.00098); F0 against the textbook formula (the complex Fresnel equations at
+    // θ = 0; measured 0), and the conductor formula at every angle (measured worst 3.3e-16,
+    // 2.1e-15, 4.4e-16), to f64 rounding: 1e-12.
+    let metals = [("gold", 0.27, 2.78, 0.88, 0.0049), ("silver", 0.05, 3.6, 0.98, 0.0065), ("aluminium", 0.96, 6.69, 0.92, 0.0011)];
+    for (metal, nu, kappa, r0, tolerance) in metals {
         let f0 = optics::fresnel_f0(nu, kappa);
-        assert!((f0 - r0).abs() < 0.01, "{metal}: F0 {f0}, published ≈ {r0}");
+        let textbook = fresnel_textbook(0.0, nu, kappa);
+        eprintln!("{metal}: F0 {f0:.6}, published {r0}: |Δ| {:.2e}; |F0 − textbook| {:.2e}", (f0 - r0).abs(), (f0 - textbook).abs());
+        assert!((f0 - r0).abs() < tolerance, "{metal}: F0 {f0}, published ≈ {r0}");
+        assert!((f0 - textbook).abs() < 1e-12, "{metal}: F0 {f0}, textbook {textbook}");
+        let mut worst: f64 = 0.0;
         for theta in [0.0, 20.0, 45.0, 60.0, 75.0, 85.0, 89.0] {
             let code = optics::fresnel_conductor(deg(theta).cos(), nu, kappa);
             let textbook = fresnel_textbook(deg(theta), nu, kappa);
-            assert!((code - textbook).abs() < 1e-6, "{metal} at {theta}°: {code} vs {textbook}");
+            worst = worst.max((code - textbook).abs());
+            assert!((code - textbook).abs() < 1e-12, "{metal} at {theta}°: {code} vs {textbook}");
         }
+        eprintln!("{metal}: fresnel_conductor vs the complex Fresnel equations, worst |Δ| {worst:.2e}");
         // Metals dip towards the principal angle before rising to 1 at grazing incidence.
         assert!(optics::fresnel_conductor(deg(89.9).cos(), nu, kappa) > optics::fresnel_conductor(deg(80.0).cos(), nu, kappa));
     }
@@ -131,8 +159,11 @@ fn schlick_has_exponent_five_and_stays_near_the_exact_value() {
     assert!((optics::fresnel_schlick(0.04, 0.0) - 1.0).abs() < 1e-12);
     // Against the exact reflectance of glass: below it by 0.008 at 45°, 0.019 at 60° (the
     // largest gap), 0.013 at 70°; it runs to 1 at grazing incidence like the exact value.
-    for (theta, gap) in [(0.0, 1e-9), (30.0, 0.002), (45.0, 0.0085), (60.0, 0.0195), (70.0, 0.0135)] {
+    // Each gap bound sits within a factor 1.122 of the gap measured: 0 (0°), 0.00148 (30°),
+    // 0.00817 (45°), 0.01919 (60°), 0.01265 (70°).
+    for (theta, gap) in [(0.0, 1e-12), (30.0, 0.0016), (45.0, 0.0085), (60.0, 0.0195), (70.0, 0.0135)] {
         let (s, e) = (optics::fresnel_schlick(0.04, deg(theta).cos()), fresnel_textbook(deg(theta), 1.5, 0.0));
+        eprintln!("Schlick at {theta}°: {s:.6}, exact {e:.6}: gap {:.5}", e - s);
         assert!(s <= e + 1e-12 && e - s <= gap, "{theta}°: Schlick {s}, exact {e}");
     }
 }
@@ -187,7 +218,13 @@ fn slabs_displace_and_balls_focus_where_geometric_optics_says() {
         // Where it crosses the axis (x = 0), as distance behind the centre.
         let z = p2.z + d2.z * (-p2.x / d2.x);
         let _ = o;
-        assert!((-z - f).abs() < 0.01 * f, "h {h}: focus at {} m, paraxial {f} m", -z);
+        // The ray at height h focuses short of the paraxial focus by the ball's spherical
+        // aberration, which grows as (h/R)²: measured 2.8e-7 f at h = 1e-3 R, 2.8e-5 f at
+        // 1e-2 R, i.e. 0.2778 (h/R)² f. The tolerance 0.31 (h/R)² f leaves a factor 1.122
+        // over it, so an index off by 1e-6 relative (a focus 1.3e-6 f away) fails.
+        let rel = (-z - f).abs() / f;
+        eprintln!("ball lens, h = {h}: focus at {:.9} m, paraxial {f} m: |Δ|/f {rel:.3e} = {:.4} (h/R)²", -z, rel / (h / radius).powi(2));
+        assert!(rel < 0.31 * (h / radius).powi(2), "h {h}: focus at {} m, paraxial {f} m", -z);
     }
 }
 

@@ -41,7 +41,10 @@ fn sky_f(u: f64, v: f64) -> DVec3 {
 /// 512×256 mesh (its interpolated normals differ from the sphere's by ~1e-5 rad): measured
 /// worst |Δ| 8.9e-5, bound 3e-4 absolute (radiances are 0.1–0.9); pixels whose reflected direction lies within 3 texels of the
 /// map's seam or poles (where REPEAT filtering wraps) and the silhouette (cos θ < 0.2) are
-/// left out.
+/// left out. The sky around the sphere is the environment's formula itself, up to the f32
+/// roundings of the texels and of the output (3e-8 each for radiances under 1): bound 2e-7,
+/// measured 5.1e-8. Measured 1728 sphere and 1812 sky pixels checked, asserted more than
+/// 1540 and 1615 (a factor 1.122 under).
 #[test]
 fn reference_mirror_sphere_matches_closed_form() {
     const F0: f64 = 0.5;
@@ -62,6 +65,7 @@ fn reference_mirror_sphere_matches_closed_form() {
     let tan = (yfov as f64 * 0.5).tan();
     let o = eye.as_dvec3();
     let (mut checked, mut worst) = (0, 0.0f64);
+    let (mut sky_checked, mut sky_worst) = (0, 0.0f64);
     for y in 0..h {
         for x in 0..w {
             let dv = DVec3::new((2.0 * (x as f64 + 0.5) / w as f64 - 1.0) * tan, (1.0 - 2.0 * (y as f64 + 0.5) / h as f64) * tan, -1.0);
@@ -74,8 +78,9 @@ fn reference_mirror_sphere_matches_closed_form() {
                 let (u, v) = equirect(d);
                 if inside_exact_band(u, v, mw, mh) {
                     let e = sky_f(u, v);
-                    worst = worst.max(diff(got, e));
-                    assert!(diff(got, e) < 1e-5, "sky pixel ({x},{y}): {got:?} vs {e}");
+                    sky_worst = sky_worst.max(diff(got, e));
+                    sky_checked += 1;
+                    assert!(diff(got, e) < 2e-7, "sky pixel ({x},{y}): {got:?} vs {e}");
                 }
                 continue;
             }
@@ -95,8 +100,8 @@ fn reference_mirror_sphere_matches_closed_form() {
             checked += 1;
         }
     }
-    assert!(checked > 800, "only {checked} sphere pixels checked");
-    println!("{checked} sphere pixels, worst |Δ| {worst:e}");
+    println!("{checked} sphere pixels, worst |Δ| {worst:e}; {sky_checked} sky pixels, worst |Δ| {sky_worst:e}");
+    assert!(checked > 1540 && sky_checked > 1615, "only {checked} sphere and {sky_checked} sky pixels checked");
 }
 
 fn equirect(d: DVec3) -> (f64, f64) {
@@ -119,8 +124,9 @@ fn diff(got: &[f32], e: DVec3) -> f64 {
 /// shadows), one reference sample at each pixel centre. This pins down that the reference
 /// uses the GPU's camera, texture sampling, sRGB decoding and shading formula. The only
 /// differences allowed are where the methods differ: shadow-map texels along shadow edges
-/// and at contact points. Measured: 99.99 % of pixels within 1 % + 1e-3, PSNR 42.2 dB;
-/// asserted: ≥ 99.5 % and ≥ 40 dB.
+/// and at contact points. Measured: all pixels but 1 of 9216 within 1 % + 1e-3, PSNR
+/// 42.24 dB; asserted: at most 1 pixel outside (a factor 1.122 over 1 pixel) and
+/// ≥ 41.24 dB (1 dB under).
 #[test]
 fn reference_matches_the_gpu_where_the_gpu_is_exact() {
     let ctx = common::gpu();
@@ -140,9 +146,9 @@ fn reference_matches_the_gpu_where_the_gpu_is_exact() {
         .count();
     let share = close as f64 / (w * h) as f64;
     let e = metrics::compare(&gpu.image, &cpu).unwrap();
-    println!("{:.2} % of pixels within 1 % + 1e-3; {e}", 100.0 * share);
-    assert!(share >= 0.995, "only {:.2} % of pixels agree", 100.0 * share);
-    assert!(e.psnr >= 40.0, "{e}");
+    println!("{:.2} % of pixels within 1 % + 1e-3 ({} of {} outside); {e}", 100.0 * share, w * h - close as u32, w * h);
+    assert!(w * h - close as u32 <= 1, "only {:.2} % of pixels agree", 100.0 * share);
+    assert!(e.psnr >= 41.24, "{e}");
     common::assert_clean(&ctx);
 }
 
@@ -150,8 +156,10 @@ fn reference_matches_the_gpu_where_the_gpu_is_exact() {
 /// scene, 128², cube maps 128², reference 16 spp, depth 4. Environment mapping ignores
 /// the ray origin (no parallax) and sees other specular objects only reflecting the sky,
 /// and one GPU sample per pixel aliases, so the error is real and large; this test pins it
-/// down so a regression in either renderer shows. Measured on lavapipe (Mesa 22.3.6):
-/// PSNR 18.04 dB, mean FLIP 0.0825. Floors: PSNR ≥ 17.0 dB, mean FLIP ≤ 0.095.
+/// down so a regression in either renderer shows. Measured on lavapipe (Mesa 22.3.6), with
+/// caustics on (the default): PSNR 17.69 dB, mean FLIP 0.0875. Floors: PSNR ≥ 17.0 dB
+/// (0.69 dB under), mean FLIP ≤ 0.095 (a factor 1.085 over). A black image is 8.22 dB
+/// worse (asserted 7.22 dB).
 #[test]
 fn envmap_vs_reference_on_the_demo_scene() {
     let ctx = common::gpu();
@@ -166,7 +174,9 @@ fn envmap_vs_reference_on_the_demo_scene() {
     assert!(e.flip <= 0.095, "mean FLIP rose above its ceiling: {e}");
     // And the reference is not trivially close to anything: a black image is far worse.
     let black = specula::vk::ImageData { data: vec![0.0; reference.data.len()], ..reference.clone() };
-    assert!(metrics::compare(&black, &reference).unwrap().psnr < e.psnr - 3.0);
+    let eb = metrics::compare(&black, &reference).unwrap();
+    println!("black vs reference: {eb}; envmap {:.2} dB better", e.psnr - eb.psnr);
+    assert!(eb.psnr < e.psnr - 7.22, "black {eb} vs envmap {e}");
     common::assert_clean(&ctx);
 }
 
