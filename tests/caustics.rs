@@ -58,6 +58,21 @@ fn quality(pairs: &[&str]) -> Quality {
 /// form the caustic's energy is checked against): ∫ I (1 − F(θ))² dΩ over the sphere's cone,
 /// θ the incidence angle at impact parameter b = d sin ψ (exit at the same angle inside).
 fn two_refraction_power(ior: f64) -> f64 {
+    spot_two_refraction_power(ior, None)
+}
+
+/// The same under a spot light aimed straight down with cones (inner, outer): each
+/// direction's intensity weighted by glTF's smooth falloff, clamp((cos ψ − cos outer) /
+/// (cos inner − cos outer), 0, 1)², with the cones' cosines rounded to f32 as the GPU's
+/// light table holds them.
+fn spot_two_refraction_power(ior: f64, cones: Option<(f32, f32)>) -> f64 {
+    let falloff = |psi: f64| match cones {
+        None => 1.0,
+        Some((inner, outer)) => {
+            let (ci, co) = (inner.cos() as f64, outer.cos() as f64);
+            ((psi.cos() - co) / (ci - co)).clamp(0.0, 1.0).powi(2)
+        }
+    };
     let d = (LIGHT - C).length() as f64;
     let r = R as f64;
     let psi_max = (r / d).asin();
@@ -68,7 +83,7 @@ fn two_refraction_power(ior: f64) -> f64 {
         let sin_i = (d * psi.sin() / r).min(1.0);
         let cos_i = (1.0 - sin_i * sin_i).sqrt();
         let t = 1.0 - specula::optics::fresnel_dielectric(cos_i, ior);
-        sum += t * t * 2.0 * std::f64::consts::PI * psi.sin() * (psi_max / n as f64);
+        sum += falloff(psi) * t * t * 2.0 * std::f64::consts::PI * psi.sin() * (psi_max / n as f64);
     }
     INTENSITY as f64 * sum
 }
@@ -120,12 +135,16 @@ fn caustic_power_matches_the_fresnel_transmittances() {
     let scene = sphere_over_floor(1.5);
     let expected = two_refraction_power(1.5);
     // Lost: triangles across the silhouette (a photon missing) and across distance gaps,
-    // texels of the photon cone's rim; a few per cent, less with more photons.
-    for (filter, photons, lo) in [("splat", 64, 0.98), ("splat", 128, 0.98), ("triangles", 64, 0.93), ("triangles", 128, 0.96)] {
+    // texels of the photon cone's rim; a few per cent, less with more photons. The loss
+    // 1 − ratio may be at most 1.122 × what was measured: splat 0.0100 at 64² and 128²
+    // photons (ratios 0.99002, 0.98997), triangles 0.0577 at 64² (0.94233), 0.0319 at 128²
+    // (0.96814).
+    // Nothing is gained: at most 1.005 (the quadrature's and f32 accumulation's error).
+    for (filter, photons, lo) in [("splat", 64, 0.9888), ("splat", 128, 0.9888), ("triangles", 64, 0.9353), ("triangles", 128, 0.9643)] {
         let q = quality(&[&format!("caustics={filter}"), &format!("photons={photons}"), "caustic_paths=refracted"]);
         let (power, passes) = caustic_power(&ctx, &scene, &q);
         let ratio = power / expected;
-        eprintln!("{filter} photons={photons}: power {power:.4} W, closed form {expected:.4} W, ratio {ratio:.4}");
+        eprintln!("{filter} photons={photons}: power {power:.4} W, closed form {expected:.4} W, ratio {ratio:.5}");
         assert!((lo..=1.005).contains(&ratio), "{filter} {photons}: {ratio}");
         let accumulate = if filter == "splat" { "caustics.splat" } else { "caustics.triangles" };
         for name in ["caustics.receivers", "caustics.photons", accumulate, "caustics.filter", "caustics.project"] {
@@ -164,8 +183,9 @@ fn the_reflected_branch_adds_the_glass_surface_reflection() {
     let (both, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128"]));
     let (refracted, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128", "caustic_paths=refracted"]));
     let added = both - refracted;
-    eprintln!("reflected branch: {added:.4} W, quadrature {expected:.4} W, ratio {:.4}", added / expected);
-    assert!((0.9..=1.1).contains(&(added / expected)), "{added} vs {expected}");
+    eprintln!("reflected branch: {added:.4} W, quadrature {expected:.4} W, ratio {:.5}", added / expected);
+    // Measured ratio 1.04490: |ratio − 1| at most 1.122 × 0.0449.
+    assert!((added / expected - 1.0).abs() <= 0.0503, "{added} vs {expected}");
     common::assert_clean(&ctx);
 }
 
@@ -179,7 +199,8 @@ fn directional_and_grazing_light_keep_the_power() {
     let ctx = common::gpu();
     let e = 2.0f64;
     let r = R as f64;
-    for degrees in [0.0f64, 60.0] {
+    // Measured ratios 0.99033 (0°) and 1.00842 (60°): |ratio − 1| at most 1.122 × those.
+    for (degrees, tolerance) in [(0.0f64, 0.0108), (60.0, 0.0094)] {
         let a = degrees.to_radians();
         let d = DVec3::new(a.sin(), -a.cos(), 0.0);
         let (u, v) = (DVec3::Z, d.cross(DVec3::Z).normalize());
@@ -212,8 +233,8 @@ fn directional_and_grazing_light_keep_the_power() {
             range: None,
         };
         let (power, _) = caustic_power(&ctx, &scene, &quality(&["caustics=splat", "photons=128", "caustic_paths=refracted"]));
-        eprintln!("directional at {degrees}°: {power:.4} W, quadrature {expected:.4} W, ratio {:.4}", power / expected);
-        assert!((0.96..=1.01).contains(&(power / expected)), "{degrees}°: {power} vs {expected}");
+        eprintln!("directional at {degrees}°: {power:.4} W, quadrature {expected:.4} W, ratio {:.5}", power / expected);
+        assert!((power / expected - 1.0).abs() <= tolerance, "{degrees}°: {power} vs {expected}");
     }
     common::assert_clean(&ctx);
 }
@@ -227,11 +248,22 @@ fn spot_lights_send_photons_only_where_their_cone_reaches() {
     let refracted = quality(&["caustics=splat", "caustic_paths=refracted"]);
     let (power, _) = caustic_power(&ctx, &scene, &refracted);
     let expected = two_refraction_power(1.5);
-    assert!((0.98..=1.005).contains(&(power / expected)), "{power} vs {expected}");
-    // Narrower than the sphere: only its cone's share (less than half at these angles).
+    // Narrower than the sphere: only its cone's share, the same quadrature weighted by the
+    // spot's falloff.
     scene.lights[0].kind = LightKind::Spot { inner_cone: 0.05, outer_cone: 0.1 };
     let (narrow, _) = caustic_power(&ctx, &scene, &refracted);
-    assert!(narrow > 0.0 && narrow < 0.5 * expected, "{narrow}");
+    let share = spot_two_refraction_power(1.5, Some((0.05, 0.1)));
+    eprintln!(
+        "spot: wide {power:.4} W, closed form {expected:.4} W, ratio {:.5}; narrow {narrow:.4} W, its share {share:.4} W ({:.4} of the sphere's), ratio {:.5}",
+        power / expected,
+        share / expected,
+        narrow / share
+    );
+    // Measured: wide 0.99002 of the closed form (the point light's loss: at most 1.122 ×
+    // 0.00998); narrow 0.99076 of its share (0.0869 of the sphere's; |ratio − 1| at most
+    // 1.122 × 0.00924).
+    assert!((0.9888..=1.005).contains(&(power / expected)), "{power} vs {expected}");
+    assert!((narrow / share - 1.0).abs() <= 0.0103, "{narrow} vs {share}");
     // Aimed away: the light sees no generator, the plan has no caustics.
     scene.lights[0].direction = Vec3::Y;
     let p = plan(&scene, specula::methods::REFRACTOR_MAP, &quality(&["caustics=splat"]));
@@ -283,7 +315,10 @@ fn the_distance_test_stops_light_leaks() {
         .unwrap();
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.12, 2.0), Vec3::new(0.0, 0.1, 0.0), 50f32.to_radians()));
     let off = image(&ctx, &scene, &quality(&["caustics=off"]));
-    for space in ["cube", "light"] {
+    // Measured: cube space 90 leak pixels, residual 6.010 of the test-less 67.532 (0.0890);
+    // light space 88 pixels, 5.502 of 49.674 (0.1108). Floors on the leak a factor 1.122
+    // under; ceilings on the residual's share 1.122 over (light space: 0.12, 1.083 over).
+    for (space, min_leak, max_share) in [("cube", 81, 0.0998), ("light", 79, 0.12)] {
         let space = format!("caustic_space={space}");
         let on = image(&ctx, &scene, &quality(&["caustics=triangles", &space]));
         let leaky = image(&ctx, &scene, &quality(&["caustics=triangles", "caustic_distance_test=off", &space]));
@@ -291,12 +326,16 @@ fn the_distance_test_stops_light_leaks() {
         let leak: Vec<usize> = (0..64 * 64).filter(|&i| luminance(&leaky, i) > 1.1 * luminance(&off, i) + 1e-4).collect();
         let sum = |img: &specula::image::ImageData| -> f64 { leak.iter().map(|&i| luminance(img, i)).sum() };
         let (s_off, s_on, s_leak) = (sum(&off), sum(&on), sum(&leaky));
-        eprintln!("{space}: {} leak pixels: off {s_off:.3}, distance test {s_on:.3}, no test {s_leak:.3}", leak.len());
-        assert!(leak.len() >= 20, "the test-less render leaks onto {} pixels", leak.len());
+        eprintln!(
+            "{space}: {} leak pixels: off {s_off:.3}, distance test {s_on:.3}, no test {s_leak:.3}, residual share {:.5}",
+            leak.len(),
+            (s_on - s_off).abs() / (s_leak - s_off)
+        );
+        assert!(leak.len() >= min_leak, "the test-less render leaks onto {} pixels", leak.len());
         // What remains is a rim one filter radius wide along the plate's edge, where the box
         // filter spreads the plate's caustic into the floor's directions.
         assert!(
-            (s_on - s_off).abs() <= 0.12 * (s_leak - s_off),
+            (s_on - s_off).abs() <= max_share * (s_leak - s_off),
             "{space}: with the test the floor under the plate stays dark: {s_on} vs {s_off}"
         );
     }
@@ -316,12 +355,15 @@ fn nu_near_one_fills_the_shadow_with_the_light_it_blocked() {
     let shadow = image(&ctx, &scene, &quality(&["caustics=off"]));
     let filled = image(&ctx, &scene, &q);
     let region: Vec<usize> = (0..64 * 64).filter(|&i| luminance(&shadow, i) < 0.5 * luminance(&lit, i)).collect();
-    assert!(region.len() > 50, "the sphere casts a shadow of {} pixels", region.len());
+    // Measured 344 pixels; floor a factor 1.122 under.
+    assert!(region.len() >= 307, "the sphere casts a shadow of {} pixels", region.len());
     let mut ratios: Vec<f64> = region.iter().map(|&i| luminance(&filled, i) / luminance(&lit, i)).collect();
     ratios.sort_by(f64::total_cmp);
     let (median, mean) = (ratios[ratios.len() / 2], ratios.iter().sum::<f64>() / ratios.len() as f64);
-    eprintln!("ν→1: {} shadow pixels, caustic/lit median {median:.4} mean {mean:.4}", ratios.len());
-    assert!((0.97..=1.03).contains(&median) && (0.9..=1.1).contains(&mean), "{median} {mean}");
+    eprintln!("ν→1: {} shadow pixels, caustic/lit median {median:.5} mean {mean:.5}", ratios.len());
+    // Measured: median 1.00286, mean 0.91256 (the shadow's rim, where the caustic's filter
+    // spreads the light out of the shadow); |median − 1| and |mean − 1| at most 1.122 × those.
+    assert!((median - 1.0).abs() <= 0.0032 && (mean - 1.0).abs() <= 0.098, "{median} {mean}");
     common::assert_clean(&ctx);
 }
 
@@ -334,8 +376,10 @@ fn caustics_hold_at_1_km_and_1_mm() {
         // Radiant intensity scales with k² like the light's: the same power over k².
         let (power, _) = caustic_power(&ctx, &scaled_sphere_over_floor(1.5, k), &q);
         let ratio = power / (k as f64 * k as f64) / unit;
-        eprintln!("scale {k}: power ratio to 1 m {ratio:.5}");
-        assert!((0.99..=1.01).contains(&ratio), "scale {k}: {ratio}");
+        eprintln!("scale {k}: power ratio to 1 m {ratio:.6}");
+        // Measured 0.99994 (1 km), 0.99991 (1 mm): f32 rounding; the bound is
+        // tests/README.md rule 2's 10⁻³.
+        assert!((ratio - 1.0).abs() <= 1e-3, "scale {k}: {ratio}");
     }
     common::assert_clean(&ctx);
 }
@@ -355,8 +399,9 @@ fn the_caustic_is_seen_through_the_glass() {
     let bare = image(&ctx, &gone, &quality(&["caustics=off"]));
     let sphere: Vec<usize> = (0..64 * 64).filter(|&i| (luminance(&off, i) - luminance(&bare, i)).abs() > 0.02).collect();
     let (a, b): (f64, f64) = (sphere.iter().map(|&i| luminance(&off, i)).sum(), sphere.iter().map(|&i| luminance(&on, i)).sum());
-    eprintln!("sphere pixels {}: off {a:.3}, with caustics {b:.3}", sphere.len());
-    assert!(b > a * 1.05, "{b} vs {a}");
+    eprintln!("sphere pixels {}: off {a:.3}, with caustics {b:.3}, ratio {:.4}", sphere.len(), b / a);
+    // Measured ratio 6.212; floor a factor 1.122 under.
+    assert!(b > a * 5.53, "{b} vs {a}");
     common::assert_clean(&ctx);
 }
 
@@ -391,7 +436,8 @@ fn caustics_match_the_cpu_light_tracer() {
     let exact = specula::reference::render_reference(&scene, &q, size).unwrap();
     let truth = caustic_part(&exact, &off);
     let region: Vec<usize> = (0..truth.len()).filter(|&i| truth[i] > 0.01).collect();
-    assert!(region.len() > 30, "the reference has a caustic of {} pixels", region.len());
+    // Measured 3085 pixels; floor a factor 1.122 under.
+    assert!(region.len() >= 2750, "the reference has a caustic of {} pixels", region.len());
     let peak = truth.iter().cloned().fold(0.0, f64::max);
     let (cx, cy) = centroid(&truth, 64);
     let mut errors = Vec::new();
@@ -405,27 +451,44 @@ fn caustics_match_the_cpu_light_tracer() {
             let mse = region.iter().map(|&i| (part[i] - truth[i]).powi(2)).sum::<f64>() / region.len() as f64;
             let psnr = 10.0 * (peak * peak / mse).log10();
             let l1: f64 = region.iter().map(|&i| (part[i] - truth[i]).abs()).sum::<f64>() / region.iter().map(|&i| truth[i]).sum::<f64>();
-            eprintln!("   relative L1 {l1:.4}, region {} px", region.len());
+            eprintln!("   relative L1 {l1:.5}, region {} px", region.len());
             let shift = ((gx - cx).powi(2) + (gy - cy).powi(2)).sqrt();
-            eprintln!("{filter} photons={photons}: caustic PSNR {psnr:.2} dB (peak {peak:.3}), centroid off by {shift:.2} px");
+            eprintln!("{filter} photons={photons}: caustic PSNR {psnr:.3} dB (peak {peak:.3}), centroid off by {shift:.3} px");
             errors.push((filter, photons, psnr, shift, l1));
         }
     }
-    // Measured (lavapipe): relative L1 splat 0.33 / 0.23 / 0.20, triangles 0.19 / 0.14 / 0.11
-    // at 32² / 64² / 128² photons; PSNR over the peak splat 39.9, triangles 44.7 dB; the
-    // centroid within 0.9 px. What remains: the light cube's texels and filter (the focus
-    // is sharper in the reference) and the paths the photon pass does not follow (internal
-    // reflections, a dim halo).
-    for filter in ["splat", "triangles"] {
+    // Measured (lavapipe) at 32² / 64² / 128² photons: relative L1 splat 0.3271 / 0.2304 /
+    // 0.2035, triangles 0.1895 / 0.1418 / 0.1098; PSNR over the peak splat 39.855 / 39.873 /
+    // 39.873 dB, triangles 44.573 / 44.663 / 44.684 dB; the centroid off by 0.264 / 0.296 /
+    // 0.318 px (splat), 0.865 / 0.594 / 0.308 px (triangles). What remains: the light cube's
+    // texels and filter (the focus is sharper in the reference) and the paths the photon pass
+    // does not follow (internal reflections, a dim halo). Per case: PSNR floors 1 dB under (the
+    // triangles' 44.0 dB, set before, is closer), L1 and centroid ceilings a factor 1.122
+    // over; each step's fall in L1 at least the measured one (1.4196, 1.1323 splat; 1.3371,
+    // 1.2912 triangles) over 1.122.
+    let expected: [(&str, u32, f64, f64, f64); 6] = [
+        // (filter, photons, PSNR floor, L1 ceiling, centroid ceiling)
+        ("splat", 32, 38.86, 0.367, 0.296),
+        ("splat", 64, 38.88, 0.2585, 0.332),
+        ("splat", 128, 38.88, 0.2283, 0.356),
+        ("triangles", 32, 44.0, 0.2126, 0.970),
+        ("triangles", 64, 44.0, 0.159, 0.666),
+        ("triangles", 128, 44.0, 0.1231, 0.345),
+    ];
+    for (e, &(filter, photons, psnr, l1, shift)) in errors.iter().zip(&expected) {
+        assert_eq!((e.0, e.1), (filter, photons));
+        assert!(e.2 > psnr && e.4 < l1 && e.3 < shift, "{filter} {photons}: {} dB, L1 {}, centroid {} px off", e.2, e.4, e.3);
+    }
+    for (filter, falls) in [("splat", [1.2652, 1.0092]), ("triangles", [1.1917, 1.1508])] {
         let e: Vec<_> = errors.iter().filter(|e| e.0 == filter).collect();
-        assert!(e[0].4 > e[1].4 && e[1].4 > e[2].4, "{filter}: the error falls as photons grow: {e:?}");
-        for x in &e {
-            assert!(x.3 < 1.5, "{filter} {}: centroid {} px off", x.1, x.3);
-            assert!(x.2 > if filter == "splat" { 38.5 } else { 44.0 }, "{filter} {}: {} dB", x.1, x.2);
+        for k in 0..2 {
+            assert!(e[k].4 > falls[k] * e[k + 1].4, "{filter}: the error falls as photons grow: {e:?}");
         }
     }
+    // Triangles beat splats at equal photons (survey §6.3.2): measured L1 0.2035 against
+    // 0.1098 at 128², a factor 1.8536; at least that over 1.122.
     let l1 = |f: &str| errors.iter().find(|e| e.0 == f && e.1 == 128).unwrap().4;
-    assert!(l1("triangles") < l1("splat"), "triangles beat splats at equal photons (survey §6.3.2)");
+    assert!(l1("splat") > 1.652 * l1("triangles"), "triangles beat splats at equal photons (survey §6.3.2)");
     common::assert_clean(&ctx);
 }
 
@@ -494,8 +557,9 @@ fn a_concave_mirror_focuses_a_point_light() {
     let p = plan(&s, specula::methods::DISTANCE, &quality(&["caustics=triangles", "photons=128"]));
     assert_eq!(p.caustics.as_ref().map(|c| c.photon_layers), Some(6), "a mirror has one branch, seen in six views");
     let (power, _) = caustic_power(&ctx, &s, &quality(&["caustics=splat", "photons=128"]));
-    eprintln!("mirror bowl: {power:.4} W, I·Ω(rim) {expected:.4} W, ratio {:.4}", power / expected);
-    assert!((0.99..=1.01).contains(&(power / expected)), "{power} vs {expected}");
+    eprintln!("mirror bowl: {power:.4} W, I·Ω(rim) {expected:.4} W, ratio {:.5}", power / expected);
+    // Measured ratio 0.99663: |ratio − 1| at most 1.122 × 0.00337.
+    assert!((power / expected - 1.0).abs() <= 0.0037, "{power} vs {expected}");
     common::assert_clean(&ctx);
 }
 
@@ -534,8 +598,9 @@ fn a_light_inside_the_generators_bounds_sees_it_through_six_views() {
     let patch: Vec<usize> = (24..40).flat_map(|y| (24..40).map(move |x| y * 64 + x)).collect();
     let ratio = patch.iter().map(|&i| luminance(&through, i)).sum::<f64>() / patch.iter().map(|&i| luminance(&open, i)).sum::<f64>();
     let f0 = specula::optics::fresnel_dielectric(1.0, 1.5);
-    eprintln!("pane: floor through / open {ratio:.4}, 1 − F(0) = {:.4}", 1.0 - f0);
-    assert!((ratio - (1.0 - f0)).abs() < 0.02, "{ratio}");
+    eprintln!("pane: floor through / open {ratio:.5}, 1 − F(0) = {:.5}, off by {:.5}", 1.0 - f0, (ratio - (1.0 - f0)).abs());
+    // Measured 0.95640 against 0.96000: off by at most 1.122 × 0.00360.
+    assert!((ratio - (1.0 - f0)).abs() < 0.0040, "{ratio}");
     common::assert_clean(&ctx);
 }
 
@@ -552,12 +617,14 @@ fn every_method_shows_the_caustic() {
     let exact = specula::reference::render_reference(&scene, &q, (48, 48)).unwrap();
     let truth = caustic_part(&exact, &off);
     let region: Vec<usize> = (0..truth.len()).filter(|&i| truth[i] > 0.01).collect();
-    for m in [
-        specula::methods::ENVMAP,
-        specula::methods::DISTANCE,
-        specula::methods::REFRACTOR_MAP,
-        specula::methods::BVH,
-        specula::methods::RAY_ENGINE,
+    // Measured relative L1: envmap 0.14239, distance and refractor-map 0.13422, bvh and
+    // ray-engine 0.13414; ceilings a factor 1.122 over.
+    for (m, ceiling) in [
+        (specula::methods::ENVMAP, 0.1597),
+        (specula::methods::DISTANCE, 0.1505),
+        (specula::methods::REFRACTOR_MAP, 0.1505),
+        (specula::methods::BVH, 0.1505),
+        (specula::methods::RAY_ENGINE, 0.1505),
     ] {
         let render = |c: &str| {
             let q = quality(&["cube_size=128", &format!("caustics={c}")]);
@@ -567,8 +634,8 @@ fn every_method_shows_the_caustic() {
         };
         let part = caustic_part(&render("triangles"), &render("off"));
         let l1 = region.iter().map(|&i| (part[i] - truth[i]).abs()).sum::<f64>() / region.iter().map(|&i| truth[i]).sum::<f64>();
-        eprintln!("{}: caustic relative L1 {l1:.4}", m.name);
-        assert!(l1 < 0.25, "{}: {l1}", m.name);
+        eprintln!("{}: caustic relative L1 {l1:.5}", m.name);
+        assert!(l1 < ceiling, "{}: {l1}", m.name);
     }
     common::assert_clean(&ctx);
 }
@@ -585,7 +652,8 @@ fn multiview_and_six_passes_make_the_same_caustic() {
         let six = quality(&[&format!("caustics={filter}"), "cube_mode=six"]);
         let multi = quality(&[&format!("caustics={filter}"), "cube_mode=multiview"]);
         let (a, b) = (caustic_power(&ctx, &scene, &six).0, caustic_power(&ctx, &scene, &multi).0);
-        eprintln!("{filter}: power six {a:.5} multiview {b:.5}");
+        eprintln!("{filter}: power six {a:.5} multiview {b:.5}, relative difference {:e}", (a - b).abs() / a);
+        // Measured: the same power (relative difference 0).
         assert!((a - b).abs() <= 1e-6 * a, "{filter}: {a} vs {b}");
     }
     common::assert_clean(&ctx);
@@ -635,10 +703,16 @@ fn total_internal_reflection_paths_reach_the_floor() {
     q.depth = 16;
     let tracer = specula::reference::Tracer::new(&s, &q).unwrap();
     let exact: f64 = tracer.photon_map().unwrap().photons().iter().map(|p| p.power.x).sum();
-    eprintln!("prism: internal_bounces=0 {none:.4} W, 4: {some:.4} W, light tracer {exact:.4} W");
-    assert!(some > 1.1 * none, "TIR paths carry power: {some} vs {none}");
-    // Measured: 0.743 W without bounces, 1.007 W with, the light tracer 0.993 W.
-    assert!((0.9..=1.03).contains(&(some / exact)), "{some} vs {exact}");
+    eprintln!(
+        "prism: internal_bounces=0 {none:.4} W, 4: {some:.4} W, light tracer {exact:.4} W; with / without {:.4}, with / tracer {:.5}",
+        some / none,
+        some / exact
+    );
+    // Measured: 0.7432 W without bounces, 1.0074 W with (a factor 1.3556; at least that
+    // over 1.122), the light tracer 0.9931 W (ratio 1.01441: |ratio − 1| at most 1.122 ×
+    // 0.01441).
+    assert!(some > 1.208 * none, "TIR paths carry power: {some} vs {none}");
+    assert!((some / exact - 1.0).abs() <= 0.0161, "{some} vs {exact}");
     common::assert_clean(&ctx);
 }
 
@@ -662,8 +736,9 @@ fn the_caustic_is_seen_in_a_planar_mirror() {
     let bare = render(&gone, "off").image;
     let seen: Vec<usize> = (0..64 * 64).filter(|&i| (luminance(&off, i) - luminance(&bare, i)).abs() > 1e-3).collect();
     let (a, b): (f64, f64) = (seen.iter().map(|&i| luminance(&off, i)).sum(), seen.iter().map(|&i| luminance(&on, i)).sum());
-    eprintln!("mirror pixels {}: off {a:.3}, with caustics {b:.3}", seen.len());
-    assert!(seen.len() > 200 && b > a * 1.05, "{} pixels: {b} vs {a}", seen.len());
+    eprintln!("mirror pixels {}: off {a:.3}, with caustics {b:.3}, ratio {:.4}", seen.len(), b / a);
+    // Measured 388 pixels, ratio 1.3726; floors a factor 1.122 under.
+    assert!(seen.len() >= 346 && b > a * 1.223, "{} pixels: {b} vs {a}", seen.len());
     common::assert_clean(&ctx);
 }
 
@@ -683,8 +758,9 @@ fn light_space_caustics_keep_the_power_and_compare_with_cube_space() {
     // Measured 0.93: the photons leave the generator 2.5 m from the cube's centre (the light),
     // where the linear search's probes are as far apart; a ray grazing out over the floor's
     // edge between two probes reads the sky beyond it and escapes (cube space: 0.99).
-    eprintln!("light space: {power:.4} W, closed form {expected:.4} W");
-    assert!((0.9..=1.005).contains(&(power / expected)), "{power}");
+    eprintln!("light space: {power:.4} W, closed form {expected:.4} W, ratio {:.5}", power / expected);
+    // Measured ratio 0.92853: the loss 1 − ratio at most 1.122 × 0.07147.
+    assert!((0.9199..=1.005).contains(&(power / expected)), "{power}");
 
     let mut close = scene.clone();
     close.camera = Some(Camera::look_at(Vec3::new(0.0, 0.9, 1.2), Vec3::ZERO, 40f32.to_radians()));
@@ -699,13 +775,14 @@ fn light_space_caustics_keep_the_power_and_compare_with_cube_space() {
         let gpu = image(&ctx, &close, &quality(&["cube_size=128", "caustics=triangles", "photons=128", &format!("caustic_space={space}")]));
         let part = caustic_part(&gpu, &gpu_off);
         let l1 = region.iter().map(|&i| (part[i] - truth[i]).abs()).sum::<f64>() / region.iter().map(|&i| truth[i]).sum::<f64>();
-        eprintln!("{space} space: caustic relative L1 {l1:.4}");
+        eprintln!("{space} space: caustic relative L1 {l1:.5}");
         l1s.push(l1);
     }
-    // Measured 0.11 (cube) and 0.75 (light): from the light, 3 m above, the focus under the
-    // sphere covers a few texels of its cube and smears over them, and the search misses the
-    // photons that graze out far (above); from the sphere's centre it is resolved.
-    assert!(l1s[0] < 0.2 && l1s[1] < 1.0 && l1s[0] < l1s[1], "{l1s:?}");
+    // Measured 0.1098 (cube) and 0.7452 (light): from the light, 3 m above, the focus under
+    // the sphere covers a few texels of its cube and smears over them, and the search misses
+    // the photons that graze out far (above); from the sphere's centre it is resolved.
+    // Ceilings a factor 1.122 over; light space at least 6.788 / 1.122 times cube space.
+    assert!(l1s[0] < 0.1231 && l1s[1] < 0.8361 && l1s[1] > 6.05 * l1s[0], "{l1s:?}");
     common::assert_clean(&ctx);
 }
 
@@ -763,9 +840,16 @@ fn the_receiver_orientation_factor_matches_the_light_tracer() {
             .sum()
     };
     let (exact, on, no) = (truth.iter().sum::<f64>(), sum("on"), sum("off"));
-    eprintln!("caustic in view: light tracer {exact:.3}, orientation on {on:.3}, off {no:.3}");
-    assert!(exact > 1.0, "the caustic is in view: {exact}");
-    assert!((on / exact - 1.0).abs() < 0.15 && no > 1.5 * on, "{exact} {on} {no}");
+    eprintln!(
+        "caustic in view: light tracer {exact:.3}, orientation on {on:.3}, off {no:.3}; on / tracer {:.5}, off / on {:.4}",
+        on / exact,
+        no / on
+    );
+    // Measured: the light tracer's caustic sums to 76.688 (floor a factor 1.122 under); on /
+    // tracer 0.97510 (|ratio − 1| at most 1.122 × 0.0249); off / on 1.8580 (at least that
+    // over 1.122).
+    assert!(exact > 68.35, "the caustic is in view: {exact}");
+    assert!((on / exact - 1.0).abs() < 0.0279 && no > 1.656 * on, "{exact} {on} {no}");
     common::assert_clean(&ctx);
 }
 

@@ -4,16 +4,11 @@
 mod common;
 
 use glam::{DVec3, Vec3};
-use specula::optics::{fresnel_f0, fresnel_schlick, reflect_dir};
 use specula::scene::{shapes, Camera, Scene};
 use specula::{plan, Quality, Renderer};
 
 const F0: f32 = 0.3;
 
-/// A mirror sphere (F0 = 0.3) at the centre of the quadrant room, reference point at its
-/// centre, camera looking at it. Every pixel on the sphere is predicted on the CPU: hit the
-/// analytic sphere, reflect, take the room's colour in the reflected direction from the
-/// centre (what environment mapping assumes), weight by Schlick (eq. 2).
 /// Unpolarised reflectance of a lossless interface of index n from air at incidence cos θ,
 /// from the Fresnel equations written out here (not `specula::optics`).
 fn fresnel_equations(n: f64, cos: f64) -> f64 {
@@ -24,14 +19,25 @@ fn fresnel_equations(n: f64, cos: f64) -> f64 {
     0.5 * (rs * rs + rp * rp)
 }
 
+/// Schlick's approximation F0 + (1 − F0)(1 − cos θ)⁵ (survey eq. 2), written out here too.
+fn schlick(f0: f64, cos: f64) -> f64 {
+    f0 + (1.0 - f0) * (1.0 - cos).powi(5)
+}
+
+/// A mirror sphere (F0 = 0.3) at the centre of the quadrant room, reference point at its
+/// centre, camera looking at it. Every pixel on the sphere is predicted on the CPU: hit the
+/// analytic sphere, reflect, take the room's colour in the reflected direction from the
+/// centre (what environment mapping assumes), weight by Schlick (eq. 2); both written out
+/// here, so that a mistake shared by `specula::optics` and its GLSL twin shows.
 #[test]
 fn mirror_sphere_reflects_what_the_reflection_direction_predicts() {
     predict_the_sphere("schlick");
 }
 
 /// The same prediction with `fresnel=exact`: every pixel weighted by the Fresnel equations;
-/// at mid angles they are 0.02–0.04 above Schlick here, beyond the tolerance, so a shader
-/// that ignores the knob fails.
+/// at mid angles they are 0.02–0.04 above Schlick here, beyond the tolerance (0.43 %
+/// relative: 1244 of the 3324 pixels checked would miss), so a shader that ignores the knob
+/// fails.
 #[test]
 fn exact_fresnel_follows_the_fresnel_equations_across_the_sphere() {
     predict_the_sphere("exact");
@@ -57,11 +63,21 @@ fn predict_the_sphere(fresnel: &str) {
     let frame = r.render(&ctx).unwrap();
 
     let nu = ((1.0 + F0.sqrt()) / (1.0 - F0.sqrt())) as f64;
-    let f0 = fresnel_f0(nu, 0.0);
-    assert!((f0 - F0 as f64).abs() < 1e-6);
-    let mut schlick_gap: f64 = 0.0;
+    let f0 = F0 as f64;
+    // Per mode, as measured (lavapipe, this scene): the worst relative error of a sphere
+    // pixel against its prediction (what remains: the cube map's bilinear texel
+    // interpolation beside the skipped edges, half-float storage); the worst weight error
+    // towards grazing incidence (cos θ < 0.25, where the weight changes fastest across a
+    // pixel and the tessellation's normals show); the least rise of the weight over F0
+    // there. The tolerances sit a factor 1.122 over the errors, the floor 1.122 under the
+    // rise.
+    let (tolerance, grazing_tolerance, grazing_rise) = match fresnel {
+        "exact" => (0.0043, 0.0019, 0.063), // measured 0.00383, 0.00166, 0.0707
+        _ => (0.0047, 0.0027, 0.149),       // measured 0.00415, 0.00237, 0.1672
+    };
+    let (mut worst, mut worst_normal, mut worst_grazing, mut least_rise) = (0.0f64, 0.0f64, 0.0f64, f64::INFINITY);
+    let (mut checked, mut bad, mut other_bad, mut normal, mut grazing) = (0, 0, 0, 0, 0);
     let tan = (yfov as f64 * 0.5).tan();
-    let (mut checked, mut bad, mut normal_seen, mut grazing_seen) = (0, 0, false, false);
     for y in 0..h {
         for x in 0..w {
             let d = DVec3::new((2.0 * (x as f64 + 0.5) / w as f64 - 1.0) * tan, (1.0 - 2.0 * (y as f64 + 0.5) / h as f64) * tan, -1.0)
@@ -79,7 +95,7 @@ fn predict_the_sphere(fresnel: &str) {
             if cos < 0.15 {
                 continue; // the silhouette, where the tessellation shows
             }
-            let rdir = reflect_dir(d, n);
+            let rdir = d - n * (2.0 * n.dot(d));
             let a = rdir.abs();
             let major = a.max_element();
             let minor = [a.x, a.y, a.z].into_iter().filter(|&c| c != major).fold(f64::INFINITY, f64::min);
@@ -89,67 +105,118 @@ fn predict_the_sphere(fresnel: &str) {
                 continue;
             }
             let (wall, quadrant) = shapes::quadrant_room_hit(rdir.as_vec3());
-            let weight = if fresnel == "exact" { fresnel_equations(nu, cos) } else { fresnel_schlick(f0, cos) } as f32;
-            schlick_gap = schlick_gap.max((fresnel_equations(nu, cos) - fresnel_schlick(f0, cos)).abs());
-            let expected = common::quadrant_color(wall, quadrant) * weight;
+            let colour = common::quadrant_color(wall, quadrant);
+            let (exact, approx) = (fresnel_equations(nu, cos), schlick(f0, cos));
+            let (weight, other) = if fresnel == "exact" { (exact, approx) } else { (approx, exact) };
             let got = frame.image.texel(0, x, y);
-            let err = common::max_diff(got, expected);
-            if err > 0.01 * expected.max_element() + 2e-3 {
+            let expected = colour * weight as f32;
+            let err = (common::max_diff(got, expected) / expected.max_element()) as f64;
+            worst = worst.max(err);
+            if err > tolerance {
                 bad += 1;
             }
+            // The other Fresnel mode's prediction: what a shader that ignores the knob shows.
+            let expected_other = colour * other as f32;
+            if (common::max_diff(got, expected_other) / expected_other.max_element()) as f64 > tolerance {
+                other_bad += 1;
+            }
             checked += 1;
+            let ratio = (got[0] / colour.x) as f64;
             if cos > 0.995 {
                 // Normal incidence: the weight is F0 itself (survey eq. 2).
-                normal_seen = true;
-                let ratio = got[0] / common::quadrant_color(wall, quadrant).x;
-                assert!((ratio - F0).abs() < 0.01, "normal incidence: weight {ratio}, F0 {F0}");
+                normal += 1;
+                worst_normal = worst_normal.max((ratio - f0).abs());
             }
             if cos < 0.25 {
                 // Towards grazing incidence the weight rises towards 1.
-                grazing_seen = true;
-                let ratio = got[0] / common::quadrant_color(wall, quadrant).x;
-                assert!(ratio > F0 + 0.05 && (ratio - weight).abs() < 0.02, "grazing (cos {cos:.3}): weight {ratio}, {fresnel} {weight}");
+                grazing += 1;
+                worst_grazing = worst_grazing.max((ratio - weight).abs());
+                least_rise = least_rise.min(ratio - f0);
             }
         }
     }
-    assert!(normal_seen && grazing_seen);
-    assert!(checked > 1500, "only {checked} pixels checked");
-    assert!(schlick_gap > 0.02, "the two Fresnel modes differ on this sphere by {schlick_gap}");
-    // Tolerance: 1 % of the expected value + 0.002; at most 1 % of pixels outside it
-    // (texel interpolation next to the skipped edges, half-float storage).
-    assert!(bad * 100 <= checked, "{bad} of {checked} sphere pixels differ from the prediction");
+    eprintln!(
+        "{fresnel}: {checked} sphere pixels checked, worst relative error {worst:.5} ({bad} over {tolerance}); the other mode's \
+         prediction misses {other_bad}; {normal} pixels at normal incidence |w − F0| {worst_normal:e}; {grazing} towards grazing |w − {fresnel}| {worst_grazing:.5}, \
+         w − F0 ≥ {least_rise:.4}"
+    );
+    // Measured 3324 (both modes): the pixels the prediction covers, a factor 1.122 under.
+    assert!(checked >= 2963 && normal > 0 && grazing > 0, "only {checked} pixels checked, {normal} normal, {grazing} grazing");
+    assert!(bad == 0, "{bad} of {checked} sphere pixels differ from the prediction by over {tolerance} (worst {worst})");
+    // Half-float storage of F0 × the wall's colour: |w − F0| ≤ F0 · 2⁻¹¹ = 1.5e-4 (measured
+    // 6e-8 with Schlick, 1.8e-7 exact).
+    assert!(worst_normal < 1.5e-4, "normal incidence: weight off F0 by {worst_normal}");
+    assert!(worst_grazing < grazing_tolerance && least_rise > grazing_rise, "grazing: weight off by {worst_grazing}, rise {least_rise}");
+    // The two modes differ beyond the tolerance over much of the sphere (measured: the
+    // other mode's prediction misses 1244 of the 3324 pixels, in either mode), so a shader
+    // that ignores the knob fails here by that many; floor a factor 1.122 under.
+    assert!(other_bad >= 1109, "the other Fresnel mode's prediction misses only {other_bad} pixels");
     r.destroy(&ctx);
     common::assert_clean(&ctx);
 }
 
 /// With the exact Fresnel equations the weight at normal incidence is still F0, and the
-/// dielectric branch refracts: a thin-walled ν = 1.0001 pane barely changes anything.
+/// dielectric branch refracts: a thin-walled ν = 1.0001 pane in front of the back wall
+/// barely changes anything, while a ν = 1.5 one shows.
 #[test]
 fn exact_fresnel_and_refraction_run_clean() {
     let ctx = common::gpu();
-    let mut scene = Scene::new();
-    common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
+    let render = |scene: &Scene| {
+        let mut q = Quality::default();
+        q.set("fresnel", "exact").unwrap();
+        q.set("cube_size", "32").unwrap();
+        let mut r = Renderer::new(&ctx, scene, plan(scene, specula::methods::ENVMAP, &q), 32, 32).unwrap();
+        let f = r.render(&ctx).unwrap();
+        r.destroy(&ctx);
+        assert!(f.image.data.iter().all(|v| v.is_finite()), "non-finite pixel");
+        f.image
+    };
+    let room = || {
+        let mut scene = Scene::new();
+        common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
+        scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.5), Vec3::ZERO, 1.0));
+        scene
+    };
+    let dielectric = |name: &str, ior: f32, thin: bool| specula::scene::Material {
+        name: name.into(),
+        kind: specula::scene::SurfaceKind::Dielectric { ior, thin },
+        ..Default::default()
+    };
+
+    // A mirror sphere beside a solid glass one.
+    let mut scene = room();
     let m = scene.add_material(common::mirror(F0)).unwrap();
     scene.add_mesh(shapes::uv_sphere("sphere", Vec3::ZERO, 0.5, 64, 32, m)).unwrap();
-    let glass = scene
-        .add_material(specula::scene::Material {
-            name: "glass".into(),
-            kind: specula::scene::SurfaceKind::Dielectric { ior: 1.5, thin: false },
-            ..Default::default()
-        })
-        .unwrap();
+    let glass = scene.add_material(dielectric("glass", 1.5, false)).unwrap();
     scene.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.9, 0.0, 0.0), 0.3, 32, 16, glass)).unwrap();
-    scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.5), Vec3::ZERO, 1.0));
-    let mut q = Quality::default();
-    q.set("fresnel", "exact").unwrap();
-    q.set("cube_size", "32").unwrap();
-    let mut r = Renderer::new(&ctx, &scene, plan(&scene, specula::methods::ENVMAP, &q), 32, 32).unwrap();
-    let f = r.render(&ctx).unwrap();
-    let centre = f.image.texel(0, 16, 16);
+    let centre = render(&scene).texel(0, 16, 16).to_vec();
     let wall = common::quadrant_color(4, 0); // +Z wall behind the camera, quadrant (−x, −y)
-    assert!((centre[0] / wall.x - F0).abs() < 0.02, "exact Fresnel at normal incidence: {centre:?}");
-    assert!(f.image.data.iter().all(|v| v.is_finite()));
-    r.destroy(&ctx);
+    let weight = centre[0] / wall.x;
+
+    // The pane alone in the room (another specular object would show it black in its cube
+    // map: classic environment mapping draws the scene's specular objects with the sky),
+    // facing the camera inside one quadrant of the back wall (x, y ∈ [0, 2] at z = −2),
+    // 0.3 in front of it: what the pane's cube map sees through it from its centre is that
+    // quadrant's colour, as from the camera.
+    let bare = render(&room());
+    let pane = |ior: f32| {
+        let mut scene = room();
+        let m = scene.add_material(dielectric("pane", ior, true)).unwrap();
+        scene.add_mesh(shapes::quad("pane", Vec3::new(0.3, 0.3, -1.7), Vec3::new(1.4, 0.0, 0.0), Vec3::new(0.0, 1.4, 0.0), 2, m)).unwrap();
+        specula::metrics::compare(&render(&scene), &bare).unwrap().psnr
+    };
+    let (invisible, visible) = (pane(1.0001), pane(1.5));
+    eprintln!(
+        "exact Fresnel at normal incidence: weight {weight} (F0 {F0}, off by {:e}); pane ν = 1.0001 against none {invisible:.2} dB, ν = 1.5 {visible:.2} dB",
+        (weight - F0).abs()
+    );
+    // Half-float storage of F0 × the wall's colour: |w − F0| ≤ F0 · 2⁻¹¹ = 1.5e-4 (measured
+    // 1.2e-7).
+    assert!((weight - F0).abs() < 1.5e-4, "exact Fresnel at normal incidence: {centre:?}");
+    // Measured: identical to the room without it (∞ dB); 60 dB is tests/README.md rule 2.
+    assert!(invisible >= 60.0, "a ν = 1.0001 pane should barely show: {invisible:.2} dB");
+    // Measured 43.38 dB (what the pane reflects and withholds); ceiling 1 dB over.
+    assert!(visible < 44.3, "a ν = 1.5 pane should show: {visible:.2} dB");
     common::assert_clean(&ctx);
 }
 
@@ -240,20 +307,57 @@ fn lone_object_sees_the_environment_map() {
     assert_eq!(p.passes, ["scene.upload", "envmap.generate", "scene.direct", "envmap.shade"]);
     let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (48, 48), (0, 1)).unwrap();
     let px = |x: u32, y: u32| f.image.texel(0, x, y).to_vec();
-    // Background corners: the sky straight through.
-    assert!(px(1, 1)[2] > 0.99 && px(1, 1)[1] < 0.01, "upper background is blue: {:?}", px(1, 1));
-    assert!(px(1, 46)[1] > 0.99 && px(1, 46)[2] < 0.01, "lower background is green: {:?}", px(1, 46));
+    // Where pixel (x, y)'s ray meets the sphere: the reflected direction and Schlick's
+    // weight there (the default Fresnel mode), for F0 = 0.5.
+    let eye = DVec3::new(0.0, 0.0, 2.0);
+    let tan = (0.9f64 * 0.5).tan();
+    let weight = |x: u32, y: u32| {
+        let d = DVec3::new((2.0 * (x as f64 + 0.5) / 48.0 - 1.0) * tan, (1.0 - 2.0 * (y as f64 + 0.5) / 48.0) * tan, -1.0).normalize();
+        let b = eye.dot(d);
+        let disc = b * b - (eye.length_squared() - 0.25);
+        assert!(disc > 0.0, "pixel ({x}, {y}) misses the sphere");
+        let n = (eye + d * (-b - disc.sqrt())).normalize();
+        schlick(0.5, -n.dot(d))
+    };
+    let off = |got: f32, expected: f64| (got as f64 - expected).abs();
+    let (tl, bl, l, r) = (px(1, 1), px(1, 46), px(1, 24), px(46, 24));
+    eprintln!("background: upper {tl:?}, lower {bl:?}, left {l:?}, right {r:?}");
+    // Background: the sky straight through. Each sample's filter footprint lies on texels
+    // of one colour (the left and right samples sit on the horizon, whose blue–green blend
+    // is not checked), so the values are the sky's to f32 rounding: tolerance 1e-6
+    // (measured: exact).
+    let sky_err = [
+        off(tl[0], 0.0),
+        off(tl[1], 0.0),
+        off(tl[2], 1.0),
+        off(bl[0], 0.0),
+        off(bl[1], 1.0),
+        off(bl[2], 0.0),
+        off(l[0], 0.0),
+        off(r[0], 0.5),
+    ];
+    assert!(
+        sky_err.iter().all(|&e| e <= 1e-6),
+        "background: upper {tl:?} (blue), lower {bl:?} (green), left {l:?} (no red), right {r:?} (red 0.5)"
+    );
     // On the sphere, above centre the reflection points up (blue), below it down (green),
-    // weighted by Fresnel ≥ F0 = 0.5.
-    let (top, bottom) = (px(24, 17), px(24, 31));
-    assert!(top[2] >= 0.49 && top[1] < 0.01, "upper sphere reflects the blue sky: {top:?}");
-    assert!(bottom[1] >= 0.49 && bottom[2] < 0.01, "lower sphere reflects the green ground: {bottom:?}");
-    // Near normal incidence the weight is near F0 = 0.5, not 1 (a missing Fresnel factor).
-    assert!(top[2] < 0.75 && bottom[1] < 0.75, "Fresnel-weighted: {top:?} {bottom:?}");
-    // Azimuth: the left background and the sphere's left side see dₓ < 0 (no red), the
-    // right ones dₓ > 0 (red 0.5, weighted on the sphere).
-    assert!(px(1, 24)[0] < 0.01 && px(46, 24)[0] > 0.49, "background azimuth: {:?} {:?}", px(1, 24), px(46, 24));
-    let (left, right) = (px(15, 24), px(33, 24));
-    assert!(left[0] < 0.01 && right[0] > 0.2 && right[0] < 0.5, "sphere azimuth: left {left:?}, right {right:?}");
+    // both weighted by Schlick's F (≈ F0 = 0.5 near normal incidence; a missing Fresnel
+    // factor reads 1). Azimuth: the sphere's left side reflects dₓ < 0 (no red), its right
+    // side dₓ > 0 (red 0.5, weighted); their reflections graze the horizon, so there the
+    // sum green + blue is the weight, however the filter splits it. Predicted on the CPU
+    // from the analytic sphere; what remains is the tessellation's interpolated normals:
+    // measured 6e-7 (top, blue) and 1.5e-6 (bottom, green) near normal incidence, tolerance
+    // 1.7e-6; at the sides 7.9e-5 (left, green + blue), 2.9e-5 and 7.8e-5 (right, red and
+    // green + blue), tolerance 9e-5. The channels that must be dark: 1e-6 (measured 0).
+    let (top, bottom, left, right) = (px(24, 17), px(24, 31), px(15, 24), px(33, 24));
+    let (wt, wb, wl, wr) = (weight(24, 17), weight(24, 31), weight(15, 24), weight(33, 24));
+    eprintln!("sphere: top {top:?} (F {wt:.7}), bottom {bottom:?} (F {wb:.7}), left {left:?} (F {wl:.7}), right {right:?} (F {wr:.7})");
+    assert!(off(top[2], wt) <= 1.7e-6 && off(top[1], 0.0) <= 1e-6, "upper sphere reflects the blue sky, weighted {wt}: {top:?}");
+    assert!(
+        off(bottom[1], wb) <= 1.7e-6 && off(bottom[2], 0.0) <= 1e-6,
+        "lower sphere reflects the green ground, weighted {wb}: {bottom:?}"
+    );
+    assert!(off(left[0], 0.0) <= 1e-6 && off(left[1] + left[2], wl) <= 9e-5, "sphere's left side, weighted {wl}: {left:?}");
+    assert!(off(right[0], 0.5 * wr) <= 9e-5 && off(right[1] + right[2], wr) <= 9e-5, "sphere's right side, weighted {wr}: {right:?}");
     common::assert_clean(&ctx);
 }

@@ -40,9 +40,10 @@ fn psnr(a: &ImageData, b: &ImageData) -> f64 {
     metrics::compare(a, b).unwrap().psnr
 }
 
-/// Every scheme on the demo scene and on the mirror-and-glass scene, depth 4: ≥ 45 dB
-/// against the reference (measured at 64²: 66 dB on the demo, 126 dB on mirror-and-glass),
-/// and the three schemes agree with each other (measured: identical images).
+/// Every scheme on the demo scene and on the mirror-and-glass scene, depth 4: ≥ 60 dB
+/// against the reference (tests/README.md rule 2; measured at 64²: 66.28 dB on the demo,
+/// 125.80 dB on mirror-and-glass, every scheme), and the three schemes agree with each
+/// other: ≥ 60 dB (measured: identical images, ∞ dB).
 #[test]
 fn exact_schemes_match_the_reference() {
     let ctx = common::gpu();
@@ -55,10 +56,13 @@ fn exact_schemes_match_the_reference() {
         for (m, img) in EXACT.iter().zip(&images) {
             let p = psnr(img, &reference);
             eprintln!("{name} {}: {p:.2} dB", m.name());
-            assert!(p >= 45.0, "{name} {}: {p:.2} dB against the reference", m.name());
+            // Measured: demo 66.28 dB, mirror_and_glass 125.80 dB (each scheme).
+            assert!(p >= 60.0, "{name} {}: {p:.2} dB against the reference", m.name());
         }
         for (m, img) in EXACT.iter().zip(&images).skip(1) {
             let p = psnr(img, &images[0]);
+            eprintln!("{name} {} against bvh: {p:.2} dB", m.name());
+            // Measured: identical (∞ dB).
             assert!(p >= 60.0, "{name}: {} and bvh differ ({p:.2} dB)", m.name());
         }
     }
@@ -67,8 +71,10 @@ fn exact_schemes_match_the_reference() {
 
 /// A glass sphere in the emissive quadrant room at ν → 1 (it disappears), 1.5, and 4
 /// (strong total internal reflection inside: the sphere's rim reflects at 100 %), with
-/// exact Fresnel, at 96²: ≥ 45 dB against the reference (measured 142, 122 and 115 dB),
-/// and at ν = 1.0001 the image is the sphere-less room's (measured 56 dB).
+/// exact Fresnel, at 96²: ≥ 60 dB against the reference (tests/README.md rule 2; measured
+/// 141.81, 122.30 and 114.61 dB). At ν = 1.0001 the image is the sphere-less room's:
+/// ≥ 55.5 dB against it (measured 56.46 dB; 1 dB under), while at ν = 1.5 and 4 the
+/// sphere shows: < 17 dB against the empty room (measured 16.04 and 16.02 dB, 1 dB over).
 #[test]
 fn refraction_extremes_and_total_internal_reflection() {
     let ctx = common::gpu();
@@ -92,19 +98,26 @@ fn refraction_extremes_and_total_internal_reflection() {
         let reference = render_reference(&s, &q, size).unwrap();
         let img = gpu(&ctx, &s, BVH, &q, size);
         let e = metrics::compare(&img, &reference).unwrap();
-        eprintln!("ν = {ior}: {e}; against the empty room {:.2} dB", psnr(&img, &empty));
-        assert!(e.psnr >= 45.0, "ν = {ior}: {e}");
+        let p = psnr(&img, &empty);
+        eprintln!("ν = {ior}: {e}; against the empty room {p:.2} dB");
+        // Measured 141.81 / 122.30 / 114.61 dB.
+        assert!(e.psnr >= 60.0, "ν = {ior}: {e}");
         if ior < 1.001 {
-            let p = psnr(&img, &empty);
-            assert!(p >= 45.0, "ν = 1.0001 should be invisible: {p:.2} dB against the empty room");
+            // Measured 56.46 dB.
+            assert!(p >= 55.5, "ν = 1.0001 should be invisible: {p:.2} dB against the empty room");
+        } else {
+            // Measured 16.04 dB (ν = 1.5), 16.02 dB (ν = 4).
+            assert!(p < 17.0, "ν = {ior}: the sphere should show, {p:.2} dB against the empty room");
         }
     }
     common::assert_clean(&ctx);
 }
 
 /// Two facing mirrors (F0 0.9) in the emissive room: the corridor of images. For R = 1 … 8
-/// the GPU matches the reference with the same R (≥ 45 dB each, measured ≥ 130 dB: the
-/// mirrors are flat, so f32 and f64 agree to rounding), and successive depths differ.
+/// the GPU matches the reference with the same R (≥ 60 dB each, tests/README.md rule 2;
+/// measured 131.14–132.17 dB: the mirrors are flat, so f32 and f64 agree to rounding), and
+/// each depth up to 7 differs from the one before by what its bounce adds (PSNR of R
+/// against R − 1 at most 1 dB over what was measured).
 #[test]
 fn recursion_depth_on_facing_mirrors() {
     let ctx = common::gpu();
@@ -121,26 +134,59 @@ fn recursion_depth_on_facing_mirrors() {
         let img = gpu(&ctx, &s, BVH, &q, (40, 40));
         let p = psnr(&img, &reference);
         eprintln!("R = {r}: {p:.2} dB");
-        assert!(p >= 45.0, "R = {r}: {p:.2} dB against the reference");
+        // Measured 132.17 dB (R = 1) down to 131.14 dB (R = 8).
+        assert!(p >= 60.0, "R = {r}: {p:.2} dB against the reference");
         // Each bounce adds an image (measured: the mean radiance grows up to R = 7, where
-        // the last paths leave the mirrors' edges).
-        if let (Some(prev), true) = (&previous, r <= 6) {
-            assert!(psnr(&img, prev) < 80.0, "R = {r} adds nothing over R = {}", r - 1);
+        // the last paths leave the mirrors' edges; R = 8 is R = 7's image). Measured PSNR of
+        // R against R − 1 for R = 2 … 7: 18.59, 25.44, 28.72, 31.74, 37.33, 35.14 dB; the
+        // ceilings sit 1 dB over (a bounce that adds less, or nothing, reads higher).
+        const ADDED_CEILING_DB: [f64; 6] = [19.5, 26.4, 29.7, 32.7, 38.3, 36.1];
+        if let (Some(prev), Some(&ceiling)) = (&previous, (r as usize).checked_sub(2).and_then(|i| ADDED_CEILING_DB.get(i))) {
+            let added = psnr(&img, prev);
+            eprintln!("R = {r} against R = {}: {added:.2} dB", r - 1);
+            assert!(added < ceiling, "R = {r} adds too little over R = {}: {added:.2} dB (ceiling {ceiling})", r - 1);
         }
         previous = Some(img);
     }
     common::assert_clean(&ctx);
 }
 
-/// The mirror-and-glass scene scaled to 1 km and to 1 mm (lights' intensity scaled by s²
-/// so that irradiance stays put) renders the image of the unscaled scene: the ray offsets
-/// are relative to the scene's size (measured 92 dB at 1 km, 116 dB at 1 mm).
+/// The mirror-and-glass scene, with a diffuse floor and a point light whose shadows of the
+/// two spheres are in view (directly and in the mirror), scaled to 1 km and to 1 mm
+/// (the light's intensity scaled by s² so that irradiance stays put) renders the image of
+/// the unscaled scene: the ray and shadow-ray offsets are relative to the scene's size.
+/// ≥ 60 dB (tests/README.md rule 2; measured 91.50 dB at 1 km, 116.09 dB at 1 mm, every
+/// scheme).
 #[test]
 fn one_kilometre_and_one_millimetre_scenes() {
     let ctx = common::gpu();
-    let q = quality(&["depth=4"]);
-    let base = common::mirror_and_glass(24);
-    let unscaled = gpu(&ctx, &base, BVH, &q, (48, 48));
+    // Caustics (approximate, from the light cube maps) off: the ray tracers' own offsets.
+    let q = quality(&["depth=4", "caustics=off"]);
+    let mut base = common::mirror_and_glass(24);
+    // A diffuse floor inside the emissive room and a point light above it: the spheres
+    // cast shadows on the floor, in view, so that shadow rays (their origin offsets and
+    // their distance to the light) are scaled too.
+    let floor = base.add_material(Material { name: "floor".into(), base_color: Vec3::splat(0.8), ..Default::default() }).unwrap();
+    base.add_mesh(shapes::quad("floor", Vec3::new(-2.0, 0.3, -2.0), Vec3::new(0.0, 0.0, 4.0), Vec3::new(4.0, 0.0, 0.0), 4, floor)).unwrap();
+    base.add_light(specula::scene::Light {
+        name: "lamp".into(),
+        kind: specula::scene::LightKind::Point,
+        position: Vec3::new(0.0, 3.6, 1.2),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(20.0),
+        range: None,
+    })
+    .unwrap();
+    let frame = specula::render(&ctx, &base, BVH, &q, (48, 48), (0, 1)).unwrap();
+    let unscaled = frame.image;
+    let shadow_rays = frame.stats.iter().find(|(k, _)| k == "raytrace.shadow_rays.bounce0").unwrap().1;
+    // The floor is lit by the lamp alone (the room's emission reaches only specular paths):
+    // its pixels in the spheres' shadows are black, those outside are not.
+    let lum = |img: &ImageData, i: usize| img.data[4 * i..4 * i + 3].iter().map(|&v| v as f64).sum::<f64>();
+    let black = (0..48 * 48).filter(|&i| lum(&unscaled, i) == 0.0).count();
+    eprintln!("lit scene: {shadow_rays} shadow rays at bounce 0, {black} black (shadowed) pixels");
+    // Measured 589 shadow rays and 448 black pixels; floors a factor 1.122 under.
+    assert!(shadow_rays >= 525.0 && black >= 399, "the shadows are in view: {shadow_rays} shadow rays, {black} black pixels");
     for s in [1000.0f32, 0.001] {
         let mut scene = base.clone();
         let t = Mat4::from_scale(Vec3::splat(s));
@@ -159,7 +205,8 @@ fn one_kilometre_and_one_millimetre_scenes() {
             let img = gpu(&ctx, &scene, m, &q, (48, 48));
             let p = psnr(&img, &unscaled);
             eprintln!("scale {s} {}: {p:.2} dB", m.name());
-            assert!(p >= 45.0, "scale {s}, {}: {p:.2} dB against the unscaled scene", m.name());
+            // Measured 91.50 dB (1 km), 116.09 dB (1 mm).
+            assert!(p >= 60.0, "scale {s}, {}: {p:.2} dB against the unscaled scene", m.name());
         }
     }
     common::assert_clean(&ctx);
@@ -187,6 +234,8 @@ fn degenerate_triangles_change_nothing() {
         let with = gpu(&ctx, &s, m, &q, (48, 48));
         let without = gpu(&ctx, &base, m, &q, (48, 48));
         let p = psnr(&with, &without);
+        eprintln!("{}: with the degenerate triangles against without {p:.2} dB", m.name());
+        // Measured: identical images (∞ dB); 60 dB is tests/README.md rule 2.
         assert!(p >= 60.0, "{}: degenerate triangles changed the image ({p:.2} dB)", m.name());
     }
     common::assert_clean(&ctx);
@@ -222,7 +271,9 @@ fn planner_ray_traces_objects_in_mutual_view() {
     let q = quality(&["depth=4"]);
     let img = specula::render_plan(&ctx, &s, specula::plan_with(&s, &choices, &q).unwrap(), (48, 48), (0, 1)).unwrap().image;
     let p = psnr(&img, &render_reference(&s, &q, (48, 48)).unwrap());
-    assert!(p >= 45.0, "auto on three mirrors in mutual view: {p:.2} dB");
+    eprintln!("auto on three mirrors in mutual view: {p:.2} dB against the reference");
+    // Measured 133.02 dB; 60 dB is tests/README.md rule 2.
+    assert!(p >= 60.0, "auto on three mirrors in mutual view: {p:.2} dB");
     common::assert_clean(&ctx);
 }
 
@@ -237,22 +288,37 @@ fn ray_statistics_count_rays_and_overflow() {
     let stat = |f: &specula::Frame, name: &str| f.stats.iter().find(|(k, _)| k == name).map(|(_, v)| *v);
     let q = quality(&["depth=2"]);
     let f = specula::render(&ctx, &demo(), BVH, &q, (32, 32), (0, 1)).unwrap();
+    eprintln!("demo stats: {:?}", f.stats);
     assert_eq!(stat(&f, "raytrace.rays.bounce0"), Some(1024.0), "{:?}", f.stats);
-    assert!(stat(&f, "raytrace.shadow_rays.bounce0").unwrap() > 500.0, "{:?}", f.stats);
+    // One shadow ray per diffuse hit and light: measured 851 at bounce 0; within a factor
+    // 1.122 either way (fewer: diffuse hits left unlit; more: rays spawned twice).
+    let shadows = stat(&f, "raytrace.shadow_rays.bounce0").unwrap();
+    assert!((759.0..=954.0).contains(&shadows), "{:?}", f.stats);
     assert_eq!(stat(&f, "raytrace.dropped_rays"), Some(0.0));
-    assert!(stat(&f, "raytrace.build_ms").unwrap() > 0.0);
+    // The build's time is reported (its value is the machine's, not bounded).
+    assert!(stat(&f, "raytrace.build_ms").is_some(), "{:?}", f.stats);
 
     let mut s = common::mirror_and_glass(24);
     s.camera = Some(Camera::look_at(common::GLASS + Vec3::new(0.0, 0.0, 0.8), common::GLASS, 50f32.to_radians()));
     let tight = quality(&["depth=2", "ray_budget=1"]);
     let f = specula::render(&ctx, &s, BVH, &tight, (32, 32), (0, 1)).unwrap();
-    assert!(stat(&f, "raytrace.rays.bounce1").unwrap() > 1024.0, "{:?}", f.stats);
-    assert!(stat(&f, "raytrace.dropped_rays").unwrap() > 0.0, "{:?}", f.stats);
+    eprintln!("glass stats: {:?}", f.stats);
+    // Every pixel sees the glass: two children each (reflected, refracted), 2048 (measured
+    // 2048), of which the budget of 1024 keeps half: 1024 dropped (measured 1024).
+    assert_eq!(stat(&f, "raytrace.rays.bounce1"), Some(2048.0), "{:?}", f.stats);
+    assert_eq!(stat(&f, "raytrace.dropped_rays"), Some(1024.0), "{:?}", f.stats);
 
     let h = quality(&["depth=1", "ray_stats=on", "tile_size=8"]);
     let f = specula::render(&ctx, &demo(), specula::methods::RAY_HIERARCHY, &h, (16, 16), (0, 1)).unwrap();
-    let rates: Vec<f64> = f.stats.iter().filter(|(k, _)| k.starts_with("raytrace.cull_rate")).map(|(_, v)| *v).collect();
-    assert!(!rates.is_empty() && rates.iter().all(|r| (0.0..=1.0).contains(r)), "{:?}", f.stats);
+    eprintln!("hierarchy stats: {:?}", f.stats);
+    let rate = |name: &str| stat(&f, &format!("raytrace.cull_rate.{name}"));
+    // Measured: bounce 0 rays 0.99575 (the cone test keeps 0.42 % of the tile × triangle
+    // pairs; asserted: at most 1.122 × that, 0.476 %), bounce 1 shadow rays 0.1773
+    // (asserted ≥ 0.158, a factor 1.122 under); bounce 0 shadow rays and bounce 1 rays 0
+    // (at 16² a tile's rays spread too wide: their cones cover everything), reported only.
+    assert!(rate("bounce0.rays").is_some_and(|r| r >= 0.99524), "{:?}", f.stats);
+    assert!(rate("bounce1.shadow_rays").is_some_and(|r| r >= 0.158), "{:?}", f.stats);
+    assert!(rate("bounce0.shadow_rays").is_some() && rate("bounce1.rays").is_some(), "{:?}", f.stats);
     common::assert_clean(&ctx);
 }
 
@@ -287,9 +353,10 @@ fn khr_materials_specular_scales_the_reflection() {
     let gpu_spec = gpu(&ctx, &specular, BVH, &q, size);
     let (matched, ignored, effect) = (psnr(&gpu_spec, &ref_spec), psnr(&ref_plain, &ref_spec), psnr(&gpu_spec, &ref_plain));
     eprintln!("KHR_materials_specular: GPU vs reference {matched:.2} dB; the reference with and without it {ignored:.2} dB; GPU vs plain {effect:.2} dB");
-    // Measured: 128.0 dB matched (f32 rounding against f64; the floor leaves 10⁶ × that
-    // noise's energy for other drivers' rounding), 33.5 dB between the two references.
-    assert!(matched > 68.0, "GPU bvh vs the reference: {matched:.2} dB");
+    // Measured: 128.01 dB matched (f32 rounding against f64; the floor is tests/README.md
+    // rule 2's 60 dB), 33.50 dB between the two references and between the GPU and the
+    // plain reference (ceiling 1 dB over).
+    assert!(matched > 60.0, "GPU bvh vs the reference: {matched:.2} dB");
     assert!(ignored < 34.5 && effect < 34.5, "the extension shows: {matched:.2} vs {ignored:.2} / {effect:.2} dB");
     common::assert_clean(&ctx);
 }
