@@ -2,9 +2,16 @@
 //! GPU method's camera passes, resolved on the GPU. Against the 16-spp reference, exact ray
 //! tracing with `ssaa4` comes within a stated margin where one sample per pixel does not
 //! (the edges), and `msaa4` (one ray per sample) roughly halves the FLIP error; every
-//! method's anti-aliased image is finite, no darker than its one-sample image on average,
-//! closer to its own `ssaa4` image than one sample per pixel is, and has no dark seams
-//! (no pixel darker than half of every neighbour of the one-sample image).
+//! method's anti-aliased image is finite, its mean radiance as near its one-sample image's
+//! as measured (within 2.3 %; a factor 1.122 of each method's measured difference), closer
+//! to its own `ssaa4` image than one sample per pixel is (by a factor within 1.122 of each
+//! method's measured one), and has no dark seams (no pixel darker than half of every
+//! neighbour of the one-sample image).
+//!
+//! Every GPU method but `ray-engine` and `ray-hierarchy`: those two are the `bvh` pipeline
+//! with another intersection step (their images here have bvh's means and RMSE ratios to
+//! the last printed digit, measured), and at 13–21 s per method on lavapipe (about 1 s for
+//! the others) they would triple the time of these tests.
 
 mod common;
 
@@ -14,6 +21,29 @@ fn render(ctx: &specula::vk::Context, scene: &specula::Scene, m: Method, q: &Qua
     let mut q = q.clone();
     q.set("aa", aa).unwrap();
     specula::render(ctx, scene, m, &q, (48, 36), (0, 1)).unwrap().image
+}
+
+/// Measured per method (the demo at 48×36): the relative difference of the mean radiance
+/// with ssaa4 and with msaa4 from the one-sample image's, and msaa4's RMSE to the method's
+/// own ssaa4 image over one sample's. Each is bounded within a factor 1.122 of its value.
+const MEASURED: &[(&str, f64, f64, f64)] = &[
+    ("envmap", -9.839e-4, 7.676e-3, 0.7611),
+    ("proxy-sphere", -3.008e-4, 1.452e-2, 0.7934),
+    ("proxy-box", -4.028e-3, 3.776e-3, 0.8094),
+    ("distance", -4.020e-3, 3.743e-3, 0.8099),
+    ("distance-multi", -3.603e-3, 4.230e-3, 0.8092),
+    ("refractor-map", -2.507e-3, 1.823e-2, 0.9488),
+    ("image-space-refraction", -2.226e-2, -1.546e-2, 0.8303),
+    ("layered", -7.938e-3, 8.408e-3, 0.8684),
+    ("bvh", -1.008e-4, 1.096e-2, 0.3269),
+    ("kd-tree", -1.008e-4, 1.096e-2, 0.3269),
+    ("grid", -1.008e-4, 1.096e-2, 0.3269),
+    ("planar-mirror", -4.020e-3, 3.743e-3, 0.8099),
+];
+
+fn measured(m: Method) -> (f64, f64, f64) {
+    let r = MEASURED.iter().find(|r| r.0 == m.name()).unwrap_or_else(|| panic!("{}: measure it and add it to MEASURED", m.name()));
+    (r.1, r.2, r.3)
 }
 
 fn mean(img: &specula::image::ImageData) -> f64 {
@@ -29,17 +59,25 @@ fn ssaa4_approaches_the_16_spp_reference() {
     let psnr = |img: &specula::image::ImageData| specula::metrics::compare(img, &reference).unwrap().psnr;
     let (off, ssaa2, ssaa4) = ["off", "ssaa2", "ssaa4"].map(|aa| psnr(&render(&ctx, &scene, specula::methods::BVH, &q, aa))).into();
     println!("off {off:.2} dB, ssaa2 {ssaa2:.2} dB, ssaa4 {ssaa4:.2} dB");
-    // Measured: 22.6, 29.2 and 32.3 dB here (48×36); 15.3, 24.5 and 35.7 dB at 64×48.
-    assert!(off < 25.0, "one sample per pixel is far from the 16-spp reference at the edges: {off:.2} dB");
-    assert!(ssaa2 > off + 3.0, "ssaa2 {ssaa2:.2} dB vs off {off:.2} dB");
-    assert!(ssaa4 > 30.0 && ssaa4 > ssaa2, "ssaa4 {ssaa4:.2} dB (ssaa2 {ssaa2:.2} dB)");
+    // Measured here (48×36): 21.94, 28.92 and 31.92 dB. Each bound 1 dB from its measured
+    // value: off's ceiling, ssaa4's floor, and the 6.98 dB (ssaa2 over off) and 3.00 dB
+    // (ssaa4 over ssaa2) margins.
+    assert!(off <= 22.94, "one sample per pixel is far from the 16-spp reference at the edges: {off:.2} dB");
+    assert!(ssaa2 >= off + 5.98, "ssaa2 {ssaa2:.2} dB vs off {off:.2} dB");
+    assert!(ssaa4 >= 30.92 && ssaa4 >= ssaa2 + 2.0, "ssaa4 {ssaa4:.2} dB (ssaa2 {ssaa2:.2} dB)");
 
     for &m in Method::ALL.iter().filter(|m| m.is_gpu() && !matches!(m.name(), "ray-engine" | "ray-hierarchy")) {
         let one = render(&ctx, &scene, m, &q, "off");
         let ss = render(&ctx, &scene, m, &q, "ssaa4");
         assert!(ss.data.iter().all(|v| v.is_finite()), "{}: ssaa4 has non-finite values", m.name());
         let (a, b) = (mean(&one), mean(&ss));
-        assert!((b - a).abs() <= 0.03 * a, "{}: mean radiance {b:.4} with ssaa4 vs {a:.4} without", m.name());
+        eprintln!("{}: mean radiance off {a:.5}, ssaa4 {b:.5}: relative difference {:+.4e}", m.name(), (b - a) / a);
+        let measured = measured(m).0;
+        assert!(
+            (b - a).abs() <= 1.122 * measured.abs() * a,
+            "{}: mean radiance {b:.5} with ssaa4 vs {a:.5} without (measured {measured:+e})",
+            m.name()
+        );
     }
     common::assert_clean(&ctx);
 }
@@ -82,9 +120,9 @@ fn msaa4_anti_aliases_every_method() {
     let flip = |img: &specula::image::ImageData| specula::metrics::compare(img, &reference).unwrap().flip;
     // Ray tracing traces one ray per sample: four samples at the standard positions.
     let (off, msaa4) = ["off", "msaa4"].map(|aa| flip(&render(&ctx, &scene, specula::methods::BVH, &q, aa))).into();
-    println!("bvh mean FLIP: off {off:.4}, msaa4 {msaa4:.4}");
-    // Measured 0.0695 and 0.0299 at 96×72.
-    assert!(msaa4 < 0.7 * off, "msaa4 mean FLIP {msaa4:.4} vs off {off:.4}");
+    println!("bvh mean FLIP: off {off:.4}, msaa4 {msaa4:.4}: ratio {:.4}", msaa4 / off);
+    // Measured 0.1034 and 0.0539 (48×36): ratio 0.521, the bound a factor 1.122 above it.
+    assert!(msaa4 < 0.585 * off, "msaa4 mean FLIP {msaa4:.4} vs off {off:.4}");
 
     for &m in Method::ALL.iter().filter(|m| m.is_gpu() && !matches!(m.name(), "ray-engine" | "ray-hierarchy")) {
         let one = render(&ctx, &scene, m, &q, "off");
@@ -92,10 +130,19 @@ fn msaa4_anti_aliases_every_method() {
         let ss = render(&ctx, &scene, m, &q, "ssaa4");
         assert!(ms.data.iter().all(|v| v.is_finite()), "{}: msaa4 has non-finite values", m.name());
         let (a, b) = (mean(&one), mean(&ms));
-        assert!((b - a).abs() <= 0.03 * a, "{}: mean radiance {b:.4} with msaa4 vs {a:.4} without", m.name());
+        eprintln!("{}: mean radiance off {a:.5}, msaa4 {b:.5}: relative difference {:+.4e}", m.name(), (b - a) / a);
+        let (_, measured_mean, measured) = measured(m);
+        assert!(
+            (b - a).abs() <= 1.122 * measured_mean.abs() * a,
+            "{}: mean radiance {b:.5} with msaa4 vs {a:.5} without (measured {measured_mean:+e})",
+            m.name()
+        );
         let (e_one, e_ms) = (rmse(&one, &ss), rmse(&ms, &ss));
-        println!("{}: RMSE to its ssaa4 image: off {e_one:.4}, msaa4 {e_ms:.4}", m.name());
-        assert!(e_ms < 0.95 * e_one, "{}: msaa4 is not nearer its ssaa4 image ({e_ms:.4}) than off ({e_one:.4})", m.name());
+        println!("{}: RMSE to its ssaa4 image: off {e_one:.4}, msaa4 {e_ms:.4}: ratio {:.4}", m.name(), e_ms / e_one);
+        // The ratio measured per method; the bound a factor 1.122 above it, and never above
+        // 0.95 (msaa4 nearer its ssaa4 image than off).
+        let bound = (1.122 * measured).min(0.95);
+        assert!(e_ms < bound * e_one, "{}: msaa4 {e_ms:.4} vs off {e_one:.4}, ratio above {bound:.4} (measured {measured})", m.name());
         for (name, img) in [("msaa4", &ms), ("ssaa4", &ss)] {
             let seams = dark_seams(img, &one);
             assert_eq!(seams, 0, "{}: {seams} dark seam pixel(s) with {name}", m.name());
@@ -106,14 +153,16 @@ fn msaa4_anti_aliases_every_method() {
 
 /// Per-sample shading of the specular passes (`msaa_shading=sample`, the default) anti-
 /// aliases reflections inside curved objects too: nearer the supersampled image than
-/// shading once per pixel on the pixels where the two differ (measured here, 48×36: RMSE
-/// 0.044 vs 0.066 for distance maps, 0.023 vs 0.082 for environment maps; at 96×72
-/// against the 16-spp reference 26.1 vs 22.4 dB and 23.2 vs 16.9 dB whole-image).
+/// shading once per pixel on the pixels where the two differ (measured here, 48×36: on 188
+/// pixels RMSE 0.0521 vs 0.0725 for distance maps, on 183 pixels 0.0347 vs 0.0889 for
+/// environment maps; at 96×72 against the 16-spp reference 26.1 vs 22.4 dB and 23.2 vs
+/// 16.9 dB whole-image). The pixel counts and the ratios are bounded within a factor 1.122
+/// of these.
 #[test]
 fn per_sample_shading_beats_per_pixel_inside_specular_objects() {
     let ctx = common::gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    for m in [specula::methods::DISTANCE, specula::methods::ENVMAP] {
+    for (m, pixels, ratio) in [(specula::methods::DISTANCE, 188, 0.7187), (specula::methods::ENVMAP, 183, 0.3907)] {
         let mut q = Quality { depth: 4, cube_size: 32, shadow_size: 64, ..Quality::default() };
         let ss = render(&ctx, &scene, m, &q, "ssaa4");
         let sample = render(&ctx, &scene, m, &q, "msaa4");
@@ -131,12 +180,22 @@ fn per_sample_shading_beats_per_pixel_inside_specular_objects() {
         };
         let (e_sample, e_pixel) = (err(&sample), err(&pixel));
         println!(
-            "{}: {} pixels shade differently; RMSE to ssaa4 there: per sample {e_sample:.4}, per pixel {e_pixel:.4}",
+            "{}: {} pixels shade differently; RMSE to ssaa4 there: per sample {e_sample:.4}, per pixel {e_pixel:.4}: ratio {:.4}",
+            m.name(),
+            differ.len(),
+            e_sample / e_pixel
+        );
+        assert!(
+            differ.len() as f64 >= pixels as f64 / 1.122,
+            "{}: per-sample shading changed only {} pixels (measured {pixels})",
             m.name(),
             differ.len()
         );
-        assert!(differ.len() > 20, "{}: per-sample shading changed only {} pixels", m.name(), differ.len());
-        assert!(e_sample < 0.9 * e_pixel, "{}: per-sample {e_sample:.4} vs per-pixel {e_pixel:.4}", m.name());
+        assert!(
+            e_sample < 1.122 * ratio * e_pixel,
+            "{}: per-sample {e_sample:.4} vs per-pixel {e_pixel:.4} (measured ratio {ratio})",
+            m.name()
+        );
     }
     common::assert_clean(&ctx);
 }

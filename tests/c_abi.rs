@@ -85,6 +85,11 @@ fn lit_pixels(rgba32f: &[u8]) -> usize {
     rgba32f.chunks_exact(16).filter(|p| (0..3).any(|c| channel(p, c) > 0.01)).count()
 }
 
+/// The fewest lit pixels an image of the demo may have: measured 11208 of 128 × 96 (the
+/// standalone image, envmap) and 11217–11265 (methods 4 to 11); the bound a factor 1.122
+/// under the least.
+const LIT: usize = 9990;
+
 fn read_f32(p: &Path) -> Vec<u8> {
     let b = std::fs::read(p).unwrap();
     assert_eq!(b.len(), 128 * 96 * 16, "{}", p.display());
@@ -124,7 +129,8 @@ fn examples_render_the_same_image_through_every_link_mode() {
         images.push(("raii", tag, read_f32(&f)));
     }
     let (_, _, reference) = &images[0];
-    assert!(lit_pixels(reference) > 128 * 96 / 2, "the image has content: {} lit pixels", lit_pixels(reference));
+    eprintln!("standalone (shared): {} lit pixels", lit_pixels(reference));
+    assert!(lit_pixels(reference) >= LIT, "the image has content: {} lit pixels", lit_pixels(reference));
     for (name, tag, img) in &images[1..] {
         // Tolerance: none. Same device, same passes, and the host receives a copy.
         assert!(img == reference, "{name} ({tag}) differs from standalone (shared)");
@@ -142,7 +148,8 @@ fn examples_render_the_same_image_through_every_link_mode() {
         run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new(method), depth]);
         run(&host, &[&scene, &b, Path::new(method), depth]);
         let image = read_f32(&a);
-        assert!(lit_pixels(&image) > 128 * 96 / 2, "method {method}: {} lit pixels", lit_pixels(&image));
+        eprintln!("method {method}: {} lit pixels", lit_pixels(&image));
+        assert!(lit_pixels(&image) >= LIT, "method {method}: {} lit pixels", lit_pixels(&image));
         assert!(image == read_f32(&b), "method {method}: host-device image differs from standalone");
     }
     // MSAA: standalone contexts enable sampleRateShading and render it; a host device does
@@ -171,8 +178,11 @@ fn updates_from_c_move_objects_and_rebuild_only_what_changed() {
     let exe = dir.join("updates");
     compile("tests/c/updates.c", &exe, Link::Shared, &["-lm"]);
     let out = run(&exe, &[]);
+    let ok = out.lines().filter(|l| l.contains(" ok ")).count();
+    eprintln!("updates: {ok} ok lines");
     assert!(out.contains("\n0 failure(s)"), "{out}");
-    assert!(out.lines().filter(|l| l.contains(" ok ")).count() >= 30, "{out}");
+    // Every check the program makes passed (measured 59): none skipped.
+    assert_eq!(ok, 59, "{out}");
 }
 
 #[test]
@@ -181,6 +191,10 @@ fn misuse_from_c_returns_codes_and_survives() {
     let exe = dir.join("misuse");
     compile("tests/c/misuse.c", &exe, Link::Shared, &["-lm"]);
     let out = run(&exe, &[Path::new(&format!("{ROOT}/assets/demo/demo.gltf"))]);
-    assert!(out.contains("0 failure(s)"), "{out}");
-    assert!(out.lines().filter(|l| l.contains(" ok: ")).count() >= 40, "{out}");
+    let ok = out.lines().filter(|l| l.contains(" ok: ")).count();
+    eprintln!("misuse: {ok} ok lines");
+    // "\n": "10 failure(s)" must not pass.
+    assert!(out.contains("\n0 failure(s)"), "{out}");
+    // Every check the program makes passed (measured 110): none skipped.
+    assert_eq!(ok, 110, "{out}");
 }

@@ -53,11 +53,10 @@ fn a_mirror_wall_is_exact_up_to_rasterisation() {
     let p = psnr(&f.image, &reference);
     let d = psnr(&gpu(&ctx, &s, specula::methods::DISTANCE, &q).image, &reference);
     println!("mirror wall: planar-mirror {p:.2} dB, distance {d:.2} dB");
-    f.image.write_png_srgb(std::path::Path::new("/tmp/gt/wall.png")).ok();
-    reference.write_png_srgb(std::path::Path::new("/tmp/gt/wall_ref.png")).ok();
     let names: Vec<&str> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert!(names.contains(&"geometry.mirror") && names.contains(&"geometry.mirror_view"), "{names:?}");
-    assert!(p >= 45.0, "planar-mirror {p:.2} dB against the reference");
+    // Exact (tests/README.md rule 2): measured 155.30 dB, f32 rounding against f64.
+    assert!(p >= 60.0, "planar-mirror {p:.2} dB against the reference");
     common::assert_clean(&ctx);
 }
 
@@ -86,29 +85,41 @@ fn facing_mirrors_recurse_to_the_reference_depth_within_the_budget() {
         let (views, deepest) = (stat(&f, "geometry.mirror_views"), stat(&f, "geometry.mirror_depth"));
         println!("depth {depth}: {views} views, deepest {deepest}, {p:.2} dB");
         assert_eq!(deepest, depth as f64, "depth {depth}: the corridor is visible to every level");
-        assert!(p >= 45.0, "depth {depth}: {p:.2} dB against the reference at the same depth");
+        // Exact (rule 2): measured 152.39, 150.02, 149.23, 148.84, 148.57 and 148.39 dB.
+        assert!(p >= 60.0, "depth {depth}: {p:.2} dB against the reference at the same depth");
         views_at.push(views);
     }
     // Each level adds views (the corridor: one per mirror seen at that level).
     assert!(views_at.windows(2).all(|w| w[1] > w[0]), "{views_at:?}");
 
     // The budget caps the views; the mirrors it leaves out show the fallback (black in this
-    // closed room), whose error against the full-depth reference is stated.
+    // closed room), whose error against the full-depth reference is stated per budget (within
+    // 1 dB either way: above, the budget let more views through than it says; below, the
+    // views it did render got worse), and falls step by step as the budget grows (each step
+    // within 1 dB of its measured gain). Measured 15.58, 20.30 and 28.96 dB.
     let full = quality(6);
     let reference = specula::reference::render_reference(&s, &full, SIZE).unwrap();
-    let mut last = f64::INFINITY;
-    for budget in [1u32, 2, 4] {
+    let mut last = f64::NAN;
+    for (budget, measured, gain) in [(1u32, 15.58, f64::NAN), (2, 20.30, 4.72), (4, 28.96, 8.66)] {
         let mut q = full.clone();
         q.set("mirror_budget", &budget.to_string()).unwrap();
         let f = gpu(&ctx, &s, specula::methods::PLANAR_MIRROR, &q);
         let views = stat(&f, "geometry.mirror_views");
         let p = psnr(&f.image, &reference);
-        println!("budget {budget}: {views} views, {} fallbacks, {p:.2} dB against depth 6", stat(&f, "geometry.mirror_fallbacks"));
+        let fallbacks = stat(&f, "geometry.mirror_fallbacks");
+        println!("budget {budget}: {views} views, {fallbacks} fallbacks, {p:.2} dB against depth 6");
         assert_eq!(views, budget as f64, "budget {budget}");
-        assert!(stat(&f, "geometry.mirror_fallbacks") >= 1.0);
+        // The corridor's views are a chain: the last view sees the other mirror, one fallback
+        // (measured 1 at every budget).
+        assert_eq!(fallbacks, 1.0, "budget {budget}");
         let mirror_passes = f.passes.iter().filter(|p| p.name == "geometry.mirror_view").count();
         assert!(mirror_passes >= budget as usize, "{mirror_passes} mirror-view passes for {budget} views");
-        assert!(p < 45.0 && (last.is_infinite() || p > last - 0.5), "budget {budget}: {p:.2} dB (budget {} gave {last:.2} dB)", budget / 2);
+        assert!((p - measured).abs() <= 1.0, "budget {budget}: {p:.2} dB against depth 6 (measured {measured} dB)");
+        assert!(
+            last.is_nan() || p >= last + gain - 1.0,
+            "budget {budget}: {p:.2} dB (budget {} gave {last:.2} dB; measured gain {gain} dB)",
+            budget / 2
+        );
         last = p;
     }
     common::assert_clean(&ctx);
@@ -137,7 +148,9 @@ fn grazing_behind_the_camera_and_edge_on_mirrors() {
         println!("{name}: {} views, {p:.2} dB", stat(&f, "geometry.mirror_views"));
         assert!(f.image.data.iter().all(|v| v.is_finite()), "{name}: non-finite pixels");
         assert_eq!(stat(&f, "geometry.mirror_views"), views, "{name}");
-        assert!(p >= 40.0, "{name}: {p:.2} dB");
+        // Exact (rule 2): measured 146.53 dB (grazing), 148.41 dB (behind), inf (edge-on: no
+        // mirror pixel, the images are equal).
+        assert!(p >= 60.0, "{name}: {p:.2} dB");
     }
     common::assert_clean(&ctx);
 }
@@ -164,6 +177,7 @@ fn mirrors_at_a_millimetre_and_a_kilometre() {
         let p = psnr(&f.image, &one);
         println!("scale {scale:e}: {} views, {p:.2} dB against scale 1", stat(&f, "geometry.mirror_views"));
         assert_eq!(stat(&f, "geometry.mirror_views"), 3.0, "scale {scale:e}");
+        // Exact (rule 2): measured 153.58 dB (1 mm) and 153.96 dB (1 km).
         assert!(p >= 60.0, "scale {scale:e}: {p:.2} dB");
     }
     common::assert_clean(&ctx);
@@ -232,7 +246,8 @@ fn a_mirror_sphere_beside_a_mirror_wall() {
     let distance = psnr(&gpu(&ctx, &s, specula::methods::DISTANCE, &q).image, &reference);
     println!("auto ({}): {p_auto:.2} dB; distance everywhere {distance:.2} dB", method("sphere"));
     assert_eq!(stat(&auto, "geometry.mirror_views"), 1.0);
-    assert!(p_auto > distance + 3.0, "auto {p_auto:.2} dB vs distance {distance:.2} dB");
+    // Measured 46.22 vs 21.82 dB: a margin of 24.40 dB, the bound 1 dB under it.
+    assert!(p_auto >= distance + 23.4, "auto {p_auto:.2} dB vs distance {distance:.2} dB");
 
     // The sphere by distance-multi instead: the wall shows the sphere, the sphere's map shows
     // the wall as the environment (what planar mirrors inside cube maps would fix).
@@ -244,7 +259,8 @@ fn a_mirror_sphere_beside_a_mirror_wall() {
     r.destroy(&ctx);
     let p_multi = psnr(&traced.image, &reference);
     println!("wall planar-mirror + sphere distance-multi: {p_multi:.2} dB");
-    assert!(p_auto >= 40.0 && p_auto > p_multi + 10.0, "auto {p_auto:.2} dB, with distance-multi {p_multi:.2} dB");
+    // Measured 46.22 dB (auto) and 30.41 dB: floors 1 dB under auto and under the 15.81 dB margin.
+    assert!(p_auto >= 45.22 && p_auto >= p_multi + 14.81, "auto {p_auto:.2} dB, with distance-multi {p_multi:.2} dB");
 
     // MSAA: the views resolve into their layers; against the 16-spp reference it comes
     // nearer than one sample per pixel (the mirror's edges and the reflected edges in it).
@@ -255,6 +271,7 @@ fn a_mirror_sphere_beside_a_mirror_wall() {
     let smooth = specula::reference::render_reference(&s, &Quality { spp: 16, ..q.clone() }, SIZE).unwrap();
     let (p_ms, p_one) = (psnr(&ms.image, &smooth), psnr(&auto.image, &smooth));
     println!("against 16 spp: msaa4 {p_ms:.2} dB, one sample {p_one:.2} dB");
-    assert!(p_ms > p_one + 1.0, "msaa4 {p_ms:.2} dB vs one sample {p_one:.2} dB");
+    // Measured 35.35 vs 27.01 dB: msaa4's floor and its 8.34 dB margin each 1 dB under.
+    assert!(p_ms >= 34.35 && p_ms >= p_one + 7.34, "msaa4 {p_ms:.2} dB vs one sample {p_one:.2} dB");
     common::assert_clean(&ctx);
 }

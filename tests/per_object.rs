@@ -119,7 +119,8 @@ fn mixed_methods_compose() {
             seen.push(lum(&img));
         }
     }
-    assert!(seen.len() >= 20, "the mirror reflects the glass in {} pixels", seen.len());
+    // Measured 38 pixels; the bound within a factor 1.122 (tests/README.md).
+    assert!(seen.len() >= 34, "the mirror reflects the glass in {} pixels", seen.len());
     let bright = seen.iter().filter(|&&l| l > 0.1).count() as f64 / seen.len() as f64;
     let mean = seen.iter().sum::<f32>() / seen.len() as f32;
     let spread = seen.iter().map(|l| (l - mean).abs()).sum::<f32>() / seen.len() as f32;
@@ -128,20 +129,23 @@ fn mixed_methods_compose() {
         seen.len(),
         100.0 * bright
     );
-    // Measured: 38 such pixels, all lit, mean luminance sum 0.70, mean deviation 0.041.
+    // Measured: 38 such pixels, all lit, mean luminance sum 0.703, mean deviation 0.041 (the
+    // bound within a factor 1.122 of it).
     assert!(bright > 0.95, "the reflected glass is lit: {bright}");
-    assert!(spread > 0.02, "and not one flat colour: mean {mean}, spread {spread}");
+    assert!(spread >= 0.0365, "and not one flat colour: mean {mean}, spread {spread}");
     // Against the reference, the mirror of the mixed image is better than all-distance's.
     let reference = render_reference(&scene, &quality(&["spp=1"]), (w, h)).unwrap();
     let (pm, pd) = (masked_psnr(&img, &reference, &mirror), masked_psnr(&all_d, &reference, &mirror));
     eprintln!("mirror pixels: mixed {pm:.2} dB, all-distance {pd:.2} dB");
-    // Measured 29.81 vs 25.74 dB.
-    assert!(pm > pd + 3.0, "mixed {pm} vs all-distance {pd}");
+    // Measured 29.81 vs 25.74 dB: the floor and the 4.07 dB margin each 1 dB under.
+    assert!(pm >= 28.81 && pm >= pd + 3.07, "mixed {pm} vs all-distance {pd}");
     common::assert_clean(&ctx);
 }
 
-/// Per-object choices that cannot be: an unknown object, a diffuse one, a method that
-/// cannot serve the object — each a clear error naming the object, the method and why.
+/// Per-object choices that cannot be, each a clear error: an unknown object (named, with
+/// the specular objects there are), a diffuse one (named, with its material and why: no
+/// method serves it, so none is named), a method that cannot serve the object (the object,
+/// the method and why).
 #[test]
 fn per_object_misuse_is_refused() {
     let scene = mirror_and_glass();
@@ -151,9 +155,16 @@ fn per_object_misuse_is_refused() {
     assert!(e.contains("no object is named 'teapot'") && e.contains("glass") && e.contains("mirror"), "{e}");
     let e = choose("mirror", REFRACTOR_MAP).unwrap_err().to_string();
     assert!(e.contains("'mirror'") && e.contains("refractor-map") && e.contains("cannot serve a mirror"), "{e}");
-    let wall = scene.meshes.iter().find(|m| !scene.materials[m.material].kind.is_specular()).unwrap().name.clone();
-    let e = choose(&wall, DISTANCE).unwrap_err().to_string();
-    assert!(e.contains("is not specular"), "{e}");
+    let wall = scene.meshes.iter().find(|m| !scene.materials[m.material].kind.is_specular()).unwrap();
+    let material = &scene.materials[wall.material].name;
+    let e = choose(&wall.name, DISTANCE).unwrap_err().to_string();
+    assert!(
+        e.contains(&format!("'{}'", wall.name))
+            && e.contains("is not specular")
+            && e.contains(&format!("material '{material}'"))
+            && e.contains("only specular objects take a method"),
+        "{e}"
+    );
     assert!(Method::parse("warp").unwrap_err().to_string().contains("known: auto, envmap"));
 }
 
@@ -203,8 +214,8 @@ fn auto_plans_by_object_class() {
 }
 
 /// `auto` is within 0.5 dB (PSNR against the reference) of the best single approximate
-/// method on each scene and never worse than the worst: a mirror alone, a glass alone, a
-/// thin dielectric, the mirror-and-glass pair.
+/// method on each scene, and within 1 dB of its own measured PSNR there: a mirror alone, a
+/// glass alone, a thin dielectric, the mirror-and-glass pair, the demo.
 #[test]
 fn auto_is_as_good_as_the_best_single_method() {
     let ctx = common::gpu();
@@ -222,8 +233,15 @@ fn auto_is_as_good_as_the_best_single_method() {
         .unwrap();
     thin.meshes.iter_mut().find(|m| m.name == "mirror").unwrap().material = pane;
     let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    let scenes = [("mirror", keep("glass")), ("glass", keep("mirror")), ("thin", thin), ("mirror+glass", full), ("demo", demo)];
-    for (name, scene) in &scenes {
+    // Each scene with auto's measured PSNR (72×48, cube_size 64).
+    let scenes = [
+        ("mirror", keep("glass"), 42.26),
+        ("glass", keep("mirror"), 41.31),
+        ("thin", thin, 40.83),
+        ("mirror+glass", full, 36.29),
+        ("demo", demo, 31.25),
+    ];
+    for (name, scene, measured) in &scenes {
         let reference = render_reference(scene, &quality(&["spp=1"]), (w, h)).unwrap();
         let psnr = |img: &ImageData| metrics::compare(img, &reference).unwrap().psnr;
         let auto = psnr(&render(&ctx, scene, &Choices::default(), &q, (w, h)));
@@ -243,11 +261,13 @@ fn auto_is_as_good_as_the_best_single_method() {
         // Measured (72×48, cube_size 64): mirror 42.26 = proxy-box (the room is its own proxy
         // box; distance 42.05); glass 41.31 = refractor-map; thin 40.83 = proxy-box;
         // mirror+glass 36.29 vs refractor-map 33.54 (mixed methods beat every single one);
-        // demo 31.31 = refractor-map (mirror: proxy-box; it sees the glass over 1.1 % only:
+        // demo 31.25 = refractor-map (mirror: proxy-box; it sees the glass over 1.1 % only:
         // no cycles).
         assert!(auto >= best.1 - 0.5, "{name}: auto {auto} vs best {best:?}");
-        assert!(auto >= worst, "{name}: auto {auto} vs worst {worst}");
+        // auto's own floor, 1 dB under its measured PSNR (tests/README.md rule 1).
+        assert!(auto >= measured - 1.0, "{name}: auto {auto:.2} dB (measured {measured} dB)");
         if *name == "mirror+glass" {
+            // Measured margin 2.75 dB (36.29 vs 33.54); the bound within 1 dB of it.
             assert!(auto > best.1 + 2.0, "mixed methods beat every single one: auto {auto} vs {best:?}");
         }
     }
@@ -277,7 +297,11 @@ fn reference_point_inside_another_object_is_moved() {
     let note = o.reference_note.clone().unwrap_or_default();
     eprintln!("reference point {:?}: {note}", o.reference_point);
     assert!(note.contains("inside 'core'"), "{note}");
-    assert!(o.reference_point.distance(c) > 0.12, "moved out of the core: {:?}", o.reference_point);
+    // Out of the core (radius 0.12) and still inside the mirror (radius 0.5): measured 0.125
+    // from the centre.
+    let moved_by = o.reference_point.distance(c);
+    eprintln!("reference point moved {moved_by:.4} from the centre");
+    assert!(moved_by > 0.12 && moved_by < 0.5, "moved out of the core: {:?}", o.reference_point);
     let (w, h) = (64, 64);
     let reference = render_reference(&scene, &quality(&["spp=1"]), (w, h)).unwrap();
     let mask = sphere_mask(&scene, c, 0.5, w, h);
@@ -285,8 +309,8 @@ fn reference_point_inside_another_object_is_moved() {
     let naive = render(&ctx, &scene, &whole(DISTANCE), &quality(&["ref_point=0,1.5,0"]), (w, h));
     let (pm, pn) = (masked_psnr(&moved, &reference, &mask), masked_psnr(&naive, &reference, &mask));
     eprintln!("mirror pixels: moved point {pm:.2} dB, naive point {pn:.2} dB");
-    // Measured 11.02 vs 6.48 dB.
-    assert!(pm > pn + 3.0, "moved {pm} vs naive {pn}");
+    // Measured 11.02 vs 6.48 dB: the floor and the 4.54 dB margin each 1 dB under.
+    assert!(pm >= 10.02 && pm >= pn + 3.54, "moved {pm} vs naive {pn}");
     common::assert_clean(&ctx);
 }
 

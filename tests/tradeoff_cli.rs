@@ -42,7 +42,9 @@ fn reference_renders_on_the_cpu_and_compare_reports_metrics() {
         assert!(out.contains(key), "compare lacks {key}: {out}");
     }
     let psnr: f64 = out.lines().find(|l| l.starts_with("PSNR")).unwrap().split_whitespace().nth(1).unwrap().parse().unwrap();
-    assert!(psnr > 5.0 && psnr < 60.0, "envmap vs reference is neither garbage nor identical: {psnr}");
+    eprintln!("compare envmap reference:\n{out}");
+    // Measured 19.61 dB: the floor 1 dB under it (tests/README.md rule 1); not identical.
+    assert!(psnr >= 18.61 && psnr < 60.0, "envmap vs reference is neither garbage nor identical: {psnr}");
     let img = image::open(&err).unwrap();
     assert_eq!((img.width(), img.height()), (40, 30));
     // An image compared with itself: zero error, infinite PSNR.
@@ -105,13 +107,42 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
         assert_eq!(lines[1..].iter().filter(|l| l.split(',').next() == Some(m)).count(), 4, "{m}");
     }
     let mut points = Vec::new();
+    // (method, knobs) → (RMSE, PSNR, mean FLIP) as printed.
+    let mut metrics = std::collections::HashMap::new();
     for l in &lines[1..] {
         let f: Vec<&str> = l.split(',').collect();
         let frame_ms: f64 = f[2].parse().unwrap();
         let (rmse, psnr, flip): (f64, f64, f64) = (f[3].parse().unwrap(), f[4].parse().unwrap(), f[5].parse().unwrap());
         assert!(frame_ms > 0.0 && rmse > 0.0 && psnr.is_finite() && flip > 0.0 && flip < 1.0, "{l}");
+        // PSNR is −20 log10 RMSE (peak 1), up to the printed digits (RMSE to 1e-6, at least
+        // 0.02 here, and PSNR to 0.001 dB: under 0.001 dB together).
+        assert!((psnr + 20.0 * rmse.log10()).abs() < 0.002, "PSNR {psnr} dB vs RMSE {rmse}: {l}");
         points.push((frame_ms, flip, f[8] == "true", l.to_string()));
+        metrics.insert((f[0].to_string(), f[1].to_string()), (f[3].to_string(), psnr, f[5].to_string()));
     }
+    let row = |m: &str, knobs: &str| metrics[&(m.to_string(), knobs.to_string())].clone();
+    // The exact ray tracers agree with each other and ignore the cube-map knobs: the same
+    // printed metrics in every row (measured 32.371 dB against the reference; its floor 1 dB
+    // under, rule 1: caustics are on, and every method takes them from the same approximate
+    // light cube maps, tests/raytrace.rs).
+    let traced = row("bvh", "cube_size=16 cube_precision=half");
+    eprintln!("ray tracers: RMSE {}, {} dB, mean FLIP {}", traced.0, traced.1, traced.2);
+    assert!(traced.1 >= 31.37, "bvh {} dB against the reference", traced.1);
+    for m in ["bvh", "kd-tree", "grid", "ray-engine", "ray-hierarchy"] {
+        for knobs in [
+            "cube_size=16 cube_precision=half",
+            "cube_size=16 cube_precision=single",
+            "cube_size=64 cube_precision=half",
+            "cube_size=64 cube_precision=single",
+        ] {
+            assert_eq!(row(m, knobs), traced, "{m} {knobs}");
+        }
+    }
+    // The sweep reaches the renderer: auto's maps at cube_size 64 against 16 (measured 29.932
+    // vs 27.217 dB: the margin's bound 1 dB under its 2.715 dB).
+    let (small, large) = (row("auto", "cube_size=16 cube_precision=half").1, row("auto", "cube_size=64 cube_precision=half").1);
+    eprintln!("auto: cube_size 16 {small} dB, 64 {large} dB");
+    assert!(large >= small + 1.715, "auto: cube_size 64 {large} dB vs 16 {small} dB");
     // The front is the undominated set in (frame ms, mean FLIP), checked from the printed
     // values (a relative 1e-3 for their rounding): no row on it is beaten in both, every row
     // off it is matched or beaten in both by some row.
