@@ -96,7 +96,10 @@ pub fn linear_search(
     let mut lookups = 1;
     let len_x = x.length();
     let far_stored = map.distance(r);
-    if len_x <= 1e-6 * far_stored.min(1e30) {
+    // From the reference point the map answers exactly. Off it, an empty far end does not
+    // end the search: the ray may meet a surface on the way (an open scene's floor seen
+    // past a sphere's horizon).
+    if len_x <= 0.0 || (!search_is_sky(far_stored) && len_x <= 1e-6 * far_stored) {
         if search_is_sky(far_stored) {
             return search_result(x, r, 0.0, true, lookups);
         }
@@ -346,6 +349,35 @@ mod tests {
         assert!(e1 > 1e-2 && e1 < 1e-1, "1 iteration: {e1}");
         assert!(e2 > 1e-4 && e2 < 2e-3, "2 iterations: {e2}");
         assert!(e4 > 1e-8 && e4 < 1e-6, "4 iterations: {e4}");
+    }
+
+    #[test]
+    fn an_empty_far_end_does_not_end_the_search() {
+        // An open scene: a fence, the strip x = 3, |y| ≤ 1, around the reference point at the
+        // origin, sky everywhere else. Direction r = (1, 0.5, 0) passes over the fence seen
+        // from the reference point (the map stores sky there), but the ray from x = (0, −1, 0)
+        // along r meets it at y = 0.5: the search must find it, not stop at the empty far end.
+        let fence = |dir: DVec3| {
+            let dir = dir.normalize();
+            let t = 3.0 / dir.x;
+            if dir.x > 0.0 && (t * dir.y).abs() <= 1.0 {
+                t
+            } else {
+                f64::INFINITY
+            }
+        };
+        let x = DVec3::new(0.0, -1.0, 0.0);
+        let r = DVec3::new(1.0, 0.5, 0.0).normalize();
+        assert!(search_is_sky(fence.distance(r)));
+        let exact = 3.0 / r.x;
+        let s = linear_search(&fence, x, r, 16, 0, 8, 0.0);
+        assert!(!s.escaped && ((s.d - exact) / exact).abs() < 1e-3, "{s:?} vs {exact}");
+        // Steeper, the ray passes over the fence from x too: it escapes.
+        let steep = DVec3::new(1.0, 1.0, 0.0).normalize();
+        assert!(linear_search(&fence, x, steep, 16, 0, 8, 0.0).escaped);
+        // From the reference point itself the map answers at once (one lookup).
+        let s0 = linear_search(&fence, DVec3::ZERO, r, 16, 0, 8, 0.0);
+        assert!(s0.escaped && s0.lookups == 1, "{s0:?}");
     }
 
     #[test]

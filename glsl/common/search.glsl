@@ -107,10 +107,11 @@ float search_refine(vec3 x, vec3 R, inout float d_l, inout float a_l, inout floa
 SearchResult linear_search(vec3 x, vec3 R, int steps, int binary_steps, int secant_steps, float tolerance) {
     int lookups = 0;
     float len_x = length(x);
-    // A ray from the reference point: the map answers it exactly.
+    // A ray from the reference point: the map answers it exactly. Off it, an empty far end
+    // does not end the search: the ray may meet a surface on the way.
     float far_stored = SEARCH_DISTANCE(R);
     lookups++;
-    if (len_x <= 1e-6 * min(far_stored, 1e30)) {
+    if (len_x <= 0.0 || (!search_is_sky(far_stored) && len_x <= 1e-6 * far_stored)) {
         if (search_is_sky(far_stored)) return search_result(x, R, 0.0, true, lookups);
         return search_result(x, R, far_stored, false, lookups);
     }
