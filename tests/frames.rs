@@ -272,10 +272,11 @@ fn a_hidden_object_disappears_everywhere() {
     let mut without = base.clone();
     without.meshes.remove(i);
     let q = quality();
-    // Per method, the largest ulp difference measured against the scene without the object:
-    // 0 (bit for bit) with distance maps and with the BVH (an earlier commit saw 1 value of
-    // 4800 one ulp apart with distance maps; the bound was 4 ulps).
-    for (m, ulps_measured) in [(specula::methods::DISTANCE, 0), (specula::methods::BVH, 0)] {
+    // The largest ulp difference against the scene without the object, measured 0 (bit for
+    // bit) with distance maps and with the BVH at this commit; an earlier commit saw 1 value
+    // of 4800 one ulp apart with distance maps (the other scene lays its buffers and map
+    // layers out differently, which may reorder a rounding), so 4 ulps are allowed.
+    for m in [specula::methods::DISTANCE, specula::methods::BVH] {
         let mut scene = base.clone();
         let mut r = renderer(&ctx, &scene, m, &q);
         let shown = bits(&r.render(&ctx).unwrap());
@@ -294,7 +295,7 @@ fn a_hidden_object_disappears_everywhere() {
             m.name(),
             hidden.len()
         );
-        assert!(ulps <= ulps_measured, "{}: hidden differs from a scene without the object by {ulps} ulps", m.name());
+        assert!(ulps <= 4, "{}: hidden differs from a scene without the object by {ulps} ulps", m.name());
         // The object shows (measured: 3402 of 4800 values differ from the scene without it,
         // both methods), so that a hide that changes nothing fails the comparison above.
         assert!(visible as f64 >= 3402.0 / 1.122, "{}: the object changes only {visible} values", m.name());
