@@ -555,7 +555,7 @@ fn check_expected(e: &Entry, g: &GpuResult, f: &mut Vec<String>) {
         let measured = if w.contains("eta=0.25") { 8.51e-3 } else { 0.0 };
         let short = 1.0 - g.r0[0] as f64;
         eprintln!("{w}: GPU F {} (1 − F {short:e}), CPU F {}", g.r0[0], fresnel_dielectric(e.case.c[0] as f64, e.case.c[1] as f64));
-        if !(short <= 1.122 * measured) {
+        if short.is_nan() || short > 1.122 * measured {
             fail(f, e, format!("at the critical angle F must be ≈ 1, GPU {} (1 − F {short:e} > 1.122 × {measured:e})", g.r0[0]));
         }
     }
