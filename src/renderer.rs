@@ -866,6 +866,12 @@ impl Renderer {
             stats.push(("geometry.mirror_views".into(), f.views.len() as f64));
             stats.push(("geometry.mirror_depth".into(), f.views.iter().map(|v| v.level).max().unwrap_or(0) as f64));
             stats.push(("geometry.mirror_fallbacks".into(), f.fallbacks as f64));
+            // Memory (issue 11): the layers allocated for the plan's views, the bytes of one
+            // view's layer, and the scratch target every view renders into (colour + depth).
+            let (layers, view, scratch) = m.memory();
+            stats.push(("geometry.mirror_layers".into(), layers as f64));
+            stats.push(("geometry.mirror_view_bytes".into(), view as f64));
+            stats.push(("geometry.mirror_scratch_bytes".into(), scratch as f64));
         }
         Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates: self.map_updates.clone() })
     }

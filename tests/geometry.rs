@@ -57,6 +57,21 @@ fn a_mirror_wall_is_exact_up_to_rasterisation() {
     assert!(names.contains(&"geometry.mirror") && names.contains(&"geometry.mirror_view"), "{names:?}");
     // Exact (tests/README.md rule 2): measured 155.30 dB, f32 rounding against f64.
     assert!(p >= 60.0, "planar-mirror {p:.2} dB against the reference");
+    // Memory per view: one RGBA32F layer of the frame's size per view the plan may render,
+    // and one scratch colour + depth target; the stats agree with the allocator's records.
+    let (layers, view, scratch) =
+        (stat(&f, "geometry.mirror_layers"), stat(&f, "geometry.mirror_view_bytes"), stat(&f, "geometry.mirror_scratch_bytes"));
+    let pixels = (SIZE.0 * SIZE.1) as f64;
+    println!("mirror wall: {layers} view layer(s) of {view} B, scratch {scratch} B");
+    assert_eq!((view, scratch), (16.0 * pixels, 20.0 * pixels));
+    let allocated = |name: &str| f.memory.iter().filter(|(n, _)| n == name).map(|(_, b)| *b as f64).sum::<f64>();
+    assert!(layers >= 1.0 && allocated("geometry.mirror_views") >= layers * view, "{:?}", f.memory);
+    assert!(allocated("geometry.mirror_views") < (layers + 1.0) * view, "no layer beyond the plan's: {:?}", f.memory);
+    assert!(allocated("geometry.mirror_view") + allocated("geometry.mirror_view.depth") >= scratch, "{:?}", f.memory);
+    // The same wall served by distance maps allocates none of it.
+    let none = gpu(&ctx, &s, specula::methods::DISTANCE, &q);
+    assert!(none.stats.iter().all(|(n, _)| !n.starts_with("geometry.")), "{:?}", none.stats);
+    assert!(none.memory.iter().all(|(n, _)| !n.starts_with("geometry.")), "{:?}", none.memory);
     common::assert_clean(&ctx);
 }
 

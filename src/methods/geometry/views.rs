@@ -82,6 +82,16 @@ impl MirrorViews {
         self.frame.children(v).into_iter().map(|(mesh, c)| (mesh, FLAG_MIRROR_VIEW | (c.layer << MIRROR_LAYER_SHIFT))).collect()
     }
 
+    /// (layers allocated, bytes of one view's layer, bytes of the scratch colour and depth
+    /// targets): the layered image holds one single-sample RGBA32F layer per view; the
+    /// scratch targets have the camera's samples.
+    pub fn memory(&self) -> (u32, u64, u64) {
+        let pixels = self.scratch.width as u64 * self.scratch.height as u64;
+        let colour = crate::vk::format_bytes(TARGET_FORMAT) as u64;
+        let depth = crate::vk::format_bytes(DEPTH_FORMAT) as u64;
+        (self.limits.layers, pixels * colour, pixels * self.samples as u64 * (colour + depth))
+    }
+
     /// Copies (or, with MSAA, resolves) the scratch target's `rect` into layer `layer` of
     /// `dst` (the views' layered image).
     pub fn record_store(&mut self, rec: &mut Recorder, dst: &mut Image, layer: u32, rect: Rect) {
