@@ -25,7 +25,7 @@ fn errors(got: &[f32], expected: Vec3) -> (f32, f32) {
     if expected.min_element() > 0.0 {
         (rel_err(got, expected), 0.0)
     } else {
-        (0.0, (0..3).map(|k| (got[k] - expected[k]).abs()).fold(0.0, f32::max))
+        (0.0, common::max_diff(got, expected))
     }
 }
 
