@@ -705,6 +705,7 @@ impl Renderer {
             tolerance: q.search_tolerance,
             internal_bounces: q.internal_bounces,
             depth: q.depth,
+            mirror_base: self.views.mirrors,
         };
         let full =
             vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: self.target.width, height: self.target.height } };

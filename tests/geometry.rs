@@ -290,3 +290,52 @@ fn a_mirror_sphere_beside_a_mirror_wall() {
     assert!(p_ms >= 34.35 && p_ms >= p_one + 7.34, "msaa4 {p_ms:.2} dB vs one sample {p_one:.2} dB");
     common::assert_clean(&ctx);
 }
+
+/// A glass slab (solid, flat faces) standing in the emissive room, seen from above at an
+/// angle: the room behind and below it is refracted through the top face and out of the
+/// bottom and side faces.
+fn slab_scene(ior: f32, camera: (Vec3, Vec3)) -> Scene {
+    let mut s = room(&[], camera);
+    let glass = s
+        .add_material(Material {
+            name: "glass".into(),
+            kind: specula::scene::SurfaceKind::Dielectric { ior, thin: false },
+            ..Default::default()
+        })
+        .unwrap();
+    s.add_mesh(shapes::cuboid("slab", Vec3::new(-0.2, -0.9, -0.4), Vec3::new(0.8, 0.25, 0.6), glass)).unwrap();
+    s
+}
+
+#[test]
+fn planar_refraction_explore() {
+    let ctx = common::gpu();
+    for ior in [1.1f32, 1.5, 2.4] {
+        for (label, cam) in [
+            ("steep", (Vec3::new(0.2, 1.2, 0.9), Vec3::new(-0.2, -0.9, -0.4))),
+            ("oblique", (Vec3::new(1.2, 0.0, 1.6), Vec3::new(-0.2, -0.9, -0.4))),
+        ] {
+            let s = slab_scene(ior, cam);
+            let mut q = quality(4);
+            q.set("mirror_budget", "64").unwrap();
+            let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
+            let f = gpu(&ctx, &s, specula::methods::PLANAR_REFRACTION, &q);
+            if ior == 1.5 && label == "oblique" {
+                let big = (256, 192);
+                let fb = specula::render(&ctx, &s, specula::methods::PLANAR_REFRACTION, &q, big, (0, 1)).unwrap();
+                fb.image.write_png_srgb(std::path::Path::new("/tmp/pr.png")).ok();
+                let rb = specula::reference::render_reference(&s, &q, big).unwrap();
+                rb.write_png_srgb(std::path::Path::new("/tmp/ref.png")).ok();
+            }
+            let p = psnr(&f.image, &reference);
+            let b = psnr(&gpu(&ctx, &s, specula::methods::BVH, &q).image, &reference);
+            let r = psnr(&gpu(&ctx, &s, specula::methods::REFRACTOR_MAP, &q).image, &reference);
+            println!(
+                "ior {ior} {label}: planar-refraction {p:.2} dB (views {}, fallbacks {}), bvh {b:.2}, refractor-map {r:.2}",
+                stat(&f, "geometry.mirror_views"),
+                stat(&f, "geometry.mirror_fallbacks")
+            );
+        }
+    }
+    common::assert_clean(&ctx);
+}

@@ -21,7 +21,7 @@ void main() {
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
     vec3 reflected;
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
-        ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int(push.flags >> MIRROR_LAYER_SHIFT));
+        ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int((push.flags >> MIRROR_LAYER_SHIFT) & 0xffu));
         reflected = texelFetch(mirror_views, texel, 0).rgb;
     } else {
         reflected = sky_radiance(s.r);

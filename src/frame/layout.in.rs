@@ -15,7 +15,8 @@ gpu_structs! {
         inv_view_proj: mat4,
         /// xyz: eye or reference point; w: 0 radial distance, 1 planar distance
         eye: vec4,
-        /// xyz: direction for planar distance (directional shadow maps)
+        /// xyz: direction for planar distance (directional shadow maps); w: a planar
+        /// mirror's view: how far beyond its plane `clip` lies
         dir: vec4,
         /// World-space plane (n, w) a camera view keeps the side n·p + w ≥ 0 of: a planar
         /// mirror's view (survey §5) sees only what lies in front of its mirror; (0, 0, 0, 1)
@@ -229,7 +230,9 @@ gpu_structs! {
         internal_bounces: uint,
         /// specular recursion depth R (`depth`): layered maps (§4.5) trace this many bounces
         depth: uint,
-        pad: uint,
+        /// the view table's first planar-mirror view (`ViewLayout::mirrors`): layer L of
+        /// `mirror_views` is view `mirror_base + L`
+        mirror_base: uint,
     }
 }
 
@@ -264,14 +267,16 @@ gpu_consts! {
     /// First inter-object cycle: no map holds anything yet, specular objects in maps are black
     /// (paths longer than the requested depth end black, as in the reference).
     FLAG_FIRST_CYCLE: uint = 16;
-    /// `geometry.mirror` (§5): the mirror's reflection is the mirrored view in layer
-    /// `flags >> MIRROR_LAYER_SHIFT` of `mirror_views`; without the flag, the budget's
-    /// fallback (the environment along the reflected ray).
+    /// `geometry.mirror` and `geometry.refract` (§5): the object's planes have child views
+    /// in the `(flags >> MIRROR_COUNT_SHIFT)` layers of `mirror_views` from `(flags >>
+    /// MIRROR_LAYER_SHIFT) & 0xff` on; without the flag (or for a plane none of them is
+    /// of), the budget's fallback (the environment along the ray).
     FLAG_MIRROR_VIEW: uint = 32;
     /// `Push.flags` of the camera's `scene.direct`: the caustics are projected by their own
     /// pass (`caustics.project`), not inside `shade_diffuse`.
     FLAG_CAUSTICS_APART: uint = 128;
     MIRROR_LAYER_SHIFT: uint = 16;
+    MIRROR_COUNT_SHIFT: uint = 24;
 
     /// `CausticParams.flags`: the projection's distance test (§6.3.3).
     CAUSTIC_DISTANCE_TEST: uint = 1;

@@ -45,6 +45,8 @@ pub struct FrameInputs<'a> {
     pub tolerance: f32,
     pub internal_bounces: u32,
     pub depth: u32,
+    /// `ViewLayout::mirrors`.
+    pub mirror_base: u32,
 }
 
 impl FrameInputs<'_> {
@@ -75,7 +77,7 @@ impl FrameInputs<'_> {
             tolerance: self.tolerance,
             internal_bounces: self.internal_bounces,
             depth: self.depth,
-            pad: 0,
+            mirror_base: self.mirror_base,
         };
         unsafe {
             ctx.device.cmd_push_constants(

@@ -95,7 +95,7 @@ pub fn view_table(
                 view_proj: m.view_proj.to_cols_array_2d(),
                 inv_view_proj: m.plain_view_proj.inverse().to_cols_array_2d(),
                 eye: m.eye.extend(0.0).to_array(),
-                dir: [0.0; 4],
+                dir: [0.0, 0.0, 0.0, m.hair],
                 clip: m.clip.to_array(),
             };
         }

@@ -157,6 +157,9 @@ pub enum Shape {
     Any,
     /// All vertices on one plane, normals agreeing (`ObjectFacts::planar`).
     Planar,
+    /// Flat faces: a convex solid of planar faces (`ObjectFacts::faceted`), or a planar
+    /// thin-walled pane.
+    Faceted,
 }
 
 impl Shape {
@@ -164,6 +167,11 @@ impl Shape {
         match self {
             Shape::Any => true,
             Shape::Planar => f.planar,
+            Shape::Faceted => match f.class {
+                ObjectClass::SolidDielectric => f.faceted,
+                ObjectClass::ThinDielectric => f.planar,
+                ObjectClass::Mirror => false,
+            },
         }
     }
 }

@@ -22,6 +22,9 @@ pub struct ObjectFacts {
     pub class: ObjectClass,
     /// All vertices within 1e-4 of the object's size of one plane, normals agreeing.
     pub planar: bool,
+    /// A closed convex solid of at most `faces::MAX_FACES` flat faces (each face's vertex
+    /// normals its plane's): a gem, a prism, a slab (survey §5, GS04).
+    pub faceted: bool,
     /// Every edge shared by exactly two triangles (positions welded).
     pub watertight: bool,
     /// Area fraction of the surface visible from the reference point (1: convex from it,
@@ -55,6 +58,7 @@ pub struct SceneFacts {
 #[derive(Clone, Debug)]
 struct MeshFacts {
     planar: bool,
+    faceted: bool,
     watertight: bool,
 }
 
@@ -89,7 +93,9 @@ fn mesh_facts(m: &Mesh) -> Arc<MeshFacts> {
     if let Some(f) = CACHE.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).cloned())) {
         return f;
     }
-    let f = Arc::new(MeshFacts { planar: is_planar(m), watertight: is_watertight(m) });
+    let watertight = is_watertight(m);
+    let faceted = watertight && is_faceted(m);
+    let f = Arc::new(MeshFacts { planar: is_planar(m), faceted, watertight });
     if let Ok(mut c) = CACHE.lock() {
         let map = c.get_or_insert_with(HashMap::new);
         if map.len() > 1024 {
@@ -98,6 +104,12 @@ fn mesh_facts(m: &Mesh) -> Arc<MeshFacts> {
         map.insert(key, f.clone());
     }
     f
+}
+
+/// A convex solid of flat faces (`geometry::faces`).
+pub fn is_faceted(m: &Mesh) -> bool {
+    use crate::methods::geometry::faces;
+    faces::planar_faces(m, faces::MAX_FACES).is_some_and(|f| f.len() >= 4 && faces::is_convex(m, &f))
 }
 
 /// All vertices within 1e-4 · diagonal of the area-weighted plane, and every vertex normal
@@ -426,6 +438,7 @@ impl SceneFacts {
                     mesh: i,
                     class,
                     planar: mf.planar,
+                    faceted: mf.faceted,
                     watertight: mf.watertight,
                     visible_fraction: visible,
                     sees_specular: sees,

@@ -605,8 +605,11 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         }
     }
     // Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
-    p.mirrors = p.objects.iter().filter(|o| o.method == crate::methods::PLANAR_MIRROR).map(|o| o.mesh).collect();
-    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(p.mirrors.len() as u32, q.depth, q.mirror_budget);
+    // Flat-faced refractors' faces bring two views each (reflection and refraction).
+    let geometry = [crate::methods::PLANAR_MIRROR, crate::methods::PLANAR_REFRACTION];
+    p.mirrors = p.objects.iter().filter(|o| geometry.contains(&o.method)).map(|o| o.mesh).collect();
+    let planes = p.mirrors.iter().map(|&m| crate::methods::geometry::mirror::plane_count(scene, m)).sum();
+    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(planes, q.depth, q.mirror_budget);
     stages.extend(maps.into_iter().map(StageSpec::Map));
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.

@@ -55,6 +55,70 @@ pub fn quad(name: &str, origin: Vec3, u: Vec3, v: Vec3, n: u32, material: usize)
     m
 }
 
+/// Appends `other`'s geometry to `m` (one mesh of both).
+pub fn append(m: &mut Mesh, other: &Mesh) {
+    let base = m.positions.len() as u32;
+    m.positions.extend_from_slice(&other.positions);
+    m.normals.extend_from_slice(&other.normals);
+    m.uvs.extend_from_slice(&other.uvs);
+    m.indices.extend(other.indices.iter().map(|i| base + i));
+}
+
+/// An axis-aligned box of half extents `half` around `center`, six flat outward faces
+/// (vertices split per face, so each face's normals are its own).
+pub fn cuboid(name: &str, center: Vec3, half: Vec3, material: usize) -> Mesh {
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    for axis in 0..3 {
+        for sign in [1.0f32, -1.0] {
+            let n = Vec3::AXES[axis] * sign;
+            let (u, v) = (Vec3::AXES[(axis + 1) % 3], Vec3::AXES[(axis + 2) % 3]);
+            // u × v = n for sign +1; swap for −1 so that every face winds outward.
+            let (u, v) = if sign > 0.0 {
+                (u * half[(axis + 1) % 3], v * half[(axis + 2) % 3])
+            } else {
+                (v * half[(axis + 2) % 3], u * half[(axis + 1) % 3])
+            };
+            let origin = center + n * half[axis] - u - v;
+            append(&mut m, &quad("", origin, 2.0 * u, 2.0 * v, 1, material));
+        }
+    }
+    m
+}
+
+/// A right prism along `axis` (unit) through `center`, `length` long, over the triangle
+/// `corners` (in the plane through `center` perpendicular to `axis`): five flat outward
+/// faces.
+pub fn prism(name: &str, center: Vec3, axis: Vec3, length: f32, corners: [Vec3; 3], material: usize) -> Mesh {
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    let h = axis * (0.5 * length);
+    let centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+    let mut face = |pts: &[Vec3]| {
+        let mut n = (pts[1] - pts[0]).cross(pts[2] - pts[0]).normalize();
+        let mut pts = pts.to_vec();
+        if n.dot(pts[0] - (center + centroid)) < 0.0 {
+            n = -n;
+            pts.reverse();
+        }
+        let base = m.positions.len() as u32;
+        for p in &pts {
+            m.positions.push(*p);
+            m.normals.push(n);
+            m.uvs.push(Vec2::ZERO);
+        }
+        for k in 1..pts.len() as u32 - 1 {
+            m.indices.extend([base, base + k, base + k + 1]);
+        }
+    };
+    let c = corners.map(|p| center + p);
+    face(&[c[0] + h, c[1] + h, c[2] + h]);
+    face(&[c[0] - h, c[1] - h, c[2] - h]);
+    for i in 0..3 {
+        let (a, b) = (c[i], c[(i + 1) % 3]);
+        face(&[a - h, b - h, b + h, a + h]);
+    }
+    m
+}
+
 /// The six inward-facing walls of an axis-aligned box room, in the order
 /// +X, −X, +Y, −Y, +Z, −Z, each split into 2×2 quadrants (24 meshes). Quadrant q of a
 /// wall covers the signs (bit 1: second in-plane axis > 0, bit 0: first > 0) of the two

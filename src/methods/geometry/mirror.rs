@@ -17,30 +17,69 @@ use glam::{Mat4, Vec3, Vec4};
 
 use crate::scene::Scene;
 
-/// One planar mirror: its mesh and its world plane n·p + w = 0 (unit n).
+/// What happens at a plane of the tree: a planar mirror reflects; a glass interface (a
+/// face of a flat-faced solid dielectric, or a thin-walled pane) reflects and refracts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Interface {
+    Mirror,
+    /// `ior` relative to the outside; `thin`: a thin-walled pane (light passes undeviated).
+    Glass {
+        ior: f32,
+        thin: bool,
+    },
+}
+
+/// One planar reflector or refracting face: its mesh and its world plane n·p + w = 0
+/// (unit n; a solid's face: outward).
 #[derive(Clone, Debug)]
 pub struct Mirror {
     pub mesh: usize,
     pub plane: Vec4,
     /// The largest coordinate magnitude of its vertices (the scale of their f32 rounding).
     pub far: f32,
-    /// The rectangle in its plane that bounds it (a convex polygon whose clipped
-    /// projection bounds its pixels).
-    pub outline: [Vec3; 4],
+    /// A convex polygon in its plane that bounds it (its clipped projection bounds its
+    /// pixels).
+    pub outline: Vec<Vec3>,
     /// Edge of the mirror's bounding box: the scale of "on the plane".
     pub size: f32,
+    pub interface: Interface,
 }
 
 impl Mirror {
-    /// The mirror of mesh `mesh` in its current pose; `None` for a mesh of no area (no
-    /// plane, nothing to reflect).
-    pub fn of(scene: &Scene, mesh: usize) -> Option<Mirror> {
+    /// The planes of mesh `mesh` in its current pose: a planar mirror or a thin pane is
+    /// one; a flat-faced solid dielectric is one per face (none once it is no longer
+    /// flat-faced); a mesh of no area has none (nothing to reflect).
+    pub fn of(scene: &Scene, mesh: usize) -> Vec<Mirror> {
         let m = &scene.meshes[mesh];
         if m.hidden {
-            return None;
+            return Vec::new();
         }
+        let kind = scene.materials.get(m.material).map(|mat| mat.kind.clone());
+        match kind {
+            Some(crate::scene::SurfaceKind::Dielectric { ior, thin: false }) => {
+                let Some(faces) = super::faces::planar_faces(m, super::faces::MAX_FACES) else { return Vec::new() };
+                let far = m.positions.iter().fold(0.0f32, |a, p| a.max(p.abs().max_element()));
+                faces
+                    .into_iter()
+                    .map(|f| {
+                        let (lo, hi) =
+                            f.outline.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+                        let size = (hi - lo).max_element();
+                        Mirror { mesh, plane: f.plane, far, outline: f.outline, size, interface: Interface::Glass { ior, thin: false } }
+                    })
+                    .collect()
+            }
+            Some(crate::scene::SurfaceKind::Dielectric { ior, thin: true }) => {
+                Self::plane_of(mesh, m, Interface::Glass { ior, thin: true }).into_iter().collect()
+            }
+            _ => Self::plane_of(mesh, m, Interface::Mirror).into_iter().collect(),
+        }
+    }
+
+    /// A planar mesh as one plane (that of its largest triangle, oriented by the mean
+    /// normal) with its bounding rectangle in the plane.
+    fn plane_of(mesh: usize, m: &crate::scene::Mesh, interface: Interface) -> Option<Mirror> {
         let points = &m.positions;
-        // The plane of the largest-area triangle, oriented by the mean normal.
         let mut best = (0.0f32, Vec3::ZERO, Vec3::ZERO);
         for t in m.indices.chunks_exact(3) {
             let (a, b, c) = (points[t[0] as usize], points[t[1] as usize], points[t[2] as usize]);
@@ -67,14 +106,59 @@ impl Mirror {
             hi = hi.max(q);
         }
         let at = |a: f32, b: f32| origin + u * a + v * b;
-        let outline = [at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y)];
+        let outline = vec![at(lo.x, lo.y), at(hi.x, lo.y), at(hi.x, hi.y), at(lo.x, hi.y)];
         let far = points.iter().fold(0.0f32, |a, p| a.max(p.abs().max_element()));
-        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), far, outline, size })
+        Some(Mirror { mesh, plane: n.extend(-n.dot(best.2)), far, outline, size, interface })
     }
 
     fn distance(&self, p: Vec3) -> f32 {
         self.plane.truncate().dot(p) + self.plane.w
     }
+
+    /// How far in front of its plane a view's clip plane sits: the mirror itself, and f32
+    /// rounding of points on its plane, must not cover the view (1e-4 of its size, and at
+    /// least a few ulps of its coordinates).
+    pub fn hair(&self) -> f32 {
+        (1e-4 * self.size).max(4.0 * f32::EPSILON * self.far)
+    }
+}
+
+/// The linearised refraction of GS04 through the plane `plane` (unit n towards the eye),
+/// for eye rays around the central direction `d` (unit, towards the plane), from a medium
+/// into one `eta` = ν₂/ν₁ times as dense: the affine map p ↦ p + (n·p + w)·v that fixes the
+/// plane and moves each point behind it to where it appears through the plane. The central
+/// ray is exact: a point on its refracted branch lands on its incident line. Around it,
+/// Snell's law in tangent space (tan θ_t as a function of tan θ_i) is linearised by one
+/// isotropic slope k, the mean of its radial derivative cos³θ_i / (η cos³θ_t) and its
+/// tangential ratio tan θ_t / tan θ_i (the two agree, 1/η, at normal incidence, where the
+/// map is the apparent depth d/η). `None` when the central ray is reflected totally or
+/// grazes the plane.
+pub fn linearised_refraction(plane: Vec4, d: Vec3, eta: f32) -> Option<Mat4> {
+    let n = plane.truncate();
+    let cos_i = -n.dot(d);
+    if !(cos_i > 1e-6) || !(eta > 0.0) {
+        return None;
+    }
+    let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
+    let sin2_t = sin2_i / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None; // total internal reflection of the central ray
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    if !(cos_t > 1e-6) {
+        return None;
+    }
+    let t = d / eta + (cos_i / eta - cos_t) * n;
+    // Lateral tangents of the incident and refracted directions.
+    let x0 = (d + cos_i * n) / cos_i;
+    let y0 = (t + cos_t * n) / cos_t;
+    let radial = cos_i.powi(3) / (eta * cos_t.powi(3));
+    let tan_i = sin2_i.sqrt() / cos_i;
+    let tangential = if tan_i > 1e-4 { (sin2_t.sqrt() / cos_t) / tan_i } else { 1.0 / eta };
+    let k = 0.5 * (radial + tangential);
+    let v = (k - 1.0) * n + (y0 - k * x0);
+    let lin = glam::Mat3::IDENTITY + glam::Mat3::from_cols(v * n.x, v * n.y, v * n.z);
+    Some(Mat4::from_cols(lin.x_axis.extend(0.0), lin.y_axis.extend(0.0), lin.z_axis.extend(0.0), (plane.w * v).extend(1.0)))
 }
 
 /// The reflection through the plane n·p + w = 0 (unit n): p ↦ p − 2(n·p + w) n.
@@ -112,20 +196,43 @@ impl Rect {
         self.x0 >= self.x1 || self.y0 >= self.y1
     }
 
+    /// Pixels covered.
+    pub fn area(&self) -> u64 {
+        if self.is_empty() {
+            0
+        } else {
+            (self.x1 - self.x0) as u64 * (self.y1 - self.y0) as u64
+        }
+    }
+
     fn intersect(&self, o: &Rect) -> Rect {
         Rect { x0: self.x0.max(o.x0), y0: self.y0.max(o.y0), x1: self.x1.min(o.x1), y1: self.y1.min(o.y1) }
     }
 }
 
-/// One mirrored view of a frame.
+/// What a view shows through its plane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ViewKind {
+    /// The reflection: the parent's camera mirrored through the plane (exact).
+    Reflect,
+    /// The refraction: the parent's camera seen through the plane (GS04's linearised map;
+    /// exact for a thin pane, which transmits undeviated).
+    Refract,
+}
+
+/// One mirrored (or refracted) view of a frame.
 #[derive(Clone, Debug)]
 pub struct MirrorView {
-    /// 1: seen from the camera; k: through k mirrors.
+    /// 1: seen from the camera; k: through k planes.
     pub level: u32,
     /// The view it was reflected from (`None`: the camera).
     pub parent: Option<usize>,
     /// Index into `MirrorFrame::mirrors`.
     pub mirror: usize,
+    pub kind: ViewKind,
+    /// The solid dielectric whose inside the view looks through (its mesh), if any.
+    pub medium: Option<usize>,
     /// Its layer of the views' image (its index in the frame).
     pub layer: u32,
     /// The reflected eye (virtual camera position).
@@ -134,8 +241,10 @@ pub struct MirrorView {
     pub view_proj: Mat4,
     /// World → clip without it (its inverse unprojects pixels to rays, as the camera's).
     pub plain_view_proj: Mat4,
-    /// The kept side of the mirror's plane (towards the parent's eye).
+    /// The kept side of the mirror's plane (towards the parent's eye when reflecting, away
+    /// from it when refracting), `hair` beyond the plane.
     pub clip: Vec4,
+    pub hair: f32,
     /// The pixels the mirror covers in the parent (all the view needs to render).
     pub rect: Rect,
 }
@@ -146,7 +255,8 @@ pub struct MirrorView {
 pub struct MirrorFrame {
     pub mirrors: Vec<Mirror>,
     pub views: Vec<MirrorView>,
-    /// Mirrors that were visible where the depth or the budget left no view for them.
+    /// Views that were needed where the depth or the budget left none (each falls back
+    /// to the environment along its rays).
     pub fallbacks: u32,
 }
 
@@ -160,8 +270,16 @@ pub struct Limits {
 }
 
 impl MirrorFrame {
-    /// The views of the planar mirrors `meshes` of `scene` from the camera (`view_proj`,
-    /// `eye`, a `width`×`height` target; `cos_corner` of its frustum).
+    /// The views of the planar mirrors and refracting faces of `meshes` of `scene` from the
+    /// camera (`view_proj`, `eye`, a `width`×`height` target; `cos_corner` of its frustum).
+    ///
+    /// The tree grows best first: of all the views that could be rendered next (a plane
+    /// visible in the camera or in a view already chosen, within the recursion depth), the
+    /// one whose image weighs most — the pixels it covers times the product of the Fresnel
+    /// weights of its path's central ray — until `mirror_budget` views are chosen. Through
+    /// glass the refraction carries most of the light and a weak external reflection waits;
+    /// a total internal reflection carries all of it. The chosen views are then numbered
+    /// breadth first, so that each view's children of one mesh are consecutive layers.
     pub fn plan(
         scene: &Scene,
         meshes: &[usize],
@@ -171,79 +289,99 @@ impl MirrorFrame {
         cos_corner: f32,
         lim: Limits,
     ) -> MirrorFrame {
-        let mirrors: Vec<Mirror> = meshes.iter().filter_map(|&m| Mirror::of(scene, m)).collect();
+        let mirrors: Vec<Mirror> = meshes.iter().flat_map(|&m| Mirror::of(scene, m)).collect();
         let mut frame = MirrorFrame { mirrors, views: Vec::new(), fallbacks: 0 };
-        // Breadth first: (parent view, its eye, its plain view_proj, its clip plane, its rect,
-        // its mirror, its level).
-        struct Node {
-            index: Option<usize>,
-            eye: Vec3,
-            plain: Mat4,
-            clip: Vec4,
-            rect: Rect,
-            mirror: Option<usize>,
-            level: u32,
-        }
-        let mut queue = std::collections::VecDeque::new();
-        queue.push_back(Node {
-            index: None,
+        let root = Node {
             eye,
             plain: view_proj,
             clip: Vec4::new(0.0, 0.0, 0.0, 1.0),
             rect: Rect::full(size.0, size.1),
             mirror: None,
+            medium: None,
             level: 0,
-        });
-        while let Some(parent) = queue.pop_front() {
-            for (k, m) in frame.mirrors.iter().enumerate() {
-                if parent.mirror == Some(k) {
-                    continue; // a plane does not see itself
-                }
-                let Some(rect) = visible_rect(m, &parent.plain, parent.clip, parent.eye, parent.rect, size) else { continue };
-                let level = parent.level + 1;
-                if level > lim.depth || frame.views.len() as u32 >= lim.budget.min(lim.layers) {
+            weight: 1.0,
+        };
+        let budget = lim.budget.min(lim.layers) as usize;
+        // Chosen views in the order they were chosen: (parent in this list, its candidate).
+        let mut chosen: Vec<(Option<usize>, Candidate)> = Vec::new();
+        let mut heap = std::collections::BinaryHeap::new();
+        let mut seq = 0u64;
+        let mut offer = |heap: &mut std::collections::BinaryHeap<Ranked>, parent: Option<usize>, node: &Node, frame: &mut MirrorFrame| {
+            for c in candidates(&frame.mirrors, node, size) {
+                if c.level > lim.depth {
                     frame.fallbacks += 1;
                     continue;
                 }
-                // The plane oriented towards the parent's eye: that side is kept, from a hair
-                // in front of the mirror on (the mirror itself, and f32 rounding of points
-                // on its plane, must not cover the view: 1e-4 of its size, and at least a
-                // few ulps of its coordinates).
-                let plane = if m.distance(parent.eye) >= 0.0 { m.plane } else { -m.plane };
-                let r = reflection(plane);
-                let plain = parent.plain * r;
-                let keep = plane - Vec4::new(0.0, 0.0, 0.0, (1e-4 * m.size).max(4.0 * f32::EPSILON * m.far));
-                let view = MirrorView {
-                    level,
-                    parent: parent.index,
-                    mirror: k,
-                    layer: frame.views.len() as u32,
-                    eye: r.transform_point3(parent.eye),
-                    view_proj: oblique(plain, keep, cos_corner),
-                    plain_view_proj: plain,
-                    clip: keep,
-                    rect,
-                };
-                frame.views.push(view);
-                let index = frame.views.len() - 1;
-                let v = &frame.views[index];
-                queue.push_back(Node {
-                    index: Some(index),
-                    eye: v.eye,
-                    plain: v.plain_view_proj,
-                    clip: keep,
-                    rect,
-                    mirror: Some(k),
-                    level,
-                });
+                let importance = c.weight as f64 * c.rect.area() as f64;
+                let candidate = Candidate { seq, ..c };
+                heap.push(Ranked { importance, seq, parent, candidate });
+                seq += 1;
             }
+        };
+        offer(&mut heap, None, &root, &mut frame);
+        while let Some(r) = heap.pop() {
+            if chosen.len() >= budget {
+                frame.fallbacks += 1 + heap.len() as u32;
+                break;
+            }
+            let node = r.candidate.node(r.parent.map_or(&root, |p| &chosen[p].1.child));
+            let mut c = r.candidate;
+            c.child = node;
+            chosen.push((r.parent, c));
+            let index = chosen.len() - 1;
+            let child = chosen[index].1.child.clone();
+            offer(&mut heap, Some(index), &child, &mut frame);
+        }
+        // Breadth-first numbering: children in the order their parent offered them.
+        let mut order: Vec<usize> = Vec::with_capacity(chosen.len());
+        let mut layer_of = vec![u32::MAX; chosen.len()];
+        let mut frontier: Vec<Option<usize>> = vec![None];
+        while !frontier.is_empty() {
+            let mut next = Vec::new();
+            for parent in frontier {
+                let mut kids: Vec<usize> = (0..chosen.len()).filter(|&i| chosen[i].0 == parent).collect();
+                kids.sort_by_key(|&i| chosen[i].1.seq);
+                for i in kids {
+                    layer_of[i] = order.len() as u32;
+                    order.push(i);
+                    next.push(Some(i));
+                }
+            }
+            frontier = next;
+        }
+        for &i in &order {
+            let (parent, c) = &chosen[i];
+            let n = &c.child;
+            frame.views.push(MirrorView {
+                level: n.level,
+                parent: parent.map(|p| layer_of[p] as usize),
+                mirror: c.mirror,
+                kind: c.kind,
+                medium: n.medium,
+                layer: layer_of[i],
+                eye: n.eye,
+                view_proj: oblique(n.plain, n.clip, cos_corner),
+                plain_view_proj: n.plain,
+                clip: n.clip,
+                hair: c.hair,
+                rect: n.rect,
+            });
         }
         frame
     }
 
-    /// For the camera (`None`) or view `v`: per mirror mesh it sees, its child view.
-    pub fn children(&self, v: Option<usize>) -> Vec<(usize, &MirrorView)> {
-        self.views.iter().filter(|c| c.parent == v).map(|c| (self.mirrors[c.mirror].mesh, c)).collect()
+    /// For the camera (`None`) or view `v`: per mesh it sees planes of, the layers of its
+    /// child views, (first, count); a mesh's children are consecutive layers.
+    pub fn children(&self, v: Option<usize>) -> Vec<(usize, u32, u32)> {
+        let mut out: Vec<(usize, u32, u32)> = Vec::new();
+        for c in self.views.iter().filter(|c| c.parent == v) {
+            let mesh = self.mirrors[c.mirror].mesh;
+            match out.last_mut() {
+                Some((m, first, count)) if *m == mesh && *first + *count == c.layer => *count += 1,
+                _ => out.push((mesh, c.layer, 1)),
+            }
+        }
+        out
     }
 
     /// Views in recording order: deepest level first (a view samples its children).
@@ -251,6 +389,159 @@ impl MirrorFrame {
         let mut o: Vec<usize> = (0..self.views.len()).collect();
         o.sort_by_key(|&i| std::cmp::Reverse(self.views[i].level));
         o
+    }
+}
+
+/// A view of the tree as its children are planned from it.
+#[derive(Clone, Debug)]
+struct Node {
+    eye: Vec3,
+    plain: Mat4,
+    clip: Vec4,
+    rect: Rect,
+    mirror: Option<usize>,
+    medium: Option<usize>,
+    level: u32,
+    /// Product of the Fresnel weights of its path's central ray.
+    weight: f32,
+}
+
+/// A view that could be rendered: a plane seen from a node, and which branch.
+#[derive(Clone, Debug)]
+struct Candidate {
+    mirror: usize,
+    kind: ViewKind,
+    /// World → world: the reflection or the linearised refraction.
+    transform: Mat4,
+    keep: Vec4,
+    medium: Option<usize>,
+    level: u32,
+    rect: Rect,
+    weight: f32,
+    hair: f32,
+    seq: u64,
+    /// Filled in when chosen.
+    child: Node,
+}
+
+impl Candidate {
+    fn node(&self, parent: &Node) -> Node {
+        Node {
+            eye: self.transform.inverse().transform_point3(parent.eye),
+            plain: parent.plain * self.transform,
+            clip: self.keep,
+            rect: self.rect,
+            mirror: Some(self.mirror),
+            medium: self.medium,
+            level: self.level,
+            weight: self.weight,
+        }
+    }
+}
+
+/// A candidate ranked by its image's weight (ties: the earlier offered first).
+struct Ranked {
+    importance: f64,
+    seq: u64,
+    parent: Option<usize>,
+    candidate: Candidate,
+}
+
+impl PartialEq for Ranked {
+    fn eq(&self, o: &Ranked) -> bool {
+        self.cmp(o) == std::cmp::Ordering::Equal
+    }
+}
+impl Eq for Ranked {}
+impl PartialOrd for Ranked {
+    fn partial_cmp(&self, o: &Ranked) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Ranked {
+    fn cmp(&self, o: &Ranked) -> std::cmp::Ordering {
+        self.importance.total_cmp(&o.importance).then(o.seq.cmp(&self.seq))
+    }
+}
+
+/// The views node `p` could have: per plane it sees (from inside a solid only that solid's
+/// faces, from within; from outside a solid's faces only from without: its far faces hide
+/// behind its near ones, the solids being convex), its reflection and, through glass, its
+/// refraction (none where the central ray is reflected totally).
+fn candidates(mirrors: &[Mirror], p: &Node, size: (u32, u32)) -> Vec<Candidate> {
+    let mut out = Vec::new();
+    for (k, m) in mirrors.iter().enumerate() {
+        if p.mirror == Some(k) {
+            continue; // a plane does not see itself
+        }
+        let side = m.distance(p.eye);
+        let seen = match (m.interface, p.medium) {
+            (Interface::Glass { thin: false, .. }, None) => side > 0.0,
+            (Interface::Glass { thin: false, .. }, Some(o)) => o == m.mesh && side < 0.0,
+            (_, medium) => medium.is_none(),
+        };
+        if !seen {
+            continue;
+        }
+        let Some(rect) = visible_rect(m, &p.plain, p.clip, p.eye, p.rect, size) else { continue };
+        let level = p.level + 1;
+        // The plane oriented towards the node's eye.
+        let plane = if side >= 0.0 { m.plane } else { -m.plane };
+        let hair = m.hair();
+        let hair4 = Vec4::new(0.0, 0.0, 0.0, hair);
+        let make = |kind, transform, keep, medium, weight: f32| Candidate {
+            mirror: k,
+            kind,
+            transform,
+            keep,
+            medium,
+            level,
+            rect,
+            weight: p.weight * weight,
+            hair,
+            seq: 0,
+            child: p.clone(),
+        };
+        match m.interface {
+            Interface::Mirror => out.push(make(ViewKind::Reflect, reflection(plane), plane - hair4, p.medium, 1.0)),
+            Interface::Glass { ior, thin } => {
+                let d = central_ray(&p.plain, p.eye, rect, size, plane, &m.outline);
+                let (eta, inside) = if thin || p.medium.is_none() { (ior, Some(m.mesh)) } else { (1.0 / ior, None) };
+                let f = crate::optics::fresnel_dielectric((-plane.truncate().dot(d)) as f64, eta as f64) as f32;
+                // Refraction first: through glass it carries most of the light.
+                let refract = if thin { Some(Mat4::IDENTITY) } else { linearised_refraction(plane, d, eta) };
+                if let Some(t) = refract {
+                    let medium = if thin { None } else { inside };
+                    out.push(make(ViewKind::Refract, t, -plane - hair4, medium, 1.0 - f));
+                }
+                let f = if refract.is_some() { f } else { 1.0 };
+                out.push(make(ViewKind::Reflect, reflection(plane), plane - hair4, p.medium, f));
+            }
+        }
+    }
+    out
+}
+
+/// The unit direction from `eye` to the middle of a plane's visible pixels `rect` (through
+/// the view's `plain` projection), or to its outline's centroid when that ray misses the
+/// plane: the ray the linearised refraction is exact for.
+fn central_ray(plain: &Mat4, eye: Vec3, rect: Rect, size: (u32, u32), plane: Vec4, outline: &[Vec3]) -> Vec3 {
+    let (cx, cy) = (0.5 * (rect.x0 + rect.x1) as f32, 0.5 * (rect.y0 + rect.y1) as f32);
+    let ndc = glam::Vec2::new(2.0 * cx / size.0 as f32 - 1.0, 2.0 * cy / size.1 as f32 - 1.0);
+    let near = plain.inverse() * Vec4::new(ndc.x, ndc.y, 1.0, 1.0);
+    let n = plane.truncate();
+    let centroid = outline.iter().copied().sum::<Vec3>() / outline.len().max(1) as f32;
+    let fallback = (centroid - eye).normalize_or_zero();
+    if near.w.abs() < 1e-30 {
+        return fallback;
+    }
+    let dir = (near.truncate() / near.w - eye).normalize_or_zero();
+    let denom = n.dot(dir);
+    let t = -(n.dot(eye) + plane.w) / denom;
+    if denom < -1e-6 && t.is_finite() && t > 0.0 {
+        dir
+    } else {
+        fallback
     }
 }
 
@@ -324,14 +615,29 @@ fn visible_rect(m: &Mirror, plain: &Mat4, clip: Vec4, eye: Vec3, within: Rect, s
     (!r.is_empty()).then_some(r)
 }
 
-/// The most views a frame of `mirrors` planar mirrors can have up to recursion `depth`,
-/// within `budget`: the layers of the views' image. Level k can have m(m − 1)^(k−1) views.
-pub fn layers_needed(mirrors: u32, depth: u32, budget: u32) -> u32 {
+/// The planes mesh `mesh` of `scene` brings to the tree, counting each child view it can
+/// have: a planar mirror 1; a pane 2 (its reflection and its transmission); a flat-faced
+/// solid 2 per face. Hidden or not, as it may be shown again without a new plan.
+pub fn plane_count(scene: &Scene, mesh: usize) -> u32 {
+    let m = &scene.meshes[mesh];
+    match scene.materials.get(m.material).map(|mat| &mat.kind) {
+        Some(crate::scene::SurfaceKind::Dielectric { thin: false, .. }) => {
+            super::faces::planar_faces(m, super::faces::MAX_FACES).map_or(0, |f| 2 * f.len() as u32)
+        }
+        Some(crate::scene::SurfaceKind::Dielectric { thin: true, .. }) => 2,
+        _ => 1,
+    }
+}
+
+/// The most views a frame of `planes` planes (planar mirrors, and two per refracting face:
+/// its reflection and its refraction) can have up to recursion `depth`, within `budget`:
+/// the layers of the views' image. Level k can have m(m − 1)^(k−1) views.
+pub fn layers_needed(planes: u32, depth: u32, budget: u32) -> u32 {
     let mut total = 0u64;
-    let mut at_level = mirrors as u64;
+    let mut at_level = planes as u64;
     for _ in 1..=depth.min(64) {
         total = total.saturating_add(at_level);
-        at_level = at_level.saturating_mul(mirrors.saturating_sub(1) as u64);
+        at_level = at_level.saturating_mul(planes.saturating_sub(1) as u64);
         if at_level == 0 || total >= budget as u64 {
             break;
         }

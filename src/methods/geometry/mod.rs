@@ -6,6 +6,7 @@
 //! objects (`mirror::MirrorViews` plans the views of a frame; the renderer records them
 //! before the camera's own view, deepest first).
 
+pub mod faces;
 pub mod mirror;
 pub mod views;
 
@@ -45,4 +46,30 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
             reason: "planar reflector: exact by rendering the mirrored camera's view (§5, Table 1: exact, multiple reflections)".into(),
         })
     },
+});
+
+/// `geometry.refract`: each flat-faced dielectric (and thin pane) drawn from the camera (and
+/// from every view that sees it) with its faces' reflected and refracted views at their
+/// pixels, split by the pixel's own Fresnel weights.
+pub const REFRACT_PASS: CameraPass = CameraPass {
+    name: "geometry.refract",
+    vertex: "scene/mesh.vert",
+    fragment: "geometry/refract.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+};
+
+pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
+    name: "planar-refraction",
+    abi: 15,
+    section: "§5",
+    family: "geometry",
+    summary: "flat-faced dielectrics (slabs, prisms, gems; convex) and thin panes by geometry transformation: per face seen, the scene rendered through it by the linearised refraction of the eye ray (GS04: an affine map per face, exact on the face's central ray; exact for thin panes) and reflected in it (exact), recursing through internal reflections to the exit faces up to depth, at most mirror_budget views a frame, with the pixel's own Fresnel split",
+    serves: &[ObjectClass::SolidDielectric, ObjectClass::ThinDielectric],
+    knobs: &["depth", "mirror_budget", "fresnel"],
+    gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
+    fallback: Some(crate::methods::DISTANCE),
+    shape: Shape::Faceted,
+    rule: |_, _| None,
 });

@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 
 use super::mirror::{Limits, MirrorFrame, Rect};
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
-use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT};
+use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
 use crate::frame::stage::Maps;
 use crate::plan::Plan;
 use crate::scene::Scene;
@@ -79,7 +79,8 @@ impl MirrorViews {
     /// The push flags of the planar mirrors the camera (`None`) or view `v` sees: which
     /// layer of which image holds each one's reflection. Mirrors not listed fall back.
     pub fn child_flags(&self, v: Option<usize>) -> Vec<(usize, u32)> {
-        self.frame.children(v).into_iter().map(|(mesh, c)| (mesh, FLAG_MIRROR_VIEW | (c.layer << MIRROR_LAYER_SHIFT))).collect()
+        let flags = |first: u32, count: u32| FLAG_MIRROR_VIEW | (first << MIRROR_LAYER_SHIFT) | (count << MIRROR_COUNT_SHIFT);
+        self.frame.children(v).into_iter().map(|(mesh, first, count)| (mesh, flags(first, count))).collect()
     }
 
     /// (layers allocated, bytes of one view's layer, bytes of the scratch colour and depth

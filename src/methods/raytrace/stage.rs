@@ -510,7 +510,7 @@ impl RayTrace {
             tolerance: f.tolerance,
             internal_bounces: f.internal_bounces,
             depth: f.depth,
-            pad: 0,
+            mirror_base: f.mirror_base,
         };
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };

@@ -1,0 +1,55 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// variants: PER_SAMPLE
+// geometry.refract: a flat-faced dielectric (survey §5, GS04/Sch03), or a thin-walled
+// pane. Each face the view sees has up to two child views, laid onto the face's own
+// pixels: its reflection (the view mirrored through the face, exact) and its refraction
+// (the view through the face, by the linearised refraction of the eye ray: an affine map
+// per face that is exact for the face's central ray; a pane's is exact, it transmits
+// undeviated). From inside the solid, the faces are seen from within: internal
+// reflections and the refraction out. The Fresnel split is the pixel's own, at its eye
+// ray's incidence (total internal reflection included). A face whose view the depth or the
+// budget left out shows the environment along that branch's ray.
+#include "common/specular.glsl"
+#include "common/sky.glsl"
+
+layout(location = 0) SAMPLE_INTERP in vec3 in_position;
+layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
+layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
+layout(location = 3) flat in uint in_view;
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    Object o = objects[push.object];
+    Material m = materials[o.material];
+    vec3 eye = views[in_view].eye.xyz;
+    vec3 n = normalize(in_normal);
+    SpecularSplit s = specular_split(m, in_position, n, eye);
+    vec3 reflected = sky_radiance(s.r);
+    vec3 refracted = any(greaterThan(s.ft, vec3(0.0))) ? sky_radiance(s.t) : vec3(0.0);
+    if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
+        // The face's plane, towards the eye; its child views keep that side (reflection)
+        // or the other (refraction), `dir.w` beyond the plane.
+        vec3 towards = dot(n, eye - in_position) >= 0.0 ? n : -n;
+        uint first = (push.flags >> MIRROR_LAYER_SHIFT) & 0xffu;
+        uint count = push.flags >> MIRROR_COUNT_SHIFT;
+        for (uint i = 0u; i < count; ++i) {
+            uint layer = first + i;
+            View c = views[push.mirror_base + layer];
+            float facing = dot(c.clip.xyz, towards);
+            float offset = abs(dot(c.clip.xyz, in_position) + c.clip.w);
+            // Its plane: the normals agree and the pixel lies `hair` from the clip plane
+            // (within a few hairs for the rounding of the interpolated position).
+            if (abs(abs(facing) - 1.0) > 1e-3 || offset > 4.0 * c.dir.w) {
+                continue;
+            }
+            vec3 texel = texelFetch(mirror_views, ivec3(ivec2(gl_FragCoord.xy), int(layer)), 0).rgb;
+            if (facing > 0.0) {
+                reflected = texel;
+            } else {
+                refracted = texel;
+            }
+        }
+    }
+    out_color = vec4(s.fr * reflected + s.ft * refracted, 1.0);
+}
