@@ -342,7 +342,7 @@ pub const KNOBS: &[Knob] = &[
         name: "depth",
         values: "1..=64 bounces",
         default: "16",
-        doc: "specular recursion depth R of the exact renderers (the reference, ray tracing) and of planar mirrors seen in planar mirrors: paths still specular after R bounces end black; the default is converged for glass",
+        doc: "specular recursion depth R of the exact renderers (the reference, ray tracing) and of the planar views of planar-mirror and planar-refraction (mirrors in mirrors, a face's refraction in, internal reflections, refraction out): paths still specular after R bounces end black; the default is converged for glass",
         set: |q, v| {
             q.depth = count(v, 1, 64)?;
             Ok(())
@@ -583,7 +583,7 @@ pub const KNOBS: &[Knob] = &[
         name: "mirror_budget",
         values: "0..=64 views",
         default: "8",
-        doc: "planar-mirror (§5): the most mirrored views a frame renders (breadth first: mirrors seen from the camera before mirrors seen in mirrors); mirrors beyond it, or deeper than depth, show the environment along their reflected rays (black in a closed room)",
+        doc: "planar-mirror and planar-refraction (§5): the most mirrored or refracted views a frame renders, chosen best first (the pixels a view covers times its path's Fresnel weight: mirrors and refractions seen from the camera before weak reflections and views seen in views); planes beyond it, or deeper than depth, show the environment along their rays (black in a closed room). A flat-faced solid needs about two views per pair of faces a ray crosses",
         set: |q, v| {
             q.mirror_budget = count(v, 0, 64)?;
             Ok(())

@@ -163,6 +163,35 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// What it serves, for messages.
+    pub fn serves(self) -> &'static str {
+        match self {
+            Shape::Any => "any object",
+            Shape::Planar => "planar reflectors",
+            Shape::Faceted => "flat-faced convex solids and planar thin panes",
+        }
+    }
+
+    /// Why an object does not fit, for messages.
+    pub fn why_not(self) -> &'static str {
+        match self {
+            Shape::Any => "",
+            Shape::Planar => "the mesh's vertices do not lie on one plane with agreeing normals",
+            Shape::Faceted => {
+                "the mesh is not a closed convex solid of at most 64 flat faces (each face's vertex normals its plane's), nor a planar thin pane"
+            }
+        }
+    }
+
+    /// An adjective for an object that does not fit.
+    pub fn misfit(self) -> &'static str {
+        match self {
+            Shape::Any => "",
+            Shape::Planar => "non-planar",
+            Shape::Faceted => "curved (not flat-faced)",
+        }
+    }
+
     pub fn fits(self, f: &ObjectFacts) -> bool {
         match self {
             Shape::Any => true,

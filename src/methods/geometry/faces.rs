@@ -32,7 +32,7 @@ pub struct Face {
 /// and 1e-4 of the mesh's size.
 pub fn planar_faces(m: &Mesh, max: usize) -> Option<Vec<Face>> {
     let diag = m.bounds().diagonal() as f64;
-    if !(diag.is_finite() && diag > 0.0) {
+    if !diag.is_finite() || diag <= 0.0 {
         return None;
     }
     let tol = 1e-4 * diag;
@@ -50,7 +50,7 @@ pub fn planar_faces(m: &Mesh, max: usize) -> Option<Vec<Face>> {
         let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
         let cross = (b - a).cross(c - a);
         let twice_area = cross.length();
-        if !(twice_area > 1e-12 * diag * diag) {
+        if twice_area.is_nan() || twice_area <= 1e-12 * diag * diag {
             continue; // degenerate: no plane of its own, lies in its neighbours'
         }
         let mut n = cross / twice_area;

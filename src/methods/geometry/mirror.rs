@@ -54,7 +54,7 @@ impl Mirror {
         if m.hidden {
             return Vec::new();
         }
-        let kind = scene.materials.get(m.material).map(|mat| mat.kind.clone());
+        let kind = scene.materials.get(m.material).map(|mat| mat.kind);
         match kind {
             Some(crate::scene::SurfaceKind::Dielectric { ior, thin: false }) => {
                 let Some(faces) = super::faces::planar_faces(m, super::faces::MAX_FACES) else { return Vec::new() };
@@ -136,7 +136,7 @@ impl Mirror {
 pub fn linearised_refraction(plane: Vec4, d: Vec3, eta: f32) -> Option<Mat4> {
     let n = plane.truncate();
     let cos_i = -n.dot(d);
-    if !(cos_i > 1e-6) || !(eta > 0.0) {
+    if cos_i.is_nan() || cos_i <= 1e-6 || eta.is_nan() || eta <= 0.0 {
         return None;
     }
     let sin2_i = (1.0 - cos_i * cos_i).max(0.0);
@@ -145,7 +145,7 @@ pub fn linearised_refraction(plane: Vec4, d: Vec3, eta: f32) -> Option<Mat4> {
         return None; // total internal reflection of the central ray
     }
     let cos_t = (1.0 - sin2_t).sqrt();
-    if !(cos_t > 1e-6) {
+    if cos_t.is_nan() || cos_t <= 1e-6 {
         return None;
     }
     let t = d / eta + (cos_i / eta - cos_t) * n;
