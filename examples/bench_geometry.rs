@@ -1,0 +1,96 @@
+//! Geometry transformation (survey §5) measured on flat-faced glass: `cargo run --release
+//! --example bench_geometry -- [SIZE] [FRAMES]` (default 256 and 5). The emissive quadrant
+//! room (no lights: nothing but geometry and Fresnel decides a pixel) with a glass slab and a
+//! glass prism of ν 1.5 seen from above at an angle, exact Fresnel. Prints, as Markdown:
+//!   1. the cost of each recursion level: `planar-refraction` at depth 1..6 (mirror_budget 64),
+//!      views rendered, GPU frame ms (median of FRAMES after one warm-up), the views' share,
+//!      PSNR against the reference at the same depth;
+//!   2. the budget at depth 4: mirror_budget 0..64 against the depth-4 reference, beside the
+//!      exact per-pixel refraction (`bvh`) and refractor maps (`refractor-map`).
+//! GPU times are lavapipe's (or the device's) timestamp queries: the build profile of this
+//! crate does not enter them.
+
+use glam::Vec3;
+use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
+use specula::vk::{Context, DeviceOptions};
+use specula::{Method, Quality};
+
+fn scene() -> specula::Result<Scene> {
+    let mut s = Scene::new();
+    let mut mats = Vec::new();
+    for w in 0..6 {
+        for q in 0..4 {
+            let c = Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32);
+            mats.push(s.add_material(Material { name: format!("w{w}q{q}"), base_color: Vec3::ZERO, emissive: c, ..Default::default() })?);
+        }
+    }
+    for m in shapes::quadrant_room(Vec3::ZERO, 2.0, 2, |w, q| mats[w * 4 + q]) {
+        s.add_mesh(m)?;
+    }
+    let ball =
+        s.add_material(Material { name: "ball".into(), base_color: Vec3::ZERO, emissive: Vec3::new(1.5, 0.8, 0.2), ..Default::default() })?;
+    s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.6, -1.5, -1.2), 0.35, 32, 16, ball))?;
+    let glass =
+        s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })?;
+    s.add_mesh(shapes::cuboid("slab", Vec3::new(-0.7, -1.6, -0.2), Vec3::new(0.6, 0.25, 0.5), glass))?;
+    let corners = [Vec3::new(0.0, 0.45, 0.0), Vec3::new(-0.4, -0.23, 0.0), Vec3::new(0.4, -0.23, 0.0)];
+    s.add_mesh(shapes::prism("prism", Vec3::new(0.6, -1.0, 0.1), Vec3::new(0.3, 0.0, 1.0).normalize(), 1.0, corners, glass))?;
+    s.camera = Some(Camera::look_at(Vec3::new(1.0, 0.8, 1.9), Vec3::new(-0.1, -1.3, -0.3), 55f32.to_radians()));
+    Ok(s)
+}
+
+fn stat(f: &specula::Frame, name: &str) -> f64 {
+    f.stats.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v)
+}
+
+fn views_ms(f: &specula::Frame) -> f64 {
+    f.passes.iter().filter(|p| p.name == "geometry.mirror_view").map(|p| p.gpu_ms).sum()
+}
+
+fn main() -> specula::Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let size: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(256);
+    let frames: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5);
+    let s = scene()?;
+    let ctx = Context::new(&DeviceOptions::default())?;
+    let quality = |depth: u32, budget: u32| -> specula::Result<Quality> {
+        let mut q = Quality { depth, spp: 1, ..Quality::default() };
+        q.set("fresnel", "exact")?;
+        q.set("mirror_budget", &budget.to_string())?;
+        Ok(q)
+    };
+    let run = |m: Method, q: &Quality| specula::render(&ctx, &s, m, q, (size, size), (1, frames));
+    let psnr = |a: &specula::image::ImageData, b: &specula::image::ImageData| specula::metrics::compare(a, b).map(|c| c.psnr);
+    println!("device: {}", ctx.device_name);
+    println!("\n#### planar-refraction per recursion level, {size}², mirror_budget 64");
+    println!("| depth | views | frame ms | views' share | PSNR vs reference (same depth) |");
+    println!("|---:|---:|---:|---:|---:|");
+    for depth in 1..=6 {
+        let q = quality(depth, 64)?;
+        let reference = specula::reference::render_reference(&s, &q, (size, size))?;
+        let f = run(specula::methods::PLANAR_REFRACTION, &q)?;
+        let share = 100.0 * views_ms(&f) / f.gpu_ms().max(1e-9);
+        println!(
+            "| {depth} | {} | {:.1} | {share:.0} % | {:.2} dB |",
+            stat(&f, "geometry.mirror_views"),
+            f.gpu_ms(),
+            psnr(&f.image, &reference)?
+        );
+    }
+    let q4 = quality(4, 8)?;
+    let reference = specula::reference::render_reference(&s, &q4, (size, size))?;
+    println!("\n#### mirror_budget at depth 4, {size}², against the depth-4 reference");
+    println!("| method | mirror_budget | views | fallbacks | frame ms | PSNR |");
+    println!("|---|---:|---:|---:|---:|---:|");
+    for budget in [0, 4, 8, 16, 32, 64] {
+        let q = quality(4, budget)?;
+        let f = run(specula::methods::PLANAR_REFRACTION, &q)?;
+        let (views, fallbacks) = (stat(&f, "geometry.mirror_views"), stat(&f, "geometry.mirror_fallbacks"));
+        println!("| planar-refraction | {budget} | {views} | {fallbacks} | {:.1} | {:.2} dB |", f.gpu_ms(), psnr(&f.image, &reference)?);
+    }
+    for m in [specula::methods::BVH, specula::methods::REFRACTOR_MAP] {
+        let f = run(m, &q4)?;
+        println!("| {} | – | – | – | {:.1} | {:.2} dB |", m.name(), f.gpu_ms(), psnr(&f.image, &reference)?);
+    }
+    Ok(())
+}
