@@ -7,6 +7,7 @@
 //!      PSNR against the reference at the same depth;
 //!   2. the budget at depth 4: mirror_budget 0..64 against the depth-4 reference, beside the
 //!      exact per-pixel refraction (`bvh`) and refractor maps (`refractor-map`).
+//!
 //! GPU times are lavapipe's (or the device's) timestamp queries: the build profile of this
 //! crate does not enter them.
 

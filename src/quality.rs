@@ -99,6 +99,8 @@ pub struct Quality {
     pub aa: Aa,
     /// `planar-mirror` (§5): the most mirrored views a frame renders.
     pub mirror_budget: u32,
+    /// Planar mirrors drawn into other objects' cube maps by their mirrored views (§5).
+    pub map_mirrors: bool,
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
@@ -591,6 +593,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| q.mirror_budget.to_string(),
     },
     Knob {
+        name: "map_mirrors",
+        values: "on|off",
+        default: "on",
+        doc: "planar mirrors (planar-mirror, §5) inside the other objects' cube maps (envmap, proxy-sphere, proxy-box, distance, distance-multi, refractor-map): per map face that sees one, the scene drawn again from the reference point mirrored through the mirror's plane (oblique near plane), masked to the mirror's pixels by the depth buffer and weighted by its Fresnel factor; one reflection deep (no mirror inside a mirror in a map), at most mirror_budget mirrors, redrawn only when the map is; off: the map shows the mirror reflecting the environment only",
+        set: |q, v| {
+            q.map_mirrors = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.map_mirrors, ON_OFF),
+    },
+    Knob {
         name: "msaa_shading",
         values: "sample|pixel",
         default: "sample",
@@ -799,6 +812,7 @@ impl Default for Quality {
             aa: Aa::Off,
             msaa_per_sample: true,
             mirror_budget: 8,
+            map_mirrors: true,
             caustics: Caustics::Triangles,
             photons: 128,
             splat_size: 2.0,

@@ -680,7 +680,8 @@ impl Renderer {
         let photons = self.plan.caustics.as_ref().map_or_else(Vec::new, |c| {
             crate::methods::caustics::photon_views(c, &self.cpu, &self.light_table, &self.plan.quality, self.plan.cube_near)
         });
-        let views = views::view_table(&self.plan, &self.views, &self.light_table, vp, self.camera.position, mirror_views, &photons);
+        let views =
+            views::view_table(&self.plan, &self.views, &self.light_table, (vp, self.camera.position), mirror_views, &photons, &self.cpu);
         self.view_eyes = views.iter().map(|v| glam::Vec3::from_slice(&v.eye[..3])).collect();
         self.view_buffer.write(bytemuck::cast_slice(&views))
     }

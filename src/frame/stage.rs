@@ -262,6 +262,9 @@ pub struct ViewLayout {
     pub envmaps: Vec<u32>,
     /// First of the planar mirrors' views (§5): view `mirrors + i` is the frame's i-th.
     pub mirrors: u32,
+    /// Per cube-mapped object (as `envmaps`), the first of its planar mirrors' mirrored
+    /// cube views: six per mirror of `plan.map_mirrors`, in that order.
+    pub map_mirrors: Vec<u32>,
     /// Caustics (§6): the first of each generator's six cube views around its reference
     /// point, and the first photon view (one per photon image layer).
     pub caustic_cubes: Vec<u32>,

@@ -163,6 +163,9 @@ pub struct Plan {
     /// (within `mirror_budget`): the layers of their views' image.
     pub mirrors: Vec<usize>,
     pub mirror_layers: u32,
+    /// Planar mirrors (§5) drawn into the other objects' cube maps by their mirrored views:
+    /// the first `mirror_budget` planar mirrors, when any object has cube maps.
+    pub map_mirrors: Vec<usize>,
     /// Caustics (§6): the generators and their lights, when the scene has caustics.
     pub caustics: Option<crate::methods::caustics::CausticsPlan>,
 }
@@ -300,6 +303,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         proxy_radius: 1.0,
         proxy_box: (Vec3::ZERO, Vec3::ZERO),
         mirrors: Vec::new(),
+        map_mirrors: Vec::new(),
         mirror_layers: 0,
         caustics: None,
     }
@@ -451,6 +455,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
         proxy_radius,
         proxy_box: (bounds.min, bounds.max),
         mirrors: Vec::new(),
+        map_mirrors: Vec::new(),
         mirror_layers: 0,
         caustics: None,
     };
@@ -608,6 +613,12 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     p.mirrors = p.objects.iter().filter(|o| geometry.contains(&o.method)).map(|o| o.mesh).collect();
     let planes = p.mirrors.iter().map(|&m| crate::methods::geometry::mirror::plane_count(scene, m)).sum();
     p.mirror_layers = crate::methods::geometry::mirror::layers_needed(planes, q.depth, q.mirror_budget);
+    // Planar mirrors inside cube maps: one mirrored view per cube face per mirror, at most
+    // mirror_budget mirrors (the rest show the environment there, as before).
+    if !p.envmaps.is_empty() && q.map_mirrors {
+        let planar = p.objects.iter().filter(|o| o.method == crate::methods::PLANAR_MIRROR).map(|o| o.mesh);
+        p.map_mirrors = planar.take(q.mirror_budget as usize).collect();
+    }
     stages.extend(maps.into_iter().map(StageSpec::Map));
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.

@@ -148,6 +148,8 @@ pub enum DepthOp {
     Nearer,
     /// Nearer or at the same depth: a second pass over the same surfaces (caustics.project).
     NearerOrEqual,
+    /// Always: a mask written into the depth buffer (planar mirrors in cube maps).
+    Always,
 }
 
 /// Colour blending of a pipeline's attachments.
@@ -157,6 +159,9 @@ pub enum Blend {
     Replace,
     /// Additive (ONE, ONE): accumulation, e.g. photon splats into a light cube map.
     Add,
+    /// Colour multiplied by the fragment's (ZERO, SRC_COLOR), alpha replaced: a planar
+    /// mirror's Fresnel weight laid over its reflection already in a cube map.
+    Multiply,
 }
 
 /// The rasteriser's samples per pixel for a pipeline.
@@ -237,6 +242,7 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
         .depth_compare_op(match desc.depth_op {
             DepthOp::Nearer => vk::CompareOp::GREATER,
             DepthOp::NearerOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
+            DepthOp::Always => vk::CompareOp::ALWAYS,
         });
     let blend: Vec<_> = desc
         .color_formats
@@ -252,6 +258,14 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
                     .color_blend_op(vk::BlendOp::ADD)
                     .src_alpha_blend_factor(vk::BlendFactor::ONE)
                     .dst_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .alpha_blend_op(vk::BlendOp::ADD),
+                Blend::Multiply => b
+                    .blend_enable(true)
+                    .src_color_blend_factor(vk::BlendFactor::ZERO)
+                    .dst_color_blend_factor(vk::BlendFactor::SRC_COLOR)
+                    .color_blend_op(vk::BlendOp::ADD)
+                    .src_alpha_blend_factor(vk::BlendFactor::ONE)
+                    .dst_alpha_blend_factor(vk::BlendFactor::ZERO)
                     .alpha_blend_op(vk::BlendOp::ADD),
             }
         })

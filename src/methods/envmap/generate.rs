@@ -39,6 +39,13 @@ pub struct CubeMaps {
     depth: Image,
     sky: vk::Pipeline,
     surface: vk::Pipeline,
+    /// Planar mirrors inside the maps (§5, `plan.map_mirrors`): the mirror's pixels marked
+    /// in depth and filled with the environment, and the mirror laid over its mirrored view
+    /// with its Fresnel weight (null without planar mirrors).
+    mirror_mask: vk::Pipeline,
+    mirror_weight: vk::Pipeline,
+    /// `plan.map_mirrors`.
+    map_mirrors: Vec<usize>,
     mode: CubeMode,
     cycles: u32,
     frame_latency: bool,
@@ -74,6 +81,9 @@ impl CubeMaps {
             depth: Image::placeholder(),
             sky: vk::Pipeline::null(),
             surface: vk::Pipeline::null(),
+            mirror_mask: vk::Pipeline::null(),
+            mirror_weight: vk::Pipeline::null(),
+            map_mirrors: plan.map_mirrors.clone(),
             mode: q.cube_mode,
             cycles: plan.cycles.max(1),
             frame_latency: plan.frame_latency && inter_object,
@@ -151,6 +161,14 @@ impl CubeMaps {
                 true,
             ),
         )?;
+        if !self.map_mirrors.is_empty() {
+            let mut mask = desc("geometry.map_mask", "scene/mesh.vert", "geometry/map_mask.frag", VertexInput::Mesh, true);
+            mask.depth_op = crate::vk::pipeline::DepthOp::Always;
+            self.mirror_mask = graphics_pipeline(ctx, layout, &mask)?;
+            let mut weight = desc("geometry.map_mirror", "scene/mesh.vert", "geometry/map_mirror.frag", VertexInput::Mesh, true);
+            weight.blend = crate::vk::pipeline::Blend::Multiply;
+            self.mirror_weight = graphics_pipeline(ctx, layout, &weight)?;
+        }
         Ok(())
     }
 
@@ -168,6 +186,22 @@ impl CubeMaps {
             MapKind::Distance => maps.distance = images,
         }
     }
+}
+
+/// Clears the depth attachment of the rendering in progress (a `size`² cube face, every
+/// view of a multiview pass) to `depth`.
+fn clear_depth(ctx: &Context, cmd: vk::CommandBuffer, size: u32, depth: f32) {
+    let attachment = vk::ClearAttachment {
+        aspect_mask: vk::ImageAspectFlags::DEPTH,
+        color_attachment: 0,
+        clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth, stencil: 0 } },
+    };
+    let rect = vk::ClearRect {
+        rect: vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: size, height: size } },
+        base_array_layer: 0,
+        layer_count: 1,
+    };
+    unsafe { ctx.device.cmd_clear_attachments(cmd, &[attachment], &[rect]) };
 }
 
 impl Stage for CubeMaps {
@@ -239,6 +273,9 @@ impl Stage for CubeMaps {
                     _ => Some(mesh),
                 };
                 let face_draws = &mut self.face_draws;
+                let map_mirrors = &self.map_mirrors;
+                let mirror_base = io.views.map_mirrors.get(io.plan.envmaps.iter().position(|e| e.mesh == mesh).unwrap_or(usize::MAX));
+                let (mirror_mask, mirror_weight, surface) = (self.mirror_mask, self.mirror_weight, self.surface);
                 render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
                     // Six passes: each face draws only the objects inside its frustum.
                     let face = (v - view) as usize;
@@ -248,14 +285,48 @@ impl Stage for CubeMaps {
                     f.bind(ctx, cmd, self.sky);
                     f.push_flags(ctx, cmd, v, 0, f.flags | flags);
                     unsafe { ctx.device.cmd_draw(cmd, 3, 1, 0, 0) };
-                    f.bind(ctx, cmd, self.surface);
+                    // Planar mirrors (§5): each mirror's pixels marked in depth, then the
+                    // scene from the mirrored reference point drawn there only (no mirror in
+                    // it: one reflection deep); the depth cleared for the map's own draws.
+                    let mirrored = mirror_base.filter(|_| !map_mirrors.is_empty());
+                    if let Some(&base) = mirrored {
+                        for (k, &mirror) in map_mirrors.iter().enumerate() {
+                            let Some(md) = f.scene.draws.iter().find(|d| d.mesh as usize == mirror).filter(|d| sees(d)) else { continue };
+                            clear_depth(ctx, cmd, target.width, 1.0);
+                            f.bind(ctx, cmd, mirror_mask);
+                            f.push_flags(ctx, cmd, v, md.mesh, f.flags | flags);
+                            unsafe { ctx.device.cmd_draw_indexed(cmd, md.index_count, 1, md.first_index, md.vertex_offset, 0) };
+                            f.bind(ctx, cmd, surface);
+                            if uses_maps {
+                                f.bind_maps(ctx, cmd, read_set);
+                            }
+                            let mv = base + 6 * k as u32 + (v - view);
+                            for d in f.scene.draws.iter().filter(|d| d.index_count > 0 && !map_mirrors.contains(&(d.mesh as usize))) {
+                                face_draws[face] += 1;
+                                f.push_flags(ctx, cmd, mv, d.mesh, f.flags | flags);
+                                unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+                            }
+                        }
+                        clear_depth(ctx, cmd, target.width, 0.0);
+                    }
+                    f.bind(ctx, cmd, surface);
                     if uses_maps {
                         f.bind_maps(ctx, cmd, read_set);
                     }
                     for d in f.scene.draws.iter().filter(|d| Some(d.mesh as usize) != skip).filter(sees) {
                         face_draws[face] += 1;
+                        let weighted = mirrored.is_some() && map_mirrors.contains(&(d.mesh as usize));
+                        if weighted {
+                            f.bind(ctx, cmd, mirror_weight);
+                        }
                         f.push_flags(ctx, cmd, v, d.mesh, f.flags | flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+                        if weighted {
+                            f.bind(ctx, cmd, surface);
+                            if uses_maps {
+                                f.bind_maps(ctx, cmd, read_set);
+                            }
+                        }
                     }
                 });
             }
@@ -271,9 +342,11 @@ impl Stage for CubeMaps {
 
     fn destroy(&mut self, ctx: &Context) {
         self.depth.destroy(ctx);
-        destroy_pipelines(ctx, &mut [self.sky, self.surface]);
+        destroy_pipelines(ctx, &mut [self.sky, self.surface, self.mirror_mask, self.mirror_weight]);
         self.sky = vk::Pipeline::null();
         self.surface = vk::Pipeline::null();
+        self.mirror_mask = vk::Pipeline::null();
+        self.mirror_weight = vk::Pipeline::null();
     }
 }
 

@@ -36,7 +36,7 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "planar reflectors by geometry transformation: the scene rendered again from the camera mirrored through the mirror's plane (oblique near plane at the mirror), laid onto the mirror's pixels with its Fresnel weight; mirrors in mirrors recurse up to depth, at most mirror_budget views a frame",
     serves: &[ObjectClass::Mirror],
-    knobs: &["depth", "mirror_budget", "fresnel"],
+    knobs: &["depth", "mirror_budget", "map_mirrors", "fresnel"],
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
