@@ -165,6 +165,7 @@ impl<'a> FrameShared<'a> {
         maps: &'b mut Maps,
         area: vk::Rect2D,
         object_flags: &'b [(usize, u32)],
+        depth_masked: bool,
     ) -> FrameIo<'b> {
         FrameIo {
             plan: self.plan,
@@ -177,6 +178,7 @@ impl<'a> FrameShared<'a> {
             scene_images: self.scene_images.clone(),
             area,
             object_flags,
+            depth_masked,
         }
     }
 }
@@ -385,7 +387,7 @@ impl Renderer {
                 self.resolve.push(Image::new(ctx, &desc)?);
             }
         }
-        self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, &mut self.maps)?;
+        self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, self.layout, &mut self.maps)?;
         // Each mirrored view records the camera's passes again (a ray pipeline is a hundred
         // passes at depth 16), and its copy.
         self.profiler = Profiler::new(ctx, MAX_PASSES * (1 + self.plan.mirror_layers))?;
@@ -718,7 +720,7 @@ impl Renderer {
             view_eyes: &self.view_eyes,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
         };
-        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &[]);
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &[], false);
         // The world's maps first.
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
             if per_view(deps) || !self.map_updates.iter().any(|u| u.stage == stage.name()) {
@@ -737,7 +739,16 @@ impl Renderer {
                 let views = ViewLayout { camera: self.views.mirrors + i as u32, ..self.views.clone() };
                 let flags = mv.child_flags(Some(i));
                 let area = crate::methods::geometry::views::render_area(v.rect);
-                let mut io = shared.io(&views, &mut mv.scratch, &mut mv.depth, &mut self.maps, area, &flags);
+                // geometry.stencil: the mirror's pixels (as its parent sees them) marked in the
+                // scratch depth; the view's passes draw there only. With MSAA the view renders
+                // its whole rectangle: an edge pixel of the mirror averages samples beyond it.
+                let masked = self.multisample.samples == 1;
+                if masked {
+                    let parent_view = v.parent.map_or(self.views.camera, |p| self.views.mirrors + p as u32);
+                    let mesh = mv.frame.mirrors[v.mirror].mesh;
+                    mv.record_stencil(&mut rec, &f, parent_view, mesh, area);
+                }
+                let mut io = shared.io(&views, &mut mv.scratch, &mut mv.depth, &mut self.maps, area, &flags, masked);
                 for (stage, _) in self.stages.iter_mut().zip(&self.deps).filter(|(_, d)| per_view(d)) {
                     stage.record(&mut rec, &f, &mut io);
                 }
@@ -749,7 +760,7 @@ impl Renderer {
             rec.scope = None;
         }
         let camera_flags = self.mirrors.as_ref().map_or_else(Vec::new, |m| m.child_flags(None));
-        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &camera_flags);
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &camera_flags, false);
         // Mirrored views re-recorded the camera-space maps from their cameras.
         let views_ran = self.mirrors.as_ref().is_some_and(|m| !m.frame.views.is_empty());
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {

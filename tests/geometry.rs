@@ -55,6 +55,8 @@ fn a_mirror_wall_is_exact_up_to_rasterisation() {
     println!("mirror wall: planar-mirror {p:.2} dB, distance {d:.2} dB");
     let names: Vec<&str> = f.passes.iter().map(|p| p.name.as_str()).collect();
     assert!(names.contains(&"geometry.mirror") && names.contains(&"geometry.mirror_view"), "{names:?}");
+    // The view draws on the mirror's pixels only: geometry.stencil marks them first.
+    assert!(names.contains(&"geometry.stencil"), "{names:?}");
     // Exact (tests/README.md rule 2): measured 155.30 dB, f32 rounding against f64.
     assert!(p >= 60.0, "planar-mirror {p:.2} dB against the reference");
     // Memory per view: one RGBA32F layer of the frame's size per view the plan may render,

@@ -99,7 +99,9 @@ impl Stage for SceneDirect {
         }
         let open = pass.begin();
         let (ctx, cmd, view) = (rec.ctx, rec.cmd, io.views.camera);
-        begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, true);
+        // A planar mirror's view keeps the depth mask geometry.stencil left (the colour is
+        // all overwritten by the sky).
+        begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, !io.depth_masked);
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);

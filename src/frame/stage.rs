@@ -297,6 +297,10 @@ pub struct FrameIo<'a> {
     /// Push flags a camera pass adds for an object in this view: (mesh, flags), e.g. which
     /// mirrored view a planar mirror shows (`FLAG_MIRROR_VIEW`).
     pub object_flags: &'a [(usize, u32)],
+    /// The depth buffer holds a mask the first pass must keep (a planar mirror's view:
+    /// `geometry.stencil` left the farthest depth on the mirror's pixels, the nearest
+    /// elsewhere, so that nothing is drawn where the view is not seen).
+    pub depth_masked: bool,
 }
 
 /// What a stage's constructor may look at.

@@ -11,9 +11,10 @@ use super::mirror::{Limits, MirrorFrame, Rect};
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
 use crate::frame::stage::Maps;
+use crate::frame::FrameInputs;
 use crate::plan::Plan;
 use crate::scene::Scene;
-use crate::vk::pipeline::Multisample;
+use crate::vk::pipeline::{graphics_pipeline, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{Access, Context, Image, ImageDesc, ImageKind, Recorder};
 use crate::Result;
 
@@ -23,6 +24,8 @@ pub struct MirrorViews {
     pub scratch: Image,
     pub depth: Image,
     samples: u32,
+    /// `geometry.stencil`: the mirror drawn from the parent view at the farthest depth.
+    mask: vk::Pipeline,
     /// This frame's views (planned when the view table is written).
     pub frame: MirrorFrame,
 }
@@ -30,7 +33,14 @@ pub struct MirrorViews {
 impl MirrorViews {
     /// The views' images for a plan with planar mirrors (`None` without): the layered
     /// image goes into `maps` (set 0, binding 9), the scratch target stays here.
-    pub fn new(ctx: &Context, plan: &Plan, size: (u32, u32), multisample: Multisample, maps: &mut Maps) -> Result<Option<MirrorViews>> {
+    pub fn new(
+        ctx: &Context,
+        plan: &Plan,
+        size: (u32, u32),
+        multisample: Multisample,
+        layout: vk::PipelineLayout,
+        maps: &mut Maps,
+    ) -> Result<Option<MirrorViews>> {
         let layers = plan.mirror_layers;
         if plan.mirrors.is_empty() || layers == 0 {
             return Ok(None);
@@ -48,6 +58,7 @@ impl MirrorViews {
             scratch: Image::placeholder(),
             depth: Image::placeholder(),
             samples,
+            mask: vk::Pipeline::null(),
             frame: MirrorFrame::default(),
         };
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -56,12 +67,30 @@ impl MirrorViews {
                 me.scratch = s;
                 let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
                 Image::new(ctx, &ImageDesc { name: "geometry.mirror_view.depth", format: DEPTH_FORMAT, width, height, kind, usage })
+            })
+            .and_then(|d| {
+                me.depth = d;
+                let formats = [TARGET_FORMAT];
+                let desc = GraphicsDesc {
+                    name: "geometry.stencil",
+                    vertex: "scene/mesh.vert",
+                    fragment: "geometry/map_mask.frag",
+                    vertex_input: VertexInput::Mesh,
+                    color_formats: &formats,
+                    depth_format: Some(DEPTH_FORMAT),
+                    depth_test: true,
+                    depth_write: true,
+                    view_mask: 0,
+                    cull: vk::CullModeFlags::NONE,
+                    multisample: Multisample { samples, per_sample: false },
+                    blend: Blend::Replace,
+                    depth_op: DepthOp::Always,
+                };
+                me.mask = graphics_pipeline(ctx, layout, &desc)?;
+                Ok(Image::placeholder())
             });
         match made {
-            Ok(d) => {
-                me.depth = d;
-                Ok(Some(me))
-            }
+            Ok(_) => Ok(Some(me)),
             Err(e) => {
                 me.destroy(ctx);
                 Err(e)
@@ -126,9 +155,38 @@ impl MirrorViews {
         rec.end(open);
     }
 
+    /// `geometry.stencil`: clears the scratch depth within `area` to the nearest depth and
+    /// draws mesh `mesh` (the view's mirror, or its refractor) from its parent's view
+    /// `parent_view` at the farthest: the view's passes then draw on the mirror's pixels
+    /// only (the depth buffer is the mask, as a stencil would be).
+    pub fn record_stencil(&mut self, rec: &mut Recorder, f: &FrameInputs, parent_view: u32, mesh: usize, area: vk::Rect2D) {
+        let open = rec
+            .pass("geometry.stencil")
+            .writes(&mut self.scratch, Access::ColorAttachment)
+            .writes(&mut self.depth, Access::DepthAttachment)
+            .begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        crate::frame::begin_camera_rendering(ctx, cmd, &self.scratch, &self.depth, area, false);
+        let attachment = vk::ClearAttachment {
+            aspect_mask: vk::ImageAspectFlags::DEPTH,
+            color_attachment: 0,
+            clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
+        };
+        let rect = vk::ClearRect { rect: area, base_array_layer: 0, layer_count: 1 };
+        unsafe { ctx.device.cmd_clear_attachments(cmd, &[attachment], &[rect]) };
+        f.bind(ctx, cmd, self.mask);
+        for d in f.scene.draws.iter().filter(|d| d.mesh as usize == mesh) {
+            f.push_flags(ctx, cmd, parent_view, d.mesh, f.flags);
+            unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+        }
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        rec.end(open);
+    }
+
     pub fn destroy(&mut self, ctx: &Context) {
         self.scratch.destroy(ctx);
         self.depth.destroy(ctx);
+        crate::frame::destroy_pipelines(ctx, &mut [self.mask]);
     }
 }
 
