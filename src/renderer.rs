@@ -165,7 +165,6 @@ impl<'a> FrameShared<'a> {
         maps: &'b mut Maps,
         area: vk::Rect2D,
         object_flags: &'b [(usize, u32)],
-        depth_masked: bool,
     ) -> FrameIo<'b> {
         FrameIo {
             plan: self.plan,
@@ -178,7 +177,7 @@ impl<'a> FrameShared<'a> {
             scene_images: self.scene_images.clone(),
             area,
             object_flags,
-            depth_masked,
+            depth_masked: false,
         }
     }
 }
@@ -720,7 +719,7 @@ impl Renderer {
             view_eyes: &self.view_eyes,
             scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
         };
-        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &[], false);
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &[]);
         // The world's maps first.
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
             if per_view(deps) || !self.map_updates.iter().any(|u| u.stage == stage.name()) {
@@ -748,7 +747,8 @@ impl Renderer {
                     let mesh = mv.frame.mirrors[v.mirror].mesh;
                     mv.record_stencil(&mut rec, &f, parent_view, mesh, area);
                 }
-                let mut io = shared.io(&views, &mut mv.scratch, &mut mv.depth, &mut self.maps, area, &flags, masked);
+                let mut io = shared.io(&views, &mut mv.scratch, &mut mv.depth, &mut self.maps, area, &flags);
+                io.depth_masked = masked;
                 for (stage, _) in self.stages.iter_mut().zip(&self.deps).filter(|(_, d)| per_view(d)) {
                     stage.record(&mut rec, &f, &mut io);
                 }
@@ -760,7 +760,7 @@ impl Renderer {
             rec.scope = None;
         }
         let camera_flags = self.mirrors.as_ref().map_or_else(Vec::new, |m| m.child_flags(None));
-        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &camera_flags, false);
+        let mut io = shared.io(&self.views, &mut self.target, &mut self.depth, &mut self.maps, full, &camera_flags);
         // Mirrored views re-recorded the camera-space maps from their cameras.
         let views_ran = self.mirrors.as_ref().is_some_and(|m| !m.frame.views.is_empty());
         for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {

@@ -160,6 +160,8 @@ impl MirrorViews {
     /// `parent_view` at the farthest: the view's passes then draw on the mirror's pixels
     /// only (the depth buffer is the mask, as a stencil would be).
     pub fn record_stencil(&mut self, rec: &mut Recorder, f: &FrameInputs, parent_view: u32, mesh: usize, area: vk::Rect2D) {
+        // Its own profiler row, not the views' scope.
+        let scope = rec.scope.take();
         let open = rec
             .pass("geometry.stencil")
             .writes(&mut self.scratch, Access::ColorAttachment)
@@ -181,6 +183,7 @@ impl MirrorViews {
         }
         unsafe { ctx.device.cmd_end_rendering(cmd) };
         rec.end(open);
+        rec.scope = scope;
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
