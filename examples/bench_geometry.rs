@@ -11,34 +11,8 @@
 //! GPU times are lavapipe's (or the device's) timestamp queries: the build profile of this
 //! crate does not enter them.
 
-use glam::Vec3;
-use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::vk::{Context, DeviceOptions};
 use specula::{Method, Quality};
-
-fn scene() -> specula::Result<Scene> {
-    let mut s = Scene::new();
-    let mut mats = Vec::new();
-    for w in 0..6 {
-        for q in 0..4 {
-            let c = Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32);
-            mats.push(s.add_material(Material { name: format!("w{w}q{q}"), base_color: Vec3::ZERO, emissive: c, ..Default::default() })?);
-        }
-    }
-    for m in shapes::quadrant_room(Vec3::ZERO, 2.0, 2, |w, q| mats[w * 4 + q]) {
-        s.add_mesh(m)?;
-    }
-    let ball =
-        s.add_material(Material { name: "ball".into(), base_color: Vec3::ZERO, emissive: Vec3::new(1.5, 0.8, 0.2), ..Default::default() })?;
-    s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.6, -1.5, -1.2), 0.35, 32, 16, ball))?;
-    let glass =
-        s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })?;
-    s.add_mesh(shapes::cuboid("slab", Vec3::new(-0.7, -1.6, -0.2), Vec3::new(0.6, 0.25, 0.5), glass))?;
-    let corners = [Vec3::new(0.0, 0.45, 0.0), Vec3::new(-0.4, -0.23, 0.0), Vec3::new(0.4, -0.23, 0.0)];
-    s.add_mesh(shapes::prism("prism", Vec3::new(0.6, -1.0, 0.1), Vec3::new(0.3, 0.0, 1.0).normalize(), 1.0, corners, glass))?;
-    s.camera = Some(Camera::look_at(Vec3::new(1.0, 0.8, 1.9), Vec3::new(-0.1, -1.3, -0.3), 55f32.to_radians()));
-    Ok(s)
-}
 
 fn stat(f: &specula::Frame, name: &str) -> f64 {
     f.stats.iter().find(|(n, _)| n == name).map_or(0.0, |(_, v)| *v)
@@ -52,7 +26,7 @@ fn main() -> specula::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let size: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(256);
     let frames: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5);
-    let s = scene()?;
+    let s = specula::scenes::flat_glass()?;
     let ctx = Context::new(&DeviceOptions::default())?;
     let quality = |depth: u32, budget: u32| -> specula::Result<Quality> {
         let mut q = Quality { depth, spp: 1, ..Quality::default() };

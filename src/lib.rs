@@ -3,6 +3,7 @@
 
 pub mod error;
 pub mod scene;
+pub mod scenes;
 
 pub use error::{Error, Result};
 pub mod cube;

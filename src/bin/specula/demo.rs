@@ -68,6 +68,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     // mirrors mirrored, the sphere ray traced), by planar-mirror for every mirror it serves
     // and by distance maps, against the reference.
     report += &mirrors(&ctx, &outdir.join("mirrors"), (w, h), &q)?;
+    report += &flat_glass(&ctx, &outdir.join("glass"), (w, h), &q)?;
     print!("{report}");
     let table = outdir.join("timings.txt");
     specula::output::write_file(&table, report.as_bytes())?;
@@ -109,6 +110,36 @@ fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Qu
         let e = specula::metrics::compare(&frame.image, &reference)?;
         let views = frame.stats.iter().find(|(n, _)| n == "geometry.mirror_views").map_or(0.0, |(_, v)| *v);
         report += &format!("-- {name}: {:.2} ms, {views} mirrored view(s), {e}\n", frame.gpu_ms());
+        report += &specula::profile::table(&frame.passes, &frame.memory);
+    }
+    Ok(report)
+}
+
+/// Flat glass (`specula::scenes::flat_glass`, survey §5): the reference, planar-refraction
+/// at mirror_budget 8 and 64, refractor-map and bvh, with their errors and pass tables.
+fn flat_glass(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Quality) -> specula::Result<String> {
+    let scene = specula::scenes::flat_glass()?;
+    std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
+    let mut report = format!("\n== flat glass (survey §5): a slab and a prism of ν 1.5 at {w}x{h}\n");
+    let mut q = q.clone();
+    q.depth = 4;
+    let (reference, ref_ms) = render_reference(&scene, &q, (w, h))?;
+    write_image(&outdir.join("reference.png"), &reference)?;
+    report += &format!("reference (depth 4): {ref_ms:.0} ms CPU\n");
+    let runs = [
+        ("planar-refraction", specula::methods::PLANAR_REFRACTION, 8),
+        ("planar-refraction-64", specula::methods::PLANAR_REFRACTION, 64),
+        ("refractor-map", specula::methods::REFRACTOR_MAP, 8),
+        ("bvh", specula::methods::BVH, 8),
+    ];
+    for (name, method, budget) in runs {
+        let mut qm = q.clone();
+        qm.mirror_budget = budget;
+        let frame = specula::render(ctx, &scene, method, &qm, (w, h), (1, 3))?;
+        write_image(&outdir.join(format!("{name}.png")), &frame.image)?;
+        let e = specula::metrics::compare(&frame.image, &reference)?;
+        let views = frame.stats.iter().find(|(n, _)| n == "geometry.mirror_views").map_or(0.0, |(_, v)| *v);
+        report += &format!("-- {name} (mirror_budget {budget}): {:.2} ms, {views} view(s), {e}\n", frame.gpu_ms());
         report += &specula::profile::table(&frame.passes, &frame.memory);
     }
     Ok(report)
