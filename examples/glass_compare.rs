@@ -11,16 +11,7 @@ fn main() -> specula::Result<()> {
     let out = args.get(1).cloned().unwrap_or_else(|| "glass_compare.png".into());
     let ior: f32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(1.5);
     let mut s = Scene::new();
-    let mut mats = Vec::new();
-    for w in 0..6 {
-        for q in 0..4 {
-            let c = Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32);
-            mats.push(s.add_material(Material { name: format!("w{w}q{q}"), base_color: Vec3::ZERO, emissive: c, ..Default::default() })?);
-        }
-    }
-    for m in shapes::quadrant_room(Vec3::new(0.0, 2.0, 0.0), 2.0, 2, |w, q| mats[w * 4 + q]) {
-        s.add_mesh(m)?;
-    }
+    specula::scenes::emissive_room(&mut s, Vec3::new(0.0, 2.0, 0.0), 2.0)?;
     let g = s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() })?;
     s.add_mesh(shapes::uv_sphere("glass", Vec3::new(0.0, 1.5, 0.0), 0.6, 96, 48, g))?;
     s.camera = Some(Camera::look_at(Vec3::new(0.3, 1.8, 1.9), Vec3::new(0.0, 1.5, 0.0), 40f32.to_radians()));

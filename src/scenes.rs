@@ -6,22 +6,34 @@ use glam::Vec3;
 use crate::error::Result;
 use crate::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 
+/// The emitted colour of quadrant `q` of wall `w` of `emissive_room`: distinct for all 24.
+pub fn quadrant_color(w: usize, q: usize) -> Vec3 {
+    Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32)
+}
+
+/// A room of 24 emissive quadrants (`shapes::quadrant_room`, no lights) of half-size `half`
+/// around `center`.
+pub fn emissive_room(scene: &mut Scene, center: Vec3, half: f32) -> Result<()> {
+    let mut mats = [[0usize; 4]; 6];
+    for (w, row) in mats.iter_mut().enumerate() {
+        for (q, m) in row.iter_mut().enumerate() {
+            let name = format!("w{w}q{q}");
+            *m = scene.add_material(Material { name, base_color: Vec3::ZERO, emissive: quadrant_color(w, q), ..Default::default() })?;
+        }
+    }
+    for mesh in shapes::quadrant_room(center, half, 2, |w, q| mats[w][q]) {
+        scene.add_mesh(mesh)?;
+    }
+    Ok(())
+}
+
 /// Flat glass (survey §5, `planar-refraction`'s showcase): the emissive quadrant room of
 /// half-size 2 m (24 distinct colours, no lights: nothing but geometry and Fresnel decides a
 /// pixel), an emissive ball, a glass slab (6 faces) and a glass prism (5 faces) of ν 1.5,
 /// seen from above at an angle.
 pub fn flat_glass() -> Result<Scene> {
     let mut s = Scene::new();
-    let mut mats = Vec::new();
-    for w in 0..6 {
-        for q in 0..4 {
-            let c = Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32);
-            mats.push(s.add_material(Material { name: format!("w{w}q{q}"), base_color: Vec3::ZERO, emissive: c, ..Default::default() })?);
-        }
-    }
-    for m in shapes::quadrant_room(Vec3::ZERO, 2.0, 2, |w, q| mats[w * 4 + q]) {
-        s.add_mesh(m)?;
-    }
+    emissive_room(&mut s, Vec3::ZERO, 2.0)?;
     let ball =
         s.add_material(Material { name: "ball".into(), base_color: Vec3::ZERO, emissive: Vec3::new(1.5, 0.8, 0.2), ..Default::default() })?;
     s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.6, -1.5, -1.2), 0.35, 32, 16, ball))?;

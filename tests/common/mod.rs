@@ -47,27 +47,12 @@ pub fn assert_clean(ctx: &Context) {
 
 /// The emitted colour of quadrant `q` of wall `w` in `quadrant_room`: distinct for all 24.
 pub fn quadrant_color(w: usize, q: usize) -> Vec3 {
-    Vec3::new((w + 1) as f32 / 8.0, (q + 1) as f32 / 8.0, 0.25 + 0.5 * ((w + q) % 2) as f32)
+    specula::scenes::quadrant_color(w, q)
 }
 
 /// A room of 24 emissive quadrants (no lights) of half-size `half` around `center`.
 pub fn emissive_room(scene: &mut Scene, center: Vec3, half: f32) {
-    let mut mats = vec![vec![0; 4]; 6];
-    for (w, row) in mats.iter_mut().enumerate() {
-        for (q, m) in row.iter_mut().enumerate() {
-            *m = scene
-                .add_material(Material {
-                    name: format!("w{w}q{q}"),
-                    base_color: Vec3::ZERO,
-                    emissive: quadrant_color(w, q),
-                    ..Default::default()
-                })
-                .unwrap();
-        }
-    }
-    for mesh in shapes::quadrant_room(center, half, 2, |w, q| mats[w][q]) {
-        scene.add_mesh(mesh).unwrap();
-    }
+    specula::scenes::emissive_room(scene, center, half).unwrap()
 }
 
 /// A mirror material of reflectance `f0` at normal incidence (κ = 0, ν from eq. 2).
