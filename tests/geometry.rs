@@ -375,6 +375,8 @@ fn a_thin_pane_is_exact() {
         let q = quality(3);
         let plan = specula::plan(&s, specula::methods::PLANAR_REFRACTION, &q);
         assert_eq!(plan.objects[0].method, specula::methods::PLANAR_REFRACTION, "a planar pane is served");
+        let auto = specula::plan(&s, specula::Choice::Auto, &q);
+        assert_eq!(auto.objects[0].method, specula::methods::PLANAR_REFRACTION, "{}", auto.objects[0].reason);
         let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
         let f = gpu(&ctx, &s, specula::methods::PLANAR_REFRACTION, &q);
         let p = psnr(&f.image, &reference);

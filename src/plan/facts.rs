@@ -37,9 +37,9 @@ pub struct ObjectFacts {
     /// scene's bounding box (1: the environment is a box room with nothing in it, and the
     /// proxy box of §3.2 is exact). 0 without deep facts.
     pub box_fraction: f32,
-    /// A planar mirror covers at least `MIN_COVERAGE` of its directions: cube maps show
-    /// planar mirrors as the environment (their mirrored views are the camera's), so such
-    /// an object needs rays to see the mirror's reflection.
+    /// A planar mirror or thin pane covers at least `MIN_COVERAGE` of its directions: cube
+    /// maps show a planar mirror one reflection deep and a pane reflecting and transmitting
+    /// the environment only, so such an object needs rays to see them exactly.
     pub sees_planar_mirror: bool,
     /// Area fraction of the surface whose normal faces the reference point (0: convex
     /// around it; a concave mirror that reflects itself, such as a bowl, faces it).
@@ -452,7 +452,9 @@ impl SceneFacts {
             })
             .collect::<Vec<ObjectFacts>>();
         let mut objects = objects;
-        let planar_mirrors: Vec<usize> = objects.iter().filter(|o| o.planar && o.class == ObjectClass::Mirror).map(|o| o.mesh).collect();
+        // Planar mirrors and planar thin panes: what the planner serves by planar views.
+        let planar_mirrors: Vec<usize> =
+            objects.iter().filter(|o| o.planar && o.class != ObjectClass::SolidDielectric).map(|o| o.mesh).collect();
         for o in &mut objects {
             o.sees_planar_mirror = planar_mirrors.iter().any(|&m| m != o.mesh && o.sees(m));
         }

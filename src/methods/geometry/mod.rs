@@ -71,5 +71,12 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
-    rule: |_, _| None,
+    rule: |f, _| {
+        // A solid's linearisation and its deep internal paths lose to refractor maps and ray
+        // tracing on the measured scenes (BENCHMARKS.md): only the pane, exact, is taken.
+        (f.class == ObjectClass::ThinDielectric && f.planar).then(|| Verdict {
+            score: 5.0,
+            reason: "planar thin pane: exact by its reflected and transmitted views (§5; two views, tests/geometry.rs: 154 dB)".into(),
+        })
+    },
 });

@@ -88,7 +88,7 @@ fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
     if f.sees_planar_mirror && !f.planar {
         return Some(Verdict {
             score: 4.5,
-            reason: "sees a planar mirror, which cube maps show as the environment: exact ray tracing through a BVH (tests/geometry.rs: 46 vs 30 dB)".into(),
+            reason: "sees a planar mirror or pane, which cube maps show one reflection deep (a pane: the environment only): exact ray tracing through a BVH (tests/geometry.rs: 46 vs 31 dB)".into(),
         });
     }
     if f.class == ObjectClass::SolidDielectric && f.visible_fraction < 0.9 {
