@@ -68,7 +68,7 @@
 /* planar-mirror (§5) */
 #define SPECULA_METHOD_PLANAR_MIRROR 12
 /* planar-refraction (§5) */
-#define SPECULA_METHOD_PLANAR_REFRACTION 15
+#define SPECULA_METHOD_PLANAR_REFRACTION 14
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

@@ -86,6 +86,86 @@ pub fn pixel_errors(test: &ImageData, reference: &ImageData) -> Result<(f64, f64
     Ok((rmse, psnr, max, p99))
 }
 
+/// An error restricted to a set of pixels (issue 15: the error where a method acts).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MaskedError {
+    /// What the pixels are: an object's name, "specular" or "non-specular".
+    pub name: String,
+    pub pixels: usize,
+    pub psnr: f64,
+    pub rmse: f64,
+}
+
+/// PSNR and RMSE of `test` against `reference` over the pixels where `mask` holds
+/// (`None` without pixels).
+pub fn masked_error(test: &ImageData, reference: &ImageData, mask: &[bool], name: &str) -> Result<Option<MaskedError>> {
+    check_same_size(test, reference)?;
+    let pixels = (test.width * test.height) as usize;
+    if mask.len() != pixels {
+        return Err(Error::invalid("mask", format!("{} pixels for a {}x{} image", mask.len(), test.width, test.height)));
+    }
+    let diffs = abs_differences(test, reference);
+    let (mut sum, mut n) = (0.0f64, 0usize);
+    for (k, d) in diffs.chunks_exact(3).enumerate() {
+        if mask[k] {
+            sum += d.iter().map(|d| d * d).sum::<f64>();
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return Ok(None);
+    }
+    let mse = sum / (3 * n) as f64;
+    let psnr = if mse == 0.0 { f64::INFINITY } else { -10.0 * mse.log10() };
+    Ok(Some(MaskedError { name: name.to_string(), pixels: n, psnr, rmse: mse.sqrt() }))
+}
+
+/// The errors on each specular object's pixels, on all specular pixels and on the rest,
+/// from the reference's first-hit ids (`reference::object_ids`: mesh + 1, 0 the sky, which
+/// counts as non-specular). `specular[m]` and `names[m]` describe mesh m.
+pub fn errors_by_object(
+    test: &ImageData,
+    reference: &ImageData,
+    ids: &[u32],
+    specular: &[bool],
+    names: &[String],
+) -> Result<Vec<MaskedError>> {
+    let is_specular = |id: u32| id > 0 && specular.get(id as usize - 1).copied().unwrap_or(false);
+    let mut out = Vec::new();
+    for (m, name) in names.iter().enumerate().filter(|(m, _)| specular[*m]) {
+        let mask: Vec<bool> = ids.iter().map(|&id| id == m as u32 + 1).collect();
+        out.extend(masked_error(test, reference, &mask, name)?);
+    }
+    let mask: Vec<bool> = ids.iter().map(|&id| is_specular(id)).collect();
+    out.extend(masked_error(test, reference, &mask, "specular")?);
+    let rest: Vec<bool> = mask.iter().map(|s| !s).collect();
+    out.extend(masked_error(test, reference, &rest, "non-specular")?);
+    Ok(out)
+}
+
+/// The fraction of pixels whose ids agree, over the pixels of `b` that are not on an edge
+/// (a pixel whose 3×3 neighbourhood in `b` holds one id only), and that count.
+pub fn id_agreement(a: &[u32], b: &[u32], width: u32, height: u32) -> (f64, usize) {
+    let (w, h) = (width as i64, height as i64);
+    let (mut same, mut n) = (0usize, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let id = b[(y * w + x) as usize];
+            let interior = (-1..=1).all(|dy| {
+                (-1..=1).all(|dx| {
+                    let (u, v) = (x + dx, y + dy);
+                    u < 0 || v < 0 || u >= w || v >= h || b[(v * w + u) as usize] == id
+                })
+            });
+            if interior {
+                n += 1;
+                same += (a[(y * w + x) as usize] == id) as usize;
+            }
+        }
+    }
+    (if n == 0 { 1.0 } else { same as f64 / n as f64 }, n)
+}
+
 /// The 8-bit sRGB RGB triples the PNG output would hold.
 fn srgb8(img: &ImageData) -> Vec<u8> {
     let c = img.channels as usize;

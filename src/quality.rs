@@ -101,6 +101,8 @@ pub struct Quality {
     pub mirror_budget: u32,
     /// Planar mirrors drawn into other objects' cube maps by their mirrored views (§5).
     pub map_mirrors: bool,
+    /// Debug output: each pixel's first-hit object beside the colour (`Frame::object_ids`).
+    pub object_ids: bool,
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
@@ -604,6 +606,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.map_mirrors, ON_OFF),
     },
     Knob {
+        name: "object_ids",
+        values: "on|off",
+        default: "off",
+        doc: "debug output (issue 15's masks): each frame also rasterises every object's mesh index + 1 (0: the sky) from the camera at the output size (pass frame.object_ids) and reads it back beside the colour, so that errors can be measured on one object's pixels, on the specular ones or on the rest; off: no pass, no image",
+        set: |q, v| {
+            q.object_ids = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.object_ids, ON_OFF),
+    },
+    Knob {
         name: "msaa_shading",
         values: "sample|pixel",
         default: "sample",
@@ -813,6 +826,7 @@ impl Default for Quality {
             msaa_per_sample: true,
             mirror_budget: 8,
             map_mirrors: true,
+            object_ids: false,
             caustics: Caustics::Triangles,
             photons: 128,
             splat_size: 2.0,

@@ -42,6 +42,9 @@ pub struct Frame {
     pub stats: Vec<(String, f64)>,
     /// The maps this frame regenerated, and why (a map not listed was kept).
     pub map_updates: Vec<MapUpdate>,
+    /// With `object_ids=on` (a debug output): each pixel's first-hit object from the
+    /// camera, mesh index + 1 (0: the sky), row by row from the top.
+    pub object_ids: Option<Vec<u32>>,
 }
 
 /// A map stage the frame recorded, and why: its first frame, `map_updates=always`, or what
@@ -144,6 +147,8 @@ pub struct Renderer {
     resolve: Vec<Image>,
     /// Planar mirrors' views (§5), when the plan has planar mirrors.
     mirrors: Option<MirrorViews>,
+    /// `frame.object_ids`, with `object_ids=on`.
+    ids: Option<crate::frame::ids::ObjectIds>,
 }
 
 /// The frame-wide part of what stages see, built once a frame; `io` adds one view's target.
@@ -299,6 +304,7 @@ impl Renderer {
             multisample,
             resolve: Vec::new(),
             mirrors: None,
+            ids: None,
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -385,6 +391,9 @@ impl Renderer {
                     ImageDesc { name, format: TARGET_FORMAT, width: self.width * f, height: self.height * f, kind: ImageKind::D2, usage };
                 self.resolve.push(Image::new(ctx, &desc)?);
             }
+        }
+        if self.plan.quality.object_ids {
+            self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.layout, self.width, self.height)?);
         }
         self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, self.layout, &mut self.maps)?;
         // Each mirrored view records the camera's passes again (a ray pipeline is a hundred
@@ -808,6 +817,9 @@ impl Renderer {
             unsafe { ctx.device.cmd_blit_image(cmd, src.raw, s, dst.raw, d, &[region], vk::Filter::LINEAR) };
             rec.end(open);
         }
+        if let Some(ids) = self.ids.as_mut() {
+            ids.record(&mut rec, &f, self.views.camera);
+        }
         if let Some(rb) = &self.readback {
             let out = self.resolve.last().unwrap_or(&self.target);
             let open = rec.pass("frame.readback").reads(out, Access::TransferSrc).begin();
@@ -886,7 +898,8 @@ impl Renderer {
             stats.push(("geometry.mirror_view_bytes".into(), view as f64));
             stats.push(("geometry.mirror_scratch_bytes".into(), scratch as f64));
         }
-        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates: self.map_updates.clone() })
+        let object_ids = self.ids.as_ref().map(|i| i.read()).transpose()?;
+        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates: self.map_updates.clone(), object_ids })
     }
 
     /// Frees everything. The GPU must be idle with respect to this renderer's frames.
@@ -899,6 +912,9 @@ impl Renderer {
             m.destroy(ctx);
         }
         self.mirrors = None;
+        if let Some(mut i) = self.ids.take() {
+            crate::vk::Owner::destroy(&mut i, ctx);
+        }
         self.maps.destroy(ctx);
         self.target.destroy(ctx);
         self.depth.destroy(ctx);

@@ -6,6 +6,7 @@
 
 pub mod camera;
 pub mod direct;
+pub mod ids;
 pub mod layout;
 pub mod output;
 pub mod shadow;

@@ -293,6 +293,30 @@ pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32,
     Ok(ImageData { width, height, layers: 1, channels: 4, data })
 }
 
+/// Each pixel's first-hit object from the camera (issue 15's masks): its mesh index + 1,
+/// 0 where the ray through the pixel's centre meets nothing (the sky). The same rays as
+/// `render_reference`'s single sample; hidden objects are hit by no ray.
+pub fn object_ids(scene: &Scene, (width, height): (u32, u32)) -> Result<Vec<u32>> {
+    if width == 0 || height == 0 || width > 16384 || height > 16384 {
+        return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
+    }
+    scene.validate()?;
+    let camera = scene.camera_or_default();
+    camera.validate()?;
+    let bvh = Bvh::new(scene);
+    let rays = CameraRays::new(&camera, width, height);
+    let mut ids = vec![0u32; (width * height) as usize];
+    ids.par_chunks_mut(width as usize).enumerate().for_each(|(y, row)| {
+        for (x, id) in row.iter_mut().enumerate() {
+            let (o, d, t_min) = rays.ray(x as f64 + 0.5, y as f64 + 0.5);
+            if let Some(hit) = bvh.intersect(o, d, t_min, f64::INFINITY, None) {
+                *id = bvh.triangles[hit.triangle as usize].mesh + 1;
+            }
+        }
+    });
+    Ok(ids)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -62,7 +62,7 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
 
 pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     name: "planar-refraction",
-    abi: 15,
+    abi: 14,
     section: "§5",
     family: "geometry",
     summary: "flat-faced dielectrics (slabs, prisms, gems; convex) and thin panes by geometry transformation: per face seen, the scene rendered through it by the linearised refraction of the eye ray (GS04: an affine map per face, exact on the face's central ray; exact for thin panes) and reflected in it (exact), recursing through internal reflections to the exit faces up to depth, at most mirror_budget views a frame, with the pixel's own Fresnel split",

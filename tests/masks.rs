@@ -1,0 +1,78 @@
+//! Issue 15's masks: every GPU frame can write each pixel's first-hit object beside the
+//! colour (`object_ids=on`, off by default and then costing nothing), the CPU reference
+//! writes the same from its first hits, and errors are measured where a method acts: per
+//! specular object, on all specular pixels and on the rest.
+
+mod common;
+
+use specula::Quality;
+
+const SIZE: (u32, u32) = (72, 54);
+
+fn demo() -> specula::Scene {
+    specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
+}
+
+#[test]
+fn gpu_and_reference_ids_agree_and_cost_nothing_when_off() {
+    let ctx = common::gpu();
+    let scene = demo();
+    let q = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+    let off = specula::render(&ctx, &scene, specula::Choice::Auto, &q, SIZE, (0, 1)).unwrap();
+    assert!(off.object_ids.is_none());
+    assert!(off.passes.iter().all(|p| p.name != "frame.object_ids"), "no pass when off");
+    assert!(off.memory.iter().all(|(n, _)| !n.starts_with("frame.object_ids")), "no image when off: {:?}", off.memory);
+    let mut on = q.clone();
+    on.set("object_ids", "on").unwrap();
+    let f = specula::render(&ctx, &scene, specula::Choice::Auto, &on, SIZE, (0, 1)).unwrap();
+    assert_eq!(f.image.data, off.image.data, "the ids change nothing in the colour");
+    let gpu = f.object_ids.expect("ids when on");
+    let reference = specula::reference::object_ids(&scene, SIZE).unwrap();
+    assert_eq!(gpu.len(), (SIZE.0 * SIZE.1) as usize);
+    let (agree, interior) = specula::metrics::id_agreement(&gpu, &reference, SIZE.0, SIZE.1);
+    let objects: std::collections::BTreeSet<u32> = reference.iter().copied().collect();
+    println!("ids: {:.4} of {interior} interior pixels agree; {} objects seen", agree, objects.len());
+    // Measured: every interior pixel (1.0000 of 3330); the issue asks for 99 %.
+    assert!(agree >= 0.99, "{agree}");
+    assert!(objects.len() >= 4, "{objects:?}");
+    common::assert_clean(&ctx);
+}
+
+/// The error split by the masks: with caustics off (they are cast through each method's
+/// own maps) two specular methods render the non-specular pixels to the same bits, so the
+/// split isolates what the method changes; on the specular pixels the environment map (no
+/// parallax) is worse than distance maps.
+#[test]
+fn errors_split_by_object() {
+    let ctx = common::gpu();
+    let scene = demo();
+    let mut q = Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() };
+    q.set("caustics", "off").unwrap();
+    let reference = specula::reference::render_reference(&scene, &q, SIZE).unwrap();
+    let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
+    let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();
+    let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
+    let mut split = Vec::new();
+    for m in [specula::methods::ENVMAP, specula::methods::DISTANCE] {
+        let f = specula::render(&ctx, &scene, m, &q, SIZE, (0, 1)).unwrap();
+        let e = specula::metrics::errors_by_object(&f.image, &reference, &ids, &specular, &names).unwrap();
+        for x in &e {
+            println!("{}: {} on {} pixels: {:.2} dB", m.name(), x.name, x.pixels, x.psnr);
+        }
+        split.push(e);
+    }
+    let get = |k: usize, name: &str| split[k].iter().find(|e| e.name == name).unwrap_or_else(|| panic!("{name}")).psnr;
+    assert!(split[0].len() >= 4, "two spheres, the specular pixels, the rest: {:?}", split[0]);
+    assert_eq!(get(0, "non-specular"), get(1, "non-specular"), "the rest does not depend on the specular method");
+    let (envmap, distance) = (get(0, "specular"), get(1, "specular"));
+    println!("specular pixels: envmap {envmap:.2} dB, distance {distance:.2} dB");
+    // Measured 9.53 vs 8.95 dB (the mirror's reflection of the blown-out light dominates
+    // both: issue 15's shared term): the 0.58 dB margin asserted at half (rule 1).
+    assert!(distance >= envmap + 0.29, "{distance:.2} vs {envmap:.2}");
+    // The masks partition the image: the objects' pixels add up to the specular ones.
+    let count = |name: &str| split[0].iter().find(|e| e.name == name).unwrap().pixels;
+    let objects: usize = split[0].iter().filter(|e| e.name != "specular" && e.name != "non-specular").map(|e| e.pixels).sum();
+    assert_eq!(objects, count("specular"));
+    assert_eq!(count("specular") + count("non-specular"), (SIZE.0 * SIZE.1) as usize);
+    common::assert_clean(&ctx);
+}
