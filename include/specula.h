@@ -67,6 +67,8 @@
 #define SPECULA_METHOD_RAY_HIERARCHY 11
 /* planar-mirror (§5) */
 #define SPECULA_METHOD_PLANAR_MIRROR 12
+/* curved-reflector (§5) */
+#define SPECULA_METHOD_CURVED_REFLECTOR 15
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

@@ -99,6 +99,12 @@ pub struct Quality {
     pub aa: Aa,
     /// `planar-mirror` (§5): the most mirrored views a frame renders.
     pub mirror_budget: u32,
+    /// `curved-reflector` (§5): edge of each reflector's geometry image, texels.
+    pub geometry_image: u32,
+    /// `curved-reflector`: coarse-to-fine levels of the reflection-point search.
+    pub curved_search: u32,
+    /// `curved-reflector`: each environment triangle is split into this many² triangles.
+    pub tessellation: u32,
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
@@ -591,6 +597,39 @@ pub const KNOBS: &[Knob] = &[
         get: |q| q.mirror_budget.to_string(),
     },
     Knob {
+        name: "geometry_image",
+        values: "8..=1024 texels",
+        default: "128",
+        doc: "curved-reflector (§5, EMD*05): edge of each reflector's geometry image (world positions and normals rasterised over its UV parameterisation, or a planar projection where it has none): the reflection points' sampling",
+        set: |q, v| {
+            q.geometry_image = count(v, 8, 1024)?;
+            Ok(())
+        },
+        get: |q| q.geometry_image.to_string(),
+    },
+    Knob {
+        name: "curved_search",
+        values: "0..=8 levels",
+        default: "3",
+        doc: "curved-reflector: coarse-to-fine levels of each vertex's reflection-point search in the geometry image: the coarsest level (every 2^levels-th texel) is searched exhaustively, each finer one in a 5×5 window around the last best, then a sub-texel refinement; 0: exhaustive at full resolution (slowest, finds the global minimum of the sampled image)",
+        set: |q, v| {
+            q.curved_search = count(v, 0, 8)?;
+            Ok(())
+        },
+        get: |q| q.curved_search.to_string(),
+    },
+    Knob {
+        name: "tessellation",
+        values: "1..=32 subdivisions",
+        default: "4",
+        doc: "curved-reflector: each environment triangle is split into tessellation² triangles before its vertices are moved to their virtual positions (survey Table 1: geometry transformation needs high tessellation, since the reflection of a straight edge in a curved mirror is curved)",
+        set: |q, v| {
+            q.tessellation = count(v, 1, 32)?;
+            Ok(())
+        },
+        get: |q| q.tessellation.to_string(),
+    },
+    Knob {
         name: "msaa_shading",
         values: "sample|pixel",
         default: "sample",
@@ -799,6 +838,9 @@ impl Default for Quality {
             aa: Aa::Off,
             msaa_per_sample: true,
             mirror_budget: 8,
+            geometry_image: 128,
+            curved_search: 3,
+            tessellation: 4,
             caustics: Caustics::Triangles,
             photons: 128,
             splat_size: 2.0,

@@ -214,6 +214,30 @@ gpu_structs! {
         layer_triangles: uint,
     }
 
+    /// One environment vertex of curved reflectors (survey §5, EMDT06): the scene's
+    /// triangles, subdivided `tessellation`² times, in world space.
+    struct GpuCurvedVertex => struct CurvedVertex {
+        /// xyz; w: unused
+        position: vec4,
+        /// xyz; w: unused
+        normal: vec4,
+        /// xy texture coordinates; zw: unused
+        uv: vec4,
+    }
+
+    /// What the curved-reflector passes share (survey §5, EMD*05/EMDT06).
+    struct GpuCurvedParams => struct CurvedParams {
+        /// environment vertices (one virtual vertex each per reflector)
+        vertex_count: uint,
+        /// edge of each reflector's geometry image (texels)
+        image_size: uint,
+        /// coarse-to-fine levels of the reflection-point search: the coarsest is searched
+        /// exhaustively at a stride of 2^levels texels
+        search_levels: uint,
+        /// reflectors (layers of the geometry images and of the virtual images)
+        reflector_count: uint,
+    }
+
     /// Push constants of every scene-drawing shader.
     struct Push => push_constant Push push {
         /// first view of this draw (multiview adds gl_ViewIndex)
@@ -305,6 +329,18 @@ gpu_consts! {
     /// `Push.flags`: a dielectric hit in the layered maps follows only its stronger Fresnel
     /// branch (`layered_branches=strongest`).
     FLAG_LAYERED_STRONGEST: uint = 4096;
+
+    /// Curved reflectors (§5): `Push.flags >> CURVED_REFLECTOR_SHIFT` is the reflector's layer
+    /// in the geometry and virtual images (the `geometry.curved` and `geometry.virtual` draws).
+    CURVED_REFLECTOR_SHIFT: uint = 16;
+    /// Curved reflectors: a virtual vertex is kept when the angle between the normal at its
+    /// reflection point and the bisector of the directions to the eye and to the vertex has a
+    /// cosine above this (else its reflection point lies off the reflector's silhouette or
+    /// rim, and its virtual triangles are dropped).
+    CURVED_MIN_COS: float = 0.98;
+    /// Curved reflectors: a reflector pixel its virtual image leaves uncovered takes the
+    /// nearest covered pixel within this many pixels (the holes at its silhouette and rim).
+    CURVED_FILL: int = 2;
 
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
     RAY_NO_TRIANGLE: uint = 4294967295;
@@ -431,5 +467,24 @@ descriptor_sets! {
         /// The ray hierarchy's culling counts (with the ray_stats knob): per bounce and
         /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
         CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
+    }
+
+    /// Curved reflectors by geometry transformation (survey §5, EMD*05/EMDT06), set 4 of
+    /// the `geometry.*` passes of `curved-reflector`.
+    CURVED_BINDINGS = set 4 {
+        /// The reflectors' geometry images, one layer each: xyz world position, w 1 where the
+        /// parameterisation covers the texel (0: empty)
+        GEOMETRY_POSITIONS = 0: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray geometry_positions";
+        /// xyz the interpolated unit normal (w unused)
+        GEOMETRY_NORMALS = 1: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray geometry_normals";
+        /// The environment's vertices (tessellated), in world space
+        CURVED_VERTICES = 2: STORAGE_BUFFER => "readonly buffer CurvedVertices { CurvedVertex curved_vertices[]; }";
+        /// Per reflector k and environment vertex i, entry k · vertex_count + i: xyz its
+        /// virtual position, w 1 when it has a reflection point on the reflector (else 0)
+        VIRTUAL_VERTICES = 3: STORAGE_BUFFER => "buffer VirtualVertices { vec4 virtual_vertices[]; }";
+        CURVED = 4: STORAGE_BUFFER => "readonly buffer Curved { CurvedParams curved; }";
+        /// The virtual objects drawn for each reflector from the camera, one layer each: rgb
+        /// radiance, a 1 where a virtual object covers the pixel
+        VIRTUAL_IMAGES = 5: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray virtual_images";
     }
 }

@@ -157,6 +157,9 @@ pub enum Shape {
     Any,
     /// All vertices on one plane, normals agreeing (`ObjectFacts::planar`).
     Planar,
+    /// Convex or concave (or flat), not saddle-shaped (`ObjectFacts::curvature`): where a
+    /// search on the reflector's surface finds one reflection point (survey §5).
+    ConvexOrConcave,
 }
 
 impl Shape {
@@ -164,6 +167,25 @@ impl Shape {
         match self {
             Shape::Any => true,
             Shape::Planar => f.planar,
+            Shape::ConvexOrConcave => f.curvature != crate::plan::facts::Curvature::Saddle,
+        }
+    }
+
+    /// What the shape requires, and why an object that misses it was refused.
+    pub fn requirement(self) -> &'static str {
+        match self {
+            Shape::Any => "any shape",
+            Shape::Planar => "planar reflectors only: the mesh's vertices do not lie on one plane with agreeing normals",
+            Shape::ConvexOrConcave => "convex or concave reflectors only: the mesh is saddle-shaped (neither convex nor concave), where the reflection-point search has several minima (survey §5): unsupported",
+        }
+    }
+
+    /// An object of this class that misses the shape, as the planner's reasons name it.
+    pub fn misfit(self) -> &'static str {
+        match self {
+            Shape::Any => "a",
+            Shape::Planar => "a non-planar",
+            Shape::ConvexOrConcave => "a saddle-shaped (neither convex nor concave, unsupported)",
         }
     }
 }

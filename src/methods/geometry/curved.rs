@@ -1,0 +1,703 @@
+//! Curved reflectors by geometry transformation (survey §5, EMD*05, EMDT06, RHS06). Each
+//! reflector is sampled once into a geometry image — world positions and normals in two
+//! RGBA32F layers, rasterised over its UV parameterisation, or a planar projection along
+//! its mean normal where its UVs overlap or are missing (`geometry.image`, redone only when
+//! it moves). Every frame, for every vertex of the environment (the scene's triangles,
+//! subdivided `tessellation`² times) and every reflector, a compute search finds the
+//! geometry-image sample where the normal and the bisector of the directions to the eye and
+//! to the vertex meet the reflection law (Figure 29), coarse to fine, and moves the vertex
+//! to its virtual position on the eye ray through that point; the environment is then drawn
+//! once per reflector with those positions, shaded at the real ones (one virtual object per
+//! reflector and object pair, EMDT06: `geometry.virtual`), and the reflector's camera pass
+//! lays that image onto its pixels with its Fresnel weight (`geometry.curved`).
+//!
+//! The search has one minimum only on reflectors that are convex or concave: the planner
+//! classifies each mesh by its edges' dihedral angles (`plan::facts::curvature`) and
+//! refuses a saddle-shaped one by name (or gives it the fallback), instead of drawing
+//! garbage. Cost: the search is O(S·D) per frame (S reflectors, D environment vertices),
+//! each search (size/2^levels)² + 25·levels texel reads (survey Table 1: O(S), O(N)).
+
+use ash::vk;
+use glam::{Vec2, Vec3};
+
+use crate::error::{Error, Result};
+use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
+use crate::frame::layout::{binding, GpuCurvedParams, GpuCurvedVertex, CURVED_BINDINGS, CURVED_REFLECTOR_SHIFT};
+use crate::frame::stage::{order, FrameIo, Stage, StageInit};
+use crate::frame::{destroy_pipelines, FrameInputs, Push, PUSH_BYTES};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
+use crate::plan::facts::Curvature;
+use crate::plan::CameraPlan;
+use crate::quality::Quality;
+use crate::scene::{Mesh, Scene};
+use crate::vk::pipeline::{compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, write_image};
+use crate::vk::pipeline::{sampler, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
+use crate::vk::{begin_rendering, Access, Buffer, Context, Image, ImageDesc, ImageKind, Recorder, Target};
+
+const GEOMETRY_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
+
+/// `geometry.curved`: each curved reflector drawn from the camera with its virtual objects'
+/// image at its pixels, weighted by Fresnel.
+pub const CURVED_PASS: CameraPass = CameraPass {
+    name: "geometry.curved",
+    vertex: "scene/mesh.vert",
+    fragment: "geometry/curved.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: Some(create),
+};
+
+const fn one(_: &Quality) -> u32 {
+    1
+}
+
+/// Environments whose surfaces around the reflector span at least this ratio of distances
+/// are where a search on the reflector beats a search in a distance map (survey §5: it
+/// "can cope with environment surfaces of large depth variations").
+pub const DEEP_ENVIRONMENT: f32 = 8.0;
+
+pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
+    name: "curved-reflector",
+    abi: 15,
+    section: "§5",
+    family: "geometry",
+    summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors are refused",
+    serves: &[ObjectClass::Mirror],
+    knobs: &["geometry_image", "curved_search", "tessellation", "fresnel"],
+    gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
+    fallback: Some(crate::methods::DISTANCE),
+    shape: Shape::ConvexOrConcave,
+    rule: |f, q| {
+        let shaped = matches!(f.curvature, Curvature::Convex | Curvature::Concave);
+        (shaped && !f.planar && f.depth_ratio >= DEEP_ENVIRONMENT && !q.planner.speed()).then(|| Verdict {
+            score: 3.2,
+            reason: format!(
+                "{} mirror in an environment whose depth varies {:.0}× around it: geometry transformation searches the reflector, not the environment (§5)",
+                f.curvature.label(),
+                f.depth_ratio
+            ),
+        })
+    },
+});
+
+/// Creates the stage of the plan's curved reflectors.
+fn create(init: &StageInit, plan: &CameraPlan) -> Result<Box<dyn Stage>> {
+    let mut me = CurvedReflectors::empty(init, plan);
+    match me.init(init) {
+        Ok(()) => Ok(Box::new(me)),
+        Err(e) => {
+            me.destroy(init.ctx);
+            Err(e)
+        }
+    }
+}
+
+/// One environment object's triangles in the tessellated index buffer.
+#[derive(Clone, Copy, Debug)]
+struct EnvDraw {
+    mesh: u32,
+    first_index: u32,
+    index_count: u32,
+}
+
+/// The CPU side of the stage's geometry: the environment's tessellated vertices and
+/// indices, then each reflector's triangles (three vertices each) with its
+/// parameterisation in `uv`.
+struct Geometry {
+    vertices: Vec<GpuCurvedVertex>,
+    indices: Vec<u32>,
+    env: Vec<EnvDraw>,
+    /// Environment vertices (the first `environment` entries of `vertices`).
+    environment: u32,
+    /// Per reflector: its first vertex and vertex count in `vertices`.
+    reflectors: Vec<(u32, u32)>,
+    /// Per reflector: whether its own UVs parameterise it (else a planar projection).
+    own_uvs: Vec<bool>,
+}
+
+fn vertex(p: Vec3, n: Vec3, uv: Vec2) -> GpuCurvedVertex {
+    GpuCurvedVertex { position: p.extend(1.0).to_array(), normal: n.extend(0.0).to_array(), uv: [uv.x, uv.y, 0.0, 0.0] }
+}
+
+/// Splits every triangle of `m` into `n`² triangles (a barycentric grid), appending its
+/// vertices and indices.
+fn tessellate(m: &Mesh, n: u32, vertices: &mut Vec<GpuCurvedVertex>, indices: &mut Vec<u32>) {
+    let n = n.max(1);
+    let uv = |i: usize| m.uvs.get(i).copied().unwrap_or_default();
+    for t in m.indices.chunks_exact(3) {
+        let (a, b, c) = (t[0] as usize, t[1] as usize, t[2] as usize);
+        let base = vertices.len() as u32;
+        // Grid vertex (i, j): a + (b − a)·i/n + (c − a)·j/n, row by row (i + j ≤ n).
+        let mut row_start = Vec::with_capacity(n as usize + 1);
+        for i in 0..=n {
+            row_start.push(vertices.len() as u32 - base);
+            for j in 0..=n - i {
+                let (s, r) = (i as f32 / n as f32, j as f32 / n as f32);
+                let w = 1.0 - s - r;
+                let p = m.positions[a] * w + m.positions[b] * s + m.positions[c] * r;
+                let nn = (m.normals[a] * w + m.normals[b] * s + m.normals[c] * r).normalize_or_zero();
+                vertices.push(vertex(p, nn, uv(a) * w + uv(b) * s + uv(c) * r));
+            }
+        }
+        let at = |i: u32, j: u32| base + row_start[i as usize] + j;
+        for i in 0..n {
+            for j in 0..n - i {
+                indices.extend([at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if j + 1 < n - i {
+                    indices.extend([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+    }
+}
+
+/// A reflector's parameterisation into [0,1]² (half a texel of margin at `size`): its own
+/// UVs, rescaled to fill the square, when they are present, span an area and do not overlap
+/// (the triangles' UV areas add up to no more than their bounding box); else the projection
+/// onto the plane across its area-weighted normal (the axis of its smallest extent when that
+/// vanishes, as for a closed surface). Returns the per-vertex coordinates and whether they
+/// are the mesh's own.
+pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
+    let tri_area = |a: Vec2, b: Vec2, c: Vec2| 0.5 * ((b - a).perp_dot(c - a)).abs();
+    let bbox = |uvs: &[Vec2]| uvs.iter().fold((Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)), |(lo, hi), u| (lo.min(*u), hi.max(*u)));
+    let usable = m.uvs.len() == m.positions.len() && !m.uvs.is_empty() && {
+        let (lo, hi) = bbox(&m.uvs);
+        let span = hi - lo;
+        let area: f32 = m.indices.chunks_exact(3).map(|t| tri_area(m.uvs[t[0] as usize], m.uvs[t[1] as usize], m.uvs[t[2] as usize])).sum();
+        span.x > 0.0 && span.y > 0.0 && area.is_finite() && area > 0.0 && area <= 1.02 * span.x * span.y
+    };
+    let raw: Vec<Vec2> = if usable {
+        m.uvs.clone()
+    } else {
+        let p = |i: u32| m.positions[i as usize];
+        let mut n = Vec3::ZERO;
+        for t in m.indices.chunks_exact(3) {
+            n += (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0]));
+        }
+        let b = m.bounds();
+        let extent = b.max - b.min;
+        let axis = if n.length() > 1e-3 * extent.length_squared() {
+            n.normalize()
+        } else {
+            let k = extent.min_position();
+            Vec3::AXES[k]
+        };
+        let u = axis.any_orthonormal_vector();
+        let v = axis.cross(u);
+        m.positions.iter().map(|q| Vec2::new(q.dot(u), q.dot(v))).collect()
+    };
+    let (lo, hi) = bbox(&raw);
+    let span = (hi - lo).max(Vec2::splat(f32::MIN_POSITIVE));
+    let margin = 0.5 / size as f32;
+    let scale = 1.0 - 2.0 * margin;
+    (raw.iter().map(|u| Vec2::splat(margin) + (*u - lo) / span * scale).collect(), usable)
+}
+
+impl Geometry {
+    fn of(scene: &Scene, reflectors: &[usize], tessellation: u32, size: u32) -> Geometry {
+        let mut g = Geometry {
+            vertices: Vec::new(),
+            indices: Vec::new(),
+            env: Vec::new(),
+            environment: 0,
+            reflectors: Vec::new(),
+            own_uvs: Vec::new(),
+        };
+        for (i, m) in scene.meshes.iter().enumerate() {
+            if m.hidden || m.indices.is_empty() {
+                continue;
+            }
+            let first_index = g.indices.len() as u32;
+            tessellate(m, tessellation, &mut g.vertices, &mut g.indices);
+            g.env.push(EnvDraw { mesh: i as u32, first_index, index_count: g.indices.len() as u32 - first_index });
+        }
+        g.environment = g.vertices.len() as u32;
+        for &r in reflectors {
+            let m = &scene.meshes[r];
+            let first = g.vertices.len() as u32;
+            if !m.hidden {
+                let (uv, own) = parameterisation(m, size);
+                g.own_uvs.push(own);
+                for &i in &m.indices {
+                    let i = i as usize;
+                    g.vertices.push(vertex(m.positions[i], m.normals[i], uv[i]));
+                }
+            } else {
+                g.own_uvs.push(true);
+            }
+            g.reflectors.push((first, g.vertices.len() as u32 - first));
+        }
+        g
+    }
+}
+
+pub struct CurvedReflectors {
+    name: &'static str,
+    /// Reflector meshes, in layer order.
+    reflectors: Vec<usize>,
+    size: u32,
+    levels: u32,
+    tessellation: u32,
+    width: u32,
+    height: u32,
+    multisample: Multisample,
+    positions: Image,
+    normals: Image,
+    virtual_images: Image,
+    virtual_depth: Image,
+    vertices: Buffer,
+    indices: Buffer,
+    virtuals: Buffer,
+    params: Buffer,
+    env: Vec<EnvDraw>,
+    environment: u32,
+    reflector_vertices: Vec<(u32, u32)>,
+    own_uvs: Vec<bool>,
+    empty_layout: vk::DescriptorSetLayout,
+    set_layout: vk::DescriptorSetLayout,
+    layout: vk::PipelineLayout,
+    pool: vk::DescriptorPool,
+    set: vk::DescriptorSet,
+    nearest: vk::Sampler,
+    image_pipeline: vk::Pipeline,
+    search_pipeline: vk::Pipeline,
+    virtual_pipeline: vk::Pipeline,
+    shade_pipeline: vk::Pipeline,
+    /// The geometry images must be (re)drawn before the next search.
+    dirty: bool,
+}
+
+impl CurvedReflectors {
+    fn empty(init: &StageInit, plan: &CameraPlan) -> CurvedReflectors {
+        let q = &init.plan.quality;
+        CurvedReflectors {
+            name: plan.name,
+            reflectors: plan.objects.iter().map(|(m, _)| *m).collect(),
+            size: q.geometry_image,
+            levels: q.curved_search,
+            tessellation: q.tessellation,
+            width: init.width,
+            height: init.height,
+            multisample: init.multisample,
+            positions: Image::placeholder(),
+            normals: Image::placeholder(),
+            virtual_images: Image::placeholder(),
+            virtual_depth: Image::placeholder(),
+            vertices: Buffer::placeholder(),
+            indices: Buffer::placeholder(),
+            virtuals: Buffer::placeholder(),
+            params: Buffer::placeholder(),
+            env: Vec::new(),
+            environment: 0,
+            reflector_vertices: Vec::new(),
+            own_uvs: Vec::new(),
+            empty_layout: vk::DescriptorSetLayout::null(),
+            set_layout: vk::DescriptorSetLayout::null(),
+            layout: vk::PipelineLayout::null(),
+            pool: vk::DescriptorPool::null(),
+            set: vk::DescriptorSet::null(),
+            nearest: vk::Sampler::null(),
+            image_pipeline: vk::Pipeline::null(),
+            search_pipeline: vk::Pipeline::null(),
+            virtual_pipeline: vk::Pipeline::null(),
+            shade_pipeline: vk::Pipeline::null(),
+            dirty: true,
+        }
+    }
+
+    fn init(&mut self, init: &StageInit) -> Result<()> {
+        let ctx = init.ctx;
+        let layers = self.reflectors.len() as u32;
+        if layers == 0 {
+            return Err(Error::invalid("curved-reflector", "no reflector to serve"));
+        }
+        let limit = ctx.properties.limits.max_image_dimension2_d;
+        if self.size > limit {
+            return Err(Error::invalid("knob geometry_image", format!("{} texels exceed the device's {limit}² image limit", self.size)));
+        }
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        let kind = ImageKind::D2Array { layers };
+        let image = |name, format, width, height, kind, usage| Image::new(ctx, &ImageDesc { name, format, width, height, kind, usage });
+        self.positions = image("geometry.image.positions", GEOMETRY_FORMAT, self.size, self.size, kind, usage)?;
+        self.normals = image("geometry.image.normals", GEOMETRY_FORMAT, self.size, self.size, kind, usage)?;
+        self.virtual_images = image("geometry.virtual_images", TARGET_FORMAT, self.width, self.height, kind, usage)?;
+        let depth_usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT;
+        self.virtual_depth = image("geometry.virtual_depth", DEPTH_FORMAT, self.width, self.height, ImageKind::D2, depth_usage)?;
+        self.nearest = sampler(ctx, "geometry.nearest", vk::Filter::NEAREST, vk::SamplerAddressMode::CLAMP_TO_EDGE)?;
+
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+        self.empty_layout = descriptor_set_layout(ctx, "geometry.empty_set_layout", &[], stages)?;
+        self.set_layout = descriptor_set_layout(ctx, "geometry.curved_set_layout", CURVED_BINDINGS, stages)?;
+        let sets = [init.set_layouts[0], init.set_layouts[1], self.empty_layout, self.empty_layout, self.set_layout];
+        self.layout = pipeline_layout(ctx, "geometry.curved_layout", &sets, PUSH_BYTES, stages)?;
+        let (pool, set) = crate::vk::pipeline::allocate_set(ctx, "geometry.curved_set", self.set_layout, CURVED_BINDINGS)?;
+        (self.pool, self.set) = (pool, set);
+        self.upload(ctx, init.scene)?;
+        self.create_pipelines(ctx)
+    }
+
+    /// Builds the tessellated environment and the reflectors' triangles from `scene` and
+    /// (re)creates the buffers that hold them, the virtual vertices and the parameters.
+    fn upload(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
+        let g = Geometry::of(scene, &self.reflectors, self.tessellation, self.size);
+        let layers = self.reflectors.len() as u64;
+        let virtual_bytes = 16 * layers * g.environment.max(1) as u64;
+        let range = ctx.properties.limits.max_storage_buffer_range as u64;
+        let vertex_bytes = (g.vertices.len() * std::mem::size_of::<GpuCurvedVertex>()) as u64;
+        if virtual_bytes > range || vertex_bytes > range {
+            return Err(Error::invalid(
+                "knob tessellation",
+                format!(
+                    "{} environment vertices at tessellation {} need {} MiB per buffer, beyond the device's {} MiB storage-buffer range",
+                    g.environment,
+                    self.tessellation,
+                    virtual_bytes.max(vertex_bytes) >> 20,
+                    range >> 20
+                ),
+            ));
+        }
+        for b in [&mut self.vertices, &mut self.indices, &mut self.virtuals, &mut self.params] {
+            b.destroy(ctx);
+        }
+        let vertices = if g.vertices.is_empty() { vec![vertex(Vec3::ZERO, Vec3::Z, Vec2::ZERO)] } else { g.vertices };
+        self.vertices = Buffer::with_data(ctx, "geometry.curved_vertices", &vertices, STORAGE)?;
+        let indices = if g.indices.is_empty() { vec![0u32; 3] } else { g.indices };
+        self.indices = Buffer::with_data(ctx, "geometry.curved_indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
+        self.virtuals = Buffer::new(ctx, "geometry.virtual_vertices", virtual_bytes, STORAGE, crate::vk::MemoryLocation::GpuOnly)?;
+        let params = GpuCurvedParams {
+            vertex_count: g.environment,
+            image_size: self.size,
+            search_levels: self.levels,
+            reflector_count: layers as u32,
+        };
+        self.params = Buffer::with_data(ctx, "geometry.curved_params", &[params], STORAGE)?;
+        (self.env, self.environment, self.reflector_vertices, self.own_uvs) = (g.env, g.environment, g.reflectors, g.own_uvs);
+        let sb = vk::DescriptorType::STORAGE_BUFFER;
+        let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
+        let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
+        write_image(ctx, self.set, binding::GEOMETRY_POSITIONS, 0, cis, self.positions.view, self.nearest, ro);
+        write_image(ctx, self.set, binding::GEOMETRY_NORMALS, 0, cis, self.normals.view, self.nearest, ro);
+        write_image(ctx, self.set, binding::VIRTUAL_IMAGES, 0, cis, self.virtual_images.view, self.nearest, ro);
+        write_buffer(ctx, self.set, binding::CURVED_VERTICES, sb, self.vertices.raw);
+        write_buffer(ctx, self.set, binding::VIRTUAL_VERTICES, sb, self.virtuals.raw);
+        write_buffer(ctx, self.set, binding::CURVED, sb, self.params.raw);
+        self.dirty = true;
+        Ok(())
+    }
+
+    fn create_pipelines(&mut self, ctx: &Context) -> Result<()> {
+        let desc = |name, vertex, fragment, formats, depth: Option<vk::Format>, input, multisample| GraphicsDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input: input,
+            color_formats: formats,
+            depth_format: depth,
+            depth_test: depth.is_some(),
+            depth_write: depth.is_some(),
+            view_mask: 0,
+            cull: vk::CullModeFlags::NONE,
+            multisample,
+            blend: Blend::Replace,
+            depth_op: DepthOp::Nearer,
+        };
+        let off = Multisample::OFF;
+        let geometry = [GEOMETRY_FORMAT, GEOMETRY_FORMAT];
+        let (v, f) = ("geometry/curved_image.vert", "geometry/curved_image.frag");
+        self.image_pipeline = graphics_pipeline(ctx, self.layout, &desc("geometry.image", v, f, &geometry, None, VertexInput::None, off))?;
+        self.search_pipeline = compute_pipeline(ctx, self.layout, "geometry/curved_search.comp")?;
+        let target = [TARGET_FORMAT];
+        let (v, f) = ("geometry/curved_virtual.vert", "geometry/curved_virtual.frag");
+        self.virtual_pipeline =
+            graphics_pipeline(ctx, self.layout, &desc("geometry.virtual", v, f, &target, Some(DEPTH_FORMAT), VertexInput::None, off))?;
+        let per_sample = self.multisample.per_sample && self.multisample.samples > 1;
+        let fragment = if per_sample { format!("{}#PER_SAMPLE", CURVED_PASS.fragment) } else { CURVED_PASS.fragment.to_string() };
+        self.shade_pipeline = graphics_pipeline(
+            ctx,
+            self.layout,
+            &desc(self.name, CURVED_PASS.vertex, &fragment, &target, Some(DEPTH_FORMAT), VertexInput::Mesh, self.multisample),
+        )?;
+        Ok(())
+    }
+
+    fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer, point: vk::PipelineBindPoint, pipeline: vk::Pipeline, f: &FrameInputs) {
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, point, pipeline);
+            ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[f.set], &[]);
+            ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 4, &[self.set], &[]);
+        }
+    }
+
+    fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32, object: u32, flags: u32) {
+        let p = Push {
+            view,
+            object,
+            flags,
+            light_count: f.light_count,
+            search: f.search,
+            tolerance: f.tolerance,
+            internal_bounces: f.internal_bounces,
+            depth: f.depth,
+            pad: 0,
+        };
+        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
+        unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
+    }
+
+    /// `geometry.image`: each reflector's triangles over its parameterisation.
+    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs) {
+        let open = rec
+            .pass("geometry.image")
+            .writes(&mut self.positions, Access::ColorAttachment)
+            .writes(&mut self.normals, Access::ColorAttachment)
+            .begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        for (k, &(first, count)) in self.reflector_vertices.iter().enumerate() {
+            let colors = [self.positions.layer_view(k as u32), self.normals.layer_view(k as u32)];
+            let target = Target {
+                color: &colors,
+                depth: None,
+                width: self.size,
+                height: self.size,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [0.0; 4],
+                clear: true,
+            };
+            begin_rendering(ctx, cmd, &target);
+            self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.image_pipeline, f);
+            self.push(ctx, cmd, f, 0, k as u32, f.flags);
+            unsafe {
+                if count > 0 {
+                    ctx.device.cmd_draw(cmd, count, 1, first, 0);
+                }
+                ctx.device.cmd_end_rendering(cmd);
+            }
+        }
+        rec.end(open);
+        self.dirty = false;
+    }
+
+    /// Device memory: (one reflector's geometry image: positions + normals; one reflector's
+    /// virtual image per view, and the depth buffer the views share).
+    pub fn memory(&self) -> (u64, u64, u64) {
+        let texel = crate::vk::format_bytes(GEOMETRY_FORMAT) as u64;
+        let image = 2 * self.size as u64 * self.size as u64 * texel;
+        let pixels = self.width as u64 * self.height as u64;
+        (image, pixels * crate::vk::format_bytes(TARGET_FORMAT) as u64, pixels * crate::vk::format_bytes(DEPTH_FORMAT) as u64)
+    }
+}
+
+impl Stage for CurvedReflectors {
+    fn name(&self) -> &'static str {
+        self.name
+    }
+
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let view = io.views.camera;
+        if self.dirty {
+            self.record_images(rec, f);
+        }
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        // The search: one dispatch per reflector over the environment's vertices.
+        let open = rec
+            .pass("geometry.virtual")
+            .after_buffer_writes()
+            .reads(&self.positions, Access::ComputeSampled)
+            .reads(&self.normals, Access::ComputeSampled)
+            .begin();
+        self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.search_pipeline, f);
+        for k in 0..self.reflectors.len() as u32 {
+            self.push(ctx, cmd, f, view, k, f.flags);
+            unsafe { ctx.device.cmd_dispatch(cmd, self.environment.div_ceil(64).max(1), 1, 1) };
+        }
+        rec.end(open);
+        // The virtual objects: the environment at its virtual positions, per reflector.
+        let mut pass = rec
+            .pass("geometry.virtual")
+            .after_buffer_writes()
+            .writes(&mut self.virtual_images, Access::ColorAttachment)
+            .writes(&mut self.virtual_depth, Access::DepthAttachment);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()) {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        for (k, &reflector) in self.reflectors.iter().enumerate() {
+            if k > 0 {
+                rec.barrier(&mut self.virtual_depth, Access::DepthAttachment);
+            }
+            let colors = [self.virtual_images.layer_view(k as u32)];
+            let target = Target {
+                color: &colors,
+                depth: Some(self.virtual_depth.view),
+                width: self.width,
+                height: self.height,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [0.0; 4],
+                clear: true,
+            };
+            begin_rendering(ctx, cmd, &target);
+            self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.virtual_pipeline, f);
+            unsafe { ctx.device.cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32) };
+            let flags = f.flags | ((k as u32) << CURVED_REFLECTOR_SHIFT);
+            for d in self.env.iter().filter(|d| d.mesh as usize != reflector) {
+                self.push(ctx, cmd, f, view, d.mesh, flags);
+                unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, 0, 0) };
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+        }
+        rec.end(open);
+        // The reflectors from the camera.
+        let open = rec
+            .pass(self.name)
+            .reads(&self.virtual_images, Access::FragmentSampled)
+            .writes(io.target, Access::ColorAttachment)
+            .writes(io.depth, Access::DepthAttachment)
+            .begin();
+        crate::frame::begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, false);
+        self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.shade_pipeline, f);
+        f.scene.bind_geometry(ctx, cmd);
+        for (k, &reflector) in self.reflectors.iter().enumerate() {
+            let Some(d) = f.scene.draws.get(reflector) else { continue };
+            self.push(ctx, cmd, f, view, d.mesh, f.flags | ((k as u32) << CURVED_REFLECTOR_SHIFT));
+            unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
+        }
+        unsafe { ctx.device.cmd_end_rendering(cmd) };
+        rec.end(open);
+    }
+
+    /// Moved objects: the environment's virtual objects and the geometry images follow.
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut crate::frame::stage::Maps) -> Result<()> {
+        if changes.moved.is_empty() {
+            return Ok(());
+        }
+        self.upload(init.ctx, init.scene)
+    }
+
+    /// The environment's vertices (each searched once per reflector and view: the O(S·D) of
+    /// survey Table 1), and memory (issue 11): bytes of one geometry image (positions and
+    /// normals), of one reflector's virtual image per view and of the shared depth buffer;
+    /// reflectors parameterised by a planar projection (no usable UVs).
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        let (image, view, depth) = self.memory();
+        vec![
+            ("geometry.curved_reflectors".into(), self.reflectors.len() as f64),
+            ("geometry.curved_vertices".into(), self.environment as f64),
+            ("geometry.curved_image_bytes".into(), image as f64),
+            ("geometry.curved_view_bytes".into(), view as f64),
+            ("geometry.curved_depth_bytes".into(), depth as f64),
+            ("geometry.curved_projected".into(), self.own_uvs.iter().filter(|o| !**o).count() as f64),
+        ]
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        destroy_pipelines(ctx, &mut [self.image_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline]);
+        (self.image_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline) =
+            (vk::Pipeline::null(), vk::Pipeline::null(), vk::Pipeline::null(), vk::Pipeline::null());
+        for i in [&mut self.positions, &mut self.normals, &mut self.virtual_images, &mut self.virtual_depth] {
+            i.destroy(ctx);
+        }
+        for b in [&mut self.vertices, &mut self.indices, &mut self.virtuals, &mut self.params] {
+            b.destroy(ctx);
+        }
+        unsafe {
+            let d = &ctx.device;
+            if self.layout != vk::PipelineLayout::null() {
+                d.destroy_pipeline_layout(self.layout, None);
+            }
+            if self.pool != vk::DescriptorPool::null() {
+                d.destroy_descriptor_pool(self.pool, None);
+            }
+            for l in [self.set_layout, self.empty_layout] {
+                if l != vk::DescriptorSetLayout::null() {
+                    d.destroy_descriptor_set_layout(l, None);
+                }
+            }
+            if self.nearest != vk::Sampler::null() {
+                d.destroy_sampler(self.nearest, None);
+            }
+        }
+        self.layout = vk::PipelineLayout::null();
+        self.pool = vk::DescriptorPool::null();
+        self.set = vk::DescriptorSet::null();
+        self.set_layout = vk::DescriptorSetLayout::null();
+        self.empty_layout = vk::DescriptorSetLayout::null();
+        self.nearest = vk::Sampler::null();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::facts::curvature;
+    use crate::scene::shapes;
+
+    #[test]
+    fn tessellation_splits_each_triangle_into_n_squared() {
+        let q = shapes::quad("q", Vec3::ZERO, Vec3::X, Vec3::Z, 1, 0);
+        for n in [1u32, 2, 5] {
+            let (mut v, mut i) = (Vec::new(), Vec::new());
+            tessellate(&q, n, &mut v, &mut i);
+            assert_eq!(i.len() / 3, (q.triangle_count() as u32 * n * n) as usize, "n = {n}");
+            assert_eq!(v.len() as u32, q.triangle_count() as u32 * (n + 1) * (n + 2) / 2);
+            // Sub-triangle areas add up to the triangle's.
+            let p = |k: u32| Vec3::from_slice(&v[k as usize].position[..3]);
+            let area: f32 = i.chunks_exact(3).map(|t| 0.5 * (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length()).sum();
+            assert!((area - 1.0).abs() < 1e-5, "n = {n}: {area}");
+        }
+    }
+
+    #[test]
+    fn a_sphere_keeps_its_uvs_and_a_uvless_cap_is_projected() {
+        let s = shapes::uv_sphere("s", Vec3::ZERO, 1.0, 16, 8, 0);
+        let (uv, own) = parameterisation(&s, 64);
+        assert!(own);
+        assert!(uv.iter().all(|u| u.x >= 0.5 / 64.0 - 1e-6 && u.x <= 1.0 - 0.5 / 64.0 + 1e-6));
+        let mut cap = bowl(1.0, 0.7, 12);
+        cap.uvs.clear();
+        let (uv, own) = parameterisation(&cap, 64);
+        assert!(!own);
+        assert_eq!(uv.len(), cap.positions.len());
+        assert_eq!(curvature(&cap), Curvature::Concave);
+    }
+
+    /// A spherical cap of radius r and half-angle a around −y, normals towards its centre.
+    fn bowl(r: f32, a: f32, n: u32) -> Mesh {
+        let mut m = Mesh { name: "bowl".into(), ..Default::default() };
+        for i in 0..=n {
+            for j in 0..=n {
+                let (u, v) = (i as f32 / n as f32 * 2.0 - 1.0, j as f32 / n as f32 * 2.0 - 1.0);
+                let d = Vec3::new(u * a.sin(), -1.0, v * a.sin()).normalize();
+                m.positions.push(d * r);
+                m.normals.push(-d);
+                m.uvs.push(Vec2::new(u, v));
+            }
+        }
+        for i in 0..n {
+            for j in 0..n {
+                let at = |i: u32, j: u32| i * (n + 1) + j;
+                m.indices.extend([at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn curvature_tells_spheres_bowls_planes_and_saddles_apart() {
+        assert_eq!(curvature(&shapes::uv_sphere("s", Vec3::ZERO, 1.0, 24, 12, 0)), Curvature::Convex);
+        let mut inside = shapes::uv_sphere("s", Vec3::ZERO, 1.0, 24, 12, 0);
+        inside.normals.iter_mut().for_each(|n| *n = -*n);
+        assert_eq!(curvature(&inside), Curvature::Concave);
+        assert_eq!(curvature(&bowl(1.0, 0.7, 8)), Curvature::Concave);
+        assert_eq!(curvature(&shapes::quad("q", Vec3::ZERO, Vec3::X, Vec3::Z, 4, 0)), Curvature::Flat);
+        // z = x² − y² over [−1, 1]², normals up.
+        let mut saddle = shapes::quad("q", Vec3::new(-1.0, 0.0, -1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0), 8, 0);
+        for (p, n) in saddle.positions.iter_mut().zip(saddle.normals.iter_mut()) {
+            p.y = p.x * p.x - p.z * p.z;
+            *n = Vec3::new(-2.0 * p.x, 1.0, 2.0 * p.z).normalize();
+        }
+        assert_eq!(curvature(&saddle), Curvature::Saddle);
+    }
+}
