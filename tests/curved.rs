@@ -114,7 +114,7 @@ fn a_convex_mirror_sphere() {
     keep("sphere", &[&f.image, &d.image, &reference]);
     println!("sphere: curved-reflector {p:.2} dB, distance {pd:.2} dB against the reference");
     let names: Vec<&str> = f.passes.iter().map(|p| p.name.as_str()).collect();
-    for pass in ["geometry.image", "geometry.virtual", "geometry.curved"] {
+    for pass in ["geometry.image", "geometry.virtual.search", "geometry.virtual", "geometry.curved"] {
         assert!(names.contains(&pass), "{pass} missing: {names:?}");
     }
     // Rule 1: measured 36.80 dB; distance maps 33.66 dB on the same scene (margin 3.14 dB).
@@ -163,6 +163,198 @@ fn a_concave_bowl() {
     println!("bowl without UVs: {pg:.2} dB");
     assert_eq!(stat(&g, "geometry.curved_projected"), 1.0);
     assert!(pg >= p - 1.0, "projected {pg:.2} dB vs own UVs {p:.2} dB");
+    common::assert_clean(&ctx);
+}
+
+/// A saddle z = k(x² − y²) over a square of half-size `half` around `centre` (normals up),
+/// an n×n grid.
+fn saddle(centre: Vec3, half: f32, k: f32, n: u32, material: usize) -> Mesh {
+    let mut m = shapes::quad("saddle", Vec3::ZERO, Vec3::new(2.0 * half, 0.0, 0.0), Vec3::new(0.0, 0.0, 2.0 * half), n, material);
+    for (p, nn) in m.positions.iter_mut().zip(m.normals.iter_mut()) {
+        let (x, z) = (p.x - half, p.z - half);
+        *p = centre + Vec3::new(x, k * (x * x - z * z), z);
+        *nn = Vec3::new(-2.0 * k * x, 1.0, 2.0 * k * z).normalize();
+    }
+    m
+}
+
+/// A saddle-shaped mirror has several reflection points for one vertex (survey §5): the
+/// planner's convexity test reports it as unsupported, by name when it is asked for the
+/// object, and gives it the fallback (distance maps) when it is asked for the whole scene;
+/// the frame then has no geometry-transformation pass and renders what distance maps render.
+#[test]
+fn a_saddle_is_reported_unsupported() {
+    let ctx = common::gpu();
+    let s = room(|m| saddle(Vec3::new(0.0, -1.2, 0.0), 0.8, 0.6, 16, m), (Vec3::new(-1.2, 1.0, 1.4), Vec3::new(0.0, -1.2, 0.0)));
+    let q = quality();
+    let facts = specula::plan::facts::SceneFacts::new(&s, &q, false);
+    assert_eq!(facts.objects[0].curvature, specula::plan::facts::Curvature::Saddle);
+    let choices =
+        specula::plan::Choices { method: specula::Choice::Auto, objects: vec![("saddle".into(), specula::methods::CURVED_REFLECTOR)] };
+    let e = specula::plan::plan_with(&s, &choices, &q).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("'saddle'") && e.contains("saddle-shaped") && e.contains("unsupported"), "{e}");
+    let plan = specula::plan(&s, specula::methods::CURVED_REFLECTOR, &q);
+    let o = &plan.objects[0];
+    println!("{}: {}", o.method, o.reason);
+    assert_eq!(o.method, specula::methods::DISTANCE);
+    assert!(o.reason.contains("saddle-shaped") && o.reason.contains("unsupported"), "{}", o.reason);
+    assert_ne!(specula::plan(&s, specula::Choice::Auto, &q).objects[0].method, specula::methods::CURVED_REFLECTOR);
+    let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+    assert!(f.passes.iter().all(|p| !p.name.starts_with("geometry.")), "{:?}", f.passes);
+    assert!(f.image == gpu(&ctx, &s, specula::methods::DISTANCE, &q).image, "the fallback's image");
+    common::assert_clean(&ctx);
+}
+
+/// The accuracy knobs: the geometry image's size (the reflection points' sampling) and the
+/// environment's tessellation (survey Table 1: "high tessellation"), each against the
+/// reference on the sphere, and the coarse-to-fine search against the exhaustive one.
+#[test]
+fn error_against_geometry_image_size_and_tessellation() {
+    let ctx = common::gpu();
+    let s = sphere_scene();
+    let base = quality();
+    let reference = specula::reference::render_reference(&s, &base, SIZE).unwrap();
+    let run = |knobs: &[(&str, &str)]| {
+        let mut q = base.clone();
+        for (k, v) in knobs {
+            q.set(k, v).unwrap();
+        }
+        let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+        let search = f.passes.iter().filter(|p| p.name == "geometry.virtual.search").map(|p| p.gpu_ms).sum::<f64>();
+        (psnr(&f.image, &reference), stat(&f, "geometry.curved_vertices"), search)
+    };
+    // Rule 1 and the ordering rule: each floor 1 dB under its measured PSNR, each step's gain
+    // bounded within 1 dB of its measured gain (half of it under 1 dB). Measured 33.25,
+    // 36.47, 36.80 and 36.80 dB: from 128² on the sub-texel refinement has converged.
+    let mut last = f64::NAN;
+    for (size, measured, gain) in [("32", 33.25, f64::NAN), ("64", 36.47, 2.22), ("128", 36.80, 0.16), ("256", 36.80, -0.05)] {
+        let (p, _, ms) = run(&[("geometry_image", size)]);
+        println!("geometry_image {size}: {p:.3} dB, search {ms:.1} ms");
+        assert!(p >= measured - 1.0, "geometry_image {size}: {p:.2} dB (measured {measured})");
+        assert!(last.is_nan() || p >= last + gain, "geometry_image {size}: {p:.3} dB after {last:.3} dB");
+        last = p;
+    }
+    // Survey Table 1's "high tessellation": measured 29.79, 34.46, 36.80 and 37.50 dB at 1,
+    // 2, 4 and 8 (gains 4.67, 2.34 and 0.70 dB). Every vertex is searched: (t + 1)(t + 2)/2
+    // per triangle, the search's work (O(S·D)); its time per vertex was 2.3–3.0 µs at each t
+    // (BENCHMARKS.md).
+    let mut last = f64::NAN;
+    for (t, measured, gain) in [(1u32, 29.79, f64::NAN), (2, 34.46, 3.67), (4, 36.80, 1.34), (8, 37.50, 0.35)] {
+        let (p, v, ms) = run(&[("tessellation", &t.to_string())]);
+        println!("tessellation {t}: {p:.2} dB, {v} vertices, search {ms:.1} ms ({:.2} µs per vertex)", 1e3 * ms / v);
+        assert_eq!(v, environment_vertices(&s, t));
+        assert!(p >= measured - 1.0, "tessellation {t}: {p:.2} dB (measured {measured})");
+        assert!(last.is_nan() || p >= last + gain, "tessellation {t}: {p:.2} dB after {last:.2} dB");
+        last = p;
+    }
+    // The coarse-to-fine search finds what the exhaustive one finds (measured 34.46 dB at
+    // every level count, tessellation 2) at a fraction of its time (1215, 103, 42 and 30 ms
+    // at 0, 2, 3 and 5 levels).
+    let (exhaustive, _, _) = run(&[("curved_search", "0"), ("tessellation", "2")]);
+    for levels in ["2", "3", "5"] {
+        let (p, _, ms) = run(&[("curved_search", levels), ("tessellation", "2")]);
+        println!("curved_search {levels}: {p:.3} dB (exhaustive {exhaustive:.3} dB), search {ms:.1} ms");
+        assert!(p >= exhaustive - 0.05, "curved_search {levels}: {p:.3} dB vs exhaustive {exhaustive:.3} dB");
+    }
+    common::assert_clean(&ctx);
+}
+
+/// The sphere's scene at 1 mm and 1 km: the same image as at 1 m (the search compares
+/// directions and the virtual depth is relative).
+#[test]
+fn curved_reflectors_at_a_millimetre_and_a_kilometre() {
+    let ctx = common::gpu();
+    let base = sphere_scene();
+    let q = quality();
+    let one = gpu(&ctx, &base, specula::methods::CURVED_REFLECTOR, &q).image;
+    for scale in [1e-3f32, 1e3] {
+        let mut s = base.clone();
+        for m in &mut s.meshes {
+            m.positions.iter_mut().for_each(|p| *p *= scale);
+        }
+        let mut cam = base.camera_or_default();
+        cam.position *= scale;
+        cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * scale).extend(1.0);
+        cam.znear *= scale;
+        s.camera = Some(cam);
+        let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+        let p = psnr(&f.image, &one);
+        let differ =
+            f.image.data.chunks_exact(4).zip(one.data.chunks_exact(4)).filter(|(a, b)| (0..3).any(|c| (a[c] - b[c]).abs() > 1e-3)).count();
+        println!("scale {scale:e}: {p:.2} dB against scale 1, {differ} pixels differ");
+        // Rule 2: measured 117.26 dB (1 mm) and 46.67 dB (1 km: one silhouette pixel whose
+        // virtual triangle is kept at one scale and dropped at the other, 0.43 apart).
+        let floor = if scale < 1.0 { 60.0 } else { 26.67 };
+        assert!(p >= floor && differ <= 1, "scale {scale:e}: {p:.2} dB, {differ} pixels differ");
+        keep(&format!("scale{scale:e}"), &[&f.image, &one]);
+        assert!(f.image.data.iter().all(|v| v.is_finite()), "scale {scale:e}");
+    }
+    common::assert_clean(&ctx);
+}
+
+/// A mirror sphere in a long hall (the quadrant room stretched 8× along x): deep, but
+/// tessellated coarsely as seen from the sphere.
+fn hall_scene() -> Scene {
+    let mut s = Scene::new();
+    common::emissive_room(&mut s, Vec3::ZERO, 2.0);
+    for m in &mut s.meshes {
+        m.positions.iter_mut().for_each(|p| p.x *= 8.0);
+    }
+    let m = s.add_material(common::mirror(0.9)).unwrap();
+    s.add_mesh(shapes::uv_sphere("sphere", Vec3::new(0.0, -0.4, 0.0), 0.6, 48, 24, m)).unwrap();
+    s.camera = Some(Camera::look_at(Vec3::new(-2.5, 0.3, 1.2), Vec3::new(0.0, -0.4, 0.0), 50f32.to_radians()));
+    s
+}
+
+/// The sphere's room with two more emissive balls close to the mirror: surfaces 0.25 m
+/// and 2 m from it, an environment of large depth variation.
+fn cluttered_scene() -> Scene {
+    let mut s = sphere_scene();
+    for (i, (c, e)) in
+        [(Vec3::new(-0.2, 0.1, 1.05), Vec3::new(0.2, 1.2, 0.4)), (Vec3::new(-0.9, -0.9, -0.4), Vec3::new(1.2, 0.3, 1.0))].iter().enumerate()
+    {
+        let m = s.add_material(Material { name: format!("near{i}"), base_color: Vec3::ZERO, emissive: *e, ..Default::default() }).unwrap();
+        s.add_mesh(shapes::uv_sphere(&format!("near{i}"), *c, 0.2, 24, 12, m)).unwrap();
+    }
+    s
+}
+
+/// The planner takes curved-reflector for a convex mirror in an environment of large depth
+/// variation that is tessellated finely as seen from it (two balls close to the sphere),
+/// where it measured better than distance maps and the proxy box; not for the same sphere
+/// in a long hall, deep but coarse, where it measured worse.
+#[test]
+fn the_planner_takes_it_in_a_deep_finely_tessellated_environment() {
+    let ctx = common::gpu();
+    let q = quality();
+    let s = cluttered_scene();
+    let facts = specula::plan::facts::SceneFacts::new(&s, &q, true);
+    let f = facts.objects.iter().find(|o| s.meshes[o.mesh].name == "sphere").unwrap();
+    println!("cluttered: depth ratio {:.2}, box fraction {:.3}, edge angle {:.3}", f.depth_ratio, f.box_fraction, f.edge_angle);
+    let plan = specula::plan(&s, specula::Choice::Auto, &q);
+    let o = plan.objects.iter().find(|o| o.name == "sphere").unwrap();
+    println!("auto: {} ({})", o.method, o.reason);
+    assert_eq!(o.method, specula::methods::CURVED_REFLECTOR, "{}", o.reason);
+    let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
+    let auto = psnr(&specula::render(&ctx, &s, specula::Choice::Auto, &q, SIZE, (0, 1)).unwrap().image, &reference);
+    let distance = psnr(&gpu(&ctx, &s, specula::methods::DISTANCE, &q).image, &reference);
+    let proxy = psnr(&gpu(&ctx, &s, specula::methods::PROXY_BOX, &q).image, &reference);
+    println!("cluttered: auto {auto:.2} dB, distance {distance:.2} dB, proxy-box {proxy:.2} dB");
+    // Rule 1: measured 36.80, 29.55 and 26.08 dB (margins 7.25 and 10.72 dB).
+    assert!(auto >= 35.80 && auto >= distance + 6.25 && auto >= proxy + 9.72, "auto {auto:.2} dB");
+
+    let hall = hall_scene();
+    let plan = specula::plan(&hall, specula::Choice::Auto, &q);
+    let o = plan.objects.iter().find(|o| o.name == "sphere").unwrap();
+    println!("hall: auto {} ({})", o.method, o.reason);
+    assert_ne!(o.method, specula::methods::CURVED_REFLECTOR, "{}", o.reason);
+    let reference = specula::reference::render_reference(&hall, &q, SIZE).unwrap();
+    let curved = psnr(&gpu(&ctx, &hall, specula::methods::CURVED_REFLECTOR, &q).image, &reference);
+    let distance = psnr(&gpu(&ctx, &hall, specula::methods::DISTANCE, &q).image, &reference);
+    println!("hall: curved-reflector {curved:.2} dB, distance {distance:.2} dB");
+    // Measured 31.77 vs 48.00 dB: the bound half the margin (the reason not to take it).
+    assert!(curved <= distance - 8.1, "hall: curved-reflector {curved:.2} dB vs distance {distance:.2} dB");
     common::assert_clean(&ctx);
 }
 

@@ -30,6 +30,11 @@ pub struct ObjectFacts {
     /// Farthest over nearest distance of the surfaces around the reference point (2048 rays;
     /// 1 without deep facts): the environment's depth variation.
     pub depth_ratio: f32,
+    /// The largest angle (radians) an edge of another object's triangles subtends from the
+    /// reference point: how coarsely the environment is tessellated as seen from the
+    /// object (geometry transformation bends only vertices, survey Table 1). 0 without deep
+    /// facts.
+    pub edge_angle: f32,
     /// Area fraction of the surface visible from the reference point (1: convex from it,
     /// as a single-layer map needs). Computed for `auto` only, else 1.
     pub visible_fraction: f32,
@@ -517,6 +522,25 @@ fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usi
     (out, on_box as f32 / n as f32, ratio)
 }
 
+/// The largest angle an edge of a triangle of any other mesh subtends from `x`.
+fn edge_angle(scene: &Scene, own: usize, x: Vec3) -> f32 {
+    let x = x.as_dvec3();
+    let mut largest = 0.0f64;
+    for (i, m) in scene.meshes.iter().enumerate() {
+        if i == own || m.hidden {
+            continue;
+        }
+        let d = |k: u32| (m.positions[k as usize].as_dvec3() - x).normalize_or_zero();
+        for t in m.indices.chunks_exact(3) {
+            for k in 0..3 {
+                let c = d(t[k]).dot(d(t[(k + 1) % 3])).clamp(-1.0, 1.0);
+                largest = largest.max(c.acos());
+            }
+        }
+    }
+    largest as f32
+}
+
 impl ObjectFacts {
     /// The fraction of directions from the reference point that reach other specular
     /// objects.
@@ -565,6 +589,7 @@ impl SceneFacts {
                     watertight: mf.watertight,
                     curvature: mf.curvature,
                     depth_ratio,
+                    edge_angle: if bvh.is_some() { edge_angle(scene, i, reference_point) } else { 0.0 },
                     visible_fraction: visible,
                     sees_specular: sees,
                     box_fraction,
