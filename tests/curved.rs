@@ -358,6 +358,44 @@ fn the_planner_takes_it_in_a_deep_finely_tessellated_environment() {
     common::assert_clean(&ctx);
 }
 
+/// The benchmark's sweep through `specula tradeoff` (the library behind it): error and time
+/// per geometry-image size and tessellation, the search timed apart, one row each.
+#[test]
+fn tradeoff_sweeps_the_geometry_image_and_the_tessellation() {
+    let out = std::env::temp_dir().join(format!("specula-curved-tradeoff-{}", std::process::id()));
+    let cfg = specula::tradeoff::Config {
+        scene: sphere_scene(),
+        scene_name: "sphere".into(),
+        quality: quality(),
+        sweeps: vec![
+            specula::tradeoff::Sweep::parse("geometry_image=32,128").unwrap(),
+            specula::tradeoff::Sweep::parse("tessellation=1,4").unwrap(),
+        ],
+        methods: vec![specula::methods::CURVED_REFLECTOR.into()],
+        size: SIZE,
+        warmup: 1,
+        frames: 1,
+        device: specula::vk::DeviceOptions { validation: true, device_filter: None },
+        out: out.clone(),
+    };
+    let report = specula::tradeoff::run(&cfg, &mut |_| {}).unwrap();
+    assert_eq!(report.validation, (0, 0));
+    let psnr = |knobs: &str| report.rows.iter().find(|r| r.knobs == knobs).map(|r| r.errors.psnr).unwrap();
+    for r in &report.rows {
+        let search = r.passes.iter().find(|(n, _)| n == "geometry.virtual.search").map(|p| p.1);
+        println!("{}: {:.2} dB, frame {:.1} ms, search {search:?} ms", r.knobs, r.errors.psnr, r.frame_ms);
+        assert!(search.is_some_and(|ms| ms > 0.0), "{}: {:?}", r.knobs, r.passes);
+    }
+    // The same PSNRs as rendered directly (error_against_geometry_image_size_and_tessellation:
+    // 36.80 dB at 128² and tessellation 4, 29.79 dB at tessellation 1).
+    let (coarse, fine) = (psnr("geometry_image=128 tessellation=1"), psnr("geometry_image=128 tessellation=4"));
+    assert!((coarse - 29.79).abs() < 0.01 && (fine - 36.80).abs() < 0.01, "{coarse:.2} dB, {fine:.2} dB");
+    assert!(psnr("geometry_image=32 tessellation=4") < fine, "a 32² geometry image is coarser");
+    let csv = std::fs::read_to_string(&report.csv).unwrap();
+    assert!(csv.lines().next().unwrap().contains("geometry.virtual.search ms"), "{csv}");
+    std::fs::remove_dir_all(&out).ok();
+}
+
 /// Images side by side, each scaled up `k` times (nearest).
 fn montage(images: &[&ImageData], k: u32) -> ImageData {
     let (w, h) = (images[0].width, images[0].height);
