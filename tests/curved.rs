@@ -467,6 +467,28 @@ fn two_spheres_and_a_mirror_wall() {
     common::assert_clean(&ctx);
 }
 
+/// Bad sizes are clear errors before anything is allocated: a tessellation whose vertices
+/// exceed the device's storage-buffer range, a geometry image beyond its image limit.
+#[test]
+fn too_fine_a_tessellation_is_an_error() {
+    let ctx = common::gpu();
+    let mut s = sphere_scene();
+    let ball = s.meshes.iter().find(|m| m.name == "ball").unwrap().material;
+    // 80 000 triangles × 561 vertices (tessellation 32) × 48 bytes: 2 GiB.
+    s.add_mesh(shapes::uv_sphere("fine", Vec3::new(-1.2, -1.5, -1.2), 0.2, 200, 200, ball)).unwrap();
+    let mut q = quality();
+    q.set("tessellation", "32").unwrap();
+    let e = specula::render(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q, SIZE, (0, 1)).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("knob tessellation") && e.contains("storage-buffer range"), "{e}");
+    let mut q = quality();
+    q.set("geometry_image", "1024").unwrap();
+    let f = specula::render(&ctx, &sphere_scene(), specula::methods::CURVED_REFLECTOR, &q, SIZE, (0, 1)).unwrap();
+    assert!(f.image.data.iter().all(|v| v.is_finite()));
+    assert!(q.clone().set("geometry_image", "2048").is_err() && q.set("tessellation", "0").is_err());
+    common::assert_clean(&ctx);
+}
+
 /// Images side by side, each scaled up `k` times (nearest).
 fn montage(images: &[&ImageData], k: u32) -> ImageData {
     let (w, h) = (images[0].width, images[0].height);

@@ -351,23 +351,27 @@ impl CurvedReflectors {
     /// Builds the tessellated environment and the reflectors' triangles from `scene` and
     /// (re)creates the buffers that hold them, the virtual vertices and the parameters.
     fn upload(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
-        let g = Geometry::of(scene, &self.reflectors, self.tessellation, self.size);
+        // Sizes checked before anything is built: (t + 1)(t + 2)/2 vertices per environment
+        // triangle, three per reflector triangle.
+        let t = self.tessellation.max(1) as u64;
+        let live = |m: &&Mesh| !m.hidden;
+        let environment: u64 = scene.meshes.iter().filter(live).map(|m| m.triangle_count() as u64 * (t + 1) * (t + 2) / 2).sum();
+        let own: u64 = self.reflectors.iter().map(|&r| &scene.meshes[r]).filter(live).map(|m| m.indices.len() as u64).sum();
         let layers = self.reflectors.len() as u64;
-        let virtual_bytes = 16 * layers * g.environment.max(1) as u64;
-        let range = ctx.properties.limits.max_storage_buffer_range as u64;
-        let vertex_bytes = (g.vertices.len() * std::mem::size_of::<GpuCurvedVertex>()) as u64;
+        let virtual_bytes = 16 * layers * environment.max(1);
+        let vertex_bytes = (environment + own) * std::mem::size_of::<GpuCurvedVertex>() as u64;
+        let range = (ctx.properties.limits.max_storage_buffer_range as u64).min(u32::MAX as u64);
         if virtual_bytes > range || vertex_bytes > range {
             return Err(Error::invalid(
                 "knob tessellation",
                 format!(
-                    "{} environment vertices at tessellation {} need {} MiB per buffer, beyond the device's {} MiB storage-buffer range",
-                    g.environment,
-                    self.tessellation,
+                    "{environment} environment vertices at tessellation {t} need {} MiB per buffer, beyond the device's {} MiB storage-buffer range",
                     virtual_bytes.max(vertex_bytes) >> 20,
                     range >> 20
                 ),
             ));
         }
+        let g = Geometry::of(scene, &self.reflectors, self.tessellation, self.size);
         for b in [&mut self.vertices, &mut self.indices, &mut self.virtuals, &mut self.params] {
             b.destroy(ctx);
         }
