@@ -489,6 +489,37 @@ fn too_fine_a_tessellation_is_an_error() {
     common::assert_clean(&ctx);
 }
 
+/// Frames over time: a moved environment object is tessellated again on the GPU from the
+/// scene's updated vertices (`geometry.virtual.tessellate`), a moved reflector also redraws
+/// its geometry image (`geometry.image`); a frame with no change does neither. Each frame
+/// equals a fresh render of the same scene bit for bit.
+#[test]
+fn moved_objects_equal_a_fresh_render() {
+    let ctx = common::gpu();
+    let mut s = sphere_scene();
+    let q = quality();
+    let plan = specula::plan(&s, specula::methods::CURVED_REFLECTOR, &q);
+    let mut r = specula::Renderer::new(&ctx, &s, plan, SIZE.0, SIZE.1).unwrap();
+    let names = |f: &specula::Frame| f.passes.iter().map(|p| p.name.clone()).collect::<Vec<_>>();
+    let first = names(&r.render(&ctx).unwrap());
+    assert!(first.iter().any(|n| n == "geometry.image") && first.iter().any(|n| n == "geometry.virtual.tessellate"), "{first:?}");
+    let still = names(&r.render(&ctx).unwrap());
+    assert!(still.iter().all(|n| n != "geometry.image" && n != "geometry.virtual.tessellate"), "{still:?}");
+    for (name, to, image) in [("ball", Vec3::new(-0.5, 0.3, 0.0), false), ("sphere", Vec3::new(0.2, 0.1, -0.3), true)] {
+        let i = s.meshes.iter().position(|m| m.name == name).unwrap();
+        s.set_object_transform(i, glam::Mat4::from_translation(to)).unwrap();
+        assert_eq!(r.update(&s).unwrap().moved, vec![i]);
+        let got = r.render(&ctx).unwrap();
+        let passes = names(&got);
+        assert!(passes.iter().any(|n| n == "geometry.virtual.tessellate"), "{name}: {passes:?}");
+        assert_eq!(passes.iter().any(|n| n == "geometry.image"), image, "{name}: {passes:?}");
+        let fresh = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+        assert!(got.image == fresh.image, "{name} moved: {:.2} dB from a fresh render", psnr(&got.image, &fresh.image));
+    }
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
 /// Images side by side, each scaled up `k` times (nearest).
 fn montage(images: &[&ImageData], k: u32) -> ImageData {
     let (w, h) = (images[0].width, images[0].height);

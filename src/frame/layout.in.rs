@@ -236,6 +236,11 @@ gpu_structs! {
         search_levels: uint,
         /// reflectors (layers of the geometry images and of the virtual images)
         reflector_count: uint,
+        /// each environment triangle is split into tessellation² triangles
+        tessellation: uint,
+        /// triangles of the scene (`source_triangles`), each (t + 1)(t + 2)/2 vertices
+        triangle_count: uint,
+        pad: [uint; 2],
     }
 
     /// Push constants of every scene-drawing shader.
@@ -477,8 +482,9 @@ descriptor_sets! {
         GEOMETRY_POSITIONS = 0: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray geometry_positions";
         /// xyz the interpolated unit normal (w unused)
         GEOMETRY_NORMALS = 1: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray geometry_normals";
-        /// The environment's vertices (tessellated), in world space
-        CURVED_VERTICES = 2: STORAGE_BUFFER => "readonly buffer CurvedVertices { CurvedVertex curved_vertices[]; }";
+        /// The environment's vertices (tessellated by `geometry.virtual.tessellate`), in world
+        /// space: source triangle k's grid vertices from k · (t + 1)(t + 2)/2 on
+        CURVED_VERTICES = 2: STORAGE_BUFFER => "buffer CurvedVertices { CurvedVertex curved_vertices[]; }";
         /// Per reflector k and environment vertex i, entry k · vertex_count + i: xyz its
         /// virtual position, w 1 when it has a reflection point on the reflector (else 0)
         VIRTUAL_VERTICES = 3: STORAGE_BUFFER => "buffer VirtualVertices { vec4 virtual_vertices[]; }";
@@ -486,5 +492,14 @@ descriptor_sets! {
         /// The virtual objects drawn for each reflector from the camera, one layer each: rgb
         /// radiance, a 1 where a virtual object covers the pixel
         VIRTUAL_IMAGES = 5: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray virtual_images";
+        /// The scene's vertex buffer (`gpu_scene::Vertex`: position, normal, uv; 8 floats
+        /// each), what the tessellation reads
+        SCENE_VERTICES = 6: STORAGE_BUFFER => "readonly buffer SceneVertices { float scene_vertices[]; }";
+        /// Every triangle of the scene: its three vertices' indices in `scene_vertices` (w
+        /// its mesh)
+        SOURCE_TRIANGLES = 7: STORAGE_BUFFER => "readonly buffer SourceTriangles { uvec4 source_triangles[]; }";
+        /// Each reflector's triangles, three vertices each, with its parameterisation in
+        /// `uv` (the geometry image's raster pass)
+        REFLECTOR_VERTICES = 8: STORAGE_BUFFER => "readonly buffer ReflectorVertices { CurvedVertex reflector_vertices[]; }";
     }
 }

@@ -2,17 +2,21 @@
 //! reflector is sampled once into a geometry image — world positions and normals in two
 //! RGBA32F layers, rasterised over its UV parameterisation, or a planar projection along
 //! its mean normal where its UVs overlap or are missing (`geometry.image`, redone only when
-//! it moves). Every frame, for every vertex of the environment (the scene's triangles,
-//! subdivided `tessellation`² times) and every reflector, a compute search finds the
-//! geometry-image sample where the normal and the bisector of the directions to the eye and
-//! to the vertex meet the reflection law (Figure 29), coarse to fine, and moves the vertex
-//! to its virtual position on the eye ray through that point; the environment is then drawn
-//! once per reflector with those positions, shaded at the real ones (one virtual object per
-//! reflector and object pair, EMDT06: `geometry.virtual`), and the reflector's camera pass
-//! lays that image onto its pixels with its Fresnel weight (`geometry.curved`).
+//! it moves). The environment — the scene's triangles, each split into `tessellation`²
+//! triangles by a compute pre-pass from the scene's vertex buffer
+//! (`geometry.virtual.tessellate`, redone when an object moves; the grid's indices are
+//! fixed) — is searched every frame: for each of its vertices and every reflector, a compute
+//! pass (`geometry.virtual.search`) finds the geometry-image sample where the normal and the
+//! bisector of the directions to the eye and to the vertex meet the reflection law (Figure
+//! 29), coarse to fine, and moves the vertex to its virtual position on the eye ray through
+//! that point; the environment is then drawn once per reflector at those positions, shaded
+//! at the real ones (one virtual object per reflector and object pair, EMDT06:
+//! `geometry.virtual`), and the reflector's camera pass lays that image onto its pixels
+//! with its Fresnel weight (`geometry.curved`).
 //!
 //! The search has one minimum only on reflectors that are convex or concave: the planner
-//! classifies each mesh by its edges' dihedral angles (`plan::facts::curvature`) and
+//! classifies each mesh by the sign of its normal curvature along every edge
+//! (`plan::facts::curvature`) and
 //! refuses a saddle-shaped one by name (or gives it the fallback), instead of drawing
 //! garbage. Cost: the search is O(S·D) per frame (S reflectors, D environment vertices),
 //! each search (size/2^levels)² + 25·levels texel reads (survey Table 1: O(S), O(N)).
@@ -112,52 +116,47 @@ struct EnvDraw {
     index_count: u32,
 }
 
-/// The CPU side of the stage's geometry: the environment's tessellated vertices and
-/// indices, then each reflector's triangles (three vertices each) with its
-/// parameterisation in `uv`.
-struct Geometry {
-    vertices: Vec<GpuCurvedVertex>,
-    indices: Vec<u32>,
-    env: Vec<EnvDraw>,
-    /// Environment vertices (the first `environment` entries of `vertices`).
-    environment: u32,
-    /// Per reflector: its first vertex and vertex count in `vertices`.
-    reflectors: Vec<(u32, u32)>,
-    /// Per reflector: whether its own UVs parameterise it (else a planar projection).
-    own_uvs: Vec<bool>,
-}
-
 fn vertex(p: Vec3, n: Vec3, uv: Vec2) -> GpuCurvedVertex {
     GpuCurvedVertex { position: p.extend(1.0).to_array(), normal: n.extend(0.0).to_array(), uv: [uv.x, uv.y, 0.0, 0.0] }
 }
 
-/// Splits every triangle of `m` into `n`² triangles (a barycentric grid), appending its
-/// vertices and indices.
-fn tessellate(m: &Mesh, n: u32, vertices: &mut Vec<GpuCurvedVertex>, indices: &mut Vec<u32>) {
-    let n = n.max(1);
-    let uv = |i: usize| m.uvs.get(i).copied().unwrap_or_default();
-    for t in m.indices.chunks_exact(3) {
-        let (a, b, c) = (t[0] as usize, t[1] as usize, t[2] as usize);
-        let base = vertices.len() as u32;
-        // Grid vertex (i, j): a + (b − a)·i/n + (c − a)·j/n, row by row (i + j ≤ n).
-        let mut row_start = Vec::with_capacity(n as usize + 1);
-        for i in 0..=n {
-            row_start.push(vertices.len() as u32 - base);
-            for j in 0..=n - i {
-                let (s, r) = (i as f32 / n as f32, j as f32 / n as f32);
-                let w = 1.0 - s - r;
-                let p = m.positions[a] * w + m.positions[b] * s + m.positions[c] * r;
-                let nn = (m.normals[a] * w + m.normals[b] * s + m.normals[c] * r).normalize_or_zero();
-                vertices.push(vertex(p, nn, uv(a) * w + uv(b) * s + uv(c) * r));
+/// Vertices of one triangle's barycentric grid at tessellation `t`.
+fn grid_vertices(t: u32) -> u32 {
+    (t + 1) * (t + 2) / 2
+}
+
+/// The t² triangles of one triangle's barycentric grid whose vertices start at `base`
+/// (vertex (i, j), i + j ≤ t, row by row: the order `curved_tessellate.comp` writes).
+fn grid_indices(t: u32, base: u32, indices: &mut Vec<u32>) {
+    let t = t.max(1);
+    let row_start = |i: u32| i * (t + 1) - i * (i.saturating_sub(1)) / 2;
+    let at = |i: u32, j: u32| base + row_start(i) + j;
+    for i in 0..t {
+        for j in 0..t - i {
+            indices.extend([at(i, j), at(i + 1, j), at(i, j + 1)]);
+            if j + 1 < t - i {
+                indices.extend([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
             }
         }
-        let at = |i: u32, j: u32| base + row_start[i as usize] + j;
-        for i in 0..n {
-            for j in 0..n - i {
-                indices.extend([at(i, j), at(i + 1, j), at(i, j + 1)]);
-                if j + 1 < n - i {
-                    indices.extend([at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
-                }
+    }
+}
+
+/// Splits every triangle of `m` into `t`² triangles on the CPU, as
+/// `curved_tessellate.comp` does on the GPU (the unit tests' twin).
+#[cfg(test)]
+fn tessellate(m: &Mesh, t: u32, vertices: &mut Vec<GpuCurvedVertex>, indices: &mut Vec<u32>) {
+    let t = t.max(1);
+    let uv = |i: usize| m.uvs.get(i).copied().unwrap_or_default();
+    for tri in m.indices.chunks_exact(3) {
+        let (a, b, c) = (tri[0] as usize, tri[1] as usize, tri[2] as usize);
+        grid_indices(t, vertices.len() as u32, indices);
+        for i in 0..=t {
+            for j in 0..=t - i {
+                let (s, r) = (i as f32 / t as f32, j as f32 / t as f32);
+                let w = 1.0 - s - r;
+                let p = m.positions[a] * w + m.positions[b] * s + m.positions[c] * r;
+                let n = (m.normals[a] * w + m.normals[b] * s + m.normals[c] * r).normalize_or_zero();
+                vertices.push(vertex(p, n, uv(a) * w + uv(b) * s + uv(c) * r));
             }
         }
     }
@@ -205,42 +204,22 @@ pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
     (raw.iter().map(|u| Vec2::splat(margin) + (*u - lo) / span * scale).collect(), usable)
 }
 
-impl Geometry {
-    fn of(scene: &Scene, reflectors: &[usize], tessellation: u32, size: u32) -> Geometry {
-        let mut g = Geometry {
-            vertices: Vec::new(),
-            indices: Vec::new(),
-            env: Vec::new(),
-            environment: 0,
-            reflectors: Vec::new(),
-            own_uvs: Vec::new(),
-        };
-        for (i, m) in scene.meshes.iter().enumerate() {
-            if m.hidden || m.indices.is_empty() {
-                continue;
-            }
-            let first_index = g.indices.len() as u32;
-            tessellate(m, tessellation, &mut g.vertices, &mut g.indices);
-            g.env.push(EnvDraw { mesh: i as u32, first_index, index_count: g.indices.len() as u32 - first_index });
+/// Every reflector's triangles (three vertices each) with its parameterisation in `uv`,
+/// and per reflector its first vertex, vertex count and whether its own UVs serve.
+fn reflector_vertices(scene: &Scene, reflectors: &[usize], size: u32) -> (Vec<GpuCurvedVertex>, Vec<(u32, u32)>, Vec<bool>) {
+    let (mut vertices, mut ranges, mut own_uvs) = (Vec::new(), Vec::new(), Vec::new());
+    for &r in reflectors {
+        let m = &scene.meshes[r];
+        let first = vertices.len() as u32;
+        let (uv, own) = parameterisation(m, size);
+        own_uvs.push(own);
+        for &i in &m.indices {
+            let i = i as usize;
+            vertices.push(vertex(m.positions[i], m.normals[i], uv[i]));
         }
-        g.environment = g.vertices.len() as u32;
-        for &r in reflectors {
-            let m = &scene.meshes[r];
-            let first = g.vertices.len() as u32;
-            if !m.hidden {
-                let (uv, own) = parameterisation(m, size);
-                g.own_uvs.push(own);
-                for &i in &m.indices {
-                    let i = i as usize;
-                    g.vertices.push(vertex(m.positions[i], m.normals[i], uv[i]));
-                }
-            } else {
-                g.own_uvs.push(true);
-            }
-            g.reflectors.push((first, g.vertices.len() as u32 - first));
-        }
-        g
+        ranges.push((first, vertices.len() as u32 - first));
     }
+    (vertices, ranges, own_uvs)
 }
 
 pub struct CurvedReflectors {
@@ -257,8 +236,12 @@ pub struct CurvedReflectors {
     normals: Image,
     virtual_images: Image,
     virtual_depth: Image,
+    /// The tessellated environment (written by `geometry.virtual.tessellate`), its fixed
+    /// indices, the scene's triangles it is made from, and the reflectors' triangles.
     vertices: Buffer,
     indices: Buffer,
+    triangles: Buffer,
+    reflector_buffer: Buffer,
     virtuals: Buffer,
     params: Buffer,
     env: Vec<EnvDraw>,
@@ -272,11 +255,14 @@ pub struct CurvedReflectors {
     set: vk::DescriptorSet,
     nearest: vk::Sampler,
     image_pipeline: vk::Pipeline,
+    tessellate_pipeline: vk::Pipeline,
     search_pipeline: vk::Pipeline,
     virtual_pipeline: vk::Pipeline,
     shade_pipeline: vk::Pipeline,
     /// The geometry images must be (re)drawn before the next search.
     dirty: bool,
+    /// The environment must be (re)tessellated before the next search.
+    tessellate: bool,
 }
 
 impl CurvedReflectors {
@@ -297,6 +283,8 @@ impl CurvedReflectors {
             virtual_depth: Image::placeholder(),
             vertices: Buffer::placeholder(),
             indices: Buffer::placeholder(),
+            triangles: Buffer::placeholder(),
+            reflector_buffer: Buffer::placeholder(),
             virtuals: Buffer::placeholder(),
             params: Buffer::placeholder(),
             env: Vec::new(),
@@ -310,10 +298,12 @@ impl CurvedReflectors {
             set: vk::DescriptorSet::null(),
             nearest: vk::Sampler::null(),
             image_pipeline: vk::Pipeline::null(),
+            tessellate_pipeline: vk::Pipeline::null(),
             search_pipeline: vk::Pipeline::null(),
             virtual_pipeline: vk::Pipeline::null(),
             shade_pipeline: vk::Pipeline::null(),
             dirty: true,
+            tessellate: true,
         }
     }
 
@@ -344,50 +334,77 @@ impl CurvedReflectors {
         self.layout = pipeline_layout(ctx, "geometry.curved_layout", &sets, PUSH_BYTES, stages)?;
         let (pool, set) = crate::vk::pipeline::allocate_set(ctx, "geometry.curved_set", self.set_layout, CURVED_BINDINGS)?;
         (self.pool, self.set) = (pool, set);
-        self.upload(ctx, init.scene)?;
+        self.upload(ctx, init.scene, init.gpu)?;
         self.create_pipelines(ctx)
     }
 
-    /// Builds the tessellated environment and the reflectors' triangles from `scene` and
-    /// (re)creates the buffers that hold them, the virtual vertices and the parameters.
-    fn upload(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
+    /// Creates the buffers of the environment's tessellation (its fixed indices and the
+    /// scene's triangles it reads; the vertices are the GPU's), of the reflectors' triangles,
+    /// the virtual vertices and the parameters, and writes the stage's descriptors.
+    fn upload(&mut self, ctx: &Context, scene: &Scene, gpu: &crate::gpu_scene::GpuScene) -> Result<()> {
         // Sizes checked before anything is built: (t + 1)(t + 2)/2 vertices per environment
         // triangle, three per reflector triangle.
-        let t = self.tessellation.max(1) as u64;
-        let live = |m: &&Mesh| !m.hidden;
-        let environment: u64 = scene.meshes.iter().filter(live).map(|m| m.triangle_count() as u64 * (t + 1) * (t + 2) / 2).sum();
-        let own: u64 = self.reflectors.iter().map(|&r| &scene.meshes[r]).filter(live).map(|m| m.indices.len() as u64).sum();
+        let t = self.tessellation.max(1);
+        let per = grid_vertices(t) as u64;
+        let triangles = scene.triangle_count() as u64;
+        let environment = triangles * per;
+        let own: u64 = self.reflectors.iter().map(|&r| scene.meshes[r].indices.len() as u64).sum();
         let layers = self.reflectors.len() as u64;
         let virtual_bytes = 16 * layers * environment.max(1);
-        let vertex_bytes = (environment + own) * std::mem::size_of::<GpuCurvedVertex>() as u64;
+        let vertex_bytes = environment.max(own) * std::mem::size_of::<GpuCurvedVertex>() as u64;
+        let index_bytes = 12 * triangles * (t * t) as u64;
         let range = (ctx.properties.limits.max_storage_buffer_range as u64).min(u32::MAX as u64);
-        if virtual_bytes > range || vertex_bytes > range {
+        if virtual_bytes.max(vertex_bytes).max(index_bytes) > range {
             return Err(Error::invalid(
                 "knob tessellation",
                 format!(
                     "{environment} environment vertices at tessellation {t} need {} MiB per buffer, beyond the device's {} MiB storage-buffer range",
-                    virtual_bytes.max(vertex_bytes) >> 20,
+                    virtual_bytes.max(vertex_bytes).max(index_bytes) >> 20,
                     range >> 20
                 ),
             ));
         }
-        let g = Geometry::of(scene, &self.reflectors, self.tessellation, self.size);
-        for b in [&mut self.vertices, &mut self.indices, &mut self.virtuals, &mut self.params] {
+        // The scene's triangles (global vertex indices, mesh), each object's range of the
+        // fixed tessellated indices.
+        let mut source = Vec::with_capacity(triangles as usize);
+        let mut indices = Vec::with_capacity((3 * triangles * (t * t) as u64) as usize);
+        self.env.clear();
+        for (i, m) in scene.meshes.iter().enumerate() {
+            let offset = gpu.draws.get(i).map_or(0, |d| d.vertex_offset) as u32;
+            let first_index = indices.len() as u32;
+            for tri in m.indices.chunks_exact(3) {
+                grid_indices(t, source.len() as u32 * per as u32, &mut indices);
+                source.push([offset + tri[0], offset + tri[1], offset + tri[2], i as u32]);
+            }
+            self.env.push(EnvDraw { mesh: i as u32, first_index, index_count: indices.len() as u32 - first_index });
+        }
+        let (reflector_vertices, ranges, own_uvs) = reflector_vertices(scene, &self.reflectors, self.size);
+        for b in
+            [&mut self.vertices, &mut self.indices, &mut self.triangles, &mut self.reflector_buffer, &mut self.virtuals, &mut self.params]
+        {
             b.destroy(ctx);
         }
-        let vertices = if g.vertices.is_empty() { vec![vertex(Vec3::ZERO, Vec3::Z, Vec2::ZERO)] } else { g.vertices };
-        self.vertices = Buffer::with_data(ctx, "geometry.curved_vertices", &vertices, STORAGE)?;
-        let indices = if g.indices.is_empty() { vec![0u32; 3] } else { g.indices };
+        let gpu_only = crate::vk::MemoryLocation::GpuOnly;
+        self.vertices = Buffer::new(ctx, "geometry.curved_vertices", vertex_bytes.max(16), STORAGE, gpu_only)?;
+        let indices = if indices.is_empty() { vec![0u32; 3] } else { indices };
         self.indices = Buffer::with_data(ctx, "geometry.curved_indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
-        self.virtuals = Buffer::new(ctx, "geometry.virtual_vertices", virtual_bytes, STORAGE, crate::vk::MemoryLocation::GpuOnly)?;
+        let source = if source.is_empty() { vec![[0u32; 4]] } else { source };
+        self.triangles = Buffer::with_data(ctx, "geometry.curved_triangles", &source, STORAGE)?;
+        let reflector_vertices =
+            if reflector_vertices.is_empty() { vec![vertex(Vec3::ZERO, Vec3::Z, Vec2::ZERO)] } else { reflector_vertices };
+        self.reflector_buffer = Buffer::with_data(ctx, "geometry.reflector_vertices", &reflector_vertices, STORAGE)?;
+        self.virtuals = Buffer::new(ctx, "geometry.virtual_vertices", virtual_bytes, STORAGE, gpu_only)?;
         let params = GpuCurvedParams {
-            vertex_count: g.environment,
+            vertex_count: environment as u32,
             image_size: self.size,
             search_levels: self.levels,
             reflector_count: layers as u32,
+            tessellation: t,
+            triangle_count: triangles as u32,
+            pad: [0; 2],
         };
         self.params = Buffer::with_data(ctx, "geometry.curved_params", &[params], STORAGE)?;
-        (self.env, self.environment, self.reflector_vertices, self.own_uvs) = (g.env, g.environment, g.reflectors, g.own_uvs);
+        (self.environment, self.reflector_vertices, self.own_uvs) = (environment as u32, ranges, own_uvs);
         let sb = vk::DescriptorType::STORAGE_BUFFER;
         let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
         let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
@@ -397,7 +414,11 @@ impl CurvedReflectors {
         write_buffer(ctx, self.set, binding::CURVED_VERTICES, sb, self.vertices.raw);
         write_buffer(ctx, self.set, binding::VIRTUAL_VERTICES, sb, self.virtuals.raw);
         write_buffer(ctx, self.set, binding::CURVED, sb, self.params.raw);
+        write_buffer(ctx, self.set, binding::SCENE_VERTICES, sb, gpu.vertices.raw);
+        write_buffer(ctx, self.set, binding::SOURCE_TRIANGLES, sb, self.triangles.raw);
+        write_buffer(ctx, self.set, binding::REFLECTOR_VERTICES, sb, self.reflector_buffer.raw);
         self.dirty = true;
+        self.tessellate = true;
         Ok(())
     }
 
@@ -421,6 +442,7 @@ impl CurvedReflectors {
         let geometry = [GEOMETRY_FORMAT, GEOMETRY_FORMAT];
         let (v, f) = ("geometry/curved_image.vert", "geometry/curved_image.frag");
         self.image_pipeline = graphics_pipeline(ctx, self.layout, &desc("geometry.image", v, f, &geometry, None, VertexInput::None, off))?;
+        self.tessellate_pipeline = compute_pipeline(ctx, self.layout, "geometry/curved_tessellate.comp")?;
         self.search_pipeline = compute_pipeline(ctx, self.layout, "geometry/curved_search.comp")?;
         let target = [TARGET_FORMAT];
         let (v, f) = ("geometry/curved_virtual.vert", "geometry/curved_virtual.frag");
@@ -515,6 +537,15 @@ impl Stage for CurvedReflectors {
             self.record_images(rec, f);
         }
         let (ctx, cmd) = (rec.ctx, rec.cmd);
+        if self.tessellate {
+            // The environment's tessellation, from the scene's vertices as they are now.
+            let open = rec.pass("geometry.virtual.tessellate").after_buffer_writes().begin();
+            self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.tessellate_pipeline, f);
+            self.push(ctx, cmd, f, view, 0, f.flags);
+            unsafe { ctx.device.cmd_dispatch(cmd, self.environment.div_ceil(64).max(1), 1, 1) };
+            rec.end(open);
+            self.tessellate = false;
+        }
         // The search (`geometry.virtual.search`, timed apart: its cost is the O(S·D) of survey
         // Table 1): one dispatch per reflector over the environment's vertices.
         let open = rec
@@ -558,7 +589,9 @@ impl Stage for CurvedReflectors {
             self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.virtual_pipeline, f);
             unsafe { ctx.device.cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32) };
             let flags = f.flags | ((k as u32) << CURVED_REFLECTOR_SHIFT);
-            for d in self.env.iter().filter(|d| d.mesh as usize != reflector) {
+            // Hidden objects draw nothing (their scene draw has no index).
+            let shown = |d: &&EnvDraw| f.scene.draws.get(d.mesh as usize).is_some_and(|s| s.index_count > 0);
+            for d in self.env.iter().filter(|d| d.mesh as usize != reflector).filter(shown) {
                 self.push(ctx, cmd, f, view, d.mesh, flags);
                 unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, 0, 0) };
             }
@@ -584,12 +617,20 @@ impl Stage for CurvedReflectors {
         rec.end(open);
     }
 
-    /// Moved objects: the environment's virtual objects and the geometry images follow.
+    /// Moved objects: the environment is tessellated again on the GPU from the scene's
+    /// updated vertices, the reflectors' triangles are rewritten in place and their geometry
+    /// images redrawn.
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut crate::frame::stage::Maps) -> Result<()> {
         if changes.moved.is_empty() {
             return Ok(());
         }
-        self.upload(init.ctx, init.scene)
+        self.tessellate = true;
+        if self.reflectors.iter().any(|r| changes.moved.contains(r)) {
+            let (vertices, _, _) = reflector_vertices(init.scene, &self.reflectors, self.size);
+            self.reflector_buffer.write(bytemuck::cast_slice(&vertices))?;
+            self.dirty = true;
+        }
+        Ok(())
     }
 
     /// The environment's vertices (each searched once per reflector and view: the O(S·D) of
@@ -609,13 +650,16 @@ impl Stage for CurvedReflectors {
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        destroy_pipelines(ctx, &mut [self.image_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline]);
-        (self.image_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline) =
-            (vk::Pipeline::null(), vk::Pipeline::null(), vk::Pipeline::null(), vk::Pipeline::null());
+        let mut pipelines =
+            [self.image_pipeline, self.tessellate_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline];
+        destroy_pipelines(ctx, &mut pipelines);
+        [self.image_pipeline, self.tessellate_pipeline, self.search_pipeline, self.virtual_pipeline, self.shade_pipeline] = pipelines;
         for i in [&mut self.positions, &mut self.normals, &mut self.virtual_images, &mut self.virtual_depth] {
             i.destroy(ctx);
         }
-        for b in [&mut self.vertices, &mut self.indices, &mut self.virtuals, &mut self.params] {
+        for b in
+            [&mut self.vertices, &mut self.indices, &mut self.triangles, &mut self.reflector_buffer, &mut self.virtuals, &mut self.params]
+        {
             b.destroy(ctx);
         }
         unsafe {
