@@ -133,6 +133,15 @@ fn a_convex_mirror_sphere() {
     assert!(allocated("geometry.image.positions") + allocated("geometry.image.normals") >= image, "{:?}", f.memory);
     assert!(allocated("geometry.virtual_images") >= view && allocated("geometry.virtual_depth") >= depth, "{:?}", f.memory);
     assert_eq!(stat(&f, "geometry.curved_projected"), 0.0, "the sphere's own UVs parameterise it");
+    // A convex reflector has one reflection point per vertex: none of the checked vertices
+    // (every 16th) finds a second.
+    println!(
+        "sphere: {} of {} checked vertices with several minima",
+        stat(&f, "geometry.curved_multiple_minima"),
+        stat(&f, "geometry.curved_checked")
+    );
+    assert_eq!(stat(&f, "geometry.curved_checked"), (environment_vertices(&s, 4) / 16.0).ceil());
+    assert_eq!(stat(&f, "geometry.curved_multiple_minima"), 0.0);
     // None of it for distance maps.
     assert!(d.memory.iter().all(|(n, _)| !n.starts_with("geometry.")), "{:?}", d.memory);
     common::assert_clean(&ctx);
@@ -151,6 +160,11 @@ fn a_concave_bowl() {
     let (p, pd) = (psnr(&f.image, &reference), psnr(&d.image, &reference));
     keep("bowl", &[&f.image, &d.image, &reference]);
     println!("bowl: curved-reflector {p:.2} dB, distance {pd:.2} dB against the reference");
+    println!(
+        "bowl: {} of {} checked vertices with several minima",
+        stat(&f, "geometry.curved_multiple_minima"),
+        stat(&f, "geometry.curved_checked")
+    );
     // Rule 1: measured 32.25 dB; distance maps 32.62 dB (a shallow bowl whose reference point
     // sees the whole room: distance maps do as well here).
     assert!(p >= 31.25, "curved-reflector {p:.2} dB");
@@ -517,6 +531,38 @@ fn moved_objects_equal_a_fresh_render() {
         assert!(got.image == fresh.image, "{name} moved: {:.2} dB from a fresh render", psnr(&got.image, &fresh.image));
     }
     r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+/// Two separate balls in one mesh: every edge bends the convex way, so the planner's
+/// convexity test lets it through, yet a vertex may have a reflection point on each ball —
+/// several minima, which the search's check counts (`geometry.curved_multiple_minima`).
+#[test]
+fn several_minima_are_counted() {
+    let ctx = common::gpu();
+    let s = room(
+        |m| {
+            let mut a = shapes::uv_sphere("pair", Vec3::new(-0.5, -0.3, 0.0), 0.4, 32, 16, m);
+            let b = shapes::uv_sphere("pair", Vec3::new(0.5, -0.3, 0.0), 0.4, 32, 16, m);
+            let base = a.positions.len() as u32;
+            a.positions.extend(&b.positions);
+            a.normals.extend(&b.normals);
+            // One chart: the second ball's UVs beside the first's.
+            a.uvs.iter_mut().for_each(|u| u.x *= 0.5);
+            a.uvs.extend(b.uvs.iter().map(|u| Vec2::new(0.5 + 0.5 * u.x, u.y)));
+            a.indices.extend(b.indices.iter().map(|i| i + base));
+            a
+        },
+        (Vec3::new(0.0, 0.3, 1.9), Vec3::new(0.0, -0.3, 0.0)),
+    );
+    let q = quality();
+    let plan = specula::plan(&s, specula::methods::CURVED_REFLECTOR, &q);
+    assert_eq!(plan.objects[0].method, specula::methods::CURVED_REFLECTOR, "{}", plan.objects[0].reason);
+    let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+    let (found, checked) = (stat(&f, "geometry.curved_multiple_minima"), stat(&f, "geometry.curved_checked"));
+    let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
+    println!("two balls in one mesh: {found} of {checked} checked vertices with several minima, {:.2} dB", psnr(&f.image, &reference));
+    assert!(found > 0.0);
     common::assert_clean(&ctx);
 }
 

@@ -54,24 +54,23 @@ float at_point(vec2 c, out vec3 p, out vec3 n) {
     return law(p, n);
 }
 
-void main() {
-    uint i = gl_GlobalInvocationID.x;
-    if (i >= curved.vertex_count) return;
-    layer = push.object;
-    eye = views[push.view].eye.xyz;
-    vertex = curved_vertices[i].position.xyz;
-    size = int(curved.image_size);
-    // The coarsest level keeps at least 2×2 samples.
-    int levels = min(int(curved.search_levels), max(findMSB(size) - 1, 0));
+// Coarse to fine: the best of the coarsest level's samples (every 2^levels-th texel) that
+// lie more than `apart` texels from `away`, refined by 5×5 windows at half the stride down
+// to single texels. Returns its score; bt, bp, bn its texel, position and normal.
+float descend(int levels, ivec2 away, int apart, out ivec2 bt, out vec3 bp, out vec3 bn) {
     int stride = 1 << levels;
     float best = -4.0;
-    ivec2 bt = ivec2(size / 2);
-    vec3 bp = vec3(0.0), bn = vec3(0.0);
+    bt = ivec2(size / 2);
+    bp = vec3(0.0);
+    bn = vec3(0.0);
     vec3 p, n;
     for (int y = stride / 2; y < size; y += stride) {
         for (int x = stride / 2; x < size; x += stride) {
-            float s = at_texel(ivec2(x, y), p, n);
-            if (s > best) { best = s; bt = ivec2(x, y); bp = p; bn = n; }
+            ivec2 t = ivec2(x, y);
+            ivec2 d = abs(t - away);
+            if (max(d.x, d.y) <= apart) continue;
+            float s = at_texel(t, p, n);
+            if (s > best) { best = s; bt = t; bp = p; bn = n; }
         }
     }
     while (stride > 1) {
@@ -85,6 +84,37 @@ void main() {
                 if (s > best) { best = s; bt = t; bp = p; bn = n; }
             }
         }
+    }
+    return best;
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i >= curved.vertex_count) return;
+    layer = push.object;
+    eye = views[push.view].eye.xyz;
+    vertex = curved_vertices[i].position.xyz;
+    size = int(curved.image_size);
+    // The coarsest level keeps at least 2×2 samples.
+    int levels = min(int(curved.search_levels), max(findMSB(size) - 1, 0));
+    ivec2 bt;
+    vec3 bp, bn, p, n;
+    float best = descend(levels, ivec2(-2 * size), 0, bt, bp, bn);
+    // Several minima (survey §5: a reflector neither convex nor concave): every
+    // CURVED_CHECK_STRIDE-th vertex is searched again, its coarsest level leaving out the
+    // samples within two of its stride of the reflection point found; a second point that
+    // meets the law as well with another normal (not the same valley reached again, nor the
+    // same surface point under another texel, as at a pole or a seam) is counted.
+    if (i % CURVED_CHECK_STRIDE == 0u && best >= CURVED_MIN_COS) {
+        ivec2 ot;
+        vec3 op, on;
+        float other = descend(levels, bt, 2 << levels, ot, op, on);
+        // As near the law as the first (within twice its angle and 2°): a point held at the
+        // chart's border (a seam) by the window search is not a minimum.
+        float near = 2.0 * acos(clamp(best, -1.0, 1.0)) + 0.035;
+        bool law_holds = acos(clamp(other, -1.0, 1.0)) <= near;
+        if (law_holds && dot(on, bn) < CURVED_MIN_COS && dot(on, eye - op) > 0.0 && dot(on, vertex - op) > 0.0)
+            atomicAdd(curved_minima[layer], 1u);
     }
     // Sub-texel: a pattern search over the interpolated image, the step halved from half a
     // texel to 1/64.

@@ -343,6 +343,10 @@ gpu_consts! {
     /// cosine above this (else its reflection point lies off the reflector's silhouette or
     /// rim, and its virtual triangles are dropped).
     CURVED_MIN_COS: float = 0.98;
+    /// Curved reflectors: every this many-th environment vertex is searched a second time,
+    /// away from its reflection point, for a second one (several minima: the reflector is
+    /// neither convex nor concave as seen from there, survey §5); found ones are counted.
+    CURVED_CHECK_STRIDE: uint = 16;
     /// Curved reflectors: a reflector pixel its virtual image leaves uncovered takes the
     /// nearest covered pixel within this many pixels (the holes at its silhouette and rim).
     CURVED_FILL: int = 2;
@@ -501,5 +505,8 @@ descriptor_sets! {
         /// Each reflector's triangles, three vertices each, with its parameterisation in
         /// `uv` (the geometry image's raster pass)
         REFLECTOR_VERTICES = 8: STORAGE_BUFFER => "readonly buffer ReflectorVertices { CurvedVertex reflector_vertices[]; }";
+        /// Per reflector: the checked vertices (every CURVED_CHECK_STRIDE-th) that have a
+        /// second reflection point apart from the first (read back as a frame stat)
+        CURVED_MINIMA = 9: STORAGE_BUFFER => "buffer CurvedMinima { uint curved_minima[]; }";
     }
 }

@@ -244,6 +244,8 @@ pub struct CurvedReflectors {
     reflector_buffer: Buffer,
     virtuals: Buffer,
     params: Buffer,
+    /// Per reflector, the checked vertices with a second reflection point (host-visible).
+    minima: Buffer,
     env: Vec<EnvDraw>,
     environment: u32,
     reflector_vertices: Vec<(u32, u32)>,
@@ -287,6 +289,7 @@ impl CurvedReflectors {
             reflector_buffer: Buffer::placeholder(),
             virtuals: Buffer::placeholder(),
             params: Buffer::placeholder(),
+            minima: Buffer::placeholder(),
             env: Vec::new(),
             environment: 0,
             reflector_vertices: Vec::new(),
@@ -379,9 +382,15 @@ impl CurvedReflectors {
             self.env.push(EnvDraw { mesh: i as u32, first_index, index_count: indices.len() as u32 - first_index });
         }
         let (reflector_vertices, ranges, own_uvs) = reflector_vertices(scene, &self.reflectors, self.size);
-        for b in
-            [&mut self.vertices, &mut self.indices, &mut self.triangles, &mut self.reflector_buffer, &mut self.virtuals, &mut self.params]
-        {
+        for b in [
+            &mut self.vertices,
+            &mut self.indices,
+            &mut self.triangles,
+            &mut self.reflector_buffer,
+            &mut self.virtuals,
+            &mut self.params,
+            &mut self.minima,
+        ] {
             b.destroy(ctx);
         }
         let gpu_only = crate::vk::MemoryLocation::GpuOnly;
@@ -404,6 +413,8 @@ impl CurvedReflectors {
             pad: [0; 2],
         };
         self.params = Buffer::with_data(ctx, "geometry.curved_params", &[params], STORAGE)?;
+        let usage = STORAGE | vk::BufferUsageFlags::TRANSFER_DST;
+        self.minima = Buffer::new(ctx, "geometry.curved_minima", 4 * layers, usage, crate::vk::MemoryLocation::GpuToCpu)?;
         (self.environment, self.reflector_vertices, self.own_uvs) = (environment as u32, ranges, own_uvs);
         let sb = vk::DescriptorType::STORAGE_BUFFER;
         let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
@@ -417,6 +428,7 @@ impl CurvedReflectors {
         write_buffer(ctx, self.set, binding::SCENE_VERTICES, sb, gpu.vertices.raw);
         write_buffer(ctx, self.set, binding::SOURCE_TRIANGLES, sb, self.triangles.raw);
         write_buffer(ctx, self.set, binding::REFLECTOR_VERTICES, sb, self.reflector_buffer.raw);
+        write_buffer(ctx, self.set, binding::CURVED_MINIMA, sb, self.minima.raw);
         self.dirty = true;
         self.tessellate = true;
         Ok(())
@@ -554,6 +566,13 @@ impl Stage for CurvedReflectors {
             .reads(&self.positions, Access::ComputeSampled)
             .reads(&self.normals, Access::ComputeSampled)
             .begin();
+        unsafe { ctx.device.cmd_fill_buffer(cmd, self.minima.raw, 0, vk::WHOLE_SIZE, 0) };
+        let fill = [vk::MemoryBarrier2::default()
+            .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+            .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+            .dst_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
+            .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE)];
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&fill)) };
         self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.search_pipeline, f);
         for k in 0..self.reflectors.len() as u32 {
             self.push(ctx, cmd, f, view, k, f.flags);
@@ -636,10 +655,17 @@ impl Stage for CurvedReflectors {
     /// The environment's vertices (each searched once per reflector and view: the O(S·D) of
     /// survey Table 1), and memory (issue 11): bytes of one geometry image (positions and
     /// normals), of one reflector's virtual image per view and of the shared depth buffer;
-    /// reflectors parameterised by a planar projection (no usable UVs).
+    /// reflectors parameterised by a planar projection (no usable UVs); of the vertices
+    /// checked for a second reflection point (every CURVED_CHECK_STRIDE-th, per reflector),
+    /// those that have one (several minima: a reflector neither convex nor concave from
+    /// there, which the planner's convexity test should have refused).
     fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
         let (image, view, depth) = self.memory();
+        let minima = self.minima.read().map_or(0, |w| w.chunks_exact(4).map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as u64).sum());
+        let checked = self.environment.div_ceil(crate::frame::layout::CURVED_CHECK_STRIDE) as u64 * self.reflectors.len() as u64;
         vec![
+            ("geometry.curved_checked".into(), checked as f64),
+            ("geometry.curved_multiple_minima".into(), minima as f64),
             ("geometry.curved_reflectors".into(), self.reflectors.len() as f64),
             ("geometry.curved_vertices".into(), self.environment as f64),
             ("geometry.curved_image_bytes".into(), image as f64),
@@ -657,9 +683,15 @@ impl Stage for CurvedReflectors {
         for i in [&mut self.positions, &mut self.normals, &mut self.virtual_images, &mut self.virtual_depth] {
             i.destroy(ctx);
         }
-        for b in
-            [&mut self.vertices, &mut self.indices, &mut self.triangles, &mut self.reflector_buffer, &mut self.virtuals, &mut self.params]
-        {
+        for b in [
+            &mut self.vertices,
+            &mut self.indices,
+            &mut self.triangles,
+            &mut self.reflector_buffer,
+            &mut self.virtuals,
+            &mut self.params,
+            &mut self.minima,
+        ] {
             b.destroy(ctx);
         }
         unsafe {
