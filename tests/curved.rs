@@ -165,6 +165,7 @@ fn a_concave_bowl() {
         stat(&f, "geometry.curved_multiple_minima"),
         stat(&f, "geometry.curved_checked")
     );
+    assert_eq!(stat(&f, "geometry.curved_multiple_minima"), 0.0, "a concave cap: one reflection point each");
     // Rule 1: measured 32.25 dB; distance maps 32.62 dB (a shallow bowl whose reference point
     // sees the whole room: distance maps do as well here).
     assert!(p >= 31.25, "curved-reflector {p:.2} dB");
@@ -562,7 +563,9 @@ fn several_minima_are_counted() {
     let (found, checked) = (stat(&f, "geometry.curved_multiple_minima"), stat(&f, "geometry.curved_checked"));
     let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
     println!("two balls in one mesh: {found} of {checked} checked vertices with several minima, {:.2} dB", psnr(&f.image, &reference));
-    assert!(found > 0.0);
+    // Counts (tests/README.md): measured 648 of 2475 (the convex sphere and the bowl: 0),
+    // the bound a factor 1.122 under it.
+    assert!(found >= 577.0, "{found} of {checked}");
     common::assert_clean(&ctx);
 }
 
