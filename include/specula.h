@@ -69,6 +69,8 @@
 #define SPECULA_METHOD_PLANAR_MIRROR 12
 /* planar-refraction (§5) */
 #define SPECULA_METHOD_PLANAR_REFRACTION 14
+/* curved-reflector (§5) */
+#define SPECULA_METHOD_CURVED_REFLECTOR 15
 /* reference (§2, Table 1) (CPU only: specula_context_configure refuses it) */
 #define SPECULA_METHOD_REFERENCE 99
 

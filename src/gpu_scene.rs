@@ -123,7 +123,9 @@ impl GpuScene {
             uploaded: false,
         };
         crate::vk::build(ctx, out, |out| {
-            out.vertices = Buffer::with_data(ctx, "scene.vertices", &vertices, vk::BufferUsageFlags::VERTEX_BUFFER)?;
+            // Also a storage buffer: curved reflectors' tessellation pre-pass reads it (§5).
+            let usage = vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER;
+            out.vertices = Buffer::with_data(ctx, "scene.vertices", &vertices, usage)?;
             out.indices = Buffer::with_data(ctx, "scene.indices", &indices, vk::BufferUsageFlags::INDEX_BUFFER)?;
             out.materials = Buffer::with_data(ctx, "scene.materials", &materials, vk::BufferUsageFlags::STORAGE_BUFFER)?;
             out.create_images(ctx, scene)

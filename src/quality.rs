@@ -103,6 +103,12 @@ pub struct Quality {
     pub map_mirrors: bool,
     /// Debug output: each pixel's first-hit object beside the colour (`Frame::object_ids`).
     pub object_ids: bool,
+    /// `curved-reflector` (§5): edge of each reflector's geometry image, texels.
+    pub geometry_image: u32,
+    /// `curved-reflector`: coarse-to-fine levels of the reflection-point search.
+    pub curved_search: u32,
+    /// `curved-reflector`: each environment triangle is split into this many² triangles.
+    pub tessellation: u32,
     /// With MSAA: the specular camera passes shade every sample (their search depends on
     /// the sample's position and normal), else once per pixel and coverage.
     pub msaa_per_sample: bool,
@@ -617,6 +623,39 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.object_ids, ON_OFF),
     },
     Knob {
+        name: "geometry_image",
+        values: "8..=1024 texels",
+        default: "128",
+        doc: "curved-reflector (§5, EMD*05): edge of each reflector's geometry image (world positions and normals rasterised over its UV parameterisation, or a planar projection where it has none): the reflection points' sampling",
+        set: |q, v| {
+            q.geometry_image = count(v, 8, 1024)?;
+            Ok(())
+        },
+        get: |q| q.geometry_image.to_string(),
+    },
+    Knob {
+        name: "curved_search",
+        values: "0..=8 levels",
+        default: "3",
+        doc: "curved-reflector: coarse-to-fine levels of each vertex's reflection-point search in the geometry image: the coarsest level (every 2^levels-th texel) is searched exhaustively, each finer one in a 5×5 window around the last best, then a sub-texel refinement; 0: exhaustive at full resolution (slowest, finds the global minimum of the sampled image)",
+        set: |q, v| {
+            q.curved_search = count(v, 0, 8)?;
+            Ok(())
+        },
+        get: |q| q.curved_search.to_string(),
+    },
+    Knob {
+        name: "tessellation",
+        values: "1..=32 subdivisions",
+        default: "4",
+        doc: "curved-reflector: each environment triangle is split into tessellation² triangles before its vertices are moved to their virtual positions (survey Table 1: geometry transformation needs high tessellation, since the reflection of a straight edge in a curved mirror is curved)",
+        set: |q, v| {
+            q.tessellation = count(v, 1, 32)?;
+            Ok(())
+        },
+        get: |q| q.tessellation.to_string(),
+    },
+    Knob {
         name: "msaa_shading",
         values: "sample|pixel",
         default: "sample",
@@ -827,6 +866,9 @@ impl Default for Quality {
             mirror_budget: 8,
             map_mirrors: true,
             object_ids: false,
+            geometry_image: 128,
+            curved_search: 3,
+            tessellation: 4,
             caustics: Caustics::Triangles,
             photons: 128,
             splat_size: 2.0,

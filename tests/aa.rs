@@ -41,6 +41,7 @@ const MEASURED: &[(&str, f64, f64, f64)] = &[
     ("planar-mirror", -4.020e-3, 3.743e-3, 0.8099),
     // Falls back to distance for the demo's spheres (curved glass and mirror).
     ("planar-refraction", -4.020e-3, 3.743e-3, 0.8099),
+    ("curved-reflector", -2.522e-3, -2.684e-3, 0.8587),
 ];
 
 fn measured(m: Method) -> (f64, f64, f64) {

@@ -17,7 +17,7 @@ pub mod registry;
 pub use crate::reference::REFERENCE;
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
 pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
-pub use geometry::{PLANAR_MIRROR, PLANAR_REFRACTION};
+pub use geometry::{CURVED_REFLECTOR, PLANAR_MIRROR, PLANAR_REFRACTION};
 pub use layered::LAYERED;
 pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{Choice, Method, MethodInfo, ObjectClass};
@@ -40,6 +40,7 @@ pub const ALL: &[Method] = &[
     RAY_HIERARCHY,
     PLANAR_MIRROR,
     PLANAR_REFRACTION,
+    CURVED_REFLECTOR,
     REFERENCE,
 ];
 

@@ -160,38 +160,12 @@ pub enum Shape {
     /// Flat faces: a convex solid of planar faces (`ObjectFacts::faceted`), or a planar
     /// thin-walled pane.
     Faceted,
+    /// Convex or concave (or flat), not saddle-shaped (`ObjectFacts::curvature`): where a
+    /// search on the reflector's surface finds one reflection point (survey §5).
+    ConvexOrConcave,
 }
 
 impl Shape {
-    /// What it serves, for messages.
-    pub fn serves(self) -> &'static str {
-        match self {
-            Shape::Any => "any object",
-            Shape::Planar => "planar reflectors",
-            Shape::Faceted => "flat-faced convex solids and planar thin panes",
-        }
-    }
-
-    /// Why an object does not fit, for messages.
-    pub fn why_not(self) -> &'static str {
-        match self {
-            Shape::Any => "",
-            Shape::Planar => "the mesh's vertices do not lie on one plane with agreeing normals",
-            Shape::Faceted => {
-                "the mesh is not a closed convex solid of at most 64 flat faces (each face's vertex normals its plane's), nor a planar thin pane"
-            }
-        }
-    }
-
-    /// An adjective for an object that does not fit.
-    pub fn misfit(self) -> &'static str {
-        match self {
-            Shape::Any => "",
-            Shape::Planar => "non-planar",
-            Shape::Faceted => "curved (not flat-faced)",
-        }
-    }
-
     pub fn fits(self, f: &ObjectFacts) -> bool {
         match self {
             Shape::Any => true,
@@ -201,6 +175,27 @@ impl Shape {
                 ObjectClass::ThinDielectric => f.planar,
                 ObjectClass::Mirror => false,
             },
+            Shape::ConvexOrConcave => f.curvature != crate::plan::facts::Curvature::Saddle,
+        }
+    }
+
+    /// What the shape requires, and why an object that misses it was refused.
+    pub fn requirement(self) -> &'static str {
+        match self {
+            Shape::Any => "any shape",
+            Shape::Planar => "planar reflectors only: the mesh's vertices do not lie on one plane with agreeing normals",
+            Shape::Faceted => "flat-faced convex solids and planar thin panes only: the mesh is not a closed convex solid of at most 64 flat faces (each face's vertex normals its plane's), nor a planar thin pane",
+            Shape::ConvexOrConcave => "convex or concave reflectors only: the mesh is saddle-shaped (neither convex nor concave), where the reflection-point search has several minima (survey §5): unsupported",
+        }
+    }
+
+    /// An object of this class that misses the shape, as the planner's reasons name it.
+    pub fn misfit(self) -> &'static str {
+        match self {
+            Shape::Any => "a",
+            Shape::Planar => "a non-planar",
+            Shape::Faceted => "a curved (not flat-faced)",
+            Shape::ConvexOrConcave => "a saddle-shaped (neither convex nor concave, unsupported)",
         }
     }
 }

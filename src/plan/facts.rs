@@ -27,6 +27,17 @@ pub struct ObjectFacts {
     pub faceted: bool,
     /// Every edge shared by exactly two triangles (positions welded).
     pub watertight: bool,
+    /// Convex, concave (towards its normals), flat or neither (saddle-shaped): the
+    /// reflection-point search of curved reflectors (§5) has one minimum on the first three.
+    pub curvature: Curvature,
+    /// Farthest over nearest distance of the surfaces around the reference point (2048 rays;
+    /// 1 without deep facts): the environment's depth variation.
+    pub depth_ratio: f32,
+    /// The largest angle (radians) an edge of another object's triangles subtends from the
+    /// reference point: how coarsely the environment is tessellated as seen from the
+    /// object (geometry transformation bends only vertices, survey Table 1). 0 without deep
+    /// facts.
+    pub edge_angle: f32,
     /// Area fraction of the surface visible from the reference point (1: convex from it,
     /// as a single-layer map needs). Computed for `auto` only, else 1.
     pub visible_fraction: f32,
@@ -60,6 +71,131 @@ struct MeshFacts {
     planar: bool,
     faceted: bool,
     watertight: bool,
+    curvature: Curvature,
+}
+
+/// How a mesh bends, seen from the side its vertex normals point to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Curvature {
+    /// No edge bends (a plane).
+    Flat,
+    /// Every edge bends away from the normals (a sphere seen from outside).
+    Convex,
+    /// Every edge bends towards the normals (the inside of a bowl).
+    Concave,
+    /// Both (a saddle, a torus): neither convex nor concave.
+    Saddle,
+}
+
+impl Curvature {
+    pub fn label(self) -> &'static str {
+        match self {
+            Curvature::Flat => "flat",
+            Curvature::Convex => "convex",
+            Curvature::Concave => "concave",
+            Curvature::Saddle => "saddle-shaped (neither convex nor concave)",
+        }
+    }
+}
+
+/// The fraction of the total bending (dihedral angle × edge length) that may go the other
+/// way before a mesh counts as neither convex nor concave: tessellation noise of a
+/// curved surface stays far below it.
+pub const SADDLE_FRACTION: f64 = 0.02;
+
+/// A triangle on an edge: (triangle, the edge's first corner, the opposite corner).
+type Corner = (usize, u32, u32);
+
+/// Classifies mesh `m` by how its surface bends relative to its normals. Where the vertex
+/// normals vary (a smooth mesh: what the reflection search reads, interpolated), by the sign
+/// of (n_b − n_a)·(p_b − p_a) along every triangle edge: the normal curvature in the edge's
+/// direction, positive where the normals diverge (convex), negative where they converge
+/// (concave), of both signs on a saddle; this does not depend on how the surface was
+/// triangulated. Where they do not (a faceted mesh), by the signs of the dihedral angles at
+/// edges shared by two triangles (positions welded at 1e-6 of its size): whether the
+/// opposite corner of each lies behind (convex) or in front of (concave) the other's plane.
+/// Each sign is weighted by its magnitude; a mesh counts as neither convex nor concave when
+/// the lesser sign carries more than `SADDLE_FRACTION` of the total.
+pub fn curvature(m: &Mesh) -> Curvature {
+    let diag = m.bounds().diagonal() as f64;
+    if m.indices.len() < 3 || diag <= 0.0 || !diag.is_finite() || m.normals.len() != m.positions.len() {
+        return Curvature::Flat;
+    }
+    let p = |i: u32| m.positions[i as usize].as_dvec3();
+    let n = |i: u32| m.normals[i as usize].as_dvec3().normalize_or_zero();
+    let classify = |convex: f64, concave: f64| {
+        let total = convex + concave;
+        if total <= 0.0 {
+            Curvature::Flat
+        } else if concave <= SADDLE_FRACTION * total {
+            Curvature::Convex
+        } else if convex <= SADDLE_FRACTION * total {
+            Curvature::Concave
+        } else {
+            Curvature::Saddle
+        }
+    };
+    let (mut convex, mut concave) = (0.0f64, 0.0f64);
+    let flat = 1e-9 * diag * diag;
+    for t in m.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            let s = (n(b) - n(a)).dot(p(b) - p(a));
+            if s > flat {
+                convex += s;
+            } else if s < -flat {
+                concave -= s;
+            }
+        }
+    }
+    if convex + concave > 0.0 {
+        return classify(convex, concave);
+    }
+    // Faceted: the dihedral angles.
+    let scale = 1e-6 * diag;
+    let key = |v: Vec3| ((v.x as f64 / scale).round() as i64, (v.y as f64 / scale).round() as i64, (v.z as f64 / scale).round() as i64);
+    let mut ids: HashMap<(i64, i64, i64), u32> = HashMap::new();
+    let weld: Vec<u32> = m
+        .positions
+        .iter()
+        .map(|&v| {
+            let n = ids.len() as u32;
+            *ids.entry(key(v)).or_insert(n)
+        })
+        .collect();
+    let mut normals = Vec::with_capacity(m.indices.len() / 3);
+    let mut edges: HashMap<(u32, u32), Vec<Corner>> = HashMap::new();
+    for (t, tri) in m.indices.chunks_exact(3).enumerate() {
+        let g = (p(tri[1]) - p(tri[0])).cross(p(tri[2]) - p(tri[0]));
+        let shading: DVec3 = tri.iter().map(|&i| n(i)).sum();
+        normals.push((if g.dot(shading) < 0.0 { -g } else { g }).try_normalize());
+        if normals[t].is_none() {
+            continue;
+        }
+        for k in 0..3 {
+            let (a, b) = (weld[tri[k] as usize], weld[tri[(k + 1) % 3] as usize]);
+            if a != b {
+                edges.entry((a.min(b), a.max(b))).or_default().push((t, tri[k], tri[(k + 2) % 3]));
+            }
+        }
+    }
+    let flat = 1e-7 * diag;
+    for tris in edges.values() {
+        let [(t1, a, c), (t2, _, d)] = tris[..] else { continue };
+        let (Some(n1), Some(n2)) = (normals[t1], normals[t2]) else { continue };
+        let (h1, h2) = (n1.dot(p(d) - p(a)), n2.dot(p(c) - p(a)));
+        if h1.abs() <= flat && h2.abs() <= flat {
+            continue;
+        }
+        let bend = n1.dot(n2).clamp(-1.0, 1.0).acos();
+        if h1 < 0.0 && h2 < 0.0 {
+            convex += bend;
+        } else if h1 > 0.0 && h2 > 0.0 {
+            concave += bend;
+        }
+    }
+    classify(convex, concave)
 }
 
 static CACHE: Mutex<Option<HashMap<u64, Arc<MeshFacts>>>> = Mutex::new(None);
@@ -95,7 +231,7 @@ fn mesh_facts(m: &Mesh) -> Arc<MeshFacts> {
     }
     let watertight = is_watertight(m);
     let faceted = watertight && is_faceted(m);
-    let f = Arc::new(MeshFacts { planar: is_planar(m), faceted, watertight });
+    let f = Arc::new(MeshFacts { planar: is_planar(m), faceted, watertight, curvature: curvature(m) });
     if let Ok(mut c) = CACHE.lock() {
         let map = c.get_or_insert_with(HashMap::new);
         if map.len() > 1024 {
@@ -354,8 +490,9 @@ fn self_facing(m: &Mesh, x: Vec3) -> f32 {
 /// itself) reach first: the other specular objects with the fraction of directions that
 /// reach each, and the fraction of directions whose hit lies on the scene's bounding box
 /// (within 1 % of its diagonal: the environment is then its own proxy box, §3.2).
-fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usize, f32)>, f32) {
+fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usize, f32)>, f32, f32) {
     let mut hits: HashMap<usize, u32> = HashMap::new();
+    let (mut nearest, mut farthest) = (f64::INFINITY, 0.0f64);
     let mut on_box = 0u32;
     let n = 2048;
     let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
@@ -381,6 +518,9 @@ fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usi
                 *hits.entry(hit_mesh).or_insert(0) += 1;
             }
             let p = o + d * h.t;
+            let dist = p.distance(x.as_dvec3());
+            nearest = nearest.min(dist);
+            farthest = farthest.max(dist);
             let to_face = (p - lo).abs().min_element().min((hi - p).abs().min_element());
             if to_face <= 0.01 * diag {
                 on_box += 1;
@@ -390,7 +530,27 @@ fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usi
     }
     let mut out: Vec<(usize, f32)> = hits.into_iter().map(|(m, k)| (m, k as f32 / n as f32)).collect();
     out.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
-    (out, on_box as f32 / n as f32)
+    let ratio = if nearest > 0.0 && farthest.is_finite() && farthest >= nearest { (farthest / nearest) as f32 } else { 1.0 };
+    (out, on_box as f32 / n as f32, ratio)
+}
+
+/// The largest angle an edge of a triangle of any other mesh subtends from `x`.
+fn edge_angle(scene: &Scene, own: usize, x: Vec3) -> f32 {
+    let x = x.as_dvec3();
+    let mut largest = 0.0f64;
+    for (i, m) in scene.meshes.iter().enumerate() {
+        if i == own || m.hidden {
+            continue;
+        }
+        let d = |k: u32| (m.positions[k as usize].as_dvec3() - x).normalize_or_zero();
+        for t in m.indices.chunks_exact(3) {
+            for k in 0..3 {
+                let c = d(t[k]).dot(d(t[(k + 1) % 3])).clamp(-1.0, 1.0);
+                largest = largest.max(c.acos());
+            }
+        }
+    }
+    largest as f32
 }
 
 impl ObjectFacts {
@@ -430,9 +590,9 @@ impl SceneFacts {
                     (None, None) => reference_point(scene, i),
                 };
                 let mf = mesh_facts(m);
-                let (visible, (sees, box_fraction)) = match &bvh {
+                let (visible, (sees, box_fraction, depth_ratio)) = match &bvh {
                     Some(b) => (visible_fraction_cached(m, reference_point), visible_specular(scene, b, i, reference_point)),
-                    None => (1.0, (Vec::new(), 0.0)),
+                    None => (1.0, (Vec::new(), 0.0, 1.0)),
                 };
                 Some(ObjectFacts {
                     mesh: i,
@@ -440,6 +600,9 @@ impl SceneFacts {
                     planar: mf.planar,
                     faceted: mf.faceted,
                     watertight: mf.watertight,
+                    curvature: mf.curvature,
+                    depth_ratio,
+                    edge_angle: if bvh.is_some() { edge_angle(scene, i, reference_point) } else { 0.0 },
                     visible_fraction: visible,
                     sees_specular: sees,
                     box_fraction,

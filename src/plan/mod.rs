@@ -315,10 +315,7 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
     let class = facts.class;
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
         if m.can_serve(class) && !m.shape.fits(facts) {
-            Err(Error::invalid(
-                format!("object '{}'", mesh.name),
-                format!("method '{}' serves {} only: {}", m.name, m.shape.serves(), m.shape.why_not()),
-            ))
+            Err(Error::invalid(format!("object '{}'", mesh.name), format!("method '{}' serves {}", m.name, m.shape.requirement())))
         } else if m.can_serve(class) {
             Ok((m, format!("{source}: {}", m.name)))
         } else {
@@ -337,8 +334,7 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
             return Ok((m, format!("--method {}", m.name)));
         }
         if let Some(f) = m.fallback.filter(|f| f.fits(facts)) {
-            let what =
-                if m.can_serve(class) { format!("a {} {}", m.shape.misfit(), class.label()) } else { format!("a {}", class.label()) };
+            let what = if m.can_serve(class) { format!("{} {}", m.shape.misfit(), class.label()) } else { format!("a {}", class.label()) };
             return Ok((f, format!("--method {} does not serve {what}: its fallback {}", m.name, f.name)));
         }
         return check(m, "--method");

@@ -4,11 +4,15 @@
 //! its Fresnel weight (`geometry.mirror`). Mirrors seen in mirrors recurse: every mirrored
 //! view is a camera view of its own, in which every camera pass of the frame draws its
 //! objects (`mirror::MirrorViews` plans the views of a frame; the renderer records them
-//! before the camera's own view, deepest first).
+//! before the camera's own view, deepest first). Curved reflectors (EMD*05, EMDT06) move the
+//! environment's vertices to their virtual positions instead (`curved`).
 
+pub mod curved;
 pub mod faces;
 pub mod mirror;
 pub mod views;
+
+pub use curved::CURVED_REFLECTOR;
 
 use crate::frame::stage::order;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
