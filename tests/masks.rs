@@ -76,3 +76,46 @@ fn errors_split_by_object() {
     assert_eq!(count("specular") + count("non-specular"), (SIZE.0 * SIZE.1) as usize);
     common::assert_clean(&ctx);
 }
+
+/// `specula compare --scene`: the per-object table and a masked error image; a mask that
+/// names nothing is refused by name.
+#[test]
+fn compare_reports_errors_per_object() {
+    let bin = env!("CARGO_BIN_EXE_specula");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+    let dir = std::env::temp_dir().join(format!("specula-masks-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let run = |args: &[&str]| std::process::Command::new(bin).args(args).output().unwrap();
+    let (r, e, err) = (dir.join("r.exr"), dir.join("e.exr"), dir.join("err.png"));
+    for (method, out) in [("reference", &r), ("envmap", &e)] {
+        let o =
+            run(&["render", scene, "--method", method, "--size", "48x36", "-q", "depth=4", "-q", "spp=1", "--out", out.to_str().unwrap()]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let o = run(&[
+        "compare",
+        e.to_str().unwrap(),
+        r.to_str().unwrap(),
+        "--scene",
+        scene,
+        "--mask",
+        "specular",
+        "--error-image",
+        err.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}{}", String::from_utf8_lossy(&o.stderr));
+    for row in ["mirror_sphere/0", "glass_sphere/0", "specular", "non-specular", "(pixels of specular only)"] {
+        assert!(text.contains(row), "{row} missing:\n{text}");
+    }
+    // The masked error image holds the colour of no error outside the specular pixels:
+    // one colour over most of it.
+    let img = image::open(&err).unwrap().to_rgb8();
+    let mut counts = std::collections::HashMap::new();
+    img.pixels().for_each(|p| *counts.entry(p.0).or_insert(0usize) += 1);
+    let most = counts.values().copied().max().unwrap_or(0);
+    assert!(most * 2 > img.pixels().count() && counts.len() > 1, "{most} of {} pixels, {} colours", img.pixels().count(), counts.len());
+    let o = run(&["compare", e.to_str().unwrap(), r.to_str().unwrap(), "--scene", scene, "--mask", "bogus"]);
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("'bogus'"));
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -70,6 +70,15 @@ enum Command {
         /// Write the FLIP error map in false colour (PNG).
         #[arg(long)]
         error_image: Option<PathBuf>,
+        /// The scene both images show (at their size, from its camera): the errors are also
+        /// reported per specular object, on all specular pixels and on the rest (issue 15),
+        /// from the exact first hits of its pixels.
+        #[arg(long)]
+        scene: Option<PathBuf>,
+        /// With --scene: restrict the error image to these pixels: `specular`,
+        /// `non-specular` or an object's name.
+        #[arg(long, requires = "scene")]
+        mask: Option<String>,
     },
     /// The speed–accuracy trade-off: every GPU method (× every --sweep combination) timed
     /// and compared with the exact reference; writes tradeoff.csv and tradeoff.svg to --out.
@@ -223,7 +232,9 @@ fn run(cmd: Command) -> specula::Result<()> {
             raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
-        Command::Compare { test, reference, error_image } => compare::run(&test, &reference, error_image.as_deref()),
+        Command::Compare { test, reference, error_image, scene, mask } => {
+            compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())
+        }
         Command::Tradeoff { args, sweep, methods, out } => tradeoff::run(&args, &sweep, &methods, &out),
     }
 }
