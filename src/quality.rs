@@ -103,6 +103,8 @@ pub struct Quality {
     pub map_mirrors: bool,
     /// Debug output: each pixel's first-hit object beside the colour (`Frame::object_ids`).
     pub object_ids: bool,
+    /// Shadows of punctual lights, in the GPU renderers and the reference alike.
+    pub shadows: bool,
     /// `curved-reflector` (§5): edge of each reflector's geometry image, texels.
     pub geometry_image: u32,
     /// `curved-reflector`: coarse-to-fine levels of the reflection-point search.
@@ -623,6 +625,17 @@ pub const KNOBS: &[Knob] = &[
         get: |q| name_of(q.object_ids, ON_OFF),
     },
     Knob {
+        name: "shadows",
+        values: "on|off",
+        default: "on",
+        doc: "shadows of punctual lights on diffuse surfaces, in the GPU renderers (shadow maps; the ray tracers' shadow rays) and the CPU reference (exact shadow rays) alike; off: every light reaches what faces it unoccluded, in both, so that a comparison's error is not the shared term of shadow maps against exact shadows (issue 15: a specular knob's curve then shows that knob). Caustic photons stay occluded in the reference's light tracing. Off is not ground truth",
+        set: |q, v| {
+            q.shadows = one_of(v, ON_OFF)?;
+            Ok(())
+        },
+        get: |q| name_of(q.shadows, ON_OFF),
+    },
+    Knob {
         name: "geometry_image",
         values: "8..=1024 texels",
         default: "128",
@@ -866,6 +879,7 @@ impl Default for Quality {
             mirror_budget: 8,
             map_mirrors: true,
             object_ids: false,
+            shadows: true,
             geometry_image: 128,
             curved_search: 3,
             tessellation: 4,

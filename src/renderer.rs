@@ -329,7 +329,8 @@ impl Renderer {
         }
         self.flags = if plan.quality.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
             | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 }
-            | if plan.quality.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST };
+            | if plan.quality.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
+            | if plan.quality.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
 
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         // The sets are visible to compute too: the ray pipeline's kernels shade with them.

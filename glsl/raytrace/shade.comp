@@ -36,6 +36,10 @@ void main() {
         if (cos_t <= 0.0 || all(equal(c, vec3(0.0)))) continue;
         // Up to the light, short of it by the offset the ray starts with.
         float t_max = isinf(dist) ? dist : dist - trace.t_min;
+        if ((push.flags & FLAG_UNSHADOWED) != 0u) {
+            accumulate(pl.pixel, c);  // shadows=off: unoccluded, as the reference then
+            continue;
+        }
         push_shadow(make_query(s.p, wi, trace.t_min, t_max, h.triangle, RAY_ANY_HIT), make_payload(c, pl.pixel));
     }
 }

@@ -339,6 +339,9 @@ gpu_consts! {
     /// `Push.flags`: a dielectric hit in the layered maps follows only its stronger Fresnel
     /// branch (`layered_branches=strongest`).
     FLAG_LAYERED_STRONGEST: uint = 4096;
+    /// `Push.flags` (`shadows=off`): punctual lights reach every diffuse surface facing them
+    /// unoccluded (no shadow maps are planned; ray tracers send no shadow rays).
+    FLAG_UNSHADOWED: uint = 8192;
 
     /// Curved reflectors (§5): `Push.flags >> CURVED_REFLECTOR_SHIFT` is the reflector's layer
     /// in the geometry and virtual images (the `geometry.curved` and `geometry.virtual` draws).

@@ -486,7 +486,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     // caustic photons need them (occluders between a light and a generator).
     let traced_everywhere = matches!(p.choice, Choice::Method(m) if m.family == "raytrace");
     p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q);
-    if has_diffuse && (!traced_everywhere || p.caustics.is_some()) {
+    if has_diffuse && q.shadows && (!traced_everywhere || p.caustics.is_some()) {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),

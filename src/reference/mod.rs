@@ -69,6 +69,8 @@ pub struct Tracer<'a> {
     epsilon: f64,
     /// The caustic photons, built only when `Quality::caustics` is not off.
     caustics: Option<PhotonMap>,
+    /// `shadows=off`: no shadow rays (every light reaches what faces it).
+    shadows: bool,
 }
 
 /// What one camera ray sees, pre-computed per pixel sample.
@@ -158,6 +160,7 @@ impl<'a> Tracer<'a> {
             depth: quality.depth,
             epsilon: diag.max(f64::MIN_POSITIVE) * 1e-9,
             caustics: None,
+            shadows: quality.shadows,
         };
         if quality.caustics != Caustics::Off {
             tracer.caustics = Some(PhotonMap::build(&tracer, quality)?);
@@ -242,7 +245,7 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let t_max = if dist.is_finite() { dist - self.epsilon } else { f64::INFINITY };
-            if !self.bvh.occluded(s.position, wi, self.epsilon, t_max, Some(triangle)) {
+            if !self.shadows || !self.bvh.occluded(s.position, wi, self.epsilon, t_max, Some(triangle)) {
                 sum += e * cos_t;
             }
         }
