@@ -284,15 +284,7 @@ fn curved_reflectors_at_a_millimetre_and_a_kilometre() {
     let q = quality();
     let one = gpu(&ctx, &base, specula::methods::CURVED_REFLECTOR, &q).image;
     for scale in [1e-3f32, 1e3] {
-        let mut s = base.clone();
-        for m in &mut s.meshes {
-            m.positions.iter_mut().for_each(|p| *p *= scale);
-        }
-        let mut cam = base.camera_or_default();
-        cam.position *= scale;
-        cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * scale).extend(1.0);
-        cam.znear *= scale;
-        s.camera = Some(cam);
+        let s = common::scaled(&base, scale);
         let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
         let p = psnr(&f.image, &one);
         let differ =

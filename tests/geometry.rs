@@ -181,15 +181,7 @@ fn mirrors_at_a_millimetre_and_a_kilometre() {
     let q = quality(3);
     let one = gpu(&ctx, &base, specula::methods::PLANAR_MIRROR, &q).image;
     for scale in [1e-3f32, 1e3] {
-        let mut s = base.clone();
-        for m in &mut s.meshes {
-            m.positions.iter_mut().for_each(|p| *p *= scale);
-        }
-        let mut cam = base.camera_or_default();
-        cam.position *= scale;
-        cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * scale).extend(1.0);
-        cam.znear *= scale;
-        s.camera = Some(cam);
+        let s = common::scaled(&base, scale);
         let f = gpu(&ctx, &s, specula::methods::PLANAR_MIRROR, &q);
         let p = psnr(&f.image, &one);
         println!("scale {scale:e}: {} views, {p:.2} dB against scale 1", stat(&f, "geometry.mirror_views"));
@@ -347,20 +339,6 @@ fn psnr_on_glass(image: &ImageData, with: &ImageData, without: &ImageData) -> (f
         }
     }
     (10.0 * (n as f64 / se.max(1e-300)).log10(), n)
-}
-
-/// Scales every position and the camera of `s` by `k`.
-fn scaled(base: &Scene, k: f32) -> Scene {
-    let mut s = base.clone();
-    for m in &mut s.meshes {
-        m.positions.iter_mut().for_each(|p| *p *= k);
-    }
-    let mut cam = base.camera_or_default();
-    cam.position *= k;
-    cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * k).extend(1.0);
-    cam.znear *= k;
-    s.camera = Some(cam);
-    s
 }
 
 /// A thin-walled pane transmits undeviated and reflects as a mirror: both views are exact,
@@ -543,7 +521,7 @@ fn planar_refraction_at_the_extremes() {
 
     // 1 mm and 1 km: the same image (the linearised maps and the clip offsets are relative).
     for k in [1e-3f32, 1e3] {
-        let f = gpu(&ctx, &scaled(&base, k), specula::methods::PLANAR_REFRACTION, &q);
+        let f = gpu(&ctx, &common::scaled(&base, k), specula::methods::PLANAR_REFRACTION, &q);
         let p = psnr(&f.image, &one.image);
         println!("scale {k:e}: {p:.2} dB against scale 1, {} views", stat(&f, "geometry.mirror_views"));
         assert_eq!(stat(&f, "geometry.mirror_views"), stat(&one, "geometry.mirror_views"), "scale {k:e}");

@@ -69,6 +69,12 @@ impl FrameInputs<'_> {
     }
 
     pub fn push_flags(&self, ctx: &Context, cmd: vk::CommandBuffer, view: u32, object: u32, flags: u32) {
+        self.push_in(ctx, cmd, self.layout, view, object, flags);
+    }
+
+    /// `push_flags` into another pipeline layout with the same push range (a method's own
+    /// stage with sets of its own).
+    pub fn push_in(&self, ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, view: u32, object: u32, flags: u32) {
         let p = Push {
             view,
             object,
@@ -83,7 +89,7 @@ impl FrameInputs<'_> {
         unsafe {
             ctx.device.cmd_push_constants(
                 cmd,
-                self.layout,
+                layout,
                 vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE,
                 0,
                 bytemuck::bytes_of(&p),

@@ -185,3 +185,17 @@ pub fn huge_png_bytes() -> Vec<u8> {
     png[29..33].copy_from_slice(&(!c).to_be_bytes());
     png
 }
+
+/// `base` with every position and its camera scaled by `k` (1 mm and 1 km scenes).
+pub fn scaled(base: &Scene, k: f32) -> Scene {
+    let mut s = base.clone();
+    for m in &mut s.meshes {
+        m.positions.iter_mut().for_each(|p| *p *= k);
+    }
+    let mut cam = base.camera_or_default();
+    cam.position *= k;
+    cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * k).extend(1.0);
+    cam.znear *= k;
+    s.camera = Some(cam);
+    s
+}

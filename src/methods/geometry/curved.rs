@@ -28,7 +28,7 @@ use crate::error::{Error, Result};
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{binding, GpuCurvedParams, GpuCurvedVertex, CURVED_BINDINGS, CURVED_REFLECTOR_SHIFT};
 use crate::frame::stage::{order, FrameIo, Stage, StageInit};
-use crate::frame::{destroy_pipelines, FrameInputs, Push, PUSH_BYTES};
+use crate::frame::{destroy_pipelines, FrameInputs, PUSH_BYTES};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
 use crate::plan::facts::Curvature;
 use crate::plan::CameraPlan;
@@ -479,19 +479,7 @@ impl CurvedReflectors {
     }
 
     fn push(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32, object: u32, flags: u32) {
-        let p = Push {
-            view,
-            object,
-            flags,
-            light_count: f.light_count,
-            search: f.search,
-            tolerance: f.tolerance,
-            internal_bounces: f.internal_bounces,
-            depth: f.depth,
-            mirror_base: f.mirror_base,
-        };
-        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
-        unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
+        f.push_in(ctx, cmd, self.layout, view, object, flags);
     }
 
     /// `geometry.image`: each reflector's triangles over its parameterisation.

@@ -27,7 +27,7 @@ use crate::frame::layout::{
     binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, TRACE_BINDINGS,
 };
 use crate::frame::stage::{FrameIo, Stage, StageInit};
-use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, Push, PUSH_BYTES};
+use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
 use crate::methods::Choice;
 use crate::plan::CameraPlan;
 use crate::vk::pipeline::{
@@ -501,19 +501,7 @@ impl RayTrace {
 
     /// `push` with `Push.object` set (cull_stats.comp: which queue it counts).
     fn push_object(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32, object: u32) {
-        let p = Push {
-            view,
-            object,
-            flags: f.flags,
-            light_count: f.light_count,
-            search: f.search,
-            tolerance: f.tolerance,
-            internal_bounces: f.internal_bounces,
-            depth: f.depth,
-            mirror_base: f.mirror_base,
-        };
-        let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
-        unsafe { ctx.device.cmd_push_constants(cmd, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
+        f.push_in(ctx, cmd, self.layout, view, object, f.flags);
     }
 
     fn bind(
