@@ -268,6 +268,19 @@ pub struct CurvedReflectors {
 }
 
 impl CurvedReflectors {
+    /// The buffers rebuilt with the scene's geometry.
+    fn buffers(&mut self) -> [&mut Buffer; 7] {
+        [
+            &mut self.vertices,
+            &mut self.indices,
+            &mut self.triangles,
+            &mut self.reflector_buffer,
+            &mut self.virtuals,
+            &mut self.params,
+            &mut self.minima,
+        ]
+    }
+
     fn empty(init: &StageInit, plan: &CameraPlan) -> CurvedReflectors {
         let q = &init.plan.quality;
         CurvedReflectors {
@@ -382,15 +395,7 @@ impl CurvedReflectors {
             self.env.push(EnvDraw { mesh: i as u32, first_index, index_count: indices.len() as u32 - first_index });
         }
         let (reflector_vertices, ranges, own_uvs) = reflector_vertices(scene, &self.reflectors, self.size);
-        for b in [
-            &mut self.vertices,
-            &mut self.indices,
-            &mut self.triangles,
-            &mut self.reflector_buffer,
-            &mut self.virtuals,
-            &mut self.params,
-            &mut self.minima,
-        ] {
+        for b in self.buffers() {
             b.destroy(ctx);
         }
         let gpu_only = crate::vk::MemoryLocation::GpuOnly;
@@ -671,15 +676,7 @@ impl Stage for CurvedReflectors {
         for i in [&mut self.positions, &mut self.normals, &mut self.virtual_images, &mut self.virtual_depth] {
             i.destroy(ctx);
         }
-        for b in [
-            &mut self.vertices,
-            &mut self.indices,
-            &mut self.triangles,
-            &mut self.reflector_buffer,
-            &mut self.virtuals,
-            &mut self.params,
-            &mut self.minima,
-        ] {
+        for b in self.buffers() {
             b.destroy(ctx);
         }
         unsafe {
