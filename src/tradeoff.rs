@@ -494,7 +494,10 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
         .margin_right(24)
         .x_label_area_size(52)
         .y_label_area_size(76)
-        .build_cartesian_2d(t_range.log_scale(), v_range)
+        .build_cartesian_2d(
+            t_range.clone().log_scale().with_key_points(log_ticks(t_range.start, t_range.end)).with_light_points(minor_log_ticks(t_range)),
+            v_range,
+        )
         .map_err(|x| e(&x))?;
     chart
         .configure_mesh()
@@ -504,8 +507,9 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
         .y_label_formatter(&|v| fmt_num(*v))
         .label_style(font(14.0))
         .axis_desc_style(font(15.0))
-        .light_line_style(RGBColor(236, 236, 236))
-        .bold_line_style(RGBColor(215, 215, 215))
+        .y_labels(8)
+        .light_line_style(RGBColor(244, 244, 244))
+        .bold_line_style(RGBColor(212, 212, 212))
         .draw()
         .map_err(|x| e(&x))?;
     let (xr, yr) = chart.plotting_area().get_pixel_range();
@@ -649,6 +653,48 @@ fn draw_legend<DB: plotters::prelude::DrawingBackend>(
         y += 26;
     }
     Ok(())
+}
+
+/// Labelled ticks of a log axis over `lo..hi`: 1-2-5 per decade (1 alone over many
+/// decades, 1 to 9 over a few), at least four; linear steps of 1, 2 or 5 × 10^k over a
+/// range too narrow for that.
+fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return Vec::new();
+    }
+    let per_decade = |mults: &[f64]| {
+        let mut v = Vec::new();
+        let mut p = 10f64.powf(lo.log10().floor());
+        while p <= hi {
+            v.extend(mults.iter().map(|m| m * p).filter(|x| (lo..=hi).contains(x)));
+            p *= 10.0;
+        }
+        v
+    };
+    for mults in [&[1.0][..], &[1.0, 2.0, 5.0], &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]] {
+        let v = per_decade(mults);
+        if (4..=12).contains(&v.len()) {
+            return v;
+        }
+    }
+    let rough = (hi - lo) / 5.0;
+    let mag = 10f64.powf(rough.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| *s >= rough).unwrap_or(10.0 * mag);
+    ((lo / step).ceil() as i64..=(hi / step).floor() as i64).map(|i| i as f64 * step).collect()
+}
+
+/// The grid's light lines on a log axis: 1 to 9 × 10^k.
+fn minor_log_ticks(r: std::ops::Range<f64>) -> Vec<f64> {
+    let mut v = Vec::new();
+    if !(r.start > 0.0 && r.end > r.start && r.end.is_finite()) {
+        return v;
+    }
+    let mut p = 10f64.powf(r.start.log10().floor());
+    while p <= r.end {
+        v.extend((1..10).map(|m| m as f64 * p).filter(|x| r.contains(x)));
+        p *= 10.0;
+    }
+    v
 }
 
 /// A tick label: a few significant digits, no trailing zeros.
@@ -887,6 +933,22 @@ mod tests {
             rows.push(timed("bvh", knobs, 9.0, 0.05, 35.0 + shift));
         }
         rows
+    }
+
+    #[test]
+    fn log_axis_ticks_fit_the_range() {
+        assert_eq!(log_ticks(0.5, 2000.0), [1.0, 10.0, 100.0, 1000.0]);
+        assert_eq!(log_ticks(0.7, 30.0), [1.0, 2.0, 5.0, 10.0, 20.0]);
+        assert_eq!(log_ticks(1.5, 9.5), [2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]);
+        let narrow = log_ticks(2.3, 4.1);
+        assert!(narrow.len() >= 4 && narrow.iter().all(|t| (2.3..=4.1).contains(t)), "{narrow:?}");
+        let minor = minor_log_ticks(0.5..3.0);
+        assert_eq!(minor.len(), 7, "{minor:?}");
+        assert!(minor.iter().zip([0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 2.0]).all(|(a, b)| (a - b).abs() < 1e-12), "{minor:?}");
+        assert_eq!(
+            (fmt_num(0.30000000000000004), fmt_num(12.0), fmt_num(24.5), fmt_num(0.0002)),
+            ("0.3".into(), "12".into(), "24.5".into(), "2.0e-4".into())
+        );
     }
 
     #[test]
