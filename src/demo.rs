@@ -62,16 +62,12 @@ pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<
                 let colour = if k == 0 { WHITE } else { RGBColor(205, 205, 205) };
                 let style = TextStyle::from(FontDesc::new(FontFamily::SansSerif, size as f64, FontStyle::Normal)).color(&colour);
                 let fits = |s: &str| root.estimate_text_size(s, &style).map(|(tw, _)| tw + size / 2 <= w);
+                // Cut to the tile: drop characters from the end until the rest and "…" fit.
                 let mut text = line.to_string();
-                while !fits(&text).map_err(|x| e(&x))? && !text.is_empty() {
-                    text.pop();
-                    while text.ends_with('…') {
-                        text.pop();
-                    }
-                    text = format!("{}…", text.trim_end());
-                    if text == "…" {
-                        break;
-                    }
+                let mut kept = line.chars().count();
+                while !fits(&text).map_err(|x| e(&x))? && kept > 0 {
+                    kept -= 1;
+                    text = format!("{}…", line.chars().take(kept).collect::<String>().trim_end());
                 }
                 let pos = ((ox + size / 4) as i32, (oy + size / 4 + k as u32 * (size * 5 / 4)) as i32);
                 root.draw(&Text::new(text, pos, style)).map_err(|x| e(&x))?;
@@ -95,12 +91,13 @@ mod tests {
             Tile { name: "a".into(), label: "image-space-refraction\n12.3 ms  31.25 dB".into(), image: image.clone() },
             Tile { name: "b".into(), label: "bvh".into(), image: image.clone() },
             Tile { name: "c".into(), label: "envmap\n1.0 ms  20.00 dB".into(), image: image.clone() },
+            Tile { name: "d".into(), label: "a label far too long for a tile 200 pixels wide".into(), image: image.clone() },
         ];
         let path = write_composite(&dir, &tiles, 200, 100).unwrap();
         let png = ::image::open(&path).unwrap().to_rgb8();
         // 16 px text at 200 px tiles: two lines of 20 px and 8 px of margin above each tile.
         let strip = 48;
-        assert_eq!(png.dimensions(), (600, strip + 100));
+        assert_eq!(png.dimensions(), (800, strip + 100));
         let region = |x0: u32, rows: std::ops::Range<u32>| -> Vec<[u8; 3]> {
             (x0..x0 + 200).flat_map(|x| rows.clone().map(move |y| (x, y))).map(|(x, y)| png.get_pixel(x, y).0).collect()
         };
@@ -114,6 +111,8 @@ mod tests {
         assert!(bright(&region(400, 24..strip)) > 40 && bright(&region(200, 24..strip)) == 0);
         // The long name is cut to the tile, not drawn over its neighbour's strip.
         assert!(region(0, 0..strip).iter().any(|p| p[0] > 150) && png.get_pixel(201, 10).0[0] < 60);
+        let cut = region(600, 0..24);
+        assert!(bright(&cut) > 100 && (0..24).all(|y| png.get_pixel(799, y).0[0] < 60), "the long label is cut before the sheet's edge");
         // The image under the strip, sRGB-encoded (0.5 linear = 188).
         assert_eq!(png.get_pixel(100, strip + 50).0, [188, 188, 188]);
         // Tiles of another size are refused.
