@@ -273,9 +273,9 @@ const TITLE_H: u32 = 48;
 /// and bitmap backends): one panel per entry of `panels` (two columns), each the metric
 /// against frame GPU time on a log axis, both ranges from the data with a margin; one
 /// curve per method (its points in time order, a colour and marker of its own, named in
-/// the legend beside the panels), each point labelled with its knob values where there is
-/// room (Pareto points first; far labels get a leader line), the Pareto front as a step
-/// line through ringed points.
+/// the legend beside the panels), each point labelled with its knob values (a method's
+/// only point with the method's name) where there is room (Pareto points first; far
+/// labels get a leader line), the Pareto front as a step line through ringed points.
 pub fn plot(stem: &Path, panels: &[Panel], metric: Metric, title: &str) -> Result<Figure> {
     use plotters::prelude::*;
     if panels.is_empty() {
@@ -552,16 +552,19 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
         draw_marker(root, p.0, px[i], 6)?;
     }
 
-    // Knob values beside the points of methods with more than one point, front first.
+    // Knob values beside the points of methods with more than one point, the method's name
+    // beside a method's only point; front first.
     let label_font = font(13.0);
-    let many = |k: usize| pts.iter().filter(|p| p.0 == k).count() > 1;
-    let mut order: Vec<usize> = (0..pts.len()).filter(|&i| many(pts[i].0)).collect();
+    let single = |k: usize| pts.iter().filter(|p| p.0 == k).count() == 1;
+    let mut order: Vec<usize> = (0..pts.len()).collect();
     order.sort_by_key(|&i| (!front[i], pts[i].0));
     let texts: Vec<String> = order
         .iter()
         .map(|&i| {
             let l = &pts[i].3;
-            if l.len() > 2 {
+            if single(pts[i].0) {
+                methods[pts[i].0].to_string()
+            } else if l.len() > 2 {
                 format!("{} knob sets", l.len())
             } else {
                 l.join(", ")
@@ -1022,8 +1025,10 @@ mod tests {
         }
         // The error axis starts near the data, not at 0 (PSNR 24–38 dB here).
         assert!(!text.contains(&"0"), "a tick at 0");
-        // Knob names are explained once; the ray tracer's four identical rows are one point, unlabelled.
+        // Knob names are explained once; the ray tracer's four identical rows are one point,
+        // labelled with its name (twice: once per panel).
         assert!(svg.contains("Point labels: knob values (cube_size") && svg.contains("cube_precision).") && !svg.contains("4 knob sets"));
+        assert!(text.iter().filter(|l| **l == "bvh").count() >= 2, "bvh's point unlabelled");
 
         let ((w, h), counts, distinct) = read_png(&fig.png, &COLOURS[..3]);
         assert_eq!((w, h), (2 * PANEL_W + LEGEND_W, TITLE_H + PANEL_H));

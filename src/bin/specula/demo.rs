@@ -60,7 +60,10 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         errors += &format!("{name:<24} {e}  {:.2} ms  {:.1} MiB\n", frame.gpu_ms(), frame.memory_bytes() as f64 / 1048576.0);
         // Frame ms as the trade-off study counts it: every pass but the readback copy.
         let row = Row::new(name, "default", &frame.passes, e);
-        tiles.push(Tile { name: name.into(), label: format!("{name}\n{:.1} ms  {:.2} dB", row.frame_ms, e.psnr), image: frame.image });
+        let ms = if row.frame_ms >= 100.0 { format!("{:.0} ms", row.frame_ms) } else { format!("{:.1} ms", row.frame_ms) };
+        // Narrow tiles get time and PSNR on lines of their own.
+        let sep = if w < 256 { "\n" } else { "  " };
+        tiles.push(Tile { name: name.into(), label: format!("{name}\n{ms}{sep}{:.2} dB", e.psnr), image: frame.image });
         rows.push(row);
     }
     tiles.push(Tile { name: reference_method.name().into(), label: format!("reference\n{ref_ms:.0} ms CPU"), image: reference });
