@@ -1,8 +1,9 @@
-//! Image work of `specula demo` that needs no GPU: the contact sheet of every method.
+//! Image work of `specula demo` that needs no GPU: the contact sheet of every method (the
+//! trade-off figure is `crate::tradeoff::plot`).
 
 use std::path::Path;
 
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::image::ImageData;
 
 /// One tile of the contact sheet: the method's name (its PNG's stem), the label drawn on
@@ -13,88 +14,68 @@ pub struct Tile {
     pub image: ImageData,
 }
 
-/// The demo's contact sheet: every method's image in a grid of four columns, each labelled
-/// in the picture itself (8×8 bitmap glyphs of font8x8, on a dark band), as `methods.png`;
-/// and `methods.svg`, the same grid referencing the per-method PNGs beside it.
-pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<()> {
-    let images: Vec<(&str, &ImageData)> = tiles.iter().map(|t| (t.name.as_str(), &t.image)).collect();
-    let cols = 4u32.min(images.len() as u32).max(1);
-    let rows = (images.len() as u32).div_ceil(cols);
-    let (sw, sh) = (cols * w, rows * h);
-    let mut sheet = vec![0f32; (sw * sh * 4) as usize];
-    for (i, (_, img)) in images.iter().enumerate() {
-        let (ox, oy) = ((i as u32 % cols) * w, (i as u32 / cols) * h);
-        for y in 0..h {
-            let src = (y * w * 4) as usize;
-            let dst = (((oy + y) * sw + ox) * 4) as usize;
-            sheet[dst..dst + (w * 4) as usize].copy_from_slice(&img.data[src..src + (w * 4) as usize]);
-        }
+/// The label strip's font size for tiles `w` pixels wide.
+fn label_size(w: u32) -> u32 {
+    if w >= 384 {
+        22
+    } else if w >= 192 {
+        16
+    } else {
+        12
     }
-    let scale = if w >= 384 { 2 } else { 1 };
+}
+
+/// The demo's contact sheet `methods.png`: every method's image in a grid of four columns,
+/// each under a dark strip with its label (first line white, the rest light grey), the
+/// text drawn by plotters' bitmap backend in the bundled DejaVu Sans (ab_glyph), cut
+/// with "…" where wider than the tile. Returns the sheet's path.
+pub fn write_composite(outdir: &Path, tiles: &[Tile], w: u32, h: u32) -> Result<std::path::PathBuf> {
+    use plotters::prelude::*;
+    if let Some(t) = tiles.iter().find(|t| t.image.width != w || t.image.height != h || t.image.data.len() < (w * h * 4) as usize) {
+        return Err(Error::invalid("contact sheet", format!("{} is {}x{}, not {w}x{h}", t.name, t.image.width, t.image.height)));
+    }
+    let cols = 4u32.min(tiles.len() as u32).max(1);
+    let rows = (tiles.len() as u32).div_ceil(cols);
+    let size = label_size(w);
+    let lines = tiles.iter().map(|t| t.label.lines().count()).max().unwrap_or(1).max(1) as u32;
+    let strip = lines * (size * 5 / 4) + size / 2;
+    let (sw, sh) = (cols * w, rows * (strip + h));
+    let mut sheet = vec![20u8; (sw * sh * 3) as usize];
     for (i, t) in tiles.iter().enumerate() {
-        let (ox, oy) = ((i as u32 % cols) * w, (i as u32 / cols) * h);
-        draw_label(&mut sheet, sw, sh, ox, oy, scale, w, &t.label);
-    }
-    crate::scene::write_png_srgb(&outdir.join("methods.png"), sw, sh, &sheet)?;
-    let label = 24;
-    let mut svg =
-        format!("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{sw}\" height=\"{}\" style=\"background:#111\">\n", rows * (h + label));
-    for (i, (t, (name, _))) in tiles.iter().zip(&images).enumerate() {
-        let text = t.label.replace('&', "&amp;").replace('<', "&lt;").replace('\n', " · ");
-        let (x, y) = ((i as u32 % cols) * w, (i as u32 / cols) * (h + label));
-        svg += &format!(
-            "<text x=\"{}\" y=\"{}\" fill=\"#eee\" font-family=\"sans-serif\" font-size=\"16\">{text}</text>\n<image x=\"{x}\" y=\"{}\" width=\"{w}\" height=\"{h}\" href=\"{name}.png\"/>\n",
-            x + 6,
-            y + 17,
-            y + label
-        );
-    }
-    svg += "</svg>\n";
-    let path = outdir.join("methods.svg");
-    crate::output::write_file(&path, svg.as_bytes())
-}
-
-/// Draws `text` (lines split at '\n') into an RGBA32F linear image of `w`×`h` at (x, y):
-/// 8×8 glyphs (font8x8) scaled by `scale`, white on a black band, clipped to `max_w` pixels
-/// of width.
-#[allow(clippy::too_many_arguments)]
-pub fn draw_label(pixels: &mut [f32], w: u32, h: u32, x: u32, y: u32, scale: u32, max_w: u32, text: &str) {
-    for (k, line) in text.lines().enumerate() {
-        draw_line(pixels, w, h, x, y + k as u32 * 9 * scale, scale, max_w, line);
-    }
-}
-
-#[allow(clippy::too_many_arguments)]
-fn draw_line(pixels: &mut [f32], w: u32, h: u32, x: u32, y: u32, scale: u32, max_w: u32, text: &str) {
-    use font8x8::UnicodeFonts;
-    let glyph = 8 * scale;
-    let band_w = (text.chars().count() as u32 * glyph + 2 * scale).min(max_w);
-    let mut put = |px: u32, py: u32, v: f32| {
-        if px < w && py < h && px < x + max_w {
-            let i = ((py * w + px) * 4) as usize;
-            pixels[i..i + 4].copy_from_slice(&[v, v, v, 1.0]);
-        }
-    };
-    for py in y..y + glyph + scale {
-        for px in x..x + band_w {
-            put(px, py, 0.0);
-        }
-    }
-    for (k, c) in text.chars().enumerate() {
-        let rows = font8x8::BASIC_FONTS.get(c).or_else(|| font8x8::BASIC_FONTS.get('?')).unwrap_or([0; 8]);
-        for (row, bits) in rows.iter().enumerate() {
-            for col in 0..8u32 {
-                if bits & (1 << col) == 0 {
-                    continue;
-                }
-                for sy in 0..scale {
-                    for sx in 0..scale {
-                        put(x + scale + k as u32 * glyph + col * scale + sx, y + scale + row as u32 * scale + sy, 1.0);
-                    }
+        let (ox, oy) = ((i as u32 % cols) * w, (i as u32 / cols) * (strip + h) + strip);
+        for y in 0..h {
+            for x in 0..w {
+                let s = ((y * w + x) * 4) as usize;
+                let d = (((oy + y) * sw + ox + x) * 3) as usize;
+                for c in 0..3 {
+                    sheet[d + c] = crate::scene::linear_to_srgb(t.image.data[s + c]);
                 }
             }
         }
     }
+    let path = outdir.join("methods.png");
+    crate::tradeoff::write_bitmap_png(&path, (sw, sh), Some(sheet), |root| {
+        let e = |e: &dyn std::fmt::Display| e.to_string();
+        for (i, t) in tiles.iter().enumerate() {
+            let (ox, oy) = ((i as u32 % cols) * w, (i as u32 / cols) * (strip + h));
+            for (k, line) in t.label.lines().enumerate() {
+                let colour = if k == 0 { WHITE } else { RGBColor(205, 205, 205) };
+                let style = TextStyle::from(FontDesc::new(FontFamily::SansSerif, size as f64, FontStyle::Normal)).color(&colour);
+                let fits = |s: &str| root.estimate_text_size(s, &style).map(|(tw, _)| tw + size / 2 <= w);
+                // Cut to the tile: drop characters from the end until the rest and "…" fit.
+                let mut text = line.to_string();
+                let mut kept = line.chars().count();
+                while !fits(&text).map_err(|x| e(&x))? && kept > 0 {
+                    kept -= 1;
+                    text = format!("{}…", line.chars().take(kept).collect::<String>().trim_end());
+                }
+                let pos = ((ox + size / 4) as i32, (oy + size / 4 + k as u32 * (size * 5 / 4)) as i32);
+                root.draw(&Text::new(text, pos, style)).map_err(|x| e(&x))?;
+            }
+        }
+        Ok(())
+    })?;
+    Ok(path)
 }
 
 #[cfg(test)]
@@ -105,25 +86,37 @@ mod tests {
     fn labels_are_drawn_into_the_sheet() {
         let dir = std::env::temp_dir().join(format!("specula-sheet-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let image = ImageData { width: 64, height: 32, layers: 1, channels: 4, data: vec![0.5; 64 * 32 * 4] };
+        let image = ImageData { width: 200, height: 100, layers: 1, channels: 4, data: vec![0.5; 200 * 100 * 4] };
         let tiles = vec![
-            Tile { name: "a".into(), label: "envmap\n1.0 ms".into(), image: image.clone() },
-            Tile { name: "b".into(), label: "distance".into(), image },
+            Tile { name: "a".into(), label: "image-space-refraction\n12.3 ms  31.25 dB".into(), image: image.clone() },
+            Tile { name: "b".into(), label: "bvh".into(), image: image.clone() },
+            Tile { name: "c".into(), label: "envmap\n1.0 ms  20.00 dB".into(), image: image.clone() },
+            Tile { name: "d".into(), label: "a label far too long for a tile 200 pixels wide".into(), image: image.clone() },
         ];
-        write_composite(&dir, &tiles, 64, 32).unwrap();
-        let png = ::image::open(dir.join("methods.png")).unwrap().to_rgb8();
-        assert_eq!(png.dimensions(), (128, 32));
-        // The band is black, the glyphs white, the rest of the tile grey.
-        let px = |x, y| png.get_pixel(x, y).0;
-        let count = |rows: std::ops::Range<u32>, c: [u8; 3]| {
-            (0..64).flat_map(|x| rows.clone().map(move |y| (x, y))).filter(|&(x, y)| px(x, y) == c).count()
+        let path = write_composite(&dir, &tiles, 200, 100).unwrap();
+        let png = ::image::open(&path).unwrap().to_rgb8();
+        // 16 px text at 200 px tiles: two lines of 20 px and 8 px of margin above each tile.
+        let strip = 48;
+        assert_eq!(png.dimensions(), (800, strip + 100));
+        let region = |x0: u32, rows: std::ops::Range<u32>| -> Vec<[u8; 3]> {
+            (x0..x0 + 200).flat_map(|x| rows.clone().map(move |y| (x, y))).map(|(x, y)| png.get_pixel(x, y).0).collect()
         };
-        // Two lines of glyphs, white on black.
-        for rows in [0..9, 9..18] {
-            let (white, black) = (count(rows.clone(), [255, 255, 255]), count(rows.clone(), [0, 0, 0]));
-            assert!(white > 30 && black > 100, "rows {rows:?}: white {white}, black {black}");
-        }
-        assert!(px(10, 25)[0] > 150 && px(10, 25)[0] < 220, "grey below the label: {:?}", px(10, 25));
+        let bright = |px: &[[u8; 3]]| px.iter().filter(|p| p[0] > 150).count();
+        let shades = |px: &[[u8; 3]]| px.iter().collect::<std::collections::HashSet<_>>().len();
+        // Each strip carries text: light anti-aliased glyphs on the dark band, more of them
+        // for a longer label; the second line is there only where the label has one.
+        let (first_a, first_b) = (region(0, 0..24), region(200, 0..24));
+        assert!(bright(&first_a) > 3 * bright(&first_b) && bright(&first_b) > 20, "{} vs {}", bright(&first_a), bright(&first_b));
+        assert!(shades(&first_a) > 8, "anti-aliased text: {} shades", shades(&first_a));
+        assert!(bright(&region(400, 24..strip)) > 40 && bright(&region(200, 24..strip)) == 0);
+        // The long name is cut to the tile, not drawn over its neighbour's strip.
+        assert!(region(0, 0..strip).iter().any(|p| p[0] > 150) && png.get_pixel(201, 10).0[0] < 60);
+        let cut = region(600, 0..24);
+        assert!(bright(&cut) > 100 && (0..24).all(|y| png.get_pixel(799, y).0[0] < 60), "the long label is cut before the sheet's edge");
+        // The image under the strip, sRGB-encoded (0.5 linear = 188).
+        assert_eq!(png.get_pixel(100, strip + 50).0, [188, 188, 188]);
+        // Tiles of another size are refused.
+        assert!(write_composite(&dir, &tiles, 100, 100).is_err());
         std::fs::remove_dir_all(&dir).ok();
     }
 }

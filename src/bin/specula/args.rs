@@ -76,6 +76,9 @@ pub struct TradeoffArgs {
     /// Timed frames per configuration; the median per pass is reported.
     #[arg(long, default_value_t = 5)]
     pub frames: u32,
+    /// The figure's error axis: psnr (higher is better) or flip (mean FLIP, lower is better).
+    #[arg(long, default_value = "psnr")]
+    pub metric: String,
     /// Enable the Khronos validation layer.
     #[arg(long)]
     pub validate: bool,

@@ -1,11 +1,12 @@
 //! `specula demo`: `auto` and every method of the registry on the bundled demo scene:
-//! images, traces, a timing table, errors against the reference and a labelled contact
-//! sheet.
+//! images, traces, a timing table, errors against the reference, a labelled contact
+//! sheet and the trade-off figure.
 
 use std::path::Path;
 
 use specula::demo::Tile;
 use specula::scene;
+use specula::tradeoff::{Metric, Panel, Row};
 use specula::{Choice, Method, Quality};
 
 use crate::args::{context, parse_size, reference_summary, reference_timing, render_reference, write_image};
@@ -33,6 +34,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
 
     let choices = std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method));
     let mut tiles = Vec::new();
+    let mut rows = Vec::new();
     let mut errors = String::from("== error against the reference (PSNR, frame GPU ms, device memory)\n");
     for choice in choices {
         let name = choice.name();
@@ -56,19 +58,31 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         report.push('\n');
         let e = specula::metrics::compare(&frame.image, &reference)?;
         errors += &format!("{name:<24} {e}  {:.2} ms  {:.1} MiB\n", frame.gpu_ms(), frame.memory_bytes() as f64 / 1048576.0);
-        tiles.push(Tile { name: name.into(), label: format!("{name}\n{:.1} ms  {:.2} dB", frame.gpu_ms(), e.psnr), image: frame.image });
+        // Frame ms as the trade-off study counts it: every pass but the readback copy.
+        let row = Row::new(name, "default", &frame.passes, e);
+        let ms = if row.frame_ms >= 100.0 { format!("{:.0} ms", row.frame_ms) } else { format!("{:.1} ms", row.frame_ms) };
+        // Narrow tiles get time and PSNR on lines of their own.
+        let sep = if w < 256 { "\n" } else { "  " };
+        tiles.push(Tile { name: name.into(), label: format!("{name}\n{ms}{sep}{:.2} dB", e.psnr), image: frame.image });
+        rows.push(row);
     }
     tiles.push(Tile { name: reference_method.name().into(), label: format!("reference\n{ref_ms:.0} ms CPU"), image: reference });
     report += &errors;
     report.push('\n');
     // All of them side by side (the survey's Figures 20 and 24 in one sheet).
-    specula::demo::write_composite(outdir, &tiles, w, h)?;
-    report += &format!("side by side: {}, {}\n", outdir.join("methods.png").display(), outdir.join("methods.svg").display());
+    let sheet = specula::demo::write_composite(outdir, &tiles, w, h)?;
+    report += &format!("side by side: {}\n", sheet.display());
     // Planar mirrors (§5): the mirror scene's corridor of images, by the planner (planar
     // mirrors mirrored, the sphere ray traced), by planar-mirror for every mirror it serves
     // and by distance maps, against the reference.
-    report += &mirrors(&ctx, &outdir.join("mirrors"), (w, h), &q)?;
+    let (text, mirror_rows) = mirrors(&ctx, &outdir.join("mirrors"), (w, h), &q)?;
+    report += &text;
     report += &flat_glass(&ctx, &outdir.join("glass"), (w, h), &q)?;
+    // The trade-off figure of both scenes, one panel each (every method at its defaults).
+    let panels = [Panel { name: "demo scene".into(), rows }, Panel { name: "mirror scene".into(), rows: mirror_rows }];
+    let title = format!("specula demo at {w}x{h} on {}: PSNR vs GPU time", ctx.device_name);
+    let fig = specula::tradeoff::plot(&outdir.join("tradeoff"), &panels, Metric::Psnr, &title)?;
+    report += &format!("trade-off figure: {}, {}\n", fig.svg.display(), fig.png.display());
     print!("{report}");
     let table = outdir.join("timings.txt");
     specula::output::write_file(&table, report.as_bytes())?;
@@ -94,8 +108,9 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     crate::animate::run(&anim, 12.0, None, &outdir.join("animation"))
 }
 
-/// The mirror scene (`assets/mirrors/`): images and a timing table into `outdir`.
-fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Quality) -> specula::Result<String> {
+/// The mirror scene (`assets/mirrors/`): images and a timing table into `outdir`; the
+/// table and the trade-off rows.
+fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Quality) -> specula::Result<(String, Vec<Row>)> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/mirrors/mirrors.gltf");
     let scene = scene::load(&path)?;
     std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
@@ -103,6 +118,7 @@ fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Qu
     let (reference, ref_ms) = render_reference(&scene, q, (w, h))?;
     write_image(&outdir.join("reference.png"), &reference)?;
     report += &format!("reference: {ref_ms:.0} ms CPU\n");
+    let mut rows = Vec::new();
     for choice in [Choice::Auto, Choice::Method(specula::methods::PLANAR_MIRROR), Choice::Method(specula::methods::DISTANCE)] {
         let name = choice.name();
         let frame = specula::render(ctx, &scene, choice, q, (w, h), (1, 3))?;
@@ -111,8 +127,9 @@ fn mirrors(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: &Qu
         let views = frame.stats.iter().find(|(n, _)| n == "geometry.mirror_views").map_or(0.0, |(_, v)| *v);
         report += &format!("-- {name}: {:.2} ms, {views} mirrored view(s), {e}\n", frame.gpu_ms());
         report += &specula::profile::table(&frame.passes, &frame.memory);
+        rows.push(Row::new(name, "default", &frame.passes, e));
     }
-    Ok(report)
+    Ok((report, rows))
 }
 
 /// Flat glass (`specula::scenes::flat_glass`, survey §5): the reference, planar-refraction

@@ -81,7 +81,8 @@ enum Command {
         mask: Option<String>,
     },
     /// The speed–accuracy trade-off: every GPU method (× every --sweep combination) timed
-    /// and compared with the exact reference; writes tradeoff.csv and tradeoff.svg to --out.
+    /// and compared with the exact reference; writes tradeoff.csv and the figure
+    /// tradeoff.svg + tradeoff.png (--metric psnr|flip against log time) to --out.
     Tradeoff {
         #[command(flatten)]
         args: TradeoffArgs,

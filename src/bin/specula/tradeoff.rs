@@ -3,14 +3,14 @@
 
 use std::path::Path;
 
-use specula::tradeoff::{Config, Progress, Sweep};
+use specula::tradeoff::{Config, Metric, Progress, Sweep};
 use specula::vk::DeviceOptions;
 use specula::Choice;
 
 use crate::args::{prepare, reference_summary, RenderArgs, TradeoffArgs};
 
 /// The reference once, then every GPU method × every sweep variant, timed and compared;
-/// CSV, SVG plot and the images into `out`.
+/// CSV, the figure (SVG and PNG) and the images into `out`.
 pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> specula::Result<()> {
     let render_args = RenderArgs {
         scene: a.scene.clone(),
@@ -30,6 +30,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
     };
     let job = prepare(&render_args)?;
     let sweeps: Vec<Sweep> = sweeps.iter().map(|s| Sweep::parse(s)).collect::<specula::Result<_>>()?;
+    let metric = Metric::parse(&a.metric)?;
     let methods = only.iter().map(|n| Choice::parse(n)).collect::<specula::Result<Vec<_>>>()?;
     let (w, h) = (job.width, job.height);
     let quality = job.quality.clone();
@@ -44,6 +45,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
         frames: a.frames,
         device: DeviceOptions { validation: a.validate, device_filter: a.device.clone() },
         out: out.to_path_buf(),
+        metric,
     };
 
     let mut bar = None;
@@ -90,7 +92,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
             r.method, r.knobs, r.frame_ms, e.rmse, e.psnr, e.flip, e.p99_abs
         );
     }
-    println!("\nwrote {} and {}", report.csv.display(), report.svg.display());
+    println!("\nwrote {}, {} and {}", report.csv.display(), report.figure.svg.display(), report.figure.png.display());
     if a.validate {
         let (errors, warnings) = report.validation;
         println!("validation: {errors} error(s), {warnings} warning(s)");
