@@ -72,14 +72,43 @@ pub struct Row {
     /// Sum of the passes except `frame.readback` (the standalone copy to the host).
     pub frame_ms: f64,
     pub errors: ImageErrors,
+    /// The error where the method acts (issue 15): per specular object, on all specular
+    /// pixels and on the rest (`metrics::errors_by_object`); empty where not measured.
+    pub regions: Vec<crate::metrics::MaskedError>,
 }
 
 impl Row {
     pub fn new(method: &str, knobs: &str, passes: &[crate::vk::PassTiming], errors: ImageErrors) -> Row {
         let passes: Vec<(String, f64)> = passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
         let frame_ms = passes.iter().filter(|(n, _)| n != "frame.readback").map(|(_, ms)| ms).sum();
-        Row { method: method.into(), knobs: knobs.into(), passes, frame_ms, errors }
+        Row { method: method.into(), knobs: knobs.into(), passes, frame_ms, errors, regions: Vec::new() }
     }
+}
+
+/// The figure's panels: the whole image, and with PSNR and more than one specular object,
+/// one panel per object (its rows' PSNR and RMSE those of its pixels; FLIP is per image only).
+pub fn region_panels(rows: &[Row], metric: Metric) -> Vec<Panel> {
+    let mut panels = vec![Panel { name: "whole image".into(), rows: rows.to_vec() }];
+    let objects: Vec<String> = rows
+        .first()
+        .map(|r| r.regions.iter().map(|e| e.name.clone()).filter(|n| n != "specular" && n != "non-specular").collect())
+        .unwrap_or_default();
+    if metric != Metric::Psnr || objects.len() < 2 {
+        return panels;
+    }
+    for name in objects {
+        let rows: Vec<Row> = rows
+            .iter()
+            .filter_map(|r| {
+                let e = r.regions.iter().find(|e| e.name == name)?;
+                let mut r = r.clone();
+                r.errors = ImageErrors { rmse: e.rmse, psnr: e.psnr, flip: f64::NAN, ..r.errors };
+                Some(r)
+            })
+            .collect();
+        panels.push(Panel { name: format!("{name} (its pixels)"), rows });
+    }
+    panels
 }
 
 /// Which of the points (time, cost) are Pareto-optimal, the cost lower-is-better (see
@@ -171,7 +200,18 @@ pub fn csv(rows: &[Row], device: &str) -> String {
     }
     let front = |m: Metric| pareto_front(&rows.iter().map(|r| (r.frame_ms, m.cost(&r.errors))).collect::<Vec<_>>());
     let (flip_front, psnr_front) = (front(Metric::Flip), front(Metric::Psnr));
+    let mut regions: Vec<&str> = Vec::new();
+    for r in rows {
+        for e in &r.regions {
+            if !regions.contains(&e.name.as_str()) {
+                regions.push(&e.name);
+            }
+        }
+    }
     let mut s = String::from("method,knobs,frame_ms,rmse,psnr_db,flip_mean,p99_abs,max_abs,pareto,pareto_psnr,device");
+    for n in &regions {
+        let _ = write!(s, ",{}", csv_field(&format!("psnr_db[{n}]")));
+    }
     for n in &pass_names {
         let _ = write!(s, ",{} ms", csv_field(n));
     }
@@ -193,6 +233,14 @@ pub fn csv(rows: &[Row], device: &str) -> String {
             on_psnr,
             csv_field(device)
         );
+        for n in &regions {
+            match r.regions.iter().find(|e| e.name == *n) {
+                Some(e) => {
+                    let _ = write!(s, ",{:.3}", e.psnr);
+                }
+                None => s.push(','),
+            }
+        }
         for n in &pass_names {
             match r.passes.iter().find(|(p, _)| p == n) {
                 Some((_, ms)) => {
@@ -800,6 +848,10 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let t = std::time::Instant::now();
     let reference = crate::reference::render_reference(&cfg.scene, &cfg.quality, (w, h))?;
     let reference_ms = t.elapsed().as_secs_f64() * 1e3;
+    // Where each method acts: the reference's first hits split the error by object.
+    let ids = crate::reference::object_ids(&cfg.scene, (w, h))?;
+    let specular: Vec<bool> = cfg.scene.meshes.iter().map(|m| cfg.scene.materials[m.material].kind.is_specular()).collect();
+    let names: Vec<String> = cfg.scene.meshes.iter().map(|m| m.name.clone()).collect();
     reference.write_exr(&out.join("reference.exr"))?;
     reference.write_png_srgb(&out.join("reference.png"))?;
     progress(Progress::Done);
@@ -814,24 +866,27 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             Choice::Method(m) if m.family == "raytrace" => Some(m.knobs),
             _ => None,
         };
-        let mut measured: Vec<(String, crate::Frame, ImageErrors)> = Vec::new();
+        let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
         for (label, q) in &variants {
             progress(Progress::Begin(format!("{} {label}", method.name())));
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
-            let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _)| mk == k));
+            let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {
                 Some(i) => i,
                 None => {
                     let frame = crate::render(&ctx, &cfg.scene, method, q, (w, h), (cfg.warmup.max(1), cfg.frames.max(1)))?;
                     let errors = crate::metrics::compare(&frame.image, &reference)?;
-                    measured.push((key.unwrap_or_default(), frame, errors));
+                    let regions = crate::metrics::errors_by_object(&frame.image, &reference, &ids, &specular, &names)?;
+                    measured.push((key.unwrap_or_default(), frame, errors, regions));
                     measured.len() - 1
                 }
             };
-            let (_, frame, errors) = &measured[i];
+            let (_, frame, errors, regions) = &measured[i];
             let stem = format!("{}-{}", method.name(), label.replace([' ', '=', ',', ';', '/'], "_"));
             frame.image.write_png_srgb(&out.join(format!("{stem}.png")))?;
-            rows.push(Row::new(method.name(), label, &frame.passes, *errors));
+            let mut row = Row::new(method.name(), label, &frame.passes, *errors);
+            row.regions = regions.clone();
+            rows.push(row);
             if reads.is_none() {
                 measured.clear();
             }
@@ -844,9 +899,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let device = format!("{} ({})", ctx.device_name, ctx.driver_info);
     crate::output::write_file(&csv_path, csv(&rows, &device).as_bytes())?;
     let title = format!("{} at {w}x{h} on {}: {} vs GPU time", cfg.scene_name, ctx.device_name, cfg.metric.name());
-    // The rows are whole-image errors: one panel (per-object errors would be one each).
-    let panels = [Panel { name: "whole image".into(), rows: rows.clone() }];
-    let figure = plot(&out.join("tradeoff"), &panels, cfg.metric, &title)?;
+    let figure = plot(&out.join("tradeoff"), &region_panels(&rows, cfg.metric), cfg.metric, &title)?;
     Ok(Report {
         rows,
         reference_ms,

@@ -158,8 +158,24 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
     }
     assert!(points.iter().any(|p| p.2) && points.iter().any(|p| !p.2), "the front is a proper subset");
     assert!(lines.iter().any(|l| l.contains("cube_size=64 cube_precision=single")));
+    // Where the methods act (issue 15): a PSNR column per specular object, for the specular
+    // pixels and for the rest; the non-specular pixels do not depend on the cube-map knobs
+    // of a ray tracer, and the figure has a panel per specular object.
+    for col in ["psnr_db[mirror_sphere/0]", "psnr_db[glass_sphere/0]", "psnr_db[specular]", "psnr_db[non-specular]"] {
+        assert!(header.contains(&col), "no {col} column: {}", lines[0]);
+    }
+    let column = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (spec, rest) = (column("psnr_db[specular]"), column("psnr_db[non-specular]"));
+    for l in &lines[1..] {
+        let f: Vec<&str> = l.split(',').collect();
+        let (a, b): (f64, f64) = (f[spec].parse().unwrap(), f[rest].parse().unwrap());
+        assert!(a.is_finite() && b.is_finite(), "{l}");
+    }
     let svg = std::fs::read_to_string(dir.join("tradeoff.svg")).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("Pareto front"));
+    for panel in ["whole image", "mirror_sphere/0 (its pixels)", "glass_sphere/0 (its pixels)"] {
+        assert!(svg.contains(panel), "no panel {panel}");
+    }
     assert!(dir.join("reference.exr").exists());
     std::fs::remove_dir_all(&dir).ok();
 }
