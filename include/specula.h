@@ -75,6 +75,10 @@
 #define SPECULA_METHOD_REFERENCE 99
 
 
+// The size of SpeculaRenderDesc before the budget fields (type, size, method, width,
+// height): still accepted, as no budget.
+#define SPECULA_RENDER_DESC_SIZE_V1 20
+
 // Opaque context: a device (own or the host's), a scene, knobs and a configured renderer.
 typedef struct SpeculaContext SpeculaContext;
 
@@ -251,7 +255,33 @@ typedef struct {
   // Output size in pixels, 1..=16384 each.
   uint32_t width;
   uint32_t height;
+  // The budgeted planner (with SPECULA_METHOD_AUTO; 0: unset, at most one of the two):
+  // per specular object a method and for the frame the knob values, from per-object error
+  // and cost models, so that a frame takes at most `max_ms` GPU milliseconds at the least
+  // predicted error, or every specular object reaches `min_psnr_db` on its pixels at the
+  // least predicted time. specula_get_predictions reports the prediction.
+  double max_ms;
+  double min_psnr_db;
+  // The models (JSON from `specula tradeoff --calibrate`), or NULL: the stored defaults
+  // measured on the bundled scenes.
+  const char *models_path;
 } SpeculaRenderDesc;
+
+// What the budgeted planner predicted for one specular object (specula_get_predictions);
+// the last entry, named "frame", is the whole frame (method SPECULA_METHOD_AUTO, the
+// predicted frame time and the PSNR of all specular pixels).
+typedef struct {
+  // NUL-terminated object name, or "frame".
+  char name[48];
+  // SPECULA_METHOD_* chosen.
+  SpeculaMethod method;
+  // Its pixels in the models' frame, scaled to the configured size.
+  uint32_t pixels;
+  // Predicted GPU milliseconds of its passes (its share of shared ones).
+  double predicted_ms;
+  // Predicted PSNR on its pixels, dB (capped at 200).
+  double predicted_psnr_db;
+} SpeculaPrediction;
 
 typedef uint32_t SpeculaPixelFormat;
 
@@ -302,6 +332,10 @@ typedef struct {
 
 // Warning: no frame has completed on the GPU yet (host-device mode), `count` is 0.
 #define SPECULA_WARNING_NOT_READY 2
+
+// specula_context_configure with a budget: no models cover the scene's specular objects;
+// the registry's rules chose (specula_get_predictions reports none).
+#define SPECULA_WARNING_NO_MODELS 3
 
 #define SPECULA_ERROR_INVALID_ARGUMENT -1
 
@@ -452,8 +486,22 @@ SpeculaResult specula_context_set_memory_budget(SpeculaContext *ctx, uint64_t by
 SpeculaResult specula_context_set_knob(SpeculaContext *ctx, const char *key, const char *value);
 
 // Plans and creates everything a frame of the scene needs with the given method and size.
+// With a budget (`max_ms` or `min_psnr_db`, SPECULA_METHOD_AUTO only) the budgeted planner
+// chooses per object a method and the knobs (see SpeculaRenderDesc); it returns
+// SPECULA_WARNING_NO_MODELS when no models cover the scene (the rules chose). A desc of
+// SPECULA_RENDER_DESC_SIZE_V1 bytes (before the budget fields) is read as no budget.
 // Reconfiguring destroys the previous renderer: needs an idle GPU in host-device mode.
 SpeculaResult specula_context_configure(SpeculaContext *ctx, const SpeculaRenderDesc *desc);
+
+// Copies what the budgeted planner predicted at the last specula_context_configure with a
+// budget into `out` (up to `capacity`): one entry per specular object, then "frame"; their
+// number into `*count` (0 without a budget, or when no models covered the scene). `out` may
+// be NULL with capacity 0 to query the count. Returns SPECULA_WARNING_TRUNCATED when
+// capacity was too small. Compare with specula_get_pass_timings after a frame.
+SpeculaResult specula_get_predictions(SpeculaContext *ctx,
+                                      SpeculaPrediction *out,
+                                      uint32_t capacity,
+                                      uint32_t *count);
 
 // Standalone mode: renders one frame, waits for it, and writes width×height pixels of
 // `pixel_format` row by row (no padding) into `dst` of `dst_size` bytes.

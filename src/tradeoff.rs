@@ -794,6 +794,9 @@ pub struct Config {
     pub out: PathBuf,
     /// The figure's error axis (the CSV has both).
     pub metric: Metric,
+    /// `--calibrate`: also fit the budgeted planner's per-object models from the rows
+    /// (`plan::budget::fit`) and write them here as JSON.
+    pub calibrate: Option<PathBuf>,
 }
 
 /// How far [`run`] has come, for a progress bar.
@@ -823,6 +826,8 @@ pub struct Report {
     pub figure: Figure,
     /// Validation layer messages over the whole study: (errors, warnings).
     pub validation: (u32, u32),
+    /// With `calibrate`: the fitted models (also written to that path).
+    pub models: Option<crate::plan::budget::Models>,
 }
 
 /// The study behind `specula tradeoff`: the exact reference once, then every method ×
@@ -858,6 +863,8 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
 
     let ctx = Context::new(&cfg.device)?;
     let mut rows = Vec::new();
+    // With --calibrate: per row its knobs and plan (which passes serve which object).
+    let mut plans: Vec<(String, crate::plan::Plan)> = Vec::new();
     for &method in &methods {
         // A ray tracer in the original geometry (survey §2) makes no maps and no shadow
         // maps: only the knobs it lists change its image, so variants that agree on those
@@ -887,6 +894,9 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             let mut row = Row::new(method.name(), label, &frame.passes, *errors);
             row.regions = regions.clone();
             rows.push(row);
+            if cfg.calibrate.is_some() {
+                plans.push((label.clone(), crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(method), q)?));
+            }
             if reads.is_none() {
                 measured.clear();
             }
@@ -900,6 +910,19 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     crate::output::write_file(&csv_path, csv(&rows, &device).as_bytes())?;
     let title = format!("{} at {w}x{h} on {}: {} vs GPU time", cfg.scene_name, ctx.device_name, cfg.metric.name());
     let figure = plot(&out.join("tradeoff"), &region_panels(&rows, cfg.metric), cfg.metric, &title)?;
+    let models = match &cfg.calibrate {
+        Some(path) => {
+            let measured: Vec<crate::plan::budget::Measured> = rows
+                .iter()
+                .zip(&plans)
+                .map(|(r, (knobs, plan))| crate::plan::budget::Measured { knobs, plan, passes: &r.passes, regions: &r.regions })
+                .collect();
+            let m = crate::plan::budget::fit(&cfg.scene, &cfg.scene_name, &device, (w, h), &measured);
+            crate::output::write_file(path, m.to_json().as_bytes())?;
+            Some(m)
+        }
+        None => None,
+    };
     Ok(Report {
         rows,
         reference_ms,
@@ -908,6 +931,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         csv: csv_path,
         figure,
         validation: (ctx.validation.error_count(), ctx.validation.warning_count()),
+        models,
     })
 }
 

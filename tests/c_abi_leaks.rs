@@ -131,6 +131,9 @@ unsafe fn cycle() {
         method: specula::methods::ENVMAP.abi,
         width: 16,
         height: 16,
+        max_ms: 0.0,
+        min_psnr_db: 0.0,
+        models_path: std::ptr::null(),
     };
     ok(specula_context_configure(ctx, &rd), ctx);
     let mut px = [0u8; 16 * 16 * 4];

@@ -385,6 +385,7 @@ fn tradeoff_sweeps_the_geometry_image_and_the_tessellation() {
         device: specula::vk::DeviceOptions { validation: true, device_filter: None },
         out: out.clone(),
         metric: specula::tradeoff::Metric::Psnr,
+        calibrate: None,
     };
     let report = specula::tradeoff::run(&cfg, &mut |_| {}).unwrap();
     assert_eq!(report.validation, (0, 0));

@@ -9,6 +9,7 @@ use super::handle::{cstr, fail, header, with_ctx, FfiResult, SpeculaContext};
 use super::types::*;
 use crate::methods::registry::ABI_AUTO;
 use crate::methods::{Choice, Method};
+use crate::plan::budget::{self, Budget, Models};
 use crate::plan::{plan_with, Choices};
 use crate::renderer::Renderer;
 use crate::vk::Image;
@@ -37,12 +38,23 @@ pub unsafe extern "C" fn specula_context_set_knob(ctx: *mut SpeculaContext, key:
 }
 
 /// Plans and creates everything a frame of the scene needs with the given method and size.
+/// With a budget (`max_ms` or `min_psnr_db`, SPECULA_METHOD_AUTO only) the budgeted planner
+/// chooses per object a method and the knobs (see SpeculaRenderDesc); it returns
+/// SPECULA_WARNING_NO_MODELS when no models cover the scene (the rules chose). A desc of
+/// SPECULA_RENDER_DESC_SIZE_V1 bytes (before the budget fields) is read as no budget.
 /// Reconfiguring destroys the previous renderer: needs an idle GPU in host-device mode.
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, desc: *const SpeculaRenderDesc) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
-        let choice = match d.method {
+        let v1 = header(desc as *const RenderDescV1, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
+        let (method, width, height) = (v1.method, v1.width, v1.height);
+        let (max_ms, min_psnr, models_path) = if v1.size == SPECULA_RENDER_DESC_SIZE_V1 {
+            (0.0, 0.0, std::ptr::null())
+        } else {
+            let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
+            (d.max_ms, d.min_psnr_db, d.models_path)
+        };
+        let choice = match method {
             ABI_AUTO => Choice::Auto,
             m => match Method::by_abi(m).filter(|m| m.is_gpu()) {
                 Some(m) => Choice::Method(m),
@@ -55,17 +67,55 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                 }
             },
         };
-        configure(c, choice, d.width, d.height)?;
-        Ok(SPECULA_SUCCESS)
+        let budget = Budget::from_limits(Some(max_ms), Some(min_psnr)).map_err(|e| match e {
+            crate::Error::InvalidInput { what, message } => {
+                crate::Error::invalid(format!("render desc.{}", what.replace('-', "_")), message)
+            }
+            other => other,
+        })?;
+        let mut no_models = false;
+        let chosen = match budget {
+            None => None,
+            Some(b) => {
+                if choice != Choice::Auto {
+                    return fail(
+                        SPECULA_ERROR_INVALID_ARGUMENT,
+                        format!("render desc: a budget needs SPECULA_METHOD_AUTO (method {method} = {})", choice.name()),
+                    );
+                }
+                let mut sources: Vec<(Models, String)> = Vec::new();
+                if !models_path.is_null() {
+                    let p = std::path::PathBuf::from(cstr(models_path, "render desc.models_path")?);
+                    sources.push((Models::load(&p)?, format!("calibration {}", p.display())));
+                }
+                let d = budget::stored_defaults()?;
+                let from = format!("stored defaults ({})", d.scene);
+                sources.push((d, from));
+                let refs: Vec<(&Models, String)> = sources.iter().map(|(m, s)| (m, s.clone())).collect();
+                let choices = Choices { method: Choice::Auto, objects: c.object_methods.clone() };
+                let r = budget::choose(&c.scene, &choices, &c.quality, b, (width, height), &refs)?;
+                no_models = r.is_none();
+                r
+            }
+        };
+        let previous = std::mem::replace(&mut c.budget, chosen);
+        if let Err(e) = configure(c, choice, width, height) {
+            c.budget = previous;
+            return Err(e);
+        }
+        Ok(if no_models { SPECULA_WARNING_NO_MODELS } else { SPECULA_SUCCESS })
     })
 }
 
-/// Plans the scene as it is now for `choice` (with the per-object methods) and replaces the
-/// renderer by one of `width`×`height`. A planning error keeps the previous renderer; a
-/// creation error leaves none.
+/// Plans the scene as it is now for `choice` (with the per-object methods, or the budgeted
+/// planner's choices and knobs) and replaces the renderer by one of `width`×`height`. A
+/// planning error keeps the previous renderer; a creation error leaves none.
 fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) -> FfiResult<()> {
-    let choices = Choices { method: choice, objects: c.object_methods.clone() };
-    let p = plan_with(&c.scene, &choices, &c.quality)?;
+    let (choices, quality) = match &c.budget {
+        Some((choices, quality, _)) => (choices.clone(), quality.clone()),
+        None => (Choices { method: choice, objects: c.object_methods.clone() }, c.quality.clone()),
+    };
+    let p = plan_with(&c.scene, &choices, &quality)?;
     c.destroy_renderer();
     let r = Renderer::new(&c.vk, &c.scene, p, width, height)?;
     c.choice = choice;
@@ -73,6 +123,66 @@ fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) ->
     c.renderer_version = c.scene_version;
     c.replan = false;
     Ok(())
+}
+
+/// Copies what the budgeted planner predicted at the last specula_context_configure with a
+/// budget into `out` (up to `capacity`): one entry per specular object, then "frame"; their
+/// number into `*count` (0 without a budget, or when no models covered the scene). `out` may
+/// be NULL with capacity 0 to query the count. Returns SPECULA_WARNING_TRUNCATED when
+/// capacity was too small. Compare with specula_get_pass_timings after a frame.
+#[no_mangle]
+pub unsafe extern "C" fn specula_get_predictions(
+    ctx: *mut SpeculaContext,
+    out: *mut SpeculaPrediction,
+    capacity: u32,
+    count: *mut u32,
+) -> SpeculaResult {
+    with_ctx(ctx, |c| {
+        if count.is_null() {
+            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
+        }
+        if out.is_null() && capacity > 0 {
+            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
+        }
+        let mut list: Vec<SpeculaPrediction> = Vec::new();
+        if let Some((_, _, p)) = &c.budget {
+            for o in &p.objects {
+                list.push(SpeculaPrediction {
+                    name: name48(&o.name),
+                    method: o.method.abi,
+                    pixels: o.pixels.min(u32::MAX as usize) as u32,
+                    predicted_ms: o.ms,
+                    predicted_psnr_db: o.psnr_db,
+                });
+            }
+            let pixels: usize = p.objects.iter().map(|o| o.pixels).sum();
+            list.push(SpeculaPrediction {
+                name: name48("frame"),
+                method: ABI_AUTO,
+                pixels: pixels.min(u32::MAX as usize) as u32,
+                predicted_ms: p.frame_ms,
+                predicted_psnr_db: p.specular_psnr_db,
+            });
+        }
+        *count = list.len() as u32;
+        for (i, e) in list.iter().take(capacity as usize).enumerate() {
+            *out.add(i) = *e;
+        }
+        Ok(if (capacity as usize) < list.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+    })
+}
+
+/// `s` NUL-terminated in 48 bytes, cut at a character boundary.
+fn name48(s: &str) -> [c_char; 48] {
+    let mut out = [0 as c_char; 48];
+    let mut end = s.len().min(47);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    for (d, b) in out.iter_mut().zip(s[..end].bytes()) {
+        *d = b as c_char;
+    }
+    out
 }
 
 /// Standalone mode: renders one frame, waits for it, and writes width×height pixels of

@@ -34,6 +34,9 @@ pub struct SpeculaContext {
     /// Per-object methods (object name, method), set by specula_context_set_object_method.
     pub(super) object_methods: Vec<(String, Method)>,
     pub(super) renderer: Option<Renderer>,
+    /// The budgeted planner's choices and knobs of the last configure with a budget, reused
+    /// when an update replans, and its prediction.
+    pub(super) budget: Option<(crate::plan::Choices, Quality, crate::plan::budget::Prediction)>,
     /// Bumped on every scene change; a renderer built for an older scene is stale.
     pub(super) scene_version: u64,
     pub(super) renderer_version: u64,
@@ -249,6 +252,7 @@ fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Contex
             choice: Choice::Auto,
             object_methods: Vec::new(),
             renderer: None,
+            budget: None,
             scene_version: 0,
             renderer_version: 0,
             replan: false,

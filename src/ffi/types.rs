@@ -12,6 +12,9 @@ pub const SPECULA_SUCCESS: SpeculaResult = 0;
 pub const SPECULA_WARNING_TRUNCATED: SpeculaResult = 1;
 /// Warning: no frame has completed on the GPU yet (host-device mode), `count` is 0.
 pub const SPECULA_WARNING_NOT_READY: SpeculaResult = 2;
+/// specula_context_configure with a budget: no models cover the scene's specular objects;
+/// the registry's rules chose (specula_get_predictions reports none).
+pub const SPECULA_WARNING_NO_MODELS: SpeculaResult = 3;
 pub const SPECULA_ERROR_INVALID_ARGUMENT: SpeculaResult = -1;
 pub const SPECULA_ERROR_NULL_POINTER: SpeculaResult = -2;
 /// A struct's `type` tag or `size` does not match what the call expects.
@@ -239,6 +242,48 @@ pub struct SpeculaRenderDesc {
     /// Output size in pixels, 1..=16384 each.
     pub width: u32,
     pub height: u32,
+    /// The budgeted planner (with SPECULA_METHOD_AUTO; 0: unset, at most one of the two):
+    /// per specular object a method and for the frame the knob values, from per-object error
+    /// and cost models, so that a frame takes at most `max_ms` GPU milliseconds at the least
+    /// predicted error, or every specular object reaches `min_psnr_db` on its pixels at the
+    /// least predicted time. specula_get_predictions reports the prediction.
+    pub max_ms: f64,
+    pub min_psnr_db: f64,
+    /// The models (JSON from `specula tradeoff --calibrate`), or NULL: the stored defaults
+    /// measured on the bundled scenes.
+    pub models_path: *const c_char,
+}
+
+/// The size of SpeculaRenderDesc before the budget fields (type, size, method, width,
+/// height): still accepted, as no budget.
+pub const SPECULA_RENDER_DESC_SIZE_V1: u32 = 20;
+
+/// The first fields of SpeculaRenderDesc, all a caller of the first version passes.
+#[repr(C)]
+pub(super) struct RenderDescV1 {
+    pub r#type: SpeculaStructType,
+    pub size: u32,
+    pub method: SpeculaMethod,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// What the budgeted planner predicted for one specular object (specula_get_predictions);
+/// the last entry, named "frame", is the whole frame (method SPECULA_METHOD_AUTO, the
+/// predicted frame time and the PSNR of all specular pixels).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct SpeculaPrediction {
+    /// NUL-terminated object name, or "frame".
+    pub name: [c_char; 48],
+    /// SPECULA_METHOD_* chosen.
+    pub method: SpeculaMethod,
+    /// Its pixels in the models' frame, scaled to the configured size.
+    pub pixels: u32,
+    /// Predicted GPU milliseconds of its passes (its share of shared ones).
+    pub predicted_ms: f64,
+    /// Predicted PSNR on its pixels, dB (capped at 200).
+    pub predicted_psnr_db: f64,
 }
 
 /// A host image to render into (host-device mode). Usage must include TRANSFER_DST; its

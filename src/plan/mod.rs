@@ -4,6 +4,7 @@
 //! ordered stages, which are exactly what the renderer records. A scene without specular
 //! objects gets no map pass and no cube map; one without punctual lights no shadow map.
 
+pub mod budget;
 pub mod facts;
 
 use glam::Vec3;

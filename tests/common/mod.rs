@@ -163,6 +163,9 @@ pub fn render_desc(method: specula::Method, width: u32, height: u32) -> specula:
         method: method.abi,
         width,
         height,
+        max_ms: 0.0,
+        min_psnr_db: 0.0,
+        models_path: std::ptr::null(),
     }
 }
 

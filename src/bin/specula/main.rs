@@ -5,6 +5,7 @@
 mod animate;
 mod args;
 mod bench;
+mod budget;
 mod compare;
 mod demo;
 mod info;
@@ -40,6 +41,8 @@ enum Command {
         /// Write the per-pass profile as Chrome trace-event JSON (opens in Perfetto).
         #[arg(long)]
         profile: Option<PathBuf>,
+        #[command(flatten)]
+        budget: budget::BudgetArgs,
     },
     /// List meshes, materials with their classification, lights, camera and bounds.
     Info { scene: PathBuf },
@@ -50,6 +53,8 @@ enum Command {
         /// Print JSON instead of the table.
         #[arg(long)]
         json: bool,
+        #[command(flatten)]
+        budget: budget::BudgetArgs,
     },
     /// List methods and accuracy knobs with their ranges and defaults.
     Knobs,
@@ -95,6 +100,13 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "tradeoff")]
         out: PathBuf,
+        /// Also fit the budgeted planner's per-object error and cost models from the study
+        /// and write them (to --models, default SCENE.specula-models.json next to the scene).
+        #[arg(long)]
+        calibrate: bool,
+        /// Where --calibrate writes the models.
+        #[arg(long, requires = "calibrate")]
+        models: Option<PathBuf>,
     },
     /// Survey Table 1 measured for ray tracing in the original geometry: per scheme and
     /// scene size the CPU build, the GPU frame and the structure's memory (table1.csv,
@@ -223,10 +235,10 @@ fn one_line(text: &str) -> String {
 
 fn run(cmd: Command) -> specula::Result<()> {
     match cmd {
-        Command::Render { args, out, profile } => render::run(&args, &out, profile.as_deref()),
+        Command::Render { args, out, profile, budget } => render::run(&args, &out, profile.as_deref(), &budget),
         Command::Info { scene } => info::run(&scene),
         Command::Animate { args, fps, duration, out } => animate::run(&args, fps, duration, &out),
-        Command::Plan { args, json } => plan::run(&args, json),
+        Command::Plan { args, json, budget } => plan::run(&args, json, &budget),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),
         Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, parts, out, device } => {
@@ -236,6 +248,9 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())
         }
-        Command::Tradeoff { args, sweep, methods, out } => tradeoff::run(&args, &sweep, &methods, &out),
+        Command::Tradeoff { args, sweep, methods, out, calibrate, models } => {
+            let models = calibrate.then(|| models.unwrap_or_else(|| budget::default_models_path(&args.scene)));
+            tradeoff::run(&args, &sweep, &methods, &out, models.as_deref())
+        }
     }
 }

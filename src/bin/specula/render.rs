@@ -3,9 +3,11 @@
 use std::path::Path;
 
 use crate::args::{context, prepare, reference_summary, reference_timing, render_reference, write_image, RenderArgs};
+use crate::budget::BudgetArgs;
 
-pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Result<()> {
-    let job = prepare(args)?;
+pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &BudgetArgs) -> specula::Result<()> {
+    let mut job = prepare(args)?;
+    let prediction = crate::budget::apply(&mut job, &args.scene, budget)?;
     if job.cpu_method().is_some() {
         let (img, ms) = render_reference(&job.scene, &job.quality, (job.width, job.height))?;
         write_image(out, &img)?;
@@ -18,6 +20,7 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
     }
     let ctx = context(args.validate, &args.device)?;
     let plan = job.plan(&job.quality)?;
+    let budget_plan = prediction.as_ref().map(|_| plan.clone());
     let methods: Vec<String> = plan.objects.iter().map(|o| format!("{}: {}", o.name, o.method.name())).collect();
     let mut rebuilt = Vec::new();
     let frame = specula::render_frames(&ctx, &job.scene, plan, (job.width, job.height), (args.warmup, args.frames), |k, f| {
@@ -40,6 +43,30 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>) -> specula::Re
         eprintln!(
             "specula: warning: {n} rays did not fit in their queues and were dropped (their light is missing); raise the ray_budget knob"
         );
+    }
+    if let (Some(pr), Some(plan)) = (&prediction, &budget_plan) {
+        // What the frame measured beside the prediction: each object's share of the passes,
+        // and its PSNR against the exact reference (rendered now, at the same size).
+        let passes: Vec<(String, f64)> = frame.passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
+        let (costs, base) = specula::plan::budget::measured_by_object(plan, &passes);
+        let frame_ms: f64 = passes.iter().filter(|(n, _)| n != "frame.readback").map(|(_, ms)| ms).sum();
+        let size = (job.width, job.height);
+        let reference = specula::reference::render_reference(&job.scene, &job.quality, size)?;
+        let ids = specula::reference::object_ids(&job.scene, size)?;
+        let specular: Vec<bool> = job.scene.meshes.iter().map(|m| job.scene.materials[m.material].kind.is_specular()).collect();
+        let names: Vec<String> = job.scene.meshes.iter().map(|m| m.name.clone()).collect();
+        let regions = specula::metrics::errors_by_object(&frame.image, &reference, &ids, &specular, &names)?;
+        let psnr = |name: &str| regions.iter().find(|e| e.name == name).map(|e| e.psnr);
+        let objects: Vec<(f64, Option<f64>)> = pr
+            .objects
+            .iter()
+            .map(|o| {
+                let ms = costs.iter().find(|(m, _)| *m == o.mesh).map_or(0.0, |(_, ms)| *ms);
+                (ms, psnr(&o.name))
+            })
+            .collect();
+        println!("\n{}", specula::plan::budget::report(pr, Some((&objects, (frame_ms, psnr("specular"))))));
+        println!("(actual: this frame's passes split as the models split them, base {base:.3} ms; PSNR against the reference)");
     }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);

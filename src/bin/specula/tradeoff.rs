@@ -11,7 +11,7 @@ use crate::args::{prepare, reference_summary, RenderArgs, TradeoffArgs};
 
 /// The reference once, then every GPU method × every sweep variant, timed and compared;
 /// CSV, the figure (SVG and PNG) and the images into `out`.
-pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> specula::Result<()> {
+pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path, calibrate: Option<&Path>) -> specula::Result<()> {
     let render_args = RenderArgs {
         scene: a.scene.clone(),
         method: "auto".into(),
@@ -46,6 +46,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
         device: DeviceOptions { validation: a.validate, device_filter: a.device.clone() },
         out: out.to_path_buf(),
         metric,
+        calibrate: calibrate.map(Path::to_path_buf),
     };
 
     let mut bar = None;
@@ -93,6 +94,10 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path) -> 
         );
     }
     println!("\nwrote {}, {} and {}", report.csv.display(), report.figure.svg.display(), report.figure.png.display());
+    if let (Some(p), Some(m)) = (calibrate, &report.models) {
+        let n: usize = m.variants.iter().map(|v| v.objects.len()).sum();
+        println!("wrote {} ({} knob variant(s), {n} object × method model(s))", p.display(), m.variants.len());
+    }
     if a.validate {
         let (errors, warnings) = report.validation;
         println!("validation: {errors} error(s), {warnings} warning(s)");
