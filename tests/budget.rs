@@ -199,5 +199,95 @@ fn without_models_the_rules_choose_and_bad_models_are_named() {
     assert!(Budget::from_limits(Some(1.0), Some(30.0)).is_err());
     assert!(Budget::from_limits(Some(-1.0), None).unwrap_err().to_string().contains("max-ms"));
     assert!(Budget::from_limits(Some(f64::NAN), None).is_err());
-    assert_eq!(Budget::from_limits(Some(0.0), None).unwrap(), None);
+    assert!(Budget::from_limits(Some(0.0), None).is_err(), "0 ms is no budget");
+    assert_eq!(Budget::from_limits(None, None).unwrap(), None);
+}
+
+#[test]
+fn the_cli_calibrates_predicts_and_reports_what_the_frame_measured() {
+    let dir = std::env::temp_dir().join(format!("specula-budget-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let models = dir.join("demo-models.json");
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_specula")).args(args).output().unwrap();
+        (o.status.success(), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
+    };
+    let scene = "assets/demo/demo.gltf";
+    let small = [
+        "--size",
+        "24x24",
+        "-q",
+        "cube_size=16",
+        "-q",
+        "shadow_size=16",
+        "-q",
+        "photons=32",
+        "-q",
+        "reference_photons=1000",
+        "-q",
+        "spp=1",
+    ];
+    let out = dir.to_str().unwrap();
+    let m = models.to_str().unwrap();
+    let mut args = vec![
+        "tradeoff",
+        scene,
+        "--warmup",
+        "1",
+        "--frames",
+        "1",
+        "--method",
+        "envmap",
+        "--method",
+        "bvh",
+        "--calibrate",
+        "--models",
+        m,
+        "--out",
+        out,
+    ];
+    args.extend(small);
+    let (ok, stdout, stderr) = run(&args);
+    assert!(ok, "{stdout}{stderr}");
+    assert!(stdout.contains(&format!("wrote {m} (1 knob variant(s), 4 object × method model(s))")), "{stdout}");
+    let fitted = Models::load(&models).unwrap();
+    assert_eq!(fitted.size, [24, 24]);
+
+    // render with a floor: the prediction beside what the frame measured, per object.
+    let png = dir.join("budget.png");
+    let mut args = vec!["render", scene, "--min-psnr", "1", "--models", m, "--out", png.to_str().unwrap()];
+    args.extend(small);
+    let (ok, stdout, stderr) = run(&args);
+    assert!(ok, "{stdout}{stderr}");
+    assert!(stdout.contains("budget --min-psnr 1: met (predicted)") && stdout.contains(&format!("models: calibration {m}")), "{stdout}");
+    for object in ["mirror_sphere/0", "glass_sphere/0"] {
+        let line =
+            stdout.lines().find(|l| l.starts_with(object) && l.contains("object '")).unwrap_or_else(|| panic!("{object}:\n{stdout}"));
+        // method, predicted ms, actual ms, predicted PSNR, actual PSNR: all numbers present.
+        let numbers = line.split_whitespace().filter(|w| w.parse::<f64>().is_ok()).count();
+        assert!(numbers >= 4, "{line}");
+    }
+    assert!(png.exists());
+
+    // plan without a calibration: the stored defaults, by class; JSON carries the prediction.
+    let (ok, stdout, stderr) = run(&["plan", scene, "--size", "24x24", "--max-ms", "1000", "--json"]);
+    assert!(ok, "{stdout}{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    assert!(v["prediction"]["source"].as_str().unwrap().starts_with("stored defaults"), "{stdout}");
+    assert_eq!(v["prediction"]["objects"].as_array().unwrap().len(), 2);
+
+    // Bad input is named.
+    for (args, want) in [
+        (vec!["plan", scene, "--max-ms", "5", "--min-psnr", "30"], "not both"),
+        (vec!["plan", scene, "--max-ms=-5"], "max-ms"),
+        (vec!["plan", scene, "--max-ms", "0"], "max-ms"),
+        (vec!["plan", scene, "--min-psnr", "30", "--method", "envmap"], "needs --method auto"),
+        (vec!["plan", scene, "--models", m], "needs --max-ms or --min-psnr"),
+        (vec!["plan", scene, "--min-psnr", "30", "--models", "no/such.json"], "no/such.json"),
+        (vec!["plan", scene, "--min-psnr", "30", "--models", scene], "not a models file"),
+    ] {
+        let (ok, stdout, stderr) = run(&args);
+        assert!(!ok && stderr.contains(want), "{args:?}: {stdout}{stderr}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
 }

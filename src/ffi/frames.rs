@@ -67,7 +67,8 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                 }
             },
         };
-        let budget = Budget::from_limits(Some(max_ms), Some(min_psnr)).map_err(|e| match e {
+        let unset = |v: f64| Some(v).filter(|v| *v != 0.0);
+        let budget = Budget::from_limits(unset(max_ms), unset(min_psnr)).map_err(|e| match e {
             crate::Error::InvalidInput { what, message } => {
                 crate::Error::invalid(format!("render desc.{}", what.replace('-', "_")), message)
             }

@@ -134,10 +134,10 @@ pub enum Budget {
 }
 
 impl Budget {
-    /// From the CLI's or the C ABI's two numbers (0 or absent: unset); at most one may be set.
+    /// From the CLI's two options (the C ABI passes 0 as absent); at most one may be set.
     pub fn from_limits(max_ms: Option<f64>, min_psnr: Option<f64>) -> Result<Option<Budget>> {
-        match (max_ms.filter(|v| *v != 0.0), min_psnr.filter(|v| *v != 0.0)) {
-            (Some(_), Some(_)) => Err(Error::invalid("budget", "give --max-ms or --min-psnr, not both")),
+        match (max_ms, min_psnr) {
+            (Some(_), Some(_)) => Err(Error::invalid("budget", "a time budget (max-ms) or a PSNR floor (min-psnr), not both")),
             (Some(ms), None) if !(ms.is_finite() && ms > 0.0) => Err(Error::invalid("max-ms", format!("{ms} is not a positive time"))),
             (None, Some(db)) if !db.is_finite() => Err(Error::invalid("min-psnr", format!("{db} is not a finite PSNR"))),
             (Some(ms), None) => Ok(Some(Budget::MaxMs(ms))),
@@ -913,6 +913,7 @@ mod tests {
             cost: Cost { fixed_ms: 1.0, screen_ms: screen },
             shared: Cost::default(),
             cycles: 1,
+            row: "envmap".into(),
             psnr_db: 30.0,
         };
         let m = |size: u32, screen| Models {

@@ -253,6 +253,7 @@ int main(int argc, char **argv) {
     v1.size = SPECULA_RENDER_DESC_SIZE_V1;
     v1.min_psnr_db = 99.0; /* past the first version's size: not read */
     CASE("configure: first-version desc", specula_context_configure(ctx, &v1), SPECULA_SUCCESS);
+    CASE("render: first-version desc", specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, pixels, sizeof pixels), SPECULA_SUCCESS);
     CASE("predictions: none without a budget", specula_get_predictions(ctx, NULL, 0, &count), SPECULA_SUCCESS);
     expect("no predictions", count == 0 ? 0 : -1, 0, "prediction count");
     SpeculaRenderDesc short_desc = auto_desc;
