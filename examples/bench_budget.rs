@@ -104,8 +104,8 @@ fn main() -> specula::Result<()> {
             println!("| {} | {} | {:.3} | {} |", r.method, r.knobs, r.frame_ms, per.join(" | "));
         }
         println!("\n#### {name}: budgets\n");
-        println!("| budget | choice | predicted ms | measured ms | compared with | its ms | ratio | predicted dB per object | measured dB per object |");
-        println!("|---|---|---:|---:|---|---:|---:|---|---|");
+        println!("| budget | choice | predicted ms | measured ms | measured / budget | compared with | its ms now | ratio | predicted dB per object | measured dB per object |");
+        println!("|---|---|---:|---:|---:|---|---:|---:|---|---|");
         let mut floors: Vec<f64> = single.iter().map(|r| floor(r, &objects)).collect();
         floors.sort_by(f64::total_cmp);
         floors.dedup();
@@ -133,11 +133,15 @@ fn main() -> specula::Result<()> {
             let meas: Vec<String> =
                 p.objects.iter().map(|o| got.iter().find(|e| e.name == o.name).map_or("-".into(), |e| format!("{:.1}", e.psnr))).collect();
             println!(
-                "| {} | {choice} {} | {:.3} | {:.3} | {} {} | {:.3} | {:.2} | {} | {} |",
+                "| {} | {choice} {} | {:.3} | {:.3} | {} | {} {} | {:.3} | {:.2} | {} | {} |",
                 b.describe(),
                 p.knobs,
                 p.frame_ms,
                 t[0],
+                match b {
+                    Budget::MaxMs(ms) => format!("{:.2}", t[0] / ms),
+                    Budget::MinPsnr(_) => "-".into(),
+                },
                 against.method,
                 against.knobs,
                 t[1],

@@ -109,7 +109,17 @@ pub struct VariantModel {
     pub knobs: String,
     /// What belongs to no object (median over the variant's rows).
     pub base: Cost,
+    /// Each whole-scene row's own base (a row predicts exactly its measured frame).
+    #[serde(default)]
+    pub row_bases: Vec<RowBase>,
     pub objects: Vec<ObjectModel>,
+}
+
+/// One calibration row's base.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RowBase {
+    pub row: String,
+    pub base: Cost,
 }
 
 /// Per-object error and cost models of a scene (or, as stored defaults, of a few scenes).
@@ -146,9 +156,11 @@ impl Budget {
         }
     }
     pub fn describe(&self) -> String {
+        // Three decimals at most, trailing zeros dropped.
+        let short = |v: f64| format!("{:.3}", v).trim_end_matches('0').trim_end_matches('.').to_string();
         match self {
-            Budget::MaxMs(ms) => format!("--max-ms {ms}"),
-            Budget::MinPsnr(db) => format!("--min-psnr {db}"),
+            Budget::MaxMs(ms) => format!("--max-ms {}", short(*ms)),
+            Budget::MinPsnr(db) => format!("--min-psnr {}", short(*db)),
         }
     }
 }
@@ -259,6 +271,7 @@ impl Models {
             out.scene = format!("{}+{}", out.scene, m.scene);
             for mut v in m.variants {
                 v.base.screen_ms *= scale;
+                v.row_bases.iter_mut().for_each(|b| b.base.screen_ms *= scale);
                 for o in &mut v.objects {
                     o.cost.screen_ms *= scale;
                     o.shared.screen_ms *= scale;
@@ -272,6 +285,8 @@ impl Models {
                         b.screen_ms = (b.screen_ms * n + v.base.screen_ms) / (n + 1.0);
                         counts[k] += 1.0;
                         out.variants[k].objects.extend(v.objects);
+                        // Rows of several scenes: their bases differ; the variant's mean serves.
+                        out.variants[k].row_bases.clear();
                     }
                     None => {
                         out.variants.push(v);
@@ -383,13 +398,22 @@ pub fn fit(scene: &Scene, scene_name: &str, device: &str, size: (u32, u32), rows
         }
         let (costs, base) = attribute(r.plan, r.passes);
         bases.entry(r.knobs.to_string()).or_default().push(base);
+        let row_name = r.plan.choice.name().to_string();
         let k = match variants.iter().position(|v| v.knobs == r.knobs) {
             Some(k) => k,
             None => {
-                variants.push(VariantModel { knobs: r.knobs.to_string(), base: Cost::default(), objects: Vec::new() });
+                variants.push(VariantModel {
+                    knobs: r.knobs.to_string(),
+                    base: Cost::default(),
+                    row_bases: Vec::new(),
+                    objects: Vec::new(),
+                });
                 variants.len() - 1
             }
         };
+        if !variants[k].row_bases.iter().any(|b| b.row == row_name) {
+            variants[k].row_bases.push(RowBase { row: row_name, base });
+        }
         for (o, (mesh, cost, shared)) in r.plan.objects.iter().zip(costs) {
             let name = &scene.meshes[mesh].name;
             let Some(region) = r.regions.iter().find(|e| &e.name == name) else { continue };
@@ -454,8 +478,8 @@ struct VariantCandidates {
     /// Per object its candidates, one per method, for mixed choices.
     per_object: Vec<Vec<Candidate>>,
     /// The whole-scene methods the calibration ran, each with its objects as measured
-    /// (fallbacks included, cycles as run): choices of their own.
-    wholes: Vec<(Method, Vec<Candidate>)>,
+    /// (fallbacks included, cycles as run) and its own base: choices of their own.
+    wholes: Vec<(Method, f64, Vec<Candidate>)>,
 }
 
 /// The candidates of every object in every variant, from one models set; `None` when the
@@ -468,6 +492,7 @@ fn candidates(scene: &Scene, facts: &SceneFacts, choices: &Choices, models: &Mod
     for v in &models.variants {
         let mut per_object = Vec::new();
         let mut wholes: Vec<(Method, Vec<Candidate>)> = Vec::new();
+        let base = v.base.at(px, measured);
         for f in &facts.objects {
             let name = &scene.meshes[f.mesh].name;
             let forced = choices.objects.iter().rev().find(|(n, _)| super::names_object(scene, f.mesh, n)).map(|(_, m)| *m);
@@ -545,7 +570,14 @@ fn candidates(scene: &Scene, facts: &SceneFacts, choices: &Choices, models: &Mod
             if !choices.objects.is_empty() {
                 wholes.clear();
             }
-            out.push(VariantCandidates { knobs: v.knobs.clone(), base: v.base.at(px, measured), per_object, wholes });
+            let wholes = wholes
+                .into_iter()
+                .map(|(m, list)| {
+                    let own = v.row_bases.iter().find(|b| b.row == m.name).map_or(base, |b| b.base.at(px, measured));
+                    (m, own, list)
+                })
+                .collect();
+            out.push(VariantCandidates { knobs: v.knobs.clone(), base, per_object, wholes });
         }
     }
     if out.is_empty() && !facts.objects.is_empty() {
@@ -734,24 +766,25 @@ pub fn choose(
     for (models, source) in sources {
         let Some(variants) = candidates(scene, &facts, choices, models, size) else { continue };
         // (variant, whole-scene method or None for mixed, picks, rank)
-        let mut best: Option<(usize, Option<Method>, Vec<Candidate>, (bool, f64, f64))> = None;
+        let mut best: Option<(usize, Option<Method>, f64, Vec<Candidate>, (bool, f64, f64))> = None;
         for (k, v) in variants.iter().enumerate() {
             let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts: &facts };
             let idx = search(budget, &|p| timing.frame_ms(p, false), &v.per_object);
             let mixed: Vec<Candidate> = idx.iter().zip(&v.per_object).map(|(&i, c)| c[i].clone()).collect();
-            let options = std::iter::once((None, mixed)).chain(v.wholes.iter().map(|(m, list)| (Some(*m), list.clone())));
-            for (whole, picks) in options {
+            let options = std::iter::once((None, v.base, mixed)).chain(v.wholes.iter().map(|(m, b, list)| (Some(*m), *b, list.clone())));
+            for (whole, base, picks) in options {
                 let refs: Vec<&Candidate> = picks.iter().collect();
-                let r = rank(budget, timing.frame_ms(&refs, whole.is_some()), &refs);
-                if best.as_ref().is_none_or(|b| better(r, b.3)) {
-                    best = Some((k, whole, picks, r));
+                let t = Timing { base, quality: timing.quality.clone(), facts: &facts };
+                let r = rank(budget, t.frame_ms(&refs, whole.is_some()), &refs);
+                if best.as_ref().is_none_or(|b| better(r, b.4)) {
+                    best = Some((k, whole, base, picks, r));
                 }
             }
         }
-        let Some((k, whole, picks, r)) = best else { continue };
+        let Some((k, whole, base, picks, r)) = best else { continue };
         let v = &variants[k];
         let q = variant_quality(quality, &v.knobs)?;
-        let timing = Timing { base: v.base, quality: q.clone(), facts: &facts };
+        let timing = Timing { base, quality: q.clone(), facts: &facts };
         let refs: Vec<&Candidate> = picks.iter().collect();
         let objects: Vec<ObjectPrediction> = facts
             .objects
@@ -770,15 +803,15 @@ pub fn choose(
             .collect();
         // A whole-scene method as the study ran it; one method everywhere (nothing forced)
         // planned the same way; otherwise per-object methods.
+        let whole = whole.or_else(|| (Timing::uniform(&refs) && choices.objects.is_empty()).then(|| refs[0].method));
         let out = match whole {
             Some(m) => Choices::all(m),
-            None if Timing::uniform(&refs) && choices.objects.is_empty() => Choices::all(refs[0].method),
             None => Choices { method: choices.method, objects: objects.iter().map(|o| (o.name.clone(), o.method)).collect() },
         };
         let prediction = Prediction {
             budget,
             knobs: v.knobs.clone(),
-            base_ms: v.base,
+            base_ms: base,
             frame_ms: timing.frame_ms(&refs, whole.is_some()),
             specular_psnr_db: combined_psnr(&refs),
             objects,
@@ -924,6 +957,7 @@ mod tests {
             variants: vec![VariantModel {
                 knobs: "default".into(),
                 base: Cost { fixed_ms: 2.0, screen_ms: screen },
+                row_bases: Vec::new(),
                 objects: vec![obj("a", screen)],
             }],
         };
