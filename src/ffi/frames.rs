@@ -5,7 +5,7 @@ use std::ffi::{c_char, c_void};
 
 use ash::vk::{self, Handle};
 
-use super::handle::{cstr, fail, header, with_ctx, FfiResult, SpeculaContext};
+use super::handle::{cstr, fail, fixed_str, header, list_args, with_ctx, write_list, FfiResult, SpeculaContext};
 use super::types::*;
 use crate::methods::registry::ABI_AUTO;
 use crate::methods::{Choice, Method};
@@ -139,17 +139,12 @@ pub unsafe extern "C" fn specula_get_predictions(
     count: *mut u32,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        if count.is_null() {
-            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
-        }
-        if out.is_null() && capacity > 0 {
-            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
-        }
+        list_args(out, capacity, count)?;
         let mut list: Vec<SpeculaPrediction> = Vec::new();
         if let Some((_, _, p)) = &c.budget {
             for o in &p.objects {
                 list.push(SpeculaPrediction {
-                    name: name48(&o.name),
+                    name: fixed_str(&o.name),
                     method: o.method.abi,
                     pixels: o.pixels.min(u32::MAX as usize) as u32,
                     predicted_ms: o.ms,
@@ -158,32 +153,15 @@ pub unsafe extern "C" fn specula_get_predictions(
             }
             let pixels: usize = p.objects.iter().map(|o| o.pixels).sum();
             list.push(SpeculaPrediction {
-                name: name48("frame"),
+                name: fixed_str("frame"),
                 method: ABI_AUTO,
                 pixels: pixels.min(u32::MAX as usize) as u32,
                 predicted_ms: p.frame_ms,
                 predicted_psnr_db: p.specular_psnr_db,
             });
         }
-        *count = list.len() as u32;
-        for (i, e) in list.iter().take(capacity as usize).enumerate() {
-            *out.add(i) = *e;
-        }
-        Ok(if (capacity as usize) < list.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+        Ok(write_list(&list, out, capacity, count))
     })
-}
-
-/// `s` NUL-terminated in 48 bytes, cut at a character boundary.
-fn name48(s: &str) -> [c_char; 48] {
-    let mut out = [0 as c_char; 48];
-    let mut end = s.len().min(47);
-    while !s.is_char_boundary(end) {
-        end -= 1;
-    }
-    for (d, b) in out.iter_mut().zip(s[..end].bytes()) {
-        *d = b as c_char;
-    }
-    out
 }
 
 /// Standalone mode: renders one frame, waits for it, and writes width×height pixels of
@@ -350,29 +328,19 @@ pub unsafe extern "C" fn specula_get_pass_timings(
     count: *mut u32,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        if count.is_null() {
-            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
-        }
-        if out.is_null() && capacity > 0 {
-            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
-        }
+        list_args(out, capacity, count)?;
         let vkc = &c.vk;
         let Some(r) = c.renderer.as_mut() else {
             return fail(SPECULA_ERROR_WRONG_ORDER, "no renderer: call specula_context_configure first");
         };
         let timings = r.last_timings(vkc)?;
-        *count = timings.len() as u32;
         if timings.is_empty() {
+            *count = 0;
             return Ok(SPECULA_WARNING_NOT_READY);
         }
-        for (i, t) in timings.iter().take(capacity as usize).enumerate() {
-            let mut name = [0 as c_char; 48];
-            for (d, s) in name.iter_mut().zip(t.name.bytes().take(47)) {
-                *d = s as c_char;
-            }
-            *out.add(i) = SpeculaPassTiming { name, gpu_ms: t.gpu_ms, cpu_ms: t.cpu_ms };
-        }
-        Ok(if (capacity as usize) < timings.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+        let list: Vec<SpeculaPassTiming> =
+            timings.iter().map(|t| SpeculaPassTiming { name: fixed_str(&t.name), gpu_ms: t.gpu_ms, cpu_ms: t.cpu_ms }).collect();
+        Ok(write_list(&list, out, capacity, count))
     })
 }
 

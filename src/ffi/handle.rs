@@ -230,6 +230,44 @@ pub(super) unsafe fn cstr<'a>(p: *const c_char, what: &str) -> FfiResult<&'a str
     CStr::from_ptr(p).to_str().or_else(|_| fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("{what} is not UTF-8")))
 }
 
+/// Checks a list getter's output arguments: `count` non-NULL, `out` non-NULL when it has room.
+pub(super) unsafe fn list_args<T>(out: *mut T, capacity: u32, count: *mut u32) -> FfiResult<()> {
+    if count.is_null() {
+        return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
+    }
+    if out.is_null() && capacity > 0 {
+        return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
+    }
+    Ok(())
+}
+
+/// Writes `items`' count into `*count` and as many as fit into `out` (checked by
+/// `list_args`); SPECULA_WARNING_TRUNCATED when some did not fit.
+pub(super) unsafe fn write_list<T: Copy>(items: &[T], out: *mut T, capacity: u32, count: *mut u32) -> SpeculaResult {
+    *count = items.len() as u32;
+    for (i, e) in items.iter().take(capacity as usize).enumerate() {
+        *out.add(i) = *e;
+    }
+    if (capacity as usize) < items.len() {
+        SPECULA_WARNING_TRUNCATED
+    } else {
+        SPECULA_SUCCESS
+    }
+}
+
+/// `s` NUL-terminated in N bytes, cut at a character boundary.
+pub(super) fn fixed_str<const N: usize>(s: &str) -> [c_char; N] {
+    let mut out = [0 as c_char; N];
+    let mut end = s.len().min(N - 1);
+    while !s.is_char_boundary(end) {
+        end -= 1;
+    }
+    for (d, b) in out.iter_mut().zip(s[..end].bytes()) {
+        *d = b as c_char;
+    }
+    out
+}
+
 pub(super) fn vec3(a: [f32; 3]) -> Vec3 {
     Vec3::from_array(a)
 }

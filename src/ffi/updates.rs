@@ -3,11 +3,10 @@
 //! refuses, and needs no idle GPU: a configured renderer takes the change in place and the
 //! next recorded frame uploads it (and regenerates only the maps that depend on it).
 
-use std::ffi::c_char;
 
 use glam::Mat4;
 
-use super::handle::{fail, header, with_ctx, FfiResult, SpeculaContext};
+use super::handle::{fail, fixed_str, header, list_args, with_ctx, write_list, FfiResult, SpeculaContext};
 use super::scene::{light_from_desc, material_from_desc};
 use super::types::*;
 use crate::scene::Scene;
@@ -129,31 +128,12 @@ pub unsafe extern "C" fn specula_get_map_updates(
     count: *mut u32,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        if count.is_null() {
-            return fail(SPECULA_ERROR_NULL_POINTER, "count is NULL");
-        }
-        if out.is_null() && capacity > 0 {
-            return fail(SPECULA_ERROR_NULL_POINTER, "out is NULL with capacity > 0");
-        }
+        list_args(out, capacity, count)?;
         let Some(r) = c.renderer.as_ref() else {
             return fail(SPECULA_ERROR_WRONG_ORDER, "no renderer: call specula_context_configure first");
         };
-        let updates = r.map_updates();
-        *count = updates.len() as u32;
-        fn copy<const N: usize>(s: &str) -> [c_char; N] {
-            let mut out = [0 as c_char; N];
-            let mut end = s.len().min(N - 1);
-            while !s.is_char_boundary(end) {
-                end -= 1;
-            }
-            for (d, b) in out.iter_mut().zip(s[..end].bytes()) {
-                *d = b as c_char;
-            }
-            out
-        }
-        for (i, u) in updates.iter().take(capacity as usize).enumerate() {
-            *out.add(i) = SpeculaMapUpdate { stage: copy(u.stage), reason: copy(&u.reason) };
-        }
-        Ok(if (capacity as usize) < updates.len() { SPECULA_WARNING_TRUNCATED } else { SPECULA_SUCCESS })
+        let list: Vec<SpeculaMapUpdate> =
+            r.map_updates().iter().map(|u| SpeculaMapUpdate { stage: fixed_str(u.stage), reason: fixed_str(&u.reason) }).collect();
+        Ok(write_list(&list, out, capacity, count))
     })
 }
