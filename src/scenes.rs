@@ -152,7 +152,7 @@ pub fn corner_mirror() -> Result<Scene> {
     let mut ball = shapes::uv_sphere("mirror_ball", c, r, 64, 32, mirror);
     ball.reference_point = Some(ROOM_CENTER);
     s.add_mesh(ball)?;
-    s.camera = Some(Camera::look_at(Vec3::new(-0.9, 0.2, 1.3), c, 45f32.to_radians()));
+    s.camera = Some(Camera::look_at(Vec3::new(-0.2, -0.3, 0.6), c, 45f32.to_radians()));
     Ok(s)
 }
 
@@ -172,7 +172,7 @@ pub fn concave_occluder() -> Result<Scene> {
         emissive_texture: Some(tex),
         ..Default::default()
     })?;
-    s.add_mesh(shapes::cuboid("box", Vec3::new(0.45, -1.6, -0.35), Vec3::new(0.3, 0.4, 0.3), mat))?;
+    s.add_mesh(shapes::cuboid("box", Vec3::new(0.15, -1.55, -1.4), Vec3::new(0.3, 0.45, 0.3), mat))?;
     Ok(s)
 }
 
@@ -183,11 +183,8 @@ pub fn concave_occluder() -> Result<Scene> {
 pub fn glass_sphere(ior: f32) -> Result<Scene> {
     let mut s = Scene::new();
     checker_room(&mut s, ROOM_CENTER, ROOM_HALF)?;
-    let glass = s.add_material(Material {
-        name: format!("glass{ior}"),
-        kind: SurfaceKind::Dielectric { ior, thin: false },
-        ..Default::default()
-    })?;
+    let glass =
+        s.add_material(Material { name: format!("glass{ior}"), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() })?;
     s.add_mesh(shapes::uv_sphere("glass_ball", Vec3::new(0.0, -0.6, -0.4), 0.7, 64, 32, glass))?;
     s.camera = Some(Camera::look_at(Vec3::new(0.3, 0.2, 1.6), Vec3::new(0.0, -0.6, -0.4), 50f32.to_radians()));
     Ok(s)

@@ -62,6 +62,16 @@ pub fn variants(base: &Quality, sweeps: &[Sweep]) -> Result<Vec<(String, Quality
     Ok(out)
 }
 
+/// The study's series: with `each`, one per sweep, its values applied to `base` one at a
+/// time (the other knobs at `base`), named by the sweep's knob; else one unnamed series of
+/// every combination ([`variants`]).
+pub fn series(base: &Quality, sweeps: &[Sweep], each: bool) -> Result<Vec<(Option<String>, Vec<(String, Quality)>)>> {
+    if !each || sweeps.is_empty() {
+        return Ok(vec![(None, variants(base, sweeps)?)]);
+    }
+    sweeps.iter().map(|s| Ok((Some(s.knob.clone()), variants(base, std::slice::from_ref(s))?))).collect()
+}
+
 /// One measured configuration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
@@ -777,8 +787,11 @@ pub struct Config {
     pub scene_name: String,
     /// Base knobs of every variant; `spp` and `depth` also set the reference's.
     pub quality: Quality,
-    /// The combinations multiply (see [`variants`]).
+    /// The combinations multiply (see [`variants`]), unless `each`.
     pub sweeps: Vec<Sweep>,
+    /// One sweep at a time from `quality` (see [`series`]): each method gets one curve
+    /// per sweep, its rows' method `METHOD (KNOB)`.
+    pub each: bool,
     /// The choices to measure (GPU methods or `auto`); empty: `auto` and every GPU method
     /// of the registry. The reference is not one.
     pub methods: Vec<Choice>,
@@ -830,7 +843,7 @@ pub struct Report {
 /// `tradeoff.csv` and the figure (`tradeoff.svg`, `tradeoff.png`, see [`plot`]) into
 /// `cfg.out`.
 pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
-    let variants = variants(&cfg.quality, &cfg.sweeps)?;
+    let series = series(&cfg.quality, &cfg.sweeps, cfg.each)?;
     let methods: Vec<Choice> = if cfg.methods.is_empty() {
         std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method)).collect()
     } else {
@@ -843,7 +856,25 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let (w, h) = cfg.size;
 
-    progress(Progress::Start { steps: (1 + methods.len() * variants.len()) as u64 });
+    // One sweep at a time: a method gets the series of the knobs it reads, or its
+    // defaults alone when it reads none of them.
+    let defaults = vec![(None, variants(&cfg.quality, &[])?)];
+    let of = |m: &Choice| -> &Vec<(Option<String>, Vec<(String, Quality)>)> {
+        match m {
+            Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| m.knobs.contains(&k.as_str()))) => {
+                &defaults
+            }
+            _ => &series,
+        }
+    };
+    let reads = |m: &Choice, knob: &Option<String>| match (m, knob) {
+        (Choice::Method(m), Some(k)) => m.knobs.contains(&k.as_str()),
+        _ => true,
+    };
+    let runs: Vec<(Choice, &(Option<String>, Vec<(String, Quality)>))> =
+        methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
+    let steps: usize = runs.iter().map(|(_, (_, v))| v.len()).sum();
+    progress(Progress::Start { steps: (1 + steps) as u64 });
     progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.spp, cfg.quality.depth)));
     let t = std::time::Instant::now();
     let reference = crate::reference::render_reference(&cfg.scene, &cfg.quality, (w, h))?;
@@ -858,7 +889,8 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
 
     let ctx = Context::new(&cfg.device)?;
     let mut rows = Vec::new();
-    for &method in &methods {
+    for (method, (knob, variants)) in runs {
+        let name = knob.as_ref().map_or_else(|| method.name().to_string(), |k| format!("{} ({k})", method.name()));
         // A ray tracer in the original geometry (survey §2) makes no maps and no shadow
         // maps: only the knobs it lists change its image, so variants that agree on those
         // are measured once and reported for each (the sweeps are usually map knobs).
@@ -867,8 +899,8 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             _ => None,
         };
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
-        for (label, q) in &variants {
-            progress(Progress::Begin(format!("{} {label}", method.name())));
+        for (label, q) in variants {
+            progress(Progress::Begin(format!("{name} {label}")));
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {
@@ -884,7 +916,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             let (_, frame, errors, regions) = &measured[i];
             let stem = format!("{}-{}", method.name(), label.replace([' ', '=', ',', ';', '/'], "_"));
             frame.image.write_png_srgb(&out.join(format!("{stem}.png")))?;
-            let mut row = Row::new(method.name(), label, &frame.passes, *errors);
+            let mut row = Row::new(&name, label, &frame.passes, *errors);
             row.regions = regions.clone();
             rows.push(row);
             if reads.is_none() {
@@ -917,6 +949,21 @@ mod tests {
 
     fn errors(flip: f64) -> ImageErrors {
         ImageErrors { rmse: flip, psnr: 1.0, max_abs: flip, p99_abs: flip, flip }
+    }
+
+    #[test]
+    fn each_sweep_is_a_series_of_its_own() {
+        let s = [Sweep::parse("secant_steps=0,1").unwrap(), Sweep::parse("linear_steps=4,8,16").unwrap()];
+        let base = Quality { linear_steps: 4, secant_steps: 0, ..Quality::default() };
+        let v = series(&base, &s, true).unwrap();
+        assert_eq!(v.len(), 2);
+        assert_eq!(v[0].0.as_deref(), Some("secant_steps"));
+        assert_eq!(v[1].1.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>(), ["linear_steps=4", "linear_steps=8", "linear_steps=16"]);
+        // The other knobs stay at the base.
+        assert!(v[0].1.iter().all(|(_, q)| q.linear_steps == 4) && v[1].1.iter().all(|(_, q)| q.secant_steps == 0));
+        assert_eq!(v[0].1[1].1.secant_steps, 1);
+        let product = series(&base, &s, false).unwrap();
+        assert_eq!((product.len(), product[0].0.clone(), product[0].1.len()), (1, None, 6));
     }
 
     #[test]

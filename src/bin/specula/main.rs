@@ -89,6 +89,10 @@ enum Command {
         /// knob=v1,v2,... (repeatable: the combinations multiply); ref_point values split on ';'.
         #[arg(long)]
         sweep: Vec<String>,
+        /// Vary one --sweep at a time from the base knobs (-q), each its own curve per
+        /// method, named METHOD (KNOB), instead of every combination.
+        #[arg(long)]
+        each: bool,
         /// Only these methods (repeatable); default every GPU method.
         #[arg(long = "method")]
         methods: Vec<String>,
@@ -236,6 +240,6 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())
         }
-        Command::Tradeoff { args, sweep, methods, out } => tradeoff::run(&args, &sweep, &methods, &out),
+        Command::Tradeoff { args, sweep, each, methods, out } => tradeoff::run(&args, &sweep, each, &methods, &out),
     }
 }
