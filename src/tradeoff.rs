@@ -95,15 +95,15 @@ impl Row {
     }
 }
 
-/// The figure's panels: the whole image, and with PSNR and more than one specular object,
-/// one panel per object (its rows' PSNR and RMSE those of its pixels; FLIP is per image only).
+/// The figure's panels: the whole image, and with PSNR, one panel per specular object (its
+/// rows' PSNR and RMSE those of its pixels; FLIP is per image only): where the method acts.
 pub fn region_panels(rows: &[Row], metric: Metric) -> Vec<Panel> {
     let mut panels = vec![Panel { name: "whole image".into(), rows: rows.to_vec() }];
     let objects: Vec<String> = rows
         .first()
         .map(|r| r.regions.iter().map(|e| e.name.clone()).filter(|n| n != "specular" && n != "non-specular").collect())
         .unwrap_or_default();
-    if metric != Metric::Psnr || objects.len() < 2 {
+    if metric != Metric::Psnr || objects.is_empty() {
         return panels;
     }
     for name in objects {
@@ -330,8 +330,8 @@ const TITLE_H: u32 = 48;
 /// The trade-off figure, `stem`.svg and `stem`.png (the same drawing through plotters' SVG
 /// and bitmap backends): one panel per entry of `panels` (two columns), each the metric
 /// against frame GPU time on a log axis, both ranges from the data with a margin; one
-/// curve per method (its points in time order, a colour and marker of its own, named in
-/// the legend beside the panels), each point labelled with its knob values (a method's
+/// curve per method (its points in time order, or in the sweep's order where its rows vary
+/// one knob; a colour and marker of its own, named in the legend beside the panels), each point labelled with its knob values (a method's
 /// only point with the method's name) where there is room (Pareto points first; far
 /// labels get a leader line), the Pareto front as a step line through ringed points.
 pub fn plot(stem: &Path, panels: &[Panel], metric: Metric, title: &str) -> Result<Figure> {
@@ -506,7 +506,14 @@ fn draw_figure<DB: plotters::prelude::DrawingBackend>(
     for (panel, area) in panels.iter().zip(plots.split_evenly((grid, cols))) {
         draw_panel(root, &area, panel, metric, &methods, &mut omitted)?;
     }
-    let knobs = panels.iter().flat_map(|p| &p.rows).find_map(|r| knob_names(&r.knobs));
+    // Every set of knob names the labels use (one per sweep with `--each`).
+    let mut sets: Vec<String> = Vec::new();
+    for k in panels.iter().flat_map(|p| &p.rows).filter_map(|r| knob_names(&r.knobs)) {
+        if !sets.contains(&k) {
+            sets.push(k);
+        }
+    }
+    let knobs = (!sets.is_empty()).then(|| sets.join("; "));
     draw_legend(&legend, &methods, metric, knobs.as_deref(), &omitted)
 }
 
@@ -593,10 +600,15 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
     }
     root.draw(&PathElement::new(step, RGBAColor(0, 0, 0, 0.45).stroke_width(3))).map_err(|x| e(&x))?;
 
-    // One curve per method through its points in time order.
+    // One curve per method through its points in time order; a curve of one knob's sweep
+    // (`--each`) through its points in the sweep's order, so that noisy times do not fold it.
     for k in 0..methods.len() {
         let mut idx: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].0 == k).collect();
-        idx.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
+        let names: Vec<Option<String>> = panel.rows.iter().filter(|r| r.method == methods[k]).map(|r| knob_names(&r.knobs)).collect();
+        let one_knob = names.first().is_some_and(|n| n.as_ref().is_some_and(|n| !n.contains(" / ")) && names.iter().all(|m| m == n));
+        if !one_knob {
+            idx.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
+        }
         if idx.len() > 1 {
             let c = colour(k);
             let line = RGBAColor(c.0, c.1, c.2, 0.7).stroke_width(2);
