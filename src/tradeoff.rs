@@ -62,10 +62,14 @@ pub fn variants(base: &Quality, sweeps: &[Sweep]) -> Result<Vec<(String, Quality
     Ok(out)
 }
 
+/// One series of a study: the swept knob's name (`None`: every combination, or the
+/// defaults) and its labelled variants.
+pub type Series = (Option<String>, Vec<(String, Quality)>);
+
 /// The study's series: with `each`, one per sweep, its values applied to `base` one at a
 /// time (the other knobs at `base`), named by the sweep's knob; else one unnamed series of
 /// every combination ([`variants`]).
-pub fn series(base: &Quality, sweeps: &[Sweep], each: bool) -> Result<Vec<(Option<String>, Vec<(String, Quality)>)>> {
+pub fn series(base: &Quality, sweeps: &[Sweep], each: bool) -> Result<Vec<Series>> {
     if !each || sweeps.is_empty() {
         return Ok(vec![(None, variants(base, sweeps)?)]);
     }
@@ -602,9 +606,9 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
 
     // One curve per method through its points in time order; a curve of one knob's sweep
     // (`--each`) through its points in the sweep's order, so that noisy times do not fold it.
-    for k in 0..methods.len() {
+    for (k, method) in methods.iter().enumerate() {
         let mut idx: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].0 == k).collect();
-        let names: Vec<Option<String>> = panel.rows.iter().filter(|r| r.method == methods[k]).map(|r| knob_names(&r.knobs)).collect();
+        let names: Vec<Option<String>> = panel.rows.iter().filter(|r| r.method == *method).map(|r| knob_names(&r.knobs)).collect();
         let one_knob = names.first().is_some_and(|n| n.as_ref().is_some_and(|n| !n.contains(" / ")) && names.iter().all(|m| m == n));
         if !one_knob {
             idx.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
@@ -871,7 +875,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     // One sweep at a time: a method gets the series of the knobs it reads, or its
     // defaults alone when it reads none of them.
     let defaults = vec![(None, variants(&cfg.quality, &[])?)];
-    let of = |m: &Choice| -> &Vec<(Option<String>, Vec<(String, Quality)>)> {
+    let of = |m: &Choice| -> &Vec<Series> {
         match m {
             Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| m.knobs.contains(&k.as_str()))) => {
                 &defaults
@@ -883,8 +887,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         (Choice::Method(m), Some(k)) => m.knobs.contains(&k.as_str()),
         _ => true,
     };
-    let runs: Vec<(Choice, &(Option<String>, Vec<(String, Quality)>))> =
-        methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
+    let runs: Vec<(Choice, &Series)> = methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
     let steps: usize = runs.iter().map(|(_, (_, v))| v.len()).sum();
     progress(Progress::Start { steps: (1 + steps) as u64 });
     progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.spp, cfg.quality.depth)));
