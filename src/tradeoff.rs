@@ -335,9 +335,10 @@ const TITLE_H: u32 = 48;
 /// and bitmap backends): one panel per entry of `panels` (two columns), each the metric
 /// against frame GPU time on a log axis, both ranges from the data with a margin; one
 /// curve per method (its points in time order, or in the sweep's order where its rows vary
-/// one knob; a colour and marker of its own, named in the legend beside the panels), each point labelled with its knob values (a method's
-/// only point with the method's name) where there is room (Pareto points first; far
-/// labels get a leader line), the Pareto front as a step line through ringed points.
+/// one knob; a colour and marker of its own, named in the legend beside the panels), each
+/// point labelled with its knob values (a method's only point with the method's name) where
+/// there is room (Pareto points first; far labels get a leader line), the Pareto front as a
+/// step line through ringed points.
 pub fn plot(stem: &Path, panels: &[Panel], metric: Metric, title: &str) -> Result<Figure> {
     use plotters::prelude::*;
     if panels.is_empty() {
