@@ -58,6 +58,7 @@ fn main() -> specula::Result<()> {
             scene_name: name.into(),
             quality: base.clone(),
             sweeps: vec![Sweep::parse(sweep)?],
+            each: false,
             methods: methods.iter().map(|&m| m.into()).collect(),
             size: (size, size),
             warmup: 1,

@@ -148,6 +148,19 @@ pub struct Quality {
     /// while the ray stack has room (else the stronger one carrying both weights), or always
     /// along the stronger one only.
     pub layered_both: bool,
+    /// Test knob: a deliberate fault injected into a method, so that the tests can check
+    /// that the per-object error measurements see it. Never for images.
+    pub debug_fault: DebugFault,
+}
+
+/// A deliberately broken method (`debug_fault`, a test knob).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DebugFault {
+    None,
+    /// `distance.search` (the `distance` method's camera pass, §4.2) looks up the reflected
+    /// ray's opposite direction: reflections come from behind the surface.
+    FlipReflection,
 }
 
 /// The most layers a layered distance map (§4.5) peels.
@@ -839,9 +852,21 @@ pub const KNOBS: &[Knob] = &[
         },
         get: |q| name_of(q.layered_both, LAYERED_BRANCHES),
     },
+    Knob {
+        name: "debug_fault",
+        values: "none|flip_reflection",
+        default: "none",
+        doc: "test knob (never for images): flip_reflection breaks the distance method on purpose (and distance-multi, which shares its camera pass distance.search, §4.2), the pass tracing the reflected ray's opposite direction, so that tests can check that the per-object errors see a broken method and the rest of the image does not move (issue 15); the C ABI's string setter takes it too",
+        set: |q, v| {
+            q.debug_fault = one_of(v, DEBUG_FAULTS)?;
+            Ok(())
+        },
+        get: |q| name_of(q.debug_fault, DEBUG_FAULTS),
+    },
 ];
 
 const LAYERED_BRANCHES: &[(&str, bool)] = &[("both", true), ("strongest", false)];
+const DEBUG_FAULTS: &[(&str, DebugFault)] = &[("none", DebugFault::None), ("flip_reflection", DebugFault::FlipReflection)];
 
 impl Default for Quality {
     fn default() -> Self {
@@ -895,6 +920,7 @@ impl Default for Quality {
             caustic_radius: None,
             layers: None,
             layered_both: true,
+            debug_fault: DebugFault::None,
         }
     }
 }

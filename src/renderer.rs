@@ -455,7 +455,14 @@ impl Renderer {
                 StageSpec::CausticsProject => crate::methods::caustics::project::CausticsProject::create(&init)?,
                 StageSpec::Camera(c) => match c.pass.create {
                     Some(create) => create(&init, c)?,
-                    None => Box::new(CameraShade::new(ctx, self.layout, c, self.multisample)?),
+                    None => {
+                        // The test knob debug_fault=flip_reflection breaks distance.search.
+                        let mut c = c.clone();
+                        if c.name == "distance.search" && self.plan.quality.debug_fault == crate::quality::DebugFault::FlipReflection {
+                            c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
+                        }
+                        Box::new(CameraShade::new(ctx, self.layout, &c, self.multisample)?)
+                    }
                 },
             };
             self.stages.push(stage);

@@ -45,3 +45,147 @@ pub fn flat_glass() -> Result<Scene> {
     s.camera = Some(Camera::look_at(Vec3::new(1.0, 0.8, 1.9), Vec3::new(-0.1, -1.3, -0.3), 55f32.to_radians()));
     Ok(s)
 }
+
+/// The names [`builtin`] knows, in the order `specula` lists them.
+pub const BUILTIN: &[&str] = &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass"];
+
+/// A scene built in code by its name (`builtin:NAME` on the command line): `corner-mirror`,
+/// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`; `None` for another name.
+pub fn builtin(name: &str) -> Option<Result<Scene>> {
+    Some(match name {
+        "corner-mirror" => corner_mirror(),
+        "concave-occluder" => concave_occluder(),
+        "glass-1.1" => glass_sphere(1.1),
+        "glass-1.5" => glass_sphere(1.5),
+        "flat-glass" => flat_glass(),
+        _ => return None,
+    })
+}
+
+/// The centre of the showcase rooms ([`checker_room`] of half-size [`ROOM_HALF`]).
+pub const ROOM_CENTER: Vec3 = Vec3::ZERO;
+pub const ROOM_HALF: f32 = 2.0;
+
+/// An emissive checkerboard texture: `cells`×`cells` squares of `a` and `b` (linear
+/// colours, stored sRGB-encoded as textures are), 8 texels per square so that bilinear
+/// filtering blurs only a square's rim.
+fn checker_texture(name: &str, cells: u32, a: Vec3, b: Vec3) -> crate::scene::Texture {
+    let n = cells * 8;
+    let enc = |c: f32| -> u8 {
+        let c = c.clamp(0.0, 1.0);
+        let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+        (s * 255.0 + 0.5) as u8
+    };
+    let mut rgba8 = Vec::with_capacity((n * n * 4) as usize);
+    for y in 0..n {
+        for x in 0..n {
+            let c = if (x / 8 + y / 8) % 2 == 0 { a } else { b };
+            rgba8.extend([enc(c.x), enc(c.y), enc(c.z), 255]);
+        }
+    }
+    crate::scene::Texture { name: name.into(), width: n, height: n, rgba8 }
+}
+
+/// A room of six emissive checkerboard walls (no lights: nothing blows out, and nothing but
+/// geometry and Fresnel decides a specular pixel), each wall 8×8 squares of two colours of
+/// its own (emitted radiance at most 0.9), around `center` with half-size `half`. Every
+/// edge between two squares is a place where a reflection searched in the wrong place
+/// shows.
+pub fn checker_room(scene: &mut Scene, center: Vec3, half: f32) -> Result<()> {
+    const PAIRS: [(Vec3, Vec3); 6] = [
+        (Vec3::new(0.9, 0.25, 0.2), Vec3::new(0.3, 0.05, 0.05)),
+        (Vec3::new(0.2, 0.8, 0.3), Vec3::new(0.05, 0.25, 0.1)),
+        (Vec3::new(0.85, 0.85, 0.8), Vec3::new(0.25, 0.25, 0.3)),
+        (Vec3::new(0.6, 0.45, 0.3), Vec3::new(0.15, 0.1, 0.05)),
+        (Vec3::new(0.25, 0.45, 0.9), Vec3::new(0.05, 0.1, 0.3)),
+        (Vec3::new(0.9, 0.8, 0.2), Vec3::new(0.35, 0.1, 0.4)),
+    ];
+    for (wall, (a, b)) in PAIRS.iter().enumerate() {
+        let axis = wall / 2;
+        let sign = if wall % 2 == 0 { 1.0 } else { -1.0 };
+        let (a1, a2) = match axis {
+            0 => (1, 2),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let tex = scene.add_texture(checker_texture(&format!("checker{wall}"), 8, *a, *b))?;
+        let mat = scene.add_material(Material {
+            name: format!("wall{wall}"),
+            base_color: Vec3::ZERO,
+            emissive: Vec3::ONE,
+            emissive_texture: Some(tex),
+            ..Default::default()
+        })?;
+        let mut o = Vec3::ZERO;
+        o[axis] = sign * half;
+        let (mut u, mut v) = (Vec3::ZERO, Vec3::ZERO);
+        u[a1] = 2.0 * half;
+        v[a2] = 2.0 * half;
+        // The quad spans the wall from its (−, −) corner; it faces the room's centre.
+        let corner = center + o - u * 0.5 - v * 0.5;
+        let (u, v) = if u.cross(v).dot(-o) > 0.0 { (u, v) } else { (v, u) };
+        scene.add_mesh(shapes::quad(&format!("wall{wall}"), corner, u, v, 4, mat))?;
+    }
+    Ok(())
+}
+
+/// A mirror material of reflectance `f0` at normal incidence (κ = 0, ν from survey eq. 2).
+fn mirror_material(name: &str, f0: f32) -> Material {
+    let s = f0.sqrt();
+    let nu = (1.0 + s) / (1.0 - s);
+    Material { name: name.into(), kind: SurfaceKind::Mirror { nu: Vec3::splat(nu), kappa: Vec3::ZERO }, ..Default::default() }
+}
+
+/// The mirror ball of [`corner_mirror`] and [`concave_occluder`]: centre and radius.
+pub const CORNER_BALL: (Vec3, f32) = (Vec3::new(1.2, -1.25, -1.2), 0.6);
+
+/// Survey Figure 20's set-up (§4.2): a mirror ball (F0 0.9) in a corner of the emissive
+/// checkerboard room ([`checker_room`], half-size 2 m, no lights), its maps' reference point
+/// forced to the room's centre (`Mesh::reference_point`), 2.1 m from the ball's centre, so
+/// that the distance-map search, not the parallax correction, finds what the ball reflects:
+/// `linear_steps` and `secant_steps` matter. Seen from the opposite side of the room.
+pub fn corner_mirror() -> Result<Scene> {
+    let mut s = Scene::new();
+    checker_room(&mut s, ROOM_CENTER, ROOM_HALF)?;
+    let mirror = s.add_material(mirror_material("mirror", 0.9))?;
+    let (c, r) = CORNER_BALL;
+    let mut ball = shapes::uv_sphere("mirror_ball", c, r, 64, 32, mirror);
+    ball.reference_point = Some(ROOM_CENTER);
+    s.add_mesh(ball)?;
+    s.camera = Some(Camera::look_at(Vec3::new(-0.2, -0.3, 0.6), c, 45f32.to_radians()));
+    Ok(s)
+}
+
+/// Survey Figure 21's difficult case (§4.2): [`corner_mirror`] with an emissive chessboard
+/// box on the floor between the room's centre (the ball's reference point) and the ball,
+/// making the environment concave from the reference point: part of the floor and of the
+/// box's far faces that the ball reflects is hidden from the reference point, so a single
+/// distance map substitutes the box's edge for it (more search steps do not help; layered
+/// maps, §4.5, see behind the box).
+pub fn concave_occluder() -> Result<Scene> {
+    let mut s = corner_mirror()?;
+    let tex = s.add_texture(checker_texture("box_checker", 4, Vec3::new(0.1, 0.85, 0.15), Vec3::new(0.85, 0.85, 0.85)))?;
+    let mat = s.add_material(Material {
+        name: "box".into(),
+        base_color: Vec3::ZERO,
+        emissive: Vec3::ONE,
+        emissive_texture: Some(tex),
+        ..Default::default()
+    })?;
+    s.add_mesh(shapes::cuboid("box", Vec3::new(0.15, -1.55, -1.4), Vec3::new(0.3, 0.45, 0.3), mat))?;
+    Ok(s)
+}
+
+/// A solid glass ball of index `ior` (survey §4.4's refractor) in the middle of the emissive
+/// checkerboard room, seen from close by: the refractor-map search steps and the internal
+/// bounces decide what shows through it (ν 1.1: a weak lens, the refracted rays nearly
+/// straight; ν 1.5: strong refraction and total internal reflection at the rim).
+pub fn glass_sphere(ior: f32) -> Result<Scene> {
+    let mut s = Scene::new();
+    checker_room(&mut s, ROOM_CENTER, ROOM_HALF)?;
+    let glass =
+        s.add_material(Material { name: format!("glass{ior}"), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() })?;
+    s.add_mesh(shapes::uv_sphere("glass_ball", Vec3::new(0.0, -0.6, -0.4), 0.7, 64, 32, glass))?;
+    s.camera = Some(Camera::look_at(Vec3::new(0.3, 0.2, 1.6), Vec3::new(0.0, -0.6, -0.4), 50f32.to_radians()));
+    Ok(s)
+}

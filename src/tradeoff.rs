@@ -62,6 +62,20 @@ pub fn variants(base: &Quality, sweeps: &[Sweep]) -> Result<Vec<(String, Quality
     Ok(out)
 }
 
+/// One series of a study: the swept knob's name (`None`: every combination, or the
+/// defaults) and its labelled variants.
+pub type Series = (Option<String>, Vec<(String, Quality)>);
+
+/// The study's series: with `each`, one per sweep, its values applied to `base` one at a
+/// time (the other knobs at `base`), named by the sweep's knob; else one unnamed series of
+/// every combination ([`variants`]).
+pub fn series(base: &Quality, sweeps: &[Sweep], each: bool) -> Result<Vec<Series>> {
+    if !each || sweeps.is_empty() {
+        return Ok(vec![(None, variants(base, sweeps)?)]);
+    }
+    sweeps.iter().map(|s| Ok((Some(s.knob.clone()), variants(base, std::slice::from_ref(s))?))).collect()
+}
+
 /// One measured configuration.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
@@ -85,15 +99,15 @@ impl Row {
     }
 }
 
-/// The figure's panels: the whole image, and with PSNR and more than one specular object,
-/// one panel per object (its rows' PSNR and RMSE those of its pixels; FLIP is per image only).
+/// The figure's panels: the whole image, and with PSNR, one panel per specular object (its
+/// rows' PSNR and RMSE those of its pixels; FLIP is per image only): where the method acts.
 pub fn region_panels(rows: &[Row], metric: Metric) -> Vec<Panel> {
     let mut panels = vec![Panel { name: "whole image".into(), rows: rows.to_vec() }];
     let objects: Vec<String> = rows
         .first()
         .map(|r| r.regions.iter().map(|e| e.name.clone()).filter(|n| n != "specular" && n != "non-specular").collect())
         .unwrap_or_default();
-    if metric != Metric::Psnr || objects.len() < 2 {
+    if metric != Metric::Psnr || objects.is_empty() {
         return panels;
     }
     for name in objects {
@@ -320,10 +334,11 @@ const TITLE_H: u32 = 48;
 /// The trade-off figure, `stem`.svg and `stem`.png (the same drawing through plotters' SVG
 /// and bitmap backends): one panel per entry of `panels` (two columns), each the metric
 /// against frame GPU time on a log axis, both ranges from the data with a margin; one
-/// curve per method (its points in time order, a colour and marker of its own, named in
-/// the legend beside the panels), each point labelled with its knob values (a method's
-/// only point with the method's name) where there is room (Pareto points first; far
-/// labels get a leader line), the Pareto front as a step line through ringed points.
+/// curve per method (its points in time order, or in the sweep's order where its rows vary
+/// one knob; a colour and marker of its own, named in the legend beside the panels), each
+/// point labelled with its knob values (a method's only point with the method's name) where
+/// there is room (Pareto points first; far labels get a leader line), the Pareto front as a
+/// step line through ringed points.
 pub fn plot(stem: &Path, panels: &[Panel], metric: Metric, title: &str) -> Result<Figure> {
     use plotters::prelude::*;
     if panels.is_empty() {
@@ -496,7 +511,14 @@ fn draw_figure<DB: plotters::prelude::DrawingBackend>(
     for (panel, area) in panels.iter().zip(plots.split_evenly((grid, cols))) {
         draw_panel(root, &area, panel, metric, &methods, &mut omitted)?;
     }
-    let knobs = panels.iter().flat_map(|p| &p.rows).find_map(|r| knob_names(&r.knobs));
+    // Every set of knob names the labels use (one per sweep with `--each`).
+    let mut sets: Vec<String> = Vec::new();
+    for k in panels.iter().flat_map(|p| &p.rows).filter_map(|r| knob_names(&r.knobs)) {
+        if !sets.contains(&k) {
+            sets.push(k);
+        }
+    }
+    let knobs = (!sets.is_empty()).then(|| sets.join("; "));
     draw_legend(&legend, &methods, metric, knobs.as_deref(), &omitted)
 }
 
@@ -583,10 +605,15 @@ fn draw_panel<DB: plotters::prelude::DrawingBackend>(
     }
     root.draw(&PathElement::new(step, RGBAColor(0, 0, 0, 0.45).stroke_width(3))).map_err(|x| e(&x))?;
 
-    // One curve per method through its points in time order.
-    for k in 0..methods.len() {
+    // One curve per method through its points in time order; a curve of one knob's sweep
+    // (`--each`) through its points in the sweep's order, so that noisy times do not fold it.
+    for (k, method) in methods.iter().enumerate() {
         let mut idx: Vec<usize> = (0..pts.len()).filter(|&i| pts[i].0 == k).collect();
-        idx.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
+        let names: Vec<Option<String>> = panel.rows.iter().filter(|r| r.method == *method).map(|r| knob_names(&r.knobs)).collect();
+        let one_knob = names.first().is_some_and(|n| n.as_ref().is_some_and(|n| !n.contains(" / ")) && names.iter().all(|m| m == n));
+        if !one_knob {
+            idx.sort_by(|&a, &b| pts[a].1.total_cmp(&pts[b].1));
+        }
         if idx.len() > 1 {
             let c = colour(k);
             let line = RGBAColor(c.0, c.1, c.2, 0.7).stroke_width(2);
@@ -777,8 +804,11 @@ pub struct Config {
     pub scene_name: String,
     /// Base knobs of every variant; `spp` and `depth` also set the reference's.
     pub quality: Quality,
-    /// The combinations multiply (see [`variants`]).
+    /// The combinations multiply (see [`variants`]), unless `each`.
     pub sweeps: Vec<Sweep>,
+    /// One sweep at a time from `quality` (see [`series`]): each method gets one curve
+    /// per sweep, its rows' method `METHOD (KNOB)`.
+    pub each: bool,
     /// The choices to measure (GPU methods or `auto`); empty: `auto` and every GPU method
     /// of the registry. The reference is not one.
     pub methods: Vec<Choice>,
@@ -835,7 +865,7 @@ pub struct Report {
 /// `tradeoff.csv` and the figure (`tradeoff.svg`, `tradeoff.png`, see [`plot`]) into
 /// `cfg.out`.
 pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
-    let variants = variants(&cfg.quality, &cfg.sweeps)?;
+    let series = series(&cfg.quality, &cfg.sweeps, cfg.each)?;
     let methods: Vec<Choice> = if cfg.methods.is_empty() {
         std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method)).collect()
     } else {
@@ -848,7 +878,24 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let (w, h) = cfg.size;
 
-    progress(Progress::Start { steps: (1 + methods.len() * variants.len()) as u64 });
+    // One sweep at a time: a method gets the series of the knobs it reads, or its
+    // defaults alone when it reads none of them.
+    let defaults = vec![(None, variants(&cfg.quality, &[])?)];
+    let of = |m: &Choice| -> &Vec<Series> {
+        match m {
+            Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| m.knobs.contains(&k.as_str()))) => {
+                &defaults
+            }
+            _ => &series,
+        }
+    };
+    let reads = |m: &Choice, knob: &Option<String>| match (m, knob) {
+        (Choice::Method(m), Some(k)) => m.knobs.contains(&k.as_str()),
+        _ => true,
+    };
+    let runs: Vec<(Choice, &Series)> = methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
+    let steps: usize = runs.iter().map(|(_, (_, v))| v.len()).sum();
+    progress(Progress::Start { steps: (1 + steps) as u64 });
     progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.spp, cfg.quality.depth)));
     let t = std::time::Instant::now();
     let reference = crate::reference::render_reference(&cfg.scene, &cfg.quality, (w, h))?;
@@ -865,7 +912,8 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let mut rows = Vec::new();
     // With --calibrate: per row its knobs and plan (which passes serve which object).
     let mut plans: Vec<(String, crate::plan::Plan)> = Vec::new();
-    for &method in &methods {
+    for (method, (knob, variants)) in runs {
+        let name = knob.as_ref().map_or_else(|| method.name().to_string(), |k| format!("{} ({k})", method.name()));
         // A ray tracer in the original geometry (survey §2) makes no maps and no shadow
         // maps: only the knobs it lists change its image, so variants that agree on those
         // are measured once and reported for each (the sweeps are usually map knobs).
@@ -874,8 +922,8 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             _ => None,
         };
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
-        for (label, q) in &variants {
-            progress(Progress::Begin(format!("{} {label}", method.name())));
+        for (label, q) in variants {
+            progress(Progress::Begin(format!("{name} {label}")));
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {
@@ -891,7 +939,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             let (_, frame, errors, regions) = &measured[i];
             let stem = format!("{}-{}", method.name(), label.replace([' ', '=', ',', ';', '/'], "_"));
             frame.image.write_png_srgb(&out.join(format!("{stem}.png")))?;
-            let mut row = Row::new(method.name(), label, &frame.passes, *errors);
+            let mut row = Row::new(&name, label, &frame.passes, *errors);
             row.regions = regions.clone();
             rows.push(row);
             if cfg.calibrate.is_some() {
@@ -941,6 +989,21 @@ mod tests {
 
     fn errors(flip: f64) -> ImageErrors {
         ImageErrors { rmse: flip, psnr: 1.0, max_abs: flip, p99_abs: flip, flip }
+    }
+
+    #[test]
+    fn each_sweep_is_a_series_of_its_own() {
+        let s = [Sweep::parse("secant_steps=0,1").unwrap(), Sweep::parse("linear_steps=4,8,16").unwrap()];
+        let base = Quality { linear_steps: 4, secant_steps: 0, ..Quality::default() };
+        let v = series(&base, &s, true).unwrap();
+        assert_eq!(v.len(), 2);
+        assert_eq!(v[0].0.as_deref(), Some("secant_steps"));
+        assert_eq!(v[1].1.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>(), ["linear_steps=4", "linear_steps=8", "linear_steps=16"]);
+        // The other knobs stay at the base.
+        assert!(v[0].1.iter().all(|(_, q)| q.linear_steps == 4) && v[1].1.iter().all(|(_, q)| q.secant_steps == 0));
+        assert_eq!(v[0].1[1].1.secant_steps, 1);
+        let product = series(&base, &s, false).unwrap();
+        assert_eq!((product.len(), product[0].0.clone(), product[0].1.len()), (1, None, 6));
     }
 
     #[test]

@@ -29,6 +29,7 @@ fn calibrate(name: &str, scene: &Scene, methods: &[Method], sweep: &str) -> (Vec
         scene_name: name.into(),
         quality: quality(),
         sweeps: vec![Sweep::parse(sweep).unwrap()],
+        each: false,
         methods: methods.iter().map(|&m| m.into()).collect(),
         size: SIZE,
         warmup: 1,

@@ -378,6 +378,7 @@ fn tradeoff_sweeps_the_geometry_image_and_the_tessellation() {
             specula::tradeoff::Sweep::parse("geometry_image=32,128").unwrap(),
             specula::tradeoff::Sweep::parse("tessellation=1,4").unwrap(),
         ],
+        each: false,
         methods: vec![specula::methods::CURVED_REFLECTOR.into()],
         size: SIZE,
         warmup: 1,

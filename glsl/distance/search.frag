@@ -17,6 +17,8 @@ void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+    // The test knob debug_fault=flip_reflection: a deliberately broken reflection.
+    if ((push.flags & FLAG_DEBUG_FLIP_REFLECTION) != 0u) s.r = -s.r;
     vec3 c = s.fr * traced_radiance(o, in_position, s.r);
     if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * traced_radiance(o, in_position, s.t);
     out_color = vec4(c, 1.0);

@@ -342,6 +342,10 @@ gpu_consts! {
     /// `Push.flags` (`shadows=off`): punctual lights reach every diffuse surface facing them
     /// unoccluded (no shadow maps are planned; ray tracers send no shadow rays).
     FLAG_UNSHADOWED: uint = 8192;
+    /// `Push.flags` of `distance.search` only (`debug_fault=flip_reflection`, a test knob):
+    /// the reflected ray is traced in the opposite direction. Never in the frame-wide flags
+    /// (bits 8–15 of the photon pass's flags are its cube index).
+    FLAG_DEBUG_FLIP_REFLECTION: uint = 16384;
 
     /// Curved reflectors (§5): `Push.flags >> CURVED_REFLECTOR_SHIFT` is the reflector's layer
     /// in the geometry and virtual images (the `geometry.curved` and `geometry.virtual` draws).

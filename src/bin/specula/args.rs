@@ -12,7 +12,8 @@ use specula::{Choice, Method, Quality, Scene};
 
 #[derive(clap::Args, Clone)]
 pub struct RenderArgs {
-    /// glTF 2.0 scene (.gltf or .glb).
+    /// glTF 2.0 scene (.gltf or .glb), or builtin:NAME (corner-mirror, concave-occluder,
+    /// glass-1.1, glass-1.5, flat-glass).
     pub scene: PathBuf,
     /// Rendering method of every specular object, or `auto`: the planner picks one per
     /// object (`specula knobs` lists methods and knobs).
@@ -59,7 +60,8 @@ pub struct RenderArgs {
 
 #[derive(clap::Args, Clone)]
 pub struct TradeoffArgs {
-    /// glTF 2.0 scene (.gltf or .glb).
+    /// glTF 2.0 scene (.gltf or .glb), or builtin:NAME (corner-mirror, concave-occluder,
+    /// glass-1.1, glass-1.5, flat-glass).
     pub scene: PathBuf,
     /// Output size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
@@ -154,9 +156,25 @@ pub fn parse_object(s: &str) -> specula::Result<(String, Method)> {
     Ok((n.trim().to_string(), m))
 }
 
+/// Loads a glTF file, or with `builtin:NAME` one of the scenes built in code
+/// (`specula::scenes::builtin`); an unknown builtin name is an error that lists the names.
+pub fn load_scene(path: &Path) -> specula::Result<Scene> {
+    let Some(name) = path.to_str().and_then(|p| p.strip_prefix("builtin:")) else { return scene::load(path) };
+    specula::scenes::builtin(name).unwrap_or_else(|| {
+        Err(specula::Error::invalid(
+            "scene",
+            format!(
+                "'builtin:{}' names no built-in scene (known: {})",
+                specula::error::clip(name),
+                specula::scenes::BUILTIN.iter().map(|n| format!("builtin:{n}")).collect::<Vec<_>>().join(", ")
+            ),
+        ))
+    })
+}
+
 /// Loads a scene that has something to render; otherwise says what it lacks and where.
 pub fn load_renderable(path: &Path) -> specula::Result<Scene> {
-    let scene = scene::load(path)?;
+    let scene = load_scene(path)?;
     renderable(path, &scene)?;
     Ok(scene)
 }

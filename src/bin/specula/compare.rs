@@ -30,7 +30,7 @@ pub fn run(
     println!("mean FLIP {:.6}", e.flip);
     let mut keep: Option<Vec<bool>> = None;
     if let Some(path) = scene_path {
-        let s = scene::load(path)?;
+        let s = crate::args::load_scene(path)?;
         let ids = specula::reference::object_ids(&s, (t.width, t.height))?;
         let specular: Vec<bool> = s.meshes.iter().map(|m| s.materials[m.material].kind.is_specular()).collect();
         let names: Vec<String> = s.meshes.iter().map(|m| m.name.clone()).collect();

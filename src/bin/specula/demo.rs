@@ -83,6 +83,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     let title = format!("specula demo at {w}x{h} on {}: PSNR vs GPU time", ctx.device_name);
     let fig = specula::tradeoff::plot(&outdir.join("tradeoff"), &panels, Metric::Psnr, &title)?;
     report += &format!("trade-off figure: {}, {}\n", fig.svg.display(), fig.png.display());
+    report += &showcase(&outdir.join("showcase"), (w, h), validate, device)?;
     print!("{report}");
     let table = outdir.join("timings.txt");
     specula::output::write_file(&table, report.as_bytes())?;
@@ -158,6 +159,118 @@ fn flat_glass(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: 
         let views = frame.stats.iter().find(|(n, _)| n == "geometry.mirror_views").map_or(0.0, |(_, v)| *v);
         report += &format!("-- {name} (mirror_budget {budget}): {:.2} ms, {views} view(s), {e}\n", frame.gpu_ms());
         report += &specula::profile::table(&frame.passes, &frame.memory);
+    }
+    Ok(report)
+}
+
+/// One showcase study (issue 15): a scene built in code, the methods of its family, the
+/// base knobs and the sweeps, each varied alone from the base (`specula tradeoff --each`).
+pub struct Study {
+    pub scene: &'static str,
+    pub methods: &'static [&'static str],
+    pub base: &'static [&'static str],
+    pub sweeps: &'static [&'static str],
+}
+
+/// The studies `specula demo` writes to out/showcase/NAME/. The reference takes one sample
+/// per pixel, as the GPU frames do, so that a curve shows the method's error, not the
+/// aliasing all of them share; bvh (exact) is each figure's anchor. Where the sweeps are
+/// search knobs, the maps are built once (`map_updates=on_change`: a static scene's steady
+/// state), so that the time axis shows what the search costs per frame; the concave
+/// occluder compares methods whose maps differ (a layered map peels `layers` layers), so
+/// its frames rebuild them.
+pub const STUDIES: &[Study] = &[
+    Study {
+        scene: "corner-mirror",
+        methods: &["distance", "bvh"],
+        base: &["spp=1", "map_updates=on_change", "linear_steps=4", "secant_steps=0"],
+        sweeps: &["secant_steps=0,1,2,4,8", "linear_steps=4,8,16,32"],
+    },
+    Study {
+        scene: "concave-occluder",
+        methods: &["distance", "distance-multi", "layered", "bvh"],
+        base: &["spp=1"],
+        sweeps: &["linear_steps=4,16,64", "layers=1,2,4"],
+    },
+    Study {
+        scene: "glass-1.1",
+        methods: &["refractor-map", "image-space-refraction", "bvh"],
+        base: &["spp=1", "map_updates=on_change"],
+        sweeps: &["internal_bounces=0,1,2,4", "linear_steps=4,8,16,32"],
+    },
+    Study {
+        scene: "glass-1.5",
+        methods: &["refractor-map", "image-space-refraction", "bvh"],
+        base: &["spp=1", "map_updates=on_change"],
+        sweeps: &["internal_bounces=0,1,2,4", "linear_steps=4,8,16,32"],
+    },
+];
+
+/// The frames per configuration of the showcase studies: (warm-up, timed).
+const STUDY_FRAMES: (u32, u32) = (1, 5);
+
+impl Study {
+    /// The `specula tradeoff` command that runs this study alone.
+    pub fn command(&self, (w, h): (u32, u32), out: &Path) -> String {
+        let mut c =
+            format!("specula tradeoff builtin:{} --size {w}x{h} --warmup {} --frames {}", self.scene, STUDY_FRAMES.0, STUDY_FRAMES.1);
+        for m in self.methods {
+            c += &format!(" --method {m}");
+        }
+        for q in self.base {
+            c += &format!(" -q {q}");
+        }
+        for s in self.sweeps {
+            c += &format!(" --sweep {s}");
+        }
+        c + &format!(" --each --out {}", out.display())
+    }
+}
+
+/// The showcase studies at the demo's size, at most 128 pixels a side: each scene's
+/// tradeoff.csv, .svg and .png in `outdir`/NAME/; the report names them with the command
+/// that runs each alone.
+fn showcase(outdir: &Path, (w, h): (u32, u32), validate: bool, device: &Option<String>) -> specula::Result<String> {
+    let size = (w.min(128), h.min(128));
+    let mut report = format!("\n== showcase studies (issue 15) at {}x{}\n", size.0, size.1);
+    for study in STUDIES {
+        let out = outdir.join(study.scene);
+        let scene = specula::scenes::builtin(study.scene).expect("a built-in scene")?;
+        let mut quality = Quality { map_updates_always: true, ..Quality::default() };
+        for q in study.base {
+            quality.set_pair(q)?;
+        }
+        let cfg = specula::tradeoff::Config {
+            scene,
+            scene_name: format!("builtin:{}", study.scene),
+            quality,
+            sweeps: study.sweeps.iter().map(|s| specula::tradeoff::Sweep::parse(s)).collect::<specula::Result<_>>()?,
+            each: true,
+            methods: study.methods.iter().map(|m| Choice::parse(m)).collect::<specula::Result<_>>()?,
+            size,
+            warmup: STUDY_FRAMES.0,
+            frames: STUDY_FRAMES.1,
+            device: specula::vk::DeviceOptions { validation: validate, device_filter: device.clone() },
+            out: out.clone(),
+            metric: Metric::Psnr,
+            calibrate: None,
+        };
+        let t = std::time::Instant::now();
+        let r = specula::tradeoff::run(&cfg, &mut |_| {})?;
+        report += &format!(
+            "-- {} ({:.1} s): {}\n   {}\n",
+            study.scene,
+            t.elapsed().as_secs_f64(),
+            r.figure.png.display(),
+            study.command(size, &out)
+        );
+        for row in &r.rows {
+            let ball = row.regions.iter().find(|e| e.name == "specular").map_or(f64::NAN, |e| e.psnr);
+            report += &format!(
+                "   {:<36} {:<22} {:>9.2} ms {:>7.2} dB (specular pixels {ball:.2} dB)\n",
+                row.method, row.knobs, row.frame_ms, row.errors.psnr
+            );
+        }
     }
     Ok(report)
 }

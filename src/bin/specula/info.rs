@@ -8,7 +8,7 @@ use specula::Scene;
 /// Prints what the scene holds; a scene with nothing to render is the same one-line error
 /// as `render` gives (after the listing), exit 1.
 pub fn run(path: &Path) -> specula::Result<()> {
-    let s = scene::load(path)?;
+    let s = crate::args::load_scene(path)?;
     print!("{}", info(&s));
     for note in &s.skipped {
         println!("skipped: {note}");

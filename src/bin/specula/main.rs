@@ -94,6 +94,10 @@ enum Command {
         /// knob=v1,v2,... (repeatable: the combinations multiply); ref_point values split on ';'.
         #[arg(long)]
         sweep: Vec<String>,
+        /// Vary one --sweep at a time from the base knobs (-q), each its own curve per
+        /// method, named METHOD (KNOB), instead of every combination.
+        #[arg(long)]
+        each: bool,
         /// Only these methods (repeatable); default every GPU method.
         #[arg(long = "method")]
         methods: Vec<String>,
@@ -248,9 +252,9 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())
         }
-        Command::Tradeoff { args, sweep, methods, out, calibrate, models } => {
+        Command::Tradeoff { args, sweep, each, methods, out, calibrate, models } => {
             let models = calibrate.then(|| models.unwrap_or_else(|| budget::default_models_path(&args.scene)));
-            tradeoff::run(&args, &sweep, &methods, &out, models.as_deref())
+            tradeoff::run(&args, &sweep, each, &methods, &out, models.as_deref())
         }
     }
 }

@@ -11,7 +11,7 @@ use crate::args::{prepare, reference_summary, RenderArgs, TradeoffArgs};
 
 /// The reference once, then every GPU method × every sweep variant, timed and compared;
 /// CSV, the figure (SVG and PNG) and the images into `out`.
-pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path, calibrate: Option<&Path>) -> specula::Result<()> {
+pub fn run(a: &TradeoffArgs, sweeps: &[String], each: bool, only: &[String], out: &Path, calibrate: Option<&Path>) -> specula::Result<()> {
     let render_args = RenderArgs {
         scene: a.scene.clone(),
         method: "auto".into(),
@@ -39,6 +39,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path, cal
         scene_name: a.scene.file_name().unwrap_or_default().to_string_lossy().into_owned(),
         quality: job.quality,
         sweeps,
+        each,
         methods,
         size: (w, h),
         warmup: a.warmup,
@@ -85,11 +86,12 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], only: &[String], out: &Path, cal
         a.warmup.max(1)
     );
     println!("{}", reference_summary(&quality, w, h, report.reference_ms));
-    println!("\n{:<10} {:<40} {:>10} {:>10} {:>9} {:>9} {:>9}", "method", "knobs", "frame ms", "RMSE", "PSNR dB", "FLIP", "p99");
+    let width = report.rows.iter().map(|r| r.method.len()).max().unwrap_or(0).max(10);
+    println!("\n{:<width$} {:<40} {:>10} {:>10} {:>9} {:>9} {:>9}", "method", "knobs", "frame ms", "RMSE", "PSNR dB", "FLIP", "p99");
     for r in &report.rows {
         let e = &r.errors;
         println!(
-            "{:<10} {:<40} {:>10.3} {:>10.5} {:>9.2} {:>9.5} {:>9.5}",
+            "{:<width$} {:<40} {:>10.3} {:>10.5} {:>9.2} {:>9.5} {:>9.5}",
             r.method, r.knobs, r.frame_ms, e.rmse, e.psnr, e.flip, e.p99_abs
         );
     }
