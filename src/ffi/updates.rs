@@ -3,7 +3,6 @@
 //! refuses, and needs no idle GPU: a configured renderer takes the change in place and the
 //! next recorded frame uploads it (and regenerates only the maps that depend on it).
 
-
 use glam::Mat4;
 
 use super::handle::{fail, fixed_str, header, list_args, with_ctx, write_list, FfiResult, SpeculaContext};
