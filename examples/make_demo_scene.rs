@@ -347,7 +347,7 @@ fn main() {
     let occluder = nodes.len() - 1;
 
     nodes.push(json!({
-        "name": "light", "translation": [0.0, 2.6, 0.3],
+        "name": "light", "translation": [0.0, 1.6, 0.0],
         "extensions": { "KHR_lights_punctual": { "light": 0 } }
     }));
     let light = nodes.len() - 1;
@@ -379,11 +379,16 @@ fn main() {
     scene_nodes.extend(glass);
     scene_nodes.extend(panels);
     scene_nodes.extend([occluder, light, camera]);
+    // 6.5 candela at 1.6 m, the room's middle: no diffuse texel can exceed radiance 1 in any
+    // view (I · albedo / (π d²) ≤ 0.95: the ceiling's brightest texel 1.4 m above the light
+    // bounds it, the box's top 1.1 m below next), so a PNG clips nothing but a caustic's
+    // focus (issue 15; 25 cd at 2.6 m clipped the box, the near walls and, reflected in the
+    // mirror, the ceiling above the light at radiance 11). tests/showcase.rs checks it.
     let doc = json!({
         "asset": { "version": "2.0", "generator": "specula examples/make_demo_scene.rs" },
         "extensionsUsed": ["KHR_lights_punctual", "KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"],
         "extensions": {
-            "KHR_lights_punctual": { "lights": [{ "name": "light", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 25.0 }] }
+            "KHR_lights_punctual": { "lights": [{ "name": "light", "type": "point", "color": [1.0, 1.0, 1.0], "intensity": 6.5 }] }
         },
         "scene": 0,
         "scenes": [{ "name": stem, "nodes": scene_nodes }],
