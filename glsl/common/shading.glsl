@@ -46,7 +46,7 @@ float light_visibility(Light l, vec3 p, vec3 n) {
     vec3 q = p + n * (dist * texel * 1.5);  // normal offset grows with distance
     vec3 dq = q - l.position_range.xyz;
     float stored = textureLod(shadow_cubes, vec4(dq, layer), 0.0).r;
-    return length(dq) <= stored * (1.0 + 2.0 * texel) + 1e-4 ? 1.0 : 0.0;
+    return length(dq) <= stored * (1.0 + 2.0 * texel) ? 1.0 : 0.0;  // relative only: scale-free
 }
 
 // Irradiance E of light l at p on a surface facing it (range window, spot cone), the unit
