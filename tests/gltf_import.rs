@@ -902,7 +902,7 @@ fn demo_scene_loads_with_expected_classification() {
 
     let light = &s.lights[0];
     assert_eq!((s.lights.len(), light.kind), (1, LightKind::Point));
-    assert!(close(light.position, Vec3::new(0.0, 2.6, 0.3)) && close(light.intensity, Vec3::splat(25.0)));
+    assert!(close(light.position, Vec3::new(0.0, 1.6, 0.0)) && close(light.intensity, Vec3::splat(6.5)));
     let c = s.camera.expect("demo camera");
     assert!(close(c.position, Vec3::new(1.6, 1.6, 1.9)));
     assert!((c.yfov - 60f32.to_radians()).abs() < 1e-5);

@@ -64,11 +64,16 @@ fn errors_split_by_object() {
     let get = |k: usize, name: &str| split[k].iter().find(|e| e.name == name).unwrap_or_else(|| panic!("{name}")).psnr;
     assert!(split[0].len() >= 4, "two spheres, the specular pixels, the rest: {:?}", split[0]);
     assert_eq!(get(0, "non-specular"), get(1, "non-specular"), "the rest does not depend on the specular method");
-    let (envmap, distance) = (get(0, "specular"), get(1, "specular"));
-    println!("specular pixels: envmap {envmap:.2} dB, distance {distance:.2} dB");
-    // Measured 9.53 vs 8.95 dB (the mirror's reflection of the blown-out light dominates
-    // both: issue 15's shared term): the 0.58 dB margin asserted at half (rule 1).
-    assert!(distance >= envmap + 0.29, "{distance:.2} vs {envmap:.2}");
+    // On the mirror sphere, where parallax is the whole difference: measured 24.75 dB with
+    // distance maps vs 23.55 dB with the environment map (the demo's 6.5 cd light, 72×54;
+    // both far under the exact ray tracer's 24.35 dB-at-1-spp ceiling set by aliasing
+    // against the 16-spp reference), the 1.20 dB margin asserted at half (rule 1). The glass
+    // sphere is not compared: both methods refract once and ignore the exit (refractor-map
+    // is the method for solid glass), so neither is nearer by design (measured 29.50 dB
+    // envmap, 28.40 dB distance).
+    let (envmap, distance) = (get(0, "mirror_sphere/0"), get(1, "mirror_sphere/0"));
+    println!("mirror sphere: envmap {envmap:.2} dB, distance {distance:.2} dB");
+    assert!(distance >= envmap + 0.60, "{distance:.2} vs {envmap:.2}");
     // The masks partition the image: the objects' pixels add up to the specular ones.
     let count = |name: &str| split[0].iter().find(|e| e.name == name).unwrap().pixels;
     let objects: usize = split[0].iter().filter(|e| e.name != "specular" && e.name != "non-specular").map(|e| e.pixels).sum();
@@ -149,12 +154,13 @@ fn shadows_off_removes_the_shared_shadow_term() {
             rest.push(non);
         }
     }
-    // Measured (one sample per pixel in both): distance 30.73 dB on the non-specular pixels
-    // with shadow maps against exact shadows, 66.25 dB with shadows off in both (bvh, exact
-    // shadow rays: 66.56 and 66.25 dB). Floors 1 dB under; the 35.52 dB gain 1 dB under.
+    // Measured (one sample per pixel in both, the demo's 6.5 cd light): distance 40.40 dB on
+    // the non-specular pixels with shadow maps against exact shadows, 73.78 dB with shadows
+    // off in both (bvh, exact shadow rays: 74.21 and 73.78 dB). Floors 1 dB under; the
+    // 33.38 dB gain 1 dB under.
     let (on_distance, on_bvh, off_distance, off_bvh) = (rest[0], rest[1], rest[2], rest[3]);
     assert!(on_bvh >= 60.0 && off_bvh >= 60.0, "bvh {on_bvh:.2} / {off_bvh:.2} dB");
-    assert!(off_distance >= 65.25 && off_distance >= on_distance + 34.52, "distance {on_distance:.2} → {off_distance:.2} dB");
+    assert!(off_distance >= 72.78 && off_distance >= on_distance + 32.38, "distance {on_distance:.2} → {off_distance:.2} dB");
     common::assert_clean(&ctx);
 }
 
@@ -184,10 +190,11 @@ fn shadows_off_keeps_the_caustics() {
     let energy: f64 = term[0].data.iter().map(|x| *x as f64).sum();
     let max = term[0].data.iter().zip(&term[1].data).map(|(a, b)| (a - b).abs()).fold(0f32, f32::max);
     println!("caustics' sum {energy:.3}; largest difference between the two {max:e}");
-    // Measured (72x54): the caustic term sums to 34.28 and differs between the two by at
-    // most 3.7e-5 (the rounding of the sums it is the difference of; bound 1e-4); with the
-    // photon pass's cube index off by 32 it differed by up to 2.36.
-    assert!(energy > 30.0, "the demo has caustics: {energy}");
-    assert!(max <= 1e-4, "{max:e}");
+    // Measured (72x54, the demo's 6.5 cd light): the caustic term sums to 68.07 and differs
+    // between the two by at most 3.0e-4 (the rounding of the sums it is the difference of;
+    // bound 1e-3); with the photon pass's cube index off by 32 it differed by up to 2.36
+    // (at the old 25 cd light, where the term summed to 34.28).
+    assert!(energy > 60.0, "the demo has caustics: {energy}");
+    assert!(max <= 1e-3, "{max:e}");
     common::assert_clean(&ctx);
 }

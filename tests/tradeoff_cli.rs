@@ -122,12 +122,15 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
     }
     let row = |m: &str, knobs: &str| metrics[&(m.to_string(), knobs.to_string())].clone();
     // The exact ray tracers agree with each other and ignore the cube-map knobs: the same
-    // printed metrics in every row (measured 32.371 dB against the reference; its floor 1 dB
+    // printed metrics in every row (measured 23.421 dB against the reference; its floor 1 dB
     // under, rule 1: caustics are on, and every method takes them from the same approximate
-    // light cube maps, tests/raytrace.rs).
+    // light cube maps, tests/raytrace.rs. With the demo's 6.5 cd light at the room's middle
+    // the glass ball's caustic on the floor peaks at radiance 3.5 in the reference and 6.3
+    // here at 32², which decides the figure; 32.371 dB at the old light, 73.69 dB with
+    // caustics off).
     let traced = row("bvh", "cube_size=16 cube_precision=half");
     eprintln!("ray tracers: RMSE {}, {} dB, mean FLIP {}", traced.0, traced.1, traced.2);
-    assert!(traced.1 >= 31.37, "bvh {} dB against the reference", traced.1);
+    assert!(traced.1 >= 22.42, "bvh {} dB against the reference", traced.1);
     for m in ["bvh", "kd-tree", "grid", "ray-engine", "ray-hierarchy"] {
         for knobs in [
             "cube_size=16 cube_precision=half",
