@@ -1002,13 +1002,15 @@ fn object_table(scene: &Scene, plan: &Plan) -> Vec<GpuObject> {
             refractor_layer: -1,
             map_shading: MAP_SHADING_SKY,
             reference_point: [0.0; 4],
+            map_centre: [0.0; 4],
             proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
             proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
         })
         .collect();
     for o in &plan.objects {
         let g = &mut objects[o.mesh];
-        g.reference_point = o.reference_point.extend(plan.proxy_radius).to_array();
+        g.reference_point = o.own_reference_point.extend(plan.proxy_radius).to_array();
+        g.map_centre = o.reference_point.extend(0.0).to_array();
         g.map_shading = o.map_shading.code();
         // The object's layer in each map array, by the slot the map fills.
         for m in &o.maps {

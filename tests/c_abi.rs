@@ -79,6 +79,18 @@ fn run(exe: &Path, args: &[&Path]) -> String {
     stdout.into_owned()
 }
 
+/// Two programs at once (the suite's binaries run one after another, so a second process
+/// is what keeps the second core busy); both must succeed.
+fn run_both(a: (&Path, &[&Path]), b: (&Path, &[&Path])) {
+    std::thread::scope(|s| {
+        let other = s.spawn(|| run(b.0, b.1));
+        run(a.0, a.1);
+        if let Err(e) = other.join() {
+            std::panic::resume_unwind(e);
+        }
+    });
+}
+
 /// Pixels of an RGBA32F image whose colour (not alpha, which is 1 everywhere) is lit.
 fn lit_pixels(rgba32f: &[u8]) -> usize {
     let channel = |p: &[u8], c: usize| f32::from_le_bytes([p[4 * c], p[4 * c + 1], p[4 * c + 2], p[4 * c + 3]]);
@@ -145,8 +157,8 @@ fn examples_render_the_same_image_through_every_link_mode() {
     for method in ["4", "5", "6", "7", "8", "9", "10", "11"] {
         let (a, b) = (dir.join(format!("m{method}_standalone.f32")), dir.join(format!("m{method}_host.f32")));
         let depth = Path::new(if matches!(method, "10" | "11") { "depth=3" } else { "depth=16" });
-        run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new(method), depth]);
-        run(&host, &[&scene, &b, Path::new(method), depth]);
+        let ppm = dir.join(format!("m{method}.ppm"));
+        run_both((&standalone, &[&scene, &ppm, &a, Path::new(method), depth]), (&host, &[&scene, &b, Path::new(method), depth]));
         let image = read_f32(&a);
         eprintln!("method {method}: {} lit pixels", lit_pixels(&image));
         assert!(lit_pixels(&image) >= LIT, "method {method}: {} lit pixels", lit_pixels(&image));
@@ -166,8 +178,11 @@ fn examples_render_the_same_image_through_every_link_mode() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && stderr.contains("knob aa") && stderr.contains("sampleRateShading"), "host with msaa4: {stderr}");
     let (a, b) = (dir.join("ssaa_standalone.f32"), dir.join("ssaa_host.f32"));
-    run(&standalone, &[&scene, &dir.join("m.ppm"), &a, Path::new("1"), Path::new("aa=ssaa2")]);
-    run(&host, &[&scene, &b, Path::new("1"), Path::new("aa=ssaa2")]);
+    let ppm = dir.join("ssaa.ppm");
+    run_both(
+        (&standalone, &[&scene, &ppm, &a, Path::new("1"), Path::new("aa=ssaa2")]),
+        (&host, &[&scene, &b, Path::new("1"), Path::new("aa=ssaa2")]),
+    );
     assert!(read_f32(&a) == read_f32(&b), "ssaa2: host-device image differs from standalone");
     std::fs::remove_dir_all(&dir).ok();
 }

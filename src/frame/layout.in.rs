@@ -60,6 +60,9 @@ gpu_structs! {
         /// proxy box (§3.2), world space
         proxy_min: vec4,
         proxy_max: vec4,
+        /// xyz: the centre of the map its own search reads: the reference point, or the
+        /// shared layered map's (§4.5) for an object that takes `layered`
+        map_centre: vec4,
     }
 
     /// std430 twin of `Light`.

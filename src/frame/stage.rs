@@ -269,6 +269,8 @@ pub struct ViewLayout {
     /// point, and the first photon view (one per photon image layer).
     pub caustic_cubes: Vec<u32>,
     pub photons: u32,
+    /// The first of the shared layered map's six views (§4.5), around `plan.layered_centre`.
+    pub layered: Option<u32>,
     pub count: u32,
 }
 

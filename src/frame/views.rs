@@ -28,6 +28,10 @@ impl ViewLayout {
             v.envmaps.push(v.count);
             v.count += 6;
         }
+        if plan.layered_centre.is_some() {
+            v.layered = Some(v.count);
+            v.count += 6;
+        }
         v.mirrors = v.count;
         v.count += plan.mirror_layers;
         if !plan.map_mirrors.is_empty() {
@@ -91,6 +95,11 @@ pub fn view_table(
         for f in 0..6 {
             views[(base + f) as usize] =
                 view(face_view_proj(f as usize, e.reference_point, near), e.reference_point.extend(0.0), Vec4::ZERO);
+        }
+    }
+    if let (Some(c), Some(base)) = (plan.layered_centre, layout.layered) {
+        for f in 0..6 {
+            views[(base + f) as usize] = view(face_view_proj(f as usize, c, near), c.extend(0.0), Vec4::ZERO);
         }
     }
     for (i, m) in mirrors.iter().enumerate() {

@@ -48,6 +48,11 @@ pub struct ObjectPlan {
     /// Why this method: the user's choice, the scene file's, or the planner's rule.
     pub reason: String,
     pub reference_point: Vec3,
+    /// The object's own reference point, before a shared map (layered, §4.5) moved
+    /// `reference_point` to the map's: its caustics' cube is centred here, where the
+    /// receiver map it searches does not have the object itself in front of the receivers.
+    #[serde(skip)]
+    pub own_reference_point: Vec3,
     /// Set when the automatic reference point had to move (or could not).
     pub reference_note: Option<String>,
     /// How the object appears in the other objects' distance maps.
@@ -142,8 +147,11 @@ pub struct Plan {
     pub shadow_planes: Vec<usize>,
     /// Every specular object, in mesh order.
     pub objects: Vec<ObjectPlan>,
-    /// The objects with cube maps around their reference points (their views).
+    /// The objects with cube maps around their own reference points (their views).
     pub envmaps: Vec<EnvmapPlan>,
+    /// The shared layered map's centre (§4.5), when an object takes `layered`: its six
+    /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
+    pub layered_centre: Option<Vec3>,
     /// What the renderer records, in order.
     pub stages: Vec<StageSpec>,
     /// The stages' names, in order: the stable profiler keys.
@@ -230,11 +238,13 @@ impl Plan {
         }
         for (o, f) in self.objects.iter_mut().zip(&fresh.objects) {
             o.reference_point = f.reference_point;
+            o.own_reference_point = f.own_reference_point;
             o.reference_note = f.reference_note.clone();
         }
         for (e, f) in self.envmaps.iter_mut().zip(&fresh.envmaps) {
             e.reference_point = f.reference_point;
         }
+        self.layered_centre = fresh.layered_centre;
         crate::methods::caustics::refresh(self);
         self.cube_near = fresh.cube_near;
         self.proxy_radius = fresh.proxy_radius;
@@ -295,6 +305,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         shadow_planes: Vec::new(),
         objects: Vec::new(),
         envmaps: Vec::new(),
+        layered_centre: None,
         stages: Vec::new(),
         passes: vec![REFERENCE_PASS],
         cube_near: 1e-4,
@@ -428,6 +439,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
             method,
             reason,
             reference_point: f.reference_point,
+            own_reference_point: f.reference_point,
             reference_note: f.reference_note.clone(),
             map_shading: MapShading::Sky,
             leaves_out: method.gpu.map_or(LeavesOut::Itself, |g| g.leaves_out),
@@ -443,6 +455,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
         shadow_planes: Vec::new(),
         objects,
         envmaps: Vec::new(),
+        layered_centre: None,
         stages: Vec::new(),
         passes: Vec::new(),
         cube_near,
@@ -592,7 +605,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     for o in &p.objects {
         let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.info.cube));
         if cube {
-            p.envmaps.push(EnvmapPlan { mesh: o.mesh, layer: p.envmaps.len() as u32, reference_point: o.reference_point });
+            p.envmaps.push(EnvmapPlan { mesh: o.mesh, layer: p.envmaps.len() as u32, reference_point: o.own_reference_point });
         }
     }
     for m in &mut maps {

@@ -177,7 +177,7 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
             layers += faces * branches;
         }
         if !lights.is_empty() {
-            generators.push(Generator { mesh: o.mesh, name: o.name.clone(), reference_point: o.reference_point, lights });
+            generators.push(Generator { mesh: o.mesh, name: o.name.clone(), reference_point: o.own_reference_point, lights });
         }
     }
     if generators.is_empty() {
@@ -285,7 +285,7 @@ fn light_views(lv: &LightViews, kind: LightKind, l: &GpuLight, n: f32, near_scal
 
 /// After objects moved: the generators' reference points follow their objects'.
 pub fn refresh(p: &mut Plan) {
-    let refs: Vec<(usize, Vec3)> = p.objects.iter().map(|o| (o.mesh, o.reference_point)).collect();
+    let refs: Vec<(usize, Vec3)> = p.objects.iter().map(|o| (o.mesh, o.own_reference_point)).collect();
     if let Some(c) = p.caustics.as_mut() {
         for g in &mut c.generators {
             if let Some((_, r)) = refs.iter().find(|(m, _)| *m == g.mesh) {

@@ -128,6 +128,7 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
         return;
     }
     let c = centre(scene, &p.quality, &meshes);
+    p.layered_centre = Some(c);
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
         o.reference_note = Some(if p.quality.ref_point.is_some() {

@@ -45,9 +45,6 @@ pub fn describe_layer(q: &Quality) -> String {
 const HALF_MATERIALS: usize = 2048;
 
 pub struct LayeredMaps {
-    /// The objects that take the method (they share the map; the first one's cube views
-    /// are the map's).
-    objects: Vec<usize>,
     layers: u32,
     /// The depth complexity counted (`layers=auto`), and whether the GPU counted it.
     measured: Option<(u32, bool)>,
@@ -59,9 +56,10 @@ pub struct LayeredMaps {
     mode: CubeMode,
 }
 
-pub fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+/// The objects that take the method share one map around `plan.layered_centre`, with its
+/// own six views (`ViewLayout::layered`); their own cube views serve their other maps.
+pub fn create(init: &StageInit, _objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
     let me = LayeredMaps {
-        objects: objects.to_vec(),
         layers: 0,
         measured: None,
         depth: Vec::new(),
@@ -75,7 +73,7 @@ pub fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Bo
 
 impl LayeredMaps {
     fn centre(&self, init: &StageInit) -> Vec3 {
-        self.objects.first().and_then(|&m| init.plan.object(m)).map_or(Vec3::ZERO, |o| o.reference_point)
+        init.plan.layered_centre.unwrap_or(Vec3::ZERO)
     }
 
     fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
@@ -296,7 +294,7 @@ impl Stage for LayeredMaps {
     /// depth buffer); six passes per layer, or one multiview pass.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let (Some(mut radiance), Some(mut normals)) = (io.maps.layered.take(), io.maps.layered_normals.take()) else { return };
-        let Some(view) = self.objects.first().and_then(|&m| io.views.cube_of(io.plan, m)) else {
+        let Some(view) = io.views.layered else {
             (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
             return;
         };
