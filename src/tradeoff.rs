@@ -916,14 +916,19 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         let name = knob.as_ref().map_or_else(|| method.name().to_string(), |k| format!("{} ({k})", method.name()));
         // A ray tracer in the original geometry (survey §2) makes no maps and no shadow
         // maps: only the knobs it lists change its image, so variants that agree on those
-        // are measured once and reported for each (the sweeps are usually map knobs).
-        let reads = match method {
+        // are measured once and reported for each (the sweeps are usually map knobs). Not
+        // when the frame has caustics (§6): they come from light cube maps, refractor maps
+        // and shadow maps whatever the method, so every map knob can change its image.
+        let raytrace = match method {
             Choice::Method(m) if m.family == "raytrace" => Some(m.knobs),
             _ => None,
         };
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
         for (label, q) in variants {
             progress(Progress::Begin(format!("{name} {label}")));
+            let caustics =
+                raytrace.is_some() && crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(method), q)?.caustics.is_some();
+            let reads = raytrace.filter(|_| !caustics);
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {
