@@ -47,10 +47,12 @@ pub fn flat_glass() -> Result<Scene> {
 }
 
 /// The names [`builtin`] knows, in the order `specula` lists them.
-pub const BUILTIN: &[&str] = &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass"];
+pub const BUILTIN: &[&str] =
+    &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball"];
 
 /// A scene built in code by its name (`builtin:NAME` on the command line): `corner-mirror`,
-/// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`; `None` for another name.
+/// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
+/// `caustic-ball`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
     Some(match name {
         "corner-mirror" => corner_mirror(),
@@ -58,6 +60,8 @@ pub fn builtin(name: &str) -> Option<Result<Scene>> {
         "glass-1.1" => glass_sphere(1.1),
         "glass-1.5" => glass_sphere(1.5),
         "flat-glass" => flat_glass(),
+        "convex-mirror" => convex_mirror(),
+        "caustic-ball" => caustic_ball(),
         _ => return None,
     })
 }
@@ -187,5 +191,45 @@ pub fn glass_sphere(ior: f32) -> Result<Scene> {
         s.add_material(Material { name: format!("glass{ior}"), kind: SurfaceKind::Dielectric { ior, thin: false }, ..Default::default() })?;
     s.add_mesh(shapes::uv_sphere("glass_ball", Vec3::new(0.0, -0.6, -0.4), 0.7, 64, 32, glass))?;
     s.camera = Some(Camera::look_at(Vec3::new(0.3, 0.2, 1.6), Vec3::new(0.0, -0.6, -0.4), 50f32.to_radians()));
+    Ok(s)
+}
+
+/// Curved reflectors by geometry transformation (survey §5.2, `curved-reflector`'s
+/// showcase): a mirror ball (F0 0.9) off the middle of the emissive checkerboard room,
+/// seen from close by, so that its reflection spans most of the room and each reflected
+/// checker edge shows where the geometry image's resolution, the search's levels and the
+/// environment's tessellation put it.
+pub fn convex_mirror() -> Result<Scene> {
+    let mut s = Scene::new();
+    checker_room(&mut s, ROOM_CENTER, ROOM_HALF)?;
+    let mirror = s.add_material(mirror_material("mirror", 0.9))?;
+    let c = Vec3::new(0.3, -0.8, -0.6);
+    s.add_mesh(shapes::uv_sphere("mirror_ball", c, 0.7, 64, 32, mirror))?;
+    s.camera = Some(Camera::look_at(Vec3::new(-0.4, 0.1, 1.3), c, 50f32.to_radians()));
+    Ok(s)
+}
+
+/// Caustics (survey §6's showcase): a solid glass ball (ν 1.5, radius 0.5 m) above a grey
+/// diffuse floor (albedo 0.7) under a point light (8 cd) 3 m up and to its side, no sky:
+/// the ball focuses the light into a bright spot on the floor beside its shadow. The floor
+/// lit directly stays under radiance 0.3, so only the caustic is bright: what the photon
+/// count, the light cube's filter and the splatting or triangle accumulation change shows
+/// there.
+pub fn caustic_ball() -> Result<Scene> {
+    let mut s = Scene::new();
+    let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::splat(0.7), ..Default::default() })?;
+    s.add_mesh(shapes::quad("floor", Vec3::new(-3.0, 0.0, 3.0), Vec3::new(6.0, 0.0, 0.0), Vec3::new(0.0, 0.0, -6.0), 16, floor))?;
+    let glass =
+        s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })?;
+    s.add_mesh(shapes::uv_sphere("glass_ball", Vec3::new(0.0, 0.5, 0.0), 0.5, 64, 32, glass))?;
+    s.add_light(crate::scene::Light {
+        name: "lamp".into(),
+        kind: crate::scene::LightKind::Point,
+        position: Vec3::new(1.2, 3.0, 0.0),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(8.0),
+        range: None,
+    })?;
+    s.camera = Some(Camera::look_at(Vec3::new(0.2, 2.0, 2.4), Vec3::new(-0.4, 0.2, 0.0), 45f32.to_radians()));
     Ok(s)
 }

@@ -879,18 +879,18 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let (w, h) = cfg.size;
 
     // One sweep at a time: a method gets the series of the knobs it reads, or its
-    // defaults alone when it reads none of them.
+    // defaults alone when it reads none of them. A knob no method lists is the frame's
+    // (shadow maps, caustics, anti-aliasing): every method reads it.
     let defaults = vec![(None, variants(&cfg.quality, &[])?)];
+    let method_reads = |m: &Method, k: &str| m.knobs.contains(&k) || !Method::ALL.iter().any(|o| o.knobs.contains(&k));
     let of = |m: &Choice| -> &Vec<Series> {
         match m {
-            Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| m.knobs.contains(&k.as_str()))) => {
-                &defaults
-            }
+            Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| method_reads(m, k))) => &defaults,
             _ => &series,
         }
     };
     let reads = |m: &Choice, knob: &Option<String>| match (m, knob) {
-        (Choice::Method(m), Some(k)) => m.knobs.contains(&k.as_str()),
+        (Choice::Method(m), Some(k)) => method_reads(m, k),
         _ => true,
     };
     let runs: Vec<(Choice, &Series)> = methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
@@ -920,7 +920,14 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         // when the frame has caustics (§6): they come from light cube maps, refractor maps
         // and shadow maps whatever the method, so every map knob can change its image.
         let raytrace = match method {
-            Choice::Method(m) if m.family == "raytrace" => Some(m.knobs),
+            // Its own knobs and the frame's (those no method lists: anti-aliasing, ...).
+            Choice::Method(m) if m.family == "raytrace" => Some(
+                crate::quality::KNOBS
+                    .iter()
+                    .map(|k| k.name)
+                    .filter(|k| m.knobs.contains(k) || !Method::ALL.iter().any(|o| o.knobs.contains(k)))
+                    .collect::<Vec<_>>(),
+            ),
             _ => None,
         };
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
@@ -928,7 +935,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
             progress(Progress::Begin(format!("{name} {label}")));
             let caustics =
                 raytrace.is_some() && crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(method), q)?.caustics.is_some();
-            let reads = raytrace.filter(|_| !caustics);
+            let reads = raytrace.as_ref().filter(|_| !caustics);
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {

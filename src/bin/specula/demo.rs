@@ -204,6 +204,24 @@ pub const STUDIES: &[Study] = &[
         base: &["spp=1", "map_updates=on_change"],
         sweeps: &["internal_bounces=0,1,2,4", "linear_steps=4,8,16,32"],
     },
+    Study {
+        scene: "flat-glass",
+        methods: &["planar-refraction", "refractor-map", "bvh"],
+        base: &["spp=1"],
+        sweeps: &["mirror_budget=2,4,8,16,32,64"],
+    },
+    Study {
+        scene: "convex-mirror",
+        methods: &["curved-reflector", "distance", "bvh"],
+        base: &["spp=1", "map_updates=on_change"],
+        sweeps: &["geometry_image=16,32,64,128", "curved_search=0,1,2,3", "tessellation=1,2,4,8"],
+    },
+    Study {
+        scene: "caustic-ball",
+        methods: &["refractor-map", "bvh"],
+        base: &["spp=1"],
+        sweeps: &["caustics=off,splat,triangles", "photons=32,64,128,256", "caustic_filter=0,1,2,4"],
+    },
 ];
 
 /// The frames per configuration of the showcase studies: (warm-up, timed).
