@@ -879,10 +879,20 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let (w, h) = cfg.size;
 
     // One sweep at a time: a method gets the series of the knobs it reads, or its
-    // defaults alone when it reads none of them. A knob no method lists is the frame's
-    // (shadow maps, caustics, anti-aliasing): every method reads it.
+    // defaults alone when it reads none of them. A knob no GPU method lists is the frame's
+    // (shadow maps, caustics, anti-aliasing): every method reads it, and so are the caustics
+    // stage's map knobs when the scene has caustics.
     let defaults = vec![(None, variants(&cfg.quality, &[])?)];
-    let method_reads = |m: &Method, k: &str| m.knobs.contains(&k) || !Method::ALL.iter().any(|o| o.knobs.contains(&k));
+    // With caustics (§6) the caustics stage's map knobs too, whatever the method.
+    // (Where auto cannot plan the scene, taken as having them: more rows measured, none
+    // copied wrongly.)
+    let caustics =
+        crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(Choice::Auto), &cfg.quality).map_or(true, |p| p.caustics.is_some());
+    let method_reads = |m: &Method, k: &str| {
+        m.knobs.contains(&k)
+            || !Method::ALL.iter().any(|o| o.is_gpu() && o.knobs.contains(&k))
+            || (caustics && crate::methods::caustics::MAP_KNOBS.contains(&k))
+    };
     let of = |m: &Choice| -> &Vec<Series> {
         match m {
             Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| method_reads(m, k))) => &defaults,
@@ -925,7 +935,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
                 crate::quality::KNOBS
                     .iter()
                     .map(|k| k.name)
-                    .filter(|k| m.knobs.contains(k) || !Method::ALL.iter().any(|o| o.knobs.contains(k)))
+                    .filter(|k| m.knobs.contains(k) || !Method::ALL.iter().any(|o| o.is_gpu() && o.knobs.contains(k)))
                     .collect::<Vec<_>>(),
             ),
             _ => None,

@@ -354,8 +354,7 @@ fn the_bundled_scenes_light_clips_no_surface() {
         let (bound, surface) = radiance_bound(&scene);
         eprintln!("{name}: diffuse radiance at most {bound:.3} ({surface})");
         assert!(bound <= 1.0, "{name}: '{surface}' can reach radiance {bound:.3}: a PNG clips it");
-        let mut q = Quality::default();
-        q.spp = 1;
+        let mut q = Quality { spp: 1, ..Quality::default() };
         q.set_pair("caustics=off").unwrap();
         let image = specula::reference::render_reference(&scene, &q, (48, 48)).unwrap();
         let max = image.data.chunks_exact(4).map(|p| p[0].max(p[1]).max(p[2])).fold(0.0f32, f32::max);
@@ -365,6 +364,7 @@ fn the_bundled_scenes_light_clips_no_surface() {
 }
 
 /// PSNR per region of `method` under `pairs` against `reference`, at `size`.
+#[allow(clippy::too_many_arguments)]
 fn regions(
     ctx: &specula::vk::Context,
     scene: &Scene,

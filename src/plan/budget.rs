@@ -766,7 +766,7 @@ pub fn choose(
     for (models, source) in sources {
         let Some(variants) = candidates(scene, &facts, choices, models, size) else { continue };
         // (variant, whole-scene method or None for mixed, picks, rank)
-        let mut best: Option<(usize, Option<Method>, f64, Vec<Candidate>, (bool, f64, f64))> = None;
+        let mut best: Option<Best> = None;
         for (k, v) in variants.iter().enumerate() {
             let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts: &facts };
             let idx = search(budget, &|p| timing.frame_ms(p, false), &v.per_object);
@@ -824,9 +824,16 @@ pub fn choose(
     Ok(None)
 }
 
-/// The prediction as a table, with what a frame measured beside it where given:
-/// per object (ms, PSNR) in the prediction's order, then the frame's (ms, specular PSNR).
-pub fn report(p: &Prediction, actual: Option<(&[(f64, Option<f64>)], (f64, Option<f64>))>) -> String {
+/// The best variant so far: (variant, whole-scene method or None for mixed, predicted ms,
+/// picks, rank).
+type Best = (usize, Option<Method>, f64, Vec<Candidate>, (bool, f64, f64));
+
+/// What a frame measured: per object (ms, PSNR) in the prediction's order, then the
+/// frame's (ms, specular PSNR).
+pub type FrameMeasured<'a> = (&'a [(f64, Option<f64>)], (f64, Option<f64>));
+
+/// The prediction as a table, with what a frame measured beside it where given.
+pub fn report(p: &Prediction, actual: Option<FrameMeasured>) -> String {
     use std::fmt::Write as _;
     let mut s = String::new();
     let _ = writeln!(

@@ -123,6 +123,22 @@ fn light_sees(kind: LightKind, position: Vec3, direction: Vec3, centre: Vec3, ra
     }
 }
 
+/// The map knobs the caustics stage reads whatever the frame's methods (its light and
+/// receiver cubes at `cube_size`, the refractor maps the photons exit through and their
+/// search, the shadow maps that occlude them, the Fresnel weights along a path): with
+/// caustics, every method's image depends on them.
+pub const MAP_KNOBS: &[&str] = &[
+    "cube_size",
+    "cube_precision",
+    "fresnel",
+    "shadow_size",
+    "linear_steps",
+    "secant_steps",
+    "binary_steps",
+    "search_tolerance",
+    "internal_bounces",
+];
+
 /// A mesh's bounding sphere: its box's centre, and the farthest vertex from it (tighter
 /// than the half diagonal: a sphere's photon cone then holds the sphere, not its box).
 pub fn bounding_sphere(scene: &Scene, mesh: usize) -> (Vec3, f32) {
