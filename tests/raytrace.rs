@@ -313,12 +313,16 @@ fn ray_statistics_count_rays_and_overflow() {
     eprintln!("hierarchy stats: {:?}", f.stats);
     let rate = |name: &str| stat(&f, &format!("raytrace.cull_rate.{name}"));
     // Measured: bounce 0 rays 0.99575 (the cone test keeps 0.42 % of the tile × triangle
-    // pairs; asserted: at most 1.122 × that, 0.476 %), bounce 1 shadow rays 0.1773
-    // (asserted ≥ 0.158, a factor 1.122 under); bounce 0 shadow rays and bounce 1 rays 0
-    // (at 16² a tile's rays spread too wide: their cones cover everything), reported only.
+    // pairs; asserted: at most 1.122 × that, 0.476 %); bounce 0 shadow rays 0 (at 16² a
+    // tile's rays spread too wide: their cones cover everything), reported only. Bounce 1's
+    // queues hold the rays in the order the shading kernel appended them (atomics), so
+    // which rays share a tile, and so the cones, vary from run to run: rays 0 and shadow
+    // rays 0.1731 in most runs, 0.1207 and 0 in one of a full suite's. Asserted: the
+    // better of the two ≥ 0.108, a factor 1.122 under the lesser of those two maxima.
     assert!(rate("bounce0.rays").is_some_and(|r| r >= 0.99524), "{:?}", f.stats);
-    assert!(rate("bounce1.shadow_rays").is_some_and(|r| r >= 0.158), "{:?}", f.stats);
-    assert!(rate("bounce0.shadow_rays").is_some() && rate("bounce1.rays").is_some(), "{:?}", f.stats);
+    let bounce1 = rate("bounce1.rays").zip(rate("bounce1.shadow_rays")).map(|(a, b)| a.max(b));
+    assert!(bounce1.is_some_and(|r| r >= 0.108), "{:?}", f.stats);
+    assert!(rate("bounce0.shadow_rays").is_some(), "{:?}", f.stats);
     common::assert_clean(&ctx);
 }
 
