@@ -66,6 +66,12 @@ pub fn variants(base: &Quality, sweeps: &[Sweep]) -> Result<Vec<(String, Quality
 /// defaults) and its labelled variants.
 pub type Series = (Option<String>, Vec<(String, Quality)>);
 
+/// A knob no GPU method lists is the frame's (shadow maps, caustics, anti-aliasing): every
+/// method's image may depend on it. (The CPU reference lists the ones it reads too.)
+fn frame_knob(k: &str) -> bool {
+    !Method::ALL.iter().any(|m| m.is_gpu() && m.knobs.contains(&k))
+}
+
 /// The study's series: with `each`, one per sweep, its values applied to `base` one at a
 /// time (the other knobs at `base`), named by the sweep's knob; else one unnamed series of
 /// every combination ([`variants`]).
@@ -879,20 +885,17 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let (w, h) = cfg.size;
 
     // One sweep at a time: a method gets the series of the knobs it reads, or its
-    // defaults alone when it reads none of them. A knob no GPU method lists is the frame's
-    // (shadow maps, caustics, anti-aliasing): every method reads it, and so are the caustics
-    // stage's map knobs when the scene has caustics.
+    // defaults alone when it reads none of them: its own, the frame's (`frame_knob`), and
+    // with caustics (§6) the map knobs the caustics stage reads whatever the method.
     let defaults = vec![(None, variants(&cfg.quality, &[])?)];
-    // With caustics (§6) the caustics stage's map knobs too, whatever the method.
-    // (Where auto cannot plan the scene, taken as having them: more rows measured, none
-    // copied wrongly.)
-    let caustics =
-        crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(Choice::Auto), &cfg.quality).map_or(true, |p| p.caustics.is_some());
-    let method_reads = |m: &Method, k: &str| {
-        m.knobs.contains(&k)
-            || !Method::ALL.iter().any(|o| o.is_gpu() && o.knobs.contains(&k))
-            || (caustics && crate::methods::caustics::MAP_KNOBS.contains(&k))
+    // Whether a frame under `q` has caustics (where auto cannot plan the scene, taken as
+    // having them: more rows measured, none copied wrongly).
+    let has_caustics = |q: &Quality| {
+        crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(Choice::Auto), q).map_or(true, |p| p.caustics.is_some())
     };
+    let caustics = has_caustics(&cfg.quality);
+    let method_reads =
+        |m: &Method, k: &str| m.knobs.contains(&k) || frame_knob(k) || (caustics && crate::methods::caustics::MAP_KNOBS.contains(&k));
     let of = |m: &Choice| -> &Vec<Series> {
         match m {
             Choice::Method(m) if cfg.each && !series.iter().any(|(k, _)| k.as_ref().is_some_and(|k| method_reads(m, k))) => &defaults,
@@ -930,22 +933,16 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         // when the frame has caustics (§6): they come from light cube maps, refractor maps
         // and shadow maps whatever the method, so every map knob can change its image.
         let raytrace = match method {
-            // Its own knobs and the frame's (those no method lists: anti-aliasing, ...).
-            Choice::Method(m) if m.family == "raytrace" => Some(
-                crate::quality::KNOBS
-                    .iter()
-                    .map(|k| k.name)
-                    .filter(|k| m.knobs.contains(k) || !Method::ALL.iter().any(|o| o.is_gpu() && o.knobs.contains(k)))
-                    .collect::<Vec<_>>(),
-            ),
+            // Its own knobs and the frame's.
+            Choice::Method(m) if m.family == "raytrace" => {
+                Some(crate::quality::KNOBS.iter().map(|k| k.name).filter(|k| m.knobs.contains(k) || frame_knob(k)).collect::<Vec<_>>())
+            }
             _ => None,
         };
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
         for (label, q) in variants {
             progress(Progress::Begin(format!("{name} {label}")));
-            let caustics =
-                raytrace.is_some() && crate::plan::plan_with(&cfg.scene, &crate::plan::Choices::all(method), q)?.caustics.is_some();
-            let reads = raytrace.as_ref().filter(|_| !caustics);
+            let reads = raytrace.as_ref().filter(|_| !has_caustics(q));
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {

@@ -258,52 +258,16 @@ fn tradeoff_each_on_a_builtin_scene() {
     std::fs::remove_dir_all(&out).ok();
 }
 
-/// The point of `p` nearest to `q` on triangle (a, b, c) (Ericson, Real-Time Collision
-/// Detection §5.1.5).
-fn closest_on_triangle(q: glam::DVec3, a: glam::DVec3, b: glam::DVec3, c: glam::DVec3) -> glam::DVec3 {
-    let (ab, ac, ap) = (b - a, c - a, q - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = q - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return a + ab * (d1 / (d1 - d3));
-    }
-    let cp = q - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return a + ac * (d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
-        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    a + ab * (vb * denom) + ac * (vc * denom)
-}
-
 /// The largest radiance any diffuse texel of `scene` can reach in any view, caustics aside:
 /// emission + Σ_lights I · albedo_max / (π d²), d the light's distance to each triangle and
 /// albedo_max the brightest texel × base colour of its material (cos θ ≤ 1, shadows only
 /// lower it). Returns the bound and the surface that reaches it.
 fn radiance_bound(scene: &Scene) -> (f64, String) {
-    let srgb = |c: u8| {
-        let c = c as f64 / 255.0;
-        if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
+    // The brightest texel of texture t, per channel, linear.
+    let brightest = |t: usize| {
+        let px = &scene.textures[t].rgba8;
+        let max = |k: usize| px.chunks_exact(4).map(|p| specula::scene::srgb_to_linear(p[k]) as f64).fold(0.0, f64::max);
+        glam::DVec3::new(max(0), max(1), max(2))
     };
     let mut worst = (0.0f64, String::new());
     for m in &scene.meshes {
@@ -314,14 +278,10 @@ fn radiance_bound(scene: &Scene) -> (f64, String) {
         let mut albedo = mat.base_color.as_dvec3();
         let mut emission = mat.emissive.as_dvec3();
         if let Some(t) = mat.base_color_texture {
-            let px = &scene.textures[t].rgba8;
-            let max = |k: usize| px.chunks_exact(4).map(|p| srgb(p[k])).fold(0.0, f64::max);
-            albedo *= glam::DVec3::new(max(0), max(1), max(2));
+            albedo *= brightest(t);
         }
         if let Some(t) = mat.emissive_texture {
-            let px = &scene.textures[t].rgba8;
-            let max = |k: usize| px.chunks_exact(4).map(|p| srgb(p[k])).fold(0.0, f64::max);
-            emission *= glam::DVec3::new(max(0), max(1), max(2));
+            emission *= brightest(t);
         }
         for tri in m.indices.chunks_exact(3) {
             let [a, b, c] = [0, 1, 2].map(|k| m.positions[tri[k] as usize].as_dvec3());
@@ -332,7 +292,7 @@ fn radiance_bound(scene: &Scene) -> (f64, String) {
                     specula::scene::LightKind::Directional => i * albedo / std::f64::consts::PI,
                     _ => {
                         let p = light.position.as_dvec3();
-                        i * albedo / (std::f64::consts::PI * closest_on_triangle(p, a, b, c).distance_squared(p))
+                        i * albedo / (std::f64::consts::PI * specula::plan::facts::point_triangle_distance(p, a, b, c).powi(2))
                     }
                 };
             }

@@ -303,8 +303,9 @@ fn crossings(m: &Mesh, o: DVec3, d: DVec3) -> usize {
     m.indices.chunks_exact(3).filter(|t| ray_triangle(o, d, p(t[0]), p(t[1]), p(t[2]), 0.0, f64::INFINITY).is_some()).count()
 }
 
-/// Distance from point x to triangle (a, b, c) (Ericson's closest point).
-fn point_triangle_distance(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+/// Distance from point x to triangle (a, b, c) (Ericson's closest point, Real-Time
+/// Collision Detection §5.1.5).
+pub fn point_triangle_distance(x: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let (ab, ac, ap) = (b - a, c - a, x - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
