@@ -150,7 +150,7 @@ fn cube_faces_follow_vulkan_table(mode: &str) {
     assert_eq!(p.quality.cube_mode, if mode == "six" { CubeMode::SixPasses } else { CubeMode::Multiview });
     let mut r = Renderer::new(&ctx, &scene, p, 16, 16).unwrap();
     r.render(&ctx).unwrap();
-    let cubes = read_image(&ctx, r.envmaps().unwrap()).unwrap();
+    let cubes = read_image(&ctx, r.maps().object_cubes().unwrap()).unwrap();
     assert_eq!(cubes.layers, 6);
     for face in 0..6u32 {
         for (s, t) in [(0.25f32, 0.25f32), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75), (0.6, 0.1), (0.1, 0.6), (0.9, 0.4)] {

@@ -105,9 +105,8 @@ impl Stage for SceneDirect {
         f.bind(ctx, cmd, self.sky);
         f.draw_sky(ctx, cmd, view);
         f.bind(ctx, cmd, self.direct);
-        // With a caustics.project pass the camera's surfaces get their caustics there.
-        let apart = io.plan.stages.contains(&crate::plan::StageSpec::CausticsProject);
-        let flags = f.flags | if apart { crate::frame::layout::FLAG_CAUSTICS_APART } else { 0 };
+        // Stages that take over part of direct shading say so (caustics.project).
+        let flags = f.flags | io.direct_flags;
         for d in f.scene.draws.iter().filter(|d| !d.specular) {
             f.push_flags(ctx, cmd, view, d.mesh, flags);
             unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };

@@ -55,6 +55,11 @@ pub trait Stage {
     fn update(&mut self, _init: &StageInit, _changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
         Ok(())
     }
+    /// Flags `scene.direct` shades with because this stage exists (e.g. a pass of its own
+    /// projects the caustics: `FLAG_CAUSTICS_APART`).
+    fn direct_flags(&self) -> u32 {
+        0
+    }
 }
 
 /// The frame's shared maps, one per descriptor slot (`binding::*`, src/frame/layout.in.rs).
@@ -103,6 +108,18 @@ pub struct Maps {
 }
 
 impl Maps {
+    /// The environment- or distance-map cube array the camera passes read (one cube per
+    /// object of that map), if planned.
+    pub fn object_cubes(&self) -> Option<&Image> {
+        self.distance.get(self.distance_latest).or(self.radiance.as_ref())
+    }
+
+    /// Caustics: the photon hit location images (xyz hit relative to the reference point,
+    /// w 1 for a photon) and the photons' power, one layer per light view.
+    pub fn photon_images(&self) -> Option<(&Image, &Image)> {
+        self.photon_hits.as_ref().zip(self.photon_power.as_ref())
+    }
+
     /// Every map image the camera passes sample: the current one of each slot.
     pub fn camera_reads(&self) -> Vec<&Image> {
         let mut v: Vec<&Image> = Vec::new();
@@ -303,6 +320,8 @@ pub struct FrameIo<'a> {
     /// `geometry.stencil` left the farthest depth on the mirror's pixels, the nearest
     /// elsewhere, so that nothing is drawn where the view is not seen).
     pub depth_masked: bool,
+    /// Flags `scene.direct` adds (every stage's `direct_flags`).
+    pub direct_flags: u32,
 }
 
 /// What a stage's constructor may look at.
@@ -321,6 +340,127 @@ pub struct StageInit<'a> {
     /// each sample (`aa=msaaN`, `msaa_shading`).
     pub multisample: crate::vk::pipeline::Multisample,
 }
+
+/// What a stage's output depends on, so that a frame records it only when that changed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Deps {
+    /// The camera's view (direct light, camera passes, ray tracing): every frame.
+    EveryFrame,
+    /// Shadow maps: the geometry and the lights (not materials, not the camera).
+    Shadows,
+    /// Maps of the geometry alone (refractor maps): what moved.
+    Geometry,
+    /// A light effect of some objects (caustics, §6): the geometry, the lights and the
+    /// materials of the stage's own objects (the receivers' albedo is applied when they are
+    /// shaded).
+    LitObjects,
+    /// Maps around objects (environment, distance, refractor): everything they see, which
+    /// is the whole scene's geometry, materials and lights, but not the camera.
+    World,
+    /// Maps from the camera (image-space refraction's back faces): camera and geometry.
+    CameraMap,
+}
+
+impl Deps {
+    /// Whether the stage is recorded again for every camera view (the camera's, a planar
+    /// mirror's).
+    pub fn per_view(self) -> bool {
+        matches!(self, Deps::EveryFrame | Deps::CameraMap)
+    }
+}
+
+/// A frame effect's constructor: its stage, its images into `maps`.
+pub type CreateEffect = fn(init: &StageInit, maps: &mut Maps) -> Result<Box<dyn Stage>>;
+
+/// A stage a family adds to the frame beyond maps and camera passes (caustics, §6): declared
+/// once in its family's folder, planned by the family's hook, created by the renderer
+/// without knowing what it is.
+#[derive(Clone, Copy)]
+pub struct EffectInfo {
+    /// The stage's name (for `plan.stages`); the passes it records are `passes`.
+    pub name: &'static str,
+    pub order: u32,
+    pub deps: Deps,
+    pub create: CreateEffect,
+    /// The profiled passes it records, in order, for this plan.
+    pub passes: fn(&Plan) -> Vec<&'static str>,
+}
+
+impl std::fmt::Debug for EffectInfo {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name)
+    }
+}
+
+impl PartialEq for EffectInfo {
+    fn eq(&self, o: &EffectInfo) -> bool {
+        self.name == o.name
+    }
+}
+
+/// Where the camera looks from this frame: what a family's own views are planned from.
+pub struct ViewFrame<'a> {
+    pub plan: &'a Plan,
+    /// The scene as the GPU holds it (no texels).
+    pub scene: &'a Scene,
+    pub lights: &'a [crate::gpu_scene::GpuLight],
+    pub layout: &'a ViewLayout,
+    /// The camera's world → clip matrix and eye.
+    pub view_proj: glam::Mat4,
+    pub eye: glam::Vec3,
+    pub yfov: f32,
+    pub aspect: f32,
+}
+
+/// One extra camera view a frame part renders the camera-dependent stages into.
+pub struct ViewPass<'a> {
+    /// The view table as the stages see it (`camera` is this view's entry).
+    pub views: ViewLayout,
+    pub target: &'a mut Image,
+    pub depth: &'a mut Image,
+    pub maps: &'a mut Maps,
+    pub area: vk::Rect2D,
+    pub object_flags: &'a [(usize, u32)],
+    pub depth_masked: bool,
+}
+
+/// What a family adds to a frame beyond its stages, kept across frames: views of its own
+/// in the view table, extra camera views (planar mirrors, §5), push flags the camera's
+/// objects get, counts for `Frame::stats`. Created by the family's hook
+/// (`registry::Family::frame_part`); the renderer calls it without knowing what it is.
+pub trait FramePart {
+    /// Plans this frame's views from the camera and writes its entries of the view table.
+    fn write_views(&mut self, frame: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]);
+    /// Records the camera-dependent stages again for each view of its own, through
+    /// `camera_stages`, before the camera's; returns whether any view was recorded (the
+    /// camera's own camera-space maps must then be recorded again).
+    fn record_views(
+        &mut self,
+        _rec: &mut Recorder,
+        _f: &FrameInputs,
+        _layout: &ViewLayout,
+        _maps: &mut Maps,
+        _camera_stages: &mut dyn FnMut(&mut Recorder, ViewPass),
+    ) -> bool {
+        false
+    }
+    /// Push flags the camera view adds per object (`FrameIo::object_flags`).
+    fn camera_flags(&self) -> Vec<(usize, u32)> {
+        Vec::new()
+    }
+    /// How many times a frame may record the camera's passes again (profiler capacity).
+    fn extra_views(&self) -> u32 {
+        0
+    }
+    /// What the last frame counted: (name, value), names stable like pass names.
+    fn stats(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
+    fn destroy(&mut self, ctx: &Context);
+}
+
+/// A family's frame-part constructor: `None` when the plan needs none.
+pub type CreateFramePart = fn(init: &StageInit, maps: &mut Maps) -> Result<Option<Box<dyn FramePart>>>;
 
 /// A map pass's constructor: the pass for `objects` (mesh indices), its images into `maps`.
 pub type CreateStage = fn(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>>;

@@ -64,17 +64,11 @@ pub fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
     }
 }
 
-/// The view table for a camera (`camera_view_proj`, eye), the plan's lights and maps, and
-/// this frame's mirrored views.
-pub fn view_table(
-    plan: &Plan,
-    layout: &ViewLayout,
-    lights: &[GpuLight],
-    (camera_view_proj, eye): (Mat4, Vec3),
-    mirrors: &[crate::methods::geometry::mirror::MirrorView],
-    photon_views: &[GpuView],
-    scene: &Scene,
-) -> Vec<GpuView> {
+/// The frame's part of the view table for a camera (`camera_view_proj`, eye), the plan's
+/// lights and maps: the camera, the shadow maps' views and the cube-mapped objects' faces.
+/// The families' own views (planar mirrors', the caustics') are written by their frame parts
+/// (`stage::FramePart::write_views`).
+pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], (camera_view_proj, eye): (Mat4, Vec3)) -> Vec<GpuView> {
     let mut views = vec![GpuView::zeroed(); layout.count as usize];
     views[layout.camera as usize] = view(camera_view_proj, eye.extend(0.0), Vec4::ZERO);
     let near = plan.cube_near;
@@ -102,73 +96,7 @@ pub fn view_table(
             views[(base + f) as usize] = view(face_view_proj(f as usize, c, near), c.extend(0.0), Vec4::ZERO);
         }
     }
-    for (i, m) in mirrors.iter().enumerate() {
-        if let Some(slot) = views.get_mut(layout.mirrors as usize + i) {
-            // Rasterisation clips at the mirror (oblique near plane); pixels unproject to
-            // rays through the plain mirrored projection.
-            *slot = GpuView {
-                view_proj: m.view_proj.to_cols_array_2d(),
-                inv_view_proj: m.plain_view_proj.inverse().to_cols_array_2d(),
-                eye: m.eye.extend(0.0).to_array(),
-                dir: [0.0, 0.0, 0.0, m.hair],
-                clip: m.clip.to_array(),
-            };
-        }
-    }
-    if !plan.map_mirrors.is_empty() {
-        map_mirror_views(plan, layout, scene, &mut views);
-    }
-    if let Some(c) = &plan.caustics {
-        for (k, &base) in layout.caustic_cubes.iter().enumerate() {
-            let centre = c.centre(k, lights);
-            for f in 0..6 {
-                views[(base + f) as usize] = view(face_view_proj(f as usize, centre, near), centre.extend(0.0), Vec4::ZERO);
-            }
-        }
-        for (i, v) in photon_views.iter().enumerate() {
-            if let Some(slot) = views.get_mut(layout.photons as usize + i) {
-                *slot = *v;
-            }
-        }
-    }
     views
-}
-
-/// The mirrored cube views of planar mirrors inside cube maps (§5 inside §3/§4): per
-/// cube-mapped object, per mirror of `plan.map_mirrors`, per face, the face's view mirrored
-/// through the mirror's plane (oriented towards the reference point) with an oblique near
-/// plane there, from the mirrored reference point. A mirror hidden, of no plane, or with
-/// the reference point in its plane keeps an empty view (its mask draws nothing then).
-fn map_mirror_views(plan: &Plan, layout: &ViewLayout, scene: &Scene, views: &mut [GpuView]) {
-    use crate::methods::geometry::mirror::{oblique, reflection, Mirror};
-    let near = plan.cube_near;
-    // A cube face's corner rays make an angle of arccos(1/√3) with its axis.
-    let cos_corner = 1.0 / 3f32.sqrt();
-    let mirrors: Vec<Option<Mirror>> = plan.map_mirrors.iter().map(|&m| Mirror::of(scene, m).into_iter().next()).collect();
-    for (e, &base) in plan.envmaps.iter().zip(&layout.map_mirrors) {
-        let p = e.reference_point;
-        for (k, m) in mirrors.iter().enumerate() {
-            let Some(m) = m else { continue };
-            let side = m.plane.truncate().dot(p) + m.plane.w;
-            if side.abs() <= m.hair() {
-                continue;
-            }
-            let plane = if side > 0.0 { m.plane } else { -m.plane };
-            let r = reflection(plane);
-            let keep = plane - Vec4::new(0.0, 0.0, 0.0, m.hair());
-            let eye = r.transform_point3(p);
-            for f in 0..6 {
-                let plain = face_view_proj(f, p, near) * r;
-                views[(base + 6 * k as u32 + f as u32) as usize] = GpuView {
-                    view_proj: oblique(plain, keep, cos_corner).to_cols_array_2d(),
-                    inv_view_proj: plain.inverse().to_cols_array_2d(),
-                    eye: eye.extend(0.0).to_array(),
-                    dir: [0.0, 0.0, 0.0, m.hair()],
-                    clip: keep.to_array(),
-                };
-            }
-        }
-    }
 }
 
 /// The light table: position and range, direction and kind, intensity, spot cone and

@@ -44,6 +44,10 @@ pub const ALL: &[Method] = &[
     REFERENCE,
 ];
 
+/// Every family with hooks beyond maps and camera passes, in the order the renderer calls
+/// them.
+pub const FAMILIES: &[registry::Family] = &[geometry::FAMILY, caustics::FAMILY];
+
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
 

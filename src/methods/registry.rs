@@ -6,7 +6,7 @@
 //! demo — reads `methods::ALL`.
 
 use crate::error::{Error, Result};
-use crate::frame::stage::MapInfo;
+use crate::frame::stage::{CreateFramePart, MapInfo};
 use crate::plan::facts::ObjectFacts;
 use crate::quality::Quality;
 use crate::scene::SurfaceKind;
@@ -198,6 +198,16 @@ impl Shape {
             Shape::ConvexOrConcave => "a saddle-shaped (neither convex nor concave, unsupported)",
         }
     }
+}
+
+/// A family of the survey (`src/methods/<family>/`): what it adds to a frame beyond its
+/// methods' maps and camera passes, as hooks the renderer calls without naming it.
+pub struct Family {
+    /// The folder's name, as `MethodInfo::family` names it.
+    pub name: &'static str,
+    /// State it keeps across frames: views of its own in the view table, extra camera views
+    /// (planar mirrors), push flags of the camera's objects, stats (`stage::FramePart`).
+    pub frame_part: Option<CreateFramePart>,
 }
 
 /// A handle to a registered method: copyable, compared by name.

@@ -315,7 +315,7 @@ fn fixed_pass(p: &Plan, name: &str) -> bool {
     p.stages.iter().any(|s| match s {
         StageSpec::Map(m) => m.name == name,
         StageSpec::Upload | StageSpec::Shadows => s.name() == name,
-        StageSpec::Caustics => p.caustics.as_ref().is_some_and(|c| c.passes(&p.quality).contains(&name)),
+        StageSpec::Effect(e) if !e.info.deps.per_view() => (e.info.passes)(p).contains(&name),
         _ => false,
     })
 }

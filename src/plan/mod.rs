@@ -10,7 +10,7 @@ pub mod facts;
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::frame::stage::{order, MapInfo};
+use crate::frame::stage::{order, Deps, EffectInfo, MapInfo};
 pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass, Verdict};
 use crate::quality::{Planner, Quality};
 use crate::scene::{LightKind, Scene};
@@ -104,11 +104,25 @@ pub enum StageSpec {
     /// `scene.direct`.
     Direct,
     Map(MapPlan),
-    /// The caustics stage (§6; `Plan::caustics` says what it renders).
-    Caustics,
-    /// `caustics.project`: the caustics on the camera's diffuse surfaces.
-    CausticsProject,
+    /// A family's frame effect (caustics, §6), over some objects.
+    Effect(EffectPlan),
     Camera(CameraPlan),
+}
+
+/// A frame effect over the objects it was planned for.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct EffectPlan {
+    #[serde(skip)]
+    pub info: EffectInfo,
+    pub name: &'static str,
+    /// Meshes it serves (caustics: the generators).
+    pub objects: Vec<usize>,
+}
+
+impl EffectPlan {
+    pub fn new(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
+        StageSpec::Effect(EffectPlan { info, name: info.name, objects })
+    }
 }
 
 impl StageSpec {
@@ -118,8 +132,7 @@ impl StageSpec {
             StageSpec::Shadows => "shadow.generate",
             StageSpec::Direct => "scene.direct",
             StageSpec::Map(m) => m.name,
-            StageSpec::Caustics => "caustics",
-            StageSpec::CausticsProject => "caustics.project",
+            StageSpec::Effect(e) => e.name,
             StageSpec::Camera(c) => c.name,
         }
     }
@@ -129,9 +142,38 @@ impl StageSpec {
             StageSpec::Shadows => order::SHADOWS,
             StageSpec::Direct => order::DIRECT,
             StageSpec::Map(m) => m.info.order,
-            StageSpec::Caustics => order::CAUSTICS,
-            StageSpec::CausticsProject => order::CAUSTICS_PROJECT,
+            StageSpec::Effect(e) => e.info.order,
             StageSpec::Camera(c) => c.pass.order,
+        }
+    }
+
+    /// What its output depends on: when a frame must record it again.
+    pub fn deps(&self) -> Deps {
+        match self {
+            StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
+            StageSpec::Shadows => Deps::Shadows,
+            StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
+            StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
+            StageSpec::Map(_) => Deps::World,
+            StageSpec::Effect(e) => e.info.deps,
+        }
+    }
+
+    /// The meshes it was planned for (none for the frame's own stages).
+    pub fn objects(&self) -> Vec<usize> {
+        match self {
+            StageSpec::Map(m) => m.objects.clone(),
+            StageSpec::Effect(e) => e.objects.clone(),
+            StageSpec::Camera(c) => c.objects.iter().map(|(m, _)| *m).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The profiled passes it records.
+    pub fn passes(&self, p: &Plan) -> Vec<&'static str> {
+        match self {
+            StageSpec::Effect(e) => (e.info.passes)(p),
+            s => vec![s.name()],
         }
     }
 }
@@ -587,10 +629,11 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
             maps[k].objects.push(o.mesh);
             o.passes.push(refractor.name);
         }
-        stages.push(StageSpec::Caustics);
+        let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
+        stages.push(EffectPlan::new(crate::methods::caustics::STAGE, generators.clone()));
         // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
         if !traced_everywhere {
-            stages.push(StageSpec::CausticsProject);
+            stages.push(EffectPlan::new(crate::methods::caustics::PROJECT, generators));
         }
         for o in &mut p.objects {
             if c.generators.iter().any(|g| g.mesh == o.mesh) {
@@ -633,13 +676,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.
     stages.sort_by_key(|s| s.order());
-    p.passes = stages
-        .iter()
-        .flat_map(|s| match (s, &p.caustics) {
-            (StageSpec::Caustics, Some(c)) => c.passes(&q),
-            _ => vec![s.name()],
-        })
-        .collect();
+    p.passes = stages.iter().flat_map(|s| s.passes(p)).collect();
     p.stages = stages;
 }
 

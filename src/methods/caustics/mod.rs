@@ -20,7 +20,11 @@ pub mod stage;
 
 use glam::{Mat4, Vec3};
 
+use crate::cube::face_view_proj;
+use crate::frame::stage::{order, Deps, EffectInfo, FramePart, Maps, StageInit, ViewFrame};
 use crate::frame::views::view;
+use crate::vk::Context;
+use crate::Result;
 
 use crate::gpu_scene::{GpuLight, GpuView};
 use crate::plan::{ObjectPlan, Plan};
@@ -103,6 +107,58 @@ impl CausticsPlan {
         }
         v
     }
+}
+
+/// Caustics' views are their part of a frame; their stages are planned as effects.
+pub const FAMILY: crate::methods::registry::Family =
+    crate::methods::registry::Family { name: "caustics", frame_part: Some(create_frame_part) };
+
+/// The caustics stage (§6): receiver maps, photons, light cube maps, their filter.
+pub const STAGE: EffectInfo = EffectInfo {
+    name: "caustics",
+    order: order::CAUSTICS,
+    deps: Deps::LitObjects,
+    create: stage::CausticsStage::create,
+    passes: |p| p.caustics.as_ref().map_or_else(Vec::new, |c| c.passes(&p.quality)),
+};
+
+/// `caustics.project` (§6.3.3): the caustics on the camera's diffuse surfaces, a pass of its
+/// own so that its cost is profiled.
+pub const PROJECT: EffectInfo = EffectInfo {
+    name: "caustics.project",
+    order: order::CAUSTICS_PROJECT,
+    deps: Deps::EveryFrame,
+    create: |init, _| project::CausticsProject::create(init),
+    passes: |_| vec!["caustics.project"],
+};
+
+/// The caustics' part of a frame: the views of their cubes (around each generator's
+/// reference point, or its light) and of their photon images, written every frame.
+struct CausticViews;
+
+/// `registry::Family::frame_part` of the caustics.
+pub fn create_frame_part(init: &StageInit, _maps: &mut Maps) -> Result<Option<Box<dyn FramePart>>> {
+    Ok(init.plan.caustics.as_ref().map(|_| Box::new(CausticViews) as Box<dyn FramePart>))
+}
+
+impl FramePart for CausticViews {
+    fn write_views(&mut self, fr: &ViewFrame, table: &mut [GpuView]) {
+        let Some(c) = &fr.plan.caustics else { return };
+        let near = fr.plan.cube_near;
+        for (k, &base) in fr.layout.caustic_cubes.iter().enumerate() {
+            let centre = c.centre(k, fr.lights);
+            for f in 0..6 {
+                table[(base + f) as usize] = view(face_view_proj(f as usize, centre, near), centre.extend(0.0), glam::Vec4::ZERO);
+            }
+        }
+        for (i, v) in photon_views(c, fr.scene, fr.lights, &fr.plan.quality, near).into_iter().enumerate() {
+            if let Some(slot) = table.get_mut(fr.layout.photons as usize + i) {
+                *slot = v;
+            }
+        }
+    }
+
+    fn destroy(&mut self, _ctx: &Context) {}
 }
 
 /// Whether the light can send photons into the sphere (centre, radius): a spot light's cone

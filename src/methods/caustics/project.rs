@@ -49,6 +49,11 @@ impl Stage for CausticsProject {
         "caustics.project"
     }
 
+    /// The camera's surfaces get their caustics here, not in `scene.direct`.
+    fn direct_flags(&self) -> u32 {
+        crate::frame::layout::FLAG_CAUSTICS_APART
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let mut pass = rec.pass("caustics.project").writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
         let maps = [io.maps.caustic_distances.as_ref(), io.maps.caustic_maps.as_ref()];

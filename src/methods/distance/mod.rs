@@ -11,7 +11,7 @@ use crate::methods::envmap::generate::{CubeMaps, MapKind};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
-use crate::plan::Plan;
+use crate::plan::{CameraPlan, Plan};
 use crate::quality::Quality;
 use crate::Result;
 
@@ -93,8 +93,17 @@ const SEARCH: CameraPass = CameraPass {
     fragment: "distance/search.frag",
     flags: 0,
     order: order::CAMERA,
-    create: None,
+    create: Some(create_search),
 };
+
+/// `distance.search`, which the test knob `debug_fault=flip_reflection` breaks on purpose.
+fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
+    let mut c = c.clone();
+    if init.plan.quality.debug_fault == crate::quality::DebugFault::FlipReflection {
+        c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
+    }
+    Ok(Box::new(crate::frame::camera::CameraShade::new(init.ctx, init.layout, &c, init.multisample)?))
+}
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 

@@ -18,6 +18,10 @@ use crate::frame::stage::order;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
 use crate::quality::Quality;
 
+/// Planar mirrors' views (§5) are the geometry family's part of a frame.
+pub const FAMILY: crate::methods::registry::Family =
+    crate::methods::registry::Family { name: "geometry", frame_part: Some(views::create_frame_part) };
+
 const fn one(_: &Quality) -> u32 {
     1
 }

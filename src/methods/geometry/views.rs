@@ -5,13 +5,15 @@
 //! into the scratch target, and is copied into its own layer afterwards.
 
 use ash::vk;
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec3, Vec4};
 
-use super::mirror::{Limits, MirrorFrame, Rect};
+use super::mirror::{oblique, reflection, Limits, Mirror, MirrorFrame, Rect};
+use crate::cube::face_view_proj;
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
-use crate::frame::stage::Maps;
+use crate::frame::stage::{FramePart, Maps, StageInit, ViewFrame, ViewLayout, ViewPass};
 use crate::frame::FrameInputs;
+use crate::gpu_scene::GpuView;
 use crate::plan::Plan;
 use crate::scene::Scene;
 use crate::vk::pipeline::{graphics_pipeline, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
@@ -204,4 +206,160 @@ pub fn cos_corner(yfov: f32, aspect: f32) -> f32 {
 /// A rectangle as the render area it is.
 pub fn render_area(r: Rect) -> vk::Rect2D {
     vk::Rect2D { offset: vk::Offset2D { x: r.x0 as i32, y: r.y0 as i32 }, extent: vk::Extent2D { width: r.x1 - r.x0, height: r.y1 - r.y0 } }
+}
+
+/// The geometry family's part of a frame (§5): planar mirrors' views, recorded before the
+/// camera's own, and the mirrored cube views of planar mirrors inside cube maps.
+pub struct PlanarViews {
+    /// `None` when the plan has no view layers (no planar mirror, or a budget of 0).
+    mirrors: Option<MirrorViews>,
+}
+
+/// `registry::Family::frame_part` of the geometry family.
+pub fn create_frame_part(init: &StageInit, maps: &mut Maps) -> Result<Option<Box<dyn FramePart>>> {
+    let plan = init.plan;
+    if plan.mirrors.is_empty() && plan.map_mirrors.is_empty() {
+        return Ok(None);
+    }
+    let mirrors = MirrorViews::new(init.ctx, plan, (init.width, init.height), init.multisample, init.layout, maps)?;
+    Ok(Some(Box::new(PlanarViews { mirrors })))
+}
+
+impl FramePart for PlanarViews {
+    fn write_views(&mut self, fr: &ViewFrame, table: &mut [GpuView]) {
+        if let Some(m) = self.mirrors.as_mut() {
+            m.plan_frame(fr.scene, fr.view_proj, fr.eye, cos_corner(fr.yfov, fr.aspect));
+            for (i, v) in m.frame.views.iter().enumerate() {
+                if let Some(slot) = table.get_mut(fr.layout.mirrors as usize + i) {
+                    // Rasterisation clips at the mirror (oblique near plane); pixels unproject
+                    // to rays through the plain mirrored projection.
+                    *slot = GpuView {
+                        view_proj: v.view_proj.to_cols_array_2d(),
+                        inv_view_proj: v.plain_view_proj.inverse().to_cols_array_2d(),
+                        eye: v.eye.extend(0.0).to_array(),
+                        dir: [0.0, 0.0, 0.0, v.hair],
+                        clip: v.clip.to_array(),
+                    };
+                }
+            }
+        }
+        if !fr.plan.map_mirrors.is_empty() {
+            map_mirror_views(fr.plan, fr.layout, fr.scene, table);
+        }
+    }
+
+    /// Planar mirrors' views, deepest first: each renders the camera-dependent stages from
+    /// its mirrored camera into the scratch target, within its mirror's pixels, and is
+    /// stored in its layer for the views (and the camera) that see the mirror.
+    fn record_views(
+        &mut self,
+        rec: &mut Recorder,
+        f: &FrameInputs,
+        layout: &ViewLayout,
+        maps: &mut Maps,
+        camera_stages: &mut dyn FnMut(&mut Recorder, ViewPass),
+    ) -> bool {
+        let Some(mv) = self.mirrors.as_mut() else { return false };
+        rec.scope = Some("geometry.mirror_view");
+        for i in mv.frame.order() {
+            let v = mv.frame.views[i].clone();
+            let views = ViewLayout { camera: layout.mirrors + i as u32, ..layout.clone() };
+            let flags = mv.child_flags(Some(i));
+            let area = render_area(v.rect);
+            // geometry.stencil: the mirror's pixels (as its parent sees them) marked in the
+            // scratch depth; the view's passes draw there only. With MSAA the view renders
+            // its whole rectangle: an edge pixel of the mirror averages samples beyond it.
+            let masked = mv.samples == 1;
+            if masked {
+                let parent_view = v.parent.map_or(layout.camera, |p| layout.mirrors + p as u32);
+                let mesh = mv.frame.mirrors[v.mirror].mesh;
+                mv.record_stencil(rec, f, parent_view, mesh, area);
+            }
+            let pass = ViewPass {
+                views,
+                target: &mut mv.scratch,
+                depth: &mut mv.depth,
+                maps: &mut *maps,
+                area,
+                object_flags: &flags,
+                depth_masked: masked,
+            };
+            camera_stages(rec, pass);
+            if let Some(dst) = maps.mirror_views.as_mut() {
+                mv.record_store(rec, dst, v.layer, v.rect);
+            }
+        }
+        rec.scope = None;
+        !mv.frame.views.is_empty()
+    }
+
+    fn camera_flags(&self) -> Vec<(usize, u32)> {
+        self.mirrors.as_ref().map_or_else(Vec::new, |m| m.child_flags(None))
+    }
+
+    /// Each mirrored view records the camera's passes again.
+    fn extra_views(&self) -> u32 {
+        self.mirrors.as_ref().map_or(0, |m| m.limits.layers)
+    }
+
+    fn stats(&self) -> Vec<(String, f64)> {
+        let Some(m) = &self.mirrors else { return Vec::new() };
+        // The views this frame rendered, their deepest level, and the mirrors that showed
+        // the fallback for want of depth or budget.
+        let f = &m.frame;
+        let (layers, view, scratch) = m.memory();
+        vec![
+            ("geometry.mirror_views".into(), f.views.len() as f64),
+            ("geometry.mirror_depth".into(), f.views.iter().map(|v| v.level).max().unwrap_or(0) as f64),
+            ("geometry.mirror_fallbacks".into(), f.fallbacks as f64),
+            // Memory (issue 11): the layers allocated for the plan's views, the bytes of one
+            // view's layer, and the scratch target every view renders into (colour + depth).
+            ("geometry.mirror_layers".into(), layers as f64),
+            ("geometry.mirror_view_bytes".into(), view as f64),
+            ("geometry.mirror_scratch_bytes".into(), scratch as f64),
+        ]
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        if let Some(m) = self.mirrors.as_mut() {
+            m.destroy(ctx);
+        }
+        self.mirrors = None;
+    }
+}
+
+/// The mirrored cube views of planar mirrors inside cube maps (§5 inside §3/§4): per
+/// cube-mapped object, per mirror of `plan.map_mirrors`, per face, the face's view mirrored
+/// through the mirror's plane (oriented towards the reference point) with an oblique near
+/// plane there, from the mirrored reference point. A mirror hidden, of no plane, or with
+/// the reference point in its plane keeps an empty view (its mask draws nothing then).
+fn map_mirror_views(plan: &Plan, layout: &ViewLayout, scene: &Scene, views: &mut [GpuView]) {
+    let near = plan.cube_near;
+    // A cube face's corner rays make an angle of arccos(1/√3) with its axis.
+    let cos_corner = 1.0 / 3f32.sqrt();
+    let mirrors: Vec<Option<Mirror>> = plan.map_mirrors.iter().map(|&m| Mirror::of(scene, m).into_iter().next()).collect();
+    for (e, &base) in plan.envmaps.iter().zip(&layout.map_mirrors) {
+        let p = e.reference_point;
+        for (k, m) in mirrors.iter().enumerate() {
+            let Some(m) = m else { continue };
+            let side = m.plane.truncate().dot(p) + m.plane.w;
+            if side.abs() <= m.hair() {
+                continue;
+            }
+            let plane = if side > 0.0 { m.plane } else { -m.plane };
+            let r = reflection(plane);
+            let keep = plane - Vec4::new(0.0, 0.0, 0.0, m.hair());
+            let eye = r.transform_point3(p);
+            for f in 0..6 {
+                let plain = face_view_proj(f, p, near) * r;
+                views[(base + 6 * k as u32 + f as u32) as usize] = GpuView {
+                    view_proj: oblique(plain, keep, cos_corner).to_cols_array_2d(),
+                    inv_view_proj: plain.inverse().to_cols_array_2d(),
+                    eye: eye.extend(0.0).to_array(),
+                    dir: [0.0, 0.0, 0.0, m.hair()],
+                    clip: keep.to_array(),
+                };
+            }
+        }
+    }
 }

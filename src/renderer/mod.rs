@@ -1,0 +1,446 @@
+//! Runs a Plan: creates the stages the plan lists (and nothing else) and the families'
+//! frame parts, records them in order into a command buffer it is handed, and in
+//! standalone mode submits the frame and reads the image back with its per-pass profile.
+//! It names no method and no family: stages come from the plan (`StageSpec`: the frame's
+//! own, the methods' maps and camera passes, the families' effects), frame parts from the
+//! registry's families (`methods::FAMILIES`).
+//!
+//! One job a file: `targets` (the camera's colour, depth and resolve), `bindings`
+//! (descriptor sets, the pipeline layout and the tables behind them), `updates` (scene
+//! changes between frames and which maps they invalidate); this file orchestrates.
+
+mod bindings;
+mod targets;
+mod updates;
+
+use ash::vk;
+use glam::Mat4;
+
+use crate::error::{Error, Result};
+use crate::frame::camera::CameraShade;
+use crate::frame::direct::{SceneDirect, TARGET_FORMAT};
+use crate::frame::shadow::ShadowMaps;
+use crate::frame::stage::{Deps, FrameIo, FramePart, MapSets, Maps, Stage, StageInit, ViewFrame, ViewLayout, ViewPass};
+use crate::frame::{output, views};
+use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
+use crate::gpu_scene::{GpuLight, GpuScene};
+use crate::plan::{Plan, StageSpec};
+use crate::quality::FresnelMode;
+use crate::scene::{Camera, Scene};
+use crate::vk::{record_copy_to_buffer, Access, Buffer, Context, Image, ImageData, MemoryLocation, PassTiming, Profiler, Recorder};
+use bindings::Bindings;
+use targets::Targets;
+pub use updates::MapUpdate;
+
+/// Profiled passes a frame may record (ray tracing records about 7 per bounce).
+const MAX_PASSES: u32 = 512;
+
+/// A rendered frame: linear radiance RGBA32F, its per-pass profile and the device memory
+/// that the renderer's resources hold.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    pub image: ImageData,
+    pub passes: Vec<PassTiming>,
+    pub memory: Vec<(String, u64)>,
+    /// What the stages and frame parts counted in this frame (`Stage::stats`).
+    pub stats: Vec<(String, f64)>,
+    /// The maps this frame regenerated, and why (a map not listed was kept).
+    pub map_updates: Vec<MapUpdate>,
+    /// With `object_ids=on` (a debug output): each pixel's first-hit object from the
+    /// camera, mesh index + 1 (0: the sky), row by row from the top.
+    pub object_ids: Option<Vec<u32>>,
+}
+
+impl Frame {
+    pub fn gpu_ms(&self) -> f64 {
+        self.passes.iter().map(|p| p.gpu_ms).sum()
+    }
+    pub fn memory_bytes(&self) -> u64 {
+        self.memory.iter().map(|(_, b)| b).sum()
+    }
+}
+
+pub struct Renderer {
+    pub plan: Plan,
+    pub width: u32,
+    pub height: u32,
+    scene: GpuScene,
+    camera: Camera,
+    views: ViewLayout,
+    bindings: Bindings,
+    /// The plan's stages, in recording order, and what each depends on.
+    stages: Vec<Box<dyn Stage>>,
+    deps: Vec<Deps>,
+    /// What the families add to the frame beyond stages (`methods::FAMILIES`).
+    parts: Vec<Box<dyn FramePart>>,
+    /// The frame's shared maps (every stage's images), by descriptor slot.
+    maps: Maps,
+    targets: Targets,
+    readback: Option<Buffer>,
+    profiler: Profiler,
+    flags: u32,
+    /// Flags `scene.direct` shades with (every stage's `direct_flags`).
+    direct_flags: u32,
+    light_table: Vec<GpuLight>,
+    last_timings: Vec<PassTiming>,
+    /// Scene changes and the maps they invalidate.
+    updates: updates::Updates,
+    /// Each view's eye (the view table's), for per-face culling.
+    view_eyes: Vec<glam::Vec3>,
+    /// `frame.object_ids`, with `object_ids=on`.
+    ids: Option<crate::frame::ids::ObjectIds>,
+}
+
+/// The frame-wide part of what stages see, built once a frame; `io` adds one view's target.
+struct FrameShared<'a> {
+    plan: &'a Plan,
+    sets: &'a MapSets,
+    view_eyes: &'a [glam::Vec3],
+    scene_images: Vec<&'a Image>,
+    direct_flags: u32,
+}
+
+impl<'a> FrameShared<'a> {
+    /// The stages' inputs and outputs for one camera view (the camera's, or a planar
+    /// mirror's): its view table entry, target, depth and area, and per-object push flags.
+    fn io<'b>(
+        &'b self,
+        views: &'b ViewLayout,
+        target: &'b mut Image,
+        depth: &'b mut Image,
+        maps: &'b mut Maps,
+        area: vk::Rect2D,
+        object_flags: &'b [(usize, u32)],
+    ) -> FrameIo<'b> {
+        FrameIo {
+            plan: self.plan,
+            views,
+            target,
+            depth,
+            maps,
+            sets: self.sets,
+            view_eyes: self.view_eyes,
+            scene_images: self.scene_images.clone(),
+            area,
+            object_flags,
+            depth_masked: false,
+            direct_flags: self.direct_flags,
+        }
+    }
+}
+
+/// What a stage's or frame part's constructor may look at.
+fn stage_init<'a>(
+    ctx: &'a Context,
+    scene: &'a Scene,
+    gpu: &'a GpuScene,
+    plan: &'a Plan,
+    b: &Bindings,
+    t: &Targets,
+    size: (u32, u32),
+) -> StageInit<'a> {
+    let (width, height) = t.size(size.0, size.1);
+    StageInit { ctx, scene, gpu, plan, layout: b.layout, set_layouts: b.set_layouts(), width, height, multisample: t.multisample }
+}
+
+impl Renderer {
+    /// Creates everything the plan needs at `width`×`height`. On error, everything created
+    /// so far is destroyed again.
+    pub fn new(ctx: &Context, scene: &Scene, plan: Plan, width: u32, height: u32) -> Result<Renderer> {
+        if !plan.is_gpu() {
+            return Err(Error::invalid("method", format!("'{}' renders on the CPU: use reference::render_reference", plan.choice.name())));
+        }
+        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+            return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
+        }
+        let camera = scene.camera_or_default();
+        camera.validate()?;
+        let (ssaa, multisample) = Targets::check(ctx, &plan, width, height)?;
+        // Partial construction: every field that owns something starts empty, and
+        // `destroy` frees whatever exists.
+        let r = Renderer {
+            plan,
+            width,
+            height,
+            scene: GpuScene::new(ctx, scene)?,
+            camera,
+            views: ViewLayout::default(),
+            bindings: Bindings::empty(),
+            stages: Vec::new(),
+            deps: Vec::new(),
+            parts: Vec::new(),
+            maps: Maps::default(),
+            targets: Targets::empty(ssaa, multisample),
+            readback: None,
+            profiler: Profiler::placeholder(),
+            flags: 0,
+            direct_flags: 0,
+            light_table: Vec::new(),
+            last_timings: Vec::new(),
+            updates: updates::Updates::new(scene),
+            view_eyes: Vec::new(),
+            ids: None,
+        };
+        crate::vk::build(ctx, r, |r| r.init(ctx, scene))
+    }
+
+    fn init(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
+        let plan = &self.plan;
+        self.views = ViewLayout::of(plan);
+        self.light_table = views::light_table(scene, plan);
+        self.bindings.create(ctx, self.views.count, &bindings::object_table(scene, plan), &self.light_table)?;
+        let q = &plan.quality;
+        self.flags = if q.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
+            | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 }
+            | if q.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
+            | if q.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
+        self.create_stages(ctx, scene)?;
+        self.bindings.allocate_map_sets(ctx, &self.maps)?;
+        self.targets.create(ctx, self.width, self.height)?;
+        if self.plan.quality.object_ids {
+            self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.bindings.layout, self.width, self.height)?);
+        }
+        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+        for family in crate::methods::FAMILIES {
+            if let Some(create) = family.frame_part {
+                if let Some(part) = create(&init, &mut self.maps)? {
+                    self.parts.push(part);
+                }
+            }
+        }
+        // A frame part's extra views record the camera's passes again (a ray pipeline is a
+        // hundred passes at depth 16).
+        let views: u32 = self.parts.iter().map(|p| p.extra_views()).sum();
+        self.profiler = Profiler::new(ctx, MAX_PASSES * (1 + views))?;
+        self.bindings.write(ctx, &self.scene, &self.maps);
+        Ok(())
+    }
+
+    /// Creates the plan's stages in order; each map stage puts its images into `maps`.
+    fn create_stages(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
+        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+        let multisample = self.targets.multisample;
+        let mut objects = Vec::new();
+        for spec in &self.plan.stages {
+            let stage: Box<dyn Stage> = match spec {
+                // The scene records its own upload (first frame only).
+                StageSpec::Upload => continue,
+                StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
+                StageSpec::Direct => Box::new(SceneDirect::new(ctx, init.layout, multisample)?),
+                StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
+                StageSpec::Effect(e) => (e.info.create)(&init, &mut self.maps)?,
+                StageSpec::Camera(c) => match c.pass.create {
+                    Some(create) => create(&init, c)?,
+                    None => Box::new(CameraShade::new(ctx, init.layout, c, multisample)?),
+                },
+            };
+            self.deps.push(spec.deps());
+            objects.push(spec.objects());
+            self.direct_flags |= stage.direct_flags();
+            self.stages.push(stage);
+        }
+        self.updates.track(objects);
+        Ok(())
+    }
+
+    /// Every map image, by slot: what tests and tools inspect after a frame.
+    pub fn maps(&self) -> &Maps {
+        &self.maps
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The camera's world → clip matrix (reversed-Z, infinite far plane, Vulkan y-down).
+    pub fn camera_view_proj(&self) -> Mat4 {
+        let aspect = self.width as f32 / self.height as f32;
+        let mut proj = Mat4::perspective_infinite_reverse_rh(self.camera.yfov, aspect, self.camera.znear);
+        proj.y_axis.y = -proj.y_axis.y;
+        proj * self.camera.view()
+    }
+
+    /// The view table: the frame's own views, then each frame part's.
+    fn write_views(&mut self) -> Result<()> {
+        let vp = self.camera_view_proj();
+        let mut table = views::view_table(&self.plan, &self.views, &self.light_table, (vp, self.camera.position));
+        let frame = ViewFrame {
+            plan: &self.plan,
+            scene: self.updates.scene(),
+            lights: &self.light_table,
+            layout: &self.views,
+            view_proj: vp,
+            eye: self.camera.position,
+            yfov: self.camera.yfov,
+            aspect: self.width as f32 / self.height as f32,
+        };
+        for p in &mut self.parts {
+            p.write_views(&frame, &mut table);
+        }
+        self.view_eyes = table.iter().map(|v| glam::Vec3::from_slice(&v.eye[..3])).collect();
+        self.bindings.views.write(bytemuck::cast_slice(&table))
+    }
+
+    /// Records one frame into `cmd` (any primary command buffer in the recording state on
+    /// this context's device). Afterwards `target` holds the image in COLOR_ATTACHMENT
+    /// layout. The view table is written by the host now, so only one frame may be in
+    /// flight at a time.
+    pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
+        self.apply_updates(ctx)?;
+        self.write_views()?;
+        let mut rec = Recorder::new(ctx, cmd, &mut self.profiler);
+        self.scene.record_upload(&mut rec);
+        let q = &self.plan.quality;
+        let f = FrameInputs {
+            scene: &self.scene,
+            set: self.bindings.set,
+            layout: self.bindings.layout,
+            flags: self.flags,
+            light_count: self.light_table.len() as u32,
+            search: SearchKnobs::of(q),
+            tolerance: q.search_tolerance,
+            internal_bounces: q.internal_bounces,
+            depth: q.depth,
+            mirror_base: self.views.mirrors,
+        };
+        let t = &mut self.targets;
+        let full = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.target.width, height: t.target.height } };
+        let shared = FrameShared {
+            plan: &self.plan,
+            sets: &self.bindings.sets,
+            view_eyes: &self.view_eyes,
+            scene_images: f.scene.textures.iter().chain(f.scene.environment.iter()).collect(),
+            direct_flags: self.direct_flags,
+        };
+        let updated = self.updates.recorded();
+        let mut io = shared.io(&self.views, &mut t.target, &mut t.depth, &mut self.maps, full, &[]);
+        // The world's maps first: those this frame must make again.
+        for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
+            if !deps.per_view() && updated.iter().any(|u| u.stage == stage.name()) {
+                stage.record(&mut rec, &f, &mut io);
+            }
+        }
+        drop(io);
+        // The frame parts' own camera views (planar mirrors', §5), before the camera's: each
+        // records the camera-dependent stages again.
+        let (stages, deps) = (&mut self.stages, &self.deps);
+        let mut camera_stages = |rec: &mut Recorder, v: ViewPass| {
+            let mut io = shared.io(&v.views, v.target, v.depth, v.maps, v.area, v.object_flags);
+            io.depth_masked = v.depth_masked;
+            for (stage, _) in stages.iter_mut().zip(deps).filter(|(_, d)| d.per_view()) {
+                stage.record(rec, &f, &mut io);
+            }
+        };
+        let mut views_ran = false;
+        for p in &mut self.parts {
+            views_ran |= p.record_views(&mut rec, &f, &self.views, &mut self.maps, &mut camera_stages);
+        }
+        let camera_flags: Vec<(usize, u32)> = self.parts.iter().flat_map(|p| p.camera_flags()).collect();
+        let mut io = shared.io(&self.views, &mut t.target, &mut t.depth, &mut self.maps, full, &camera_flags);
+        // Extra views re-recorded the camera-space maps from their cameras.
+        for (stage, deps) in self.stages.iter_mut().zip(&self.deps) {
+            let needed = *deps == Deps::EveryFrame || views_ran || updated.iter().any(|u| u.stage == stage.name());
+            if deps.per_view() && needed {
+                stage.record(&mut rec, &f, &mut io);
+            }
+        }
+        drop(io);
+        t.record_resolve(&mut rec);
+        if let Some(ids) = self.ids.as_mut() {
+            ids.record(&mut rec, &f, self.views.camera);
+        }
+        if let Some(rb) = &self.readback {
+            let out = t.output();
+            let open = rec.pass("frame.readback").reads(out, Access::TransferSrc).begin();
+            record_copy_to_buffer(ctx, cmd, out, rb);
+            rec.end(open);
+        }
+        Ok(())
+    }
+
+    /// Host-device mode: records a frame into the host's `cmd` and copies the result into
+    /// the host's image (same size; a bit-exact copy for R32G32B32A32_SFLOAT, a blit with
+    /// format conversion otherwise), leaving it in `final_layout`.
+    pub fn record_into(&mut self, ctx: &Context, cmd: vk::CommandBuffer, host: &mut Image, final_layout: vk::ImageLayout) -> Result<()> {
+        if host.width != self.width || host.height != self.height {
+            return Err(Error::invalid(
+                "target image",
+                format!("{}x{} but the renderer was configured for {}x{}", host.width, host.height, self.width, self.height),
+            ));
+        }
+        // The previous frame's timings, if the host has let it complete.
+        if let Some(t) = self.profiler.poll(ctx)? {
+            self.last_timings = t;
+            self.scene.release_staging(ctx);
+        }
+        self.record(ctx, cmd)?;
+        let mut rec = Recorder::resume(ctx, cmd, &mut self.profiler);
+        output::record_copy(&mut rec, self.targets.output(), host, final_layout);
+        Ok(())
+    }
+
+    /// Per-pass timings of the last frame the GPU has completed (host-device mode polls
+    /// without waiting; standalone frames are always complete).
+    pub fn last_timings(&mut self, ctx: &Context) -> Result<&[PassTiming]> {
+        if let Some(t) = self.profiler.poll(ctx)? {
+            self.last_timings = t;
+        }
+        Ok(&self.last_timings)
+    }
+
+    /// Standalone: records, submits and waits for one frame, then reads the image back.
+    pub fn render(&mut self, ctx: &Context) -> Result<Frame> {
+        if self.readback.is_none() {
+            let bytes = self.targets.output().byte_size();
+            let usage = vk::BufferUsageFlags::TRANSFER_DST;
+            self.readback = Some(Buffer::new(ctx, "frame.readback", bytes, usage, MemoryLocation::GpuToCpu)?);
+        }
+        ctx.one_shot(|cmd| self.record(ctx, cmd))?;
+        self.scene.release_staging(ctx);
+        let passes = self.profiler.results(ctx)?;
+        self.last_timings = passes.clone();
+        let rb = self.readback.as_ref().unwrap();
+        let image = crate::vk::decode(TARGET_FORMAT, self.width, self.height, 1, rb.read()?)?;
+        let errors = ctx.validation.error_count();
+        if errors > 0 {
+            return Err(Error::Validation(errors));
+        }
+        let mut stats: Vec<(String, f64)> = self.stages.iter().flat_map(|s| s.stats(ctx)).collect();
+        if self.profiler.untimed() > 0 {
+            stats.push(("profiler.untimed_passes".into(), self.profiler.untimed() as f64));
+        }
+        stats.extend(self.parts.iter().flat_map(|p| p.stats()));
+        let object_ids = self.ids.as_ref().map(|i| i.read()).transpose()?;
+        let map_updates = self.updates.recorded().to_vec();
+        Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates, object_ids })
+    }
+
+    /// Frees everything. The GPU must be idle with respect to this renderer's frames.
+    pub fn destroy(&mut self, ctx: &Context) {
+        for s in &mut self.stages {
+            s.destroy(ctx);
+        }
+        self.stages.clear();
+        for p in &mut self.parts {
+            p.destroy(ctx);
+        }
+        self.parts.clear();
+        if let Some(mut i) = self.ids.take() {
+            crate::vk::Owner::destroy(&mut i, ctx);
+        }
+        self.maps.destroy(ctx);
+        self.targets.destroy(ctx);
+        if let Some(b) = self.readback.as_mut() {
+            b.destroy(ctx);
+        }
+        self.scene.destroy(ctx);
+        self.profiler.destroy(ctx);
+        self.bindings.destroy(ctx);
+    }
+}
+
+impl crate::vk::Owner for Renderer {
+    fn destroy(&mut self, ctx: &Context) {
+        Renderer::destroy(self, ctx)
+    }
+}
