@@ -46,7 +46,7 @@ pub const ALL: &[Method] = &[
 
 /// Every family with hooks beyond maps and camera passes, in the order the renderer calls
 /// them.
-pub const FAMILIES: &[registry::Family] = &[geometry::FAMILY, caustics::FAMILY];
+pub const FAMILIES: &[registry::Family] = &[layered::FAMILY, caustics::FAMILY, geometry::FAMILY];
 
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];

@@ -8,8 +8,9 @@
 use crate::error::{Error, Result};
 use crate::frame::stage::{CreateFramePart, MapInfo};
 use crate::plan::facts::ObjectFacts;
+use crate::plan::Plan;
 use crate::quality::Quality;
-use crate::scene::SurfaceKind;
+use crate::scene::{Scene, SurfaceKind};
 
 /// What kind of specular object a method can serve (survey §1.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -95,6 +96,11 @@ pub struct CameraPass {
     /// with `vertex` and `fragment` (ray tracing in the original geometry: a pipeline of
     /// passes).
     pub create: Option<CreateCamera>,
+    /// Its stage shades every pixel of the frame when its method serves the whole scene,
+    /// diffuse surfaces included, with exact shadow rays and the caustics projected in its
+    /// own kernel (ray tracing in the original geometry, §2): the frame then needs no
+    /// shadow maps (unless caustic photons do) and no `caustics.project`.
+    pub shades_scene: bool,
 }
 
 /// Creates a method's own camera stage for the plan's objects.
@@ -201,13 +207,83 @@ impl Shape {
 }
 
 /// A family of the survey (`src/methods/<family>/`): what it adds to a frame beyond its
-/// methods' maps and camera passes, as hooks the renderer calls without naming it.
+/// methods' maps and camera passes, as hooks the planner and the renderer call without
+/// naming it. A family sets the hooks it needs over `Family::NONE`.
 pub struct Family {
     /// The folder's name, as `MethodInfo::family` names it.
     pub name: &'static str,
+    /// Before the frame's stages are derived: moves the objects' reference points (the
+    /// shared layered map's centre, §4.5).
+    pub plan_objects: Option<fn(&Scene, &mut Plan)>,
+    /// Its frame-wide plan, before the shadow maps are decided (caustics: generators and
+    /// their lights, §6).
+    pub plan_frame: Option<fn(&Scene, &mut Plan)>,
+    /// Stages and maps it adds once the objects' own maps are planned (caustics: their
+    /// effect stages and the refractor maps solid generators need).
+    pub plan_stages: Option<fn(&Scene, &mut Plan, &mut PlanStages)>,
+    /// After the maps: view layers of its own (planar mirrors', §5).
+    pub plan_views: Option<fn(&Scene, &mut Plan)>,
+    /// After objects moved, with the plan's structure kept: its plan follows them.
+    pub refresh: Option<fn(&mut Plan)>,
+    /// Its part of `specula plan`'s table, if it planned anything.
+    pub describe: Option<fn(&Plan, &Scene) -> Option<String>>,
     /// State it keeps across frames: views of its own in the view table, extra camera views
     /// (planar mirrors), push flags of the camera's objects, stats (`stage::FramePart`).
     pub frame_part: Option<CreateFramePart>,
+}
+
+impl Family {
+    /// A family with no hooks, to set the ones it needs over.
+    pub const NONE: Family = Family {
+        name: "",
+        plan_objects: None,
+        plan_frame: None,
+        plan_stages: None,
+        plan_views: None,
+        refresh: None,
+        describe: None,
+        frame_part: None,
+    };
+}
+
+/// What the planner has derived when `Family::plan_stages` runs: the map passes (one per
+/// map kind, layers in mesh order) and the frame's stages so far.
+pub struct PlanStages {
+    pub maps: Vec<crate::plan::MapPlan>,
+    pub stages: Vec<crate::plan::StageSpec>,
+    /// A whole-scene method shades every pixel itself (`CameraPass::shades_scene`).
+    pub shades_scene: bool,
+}
+
+impl PlanStages {
+    /// Gives `object` map `info` (its layer the next of that map's array), unless it has it.
+    pub fn add_map(&mut self, object: &mut crate::plan::ObjectPlan, info: MapInfo, what: String) {
+        if object.maps.iter().any(|m| m.pass == info.name) {
+            return;
+        }
+        let k = match self.maps.iter().position(|m| m.name == info.name) {
+            Some(k) => k,
+            None => {
+                self.maps.push(crate::plan::MapPlan { info, name: info.name, objects: Vec::new(), bytes: 0 });
+                self.maps.len() - 1
+            }
+        };
+        object.maps.push(crate::plan::ObjectMap {
+            pass: info.name,
+            layer: self.maps[k].objects.len() as u32,
+            layer_field: info.layer_field,
+            what,
+            bytes: 0,
+        });
+        self.maps[k].objects.push(object.mesh);
+        object.passes.push(info.name);
+    }
+}
+
+/// The map kind named `name` that some registered method needs (a family that needs
+/// another's map for its own purpose, as caustics need refractor maps).
+pub fn map_named(name: &str) -> Option<MapInfo> {
+    crate::methods::ALL.iter().filter_map(|m| m.gpu).flat_map(|g| g.maps.iter()).find(|i| i.name == name).copied()
 }
 
 /// A handle to a registered method: copyable, compared by name.

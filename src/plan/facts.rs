@@ -242,9 +242,9 @@ fn mesh_facts(m: &Mesh) -> Arc<MeshFacts> {
     f
 }
 
-/// A convex solid of flat faces (`geometry::faces`).
+/// A convex solid of flat faces (`scene::faces`).
 pub fn is_faceted(m: &Mesh) -> bool {
-    use crate::methods::geometry::faces;
+    use crate::scene::faces;
     faces::planar_faces(m, faces::MAX_FACES).is_some_and(|f| f.len() >= 4 && faces::is_convex(m, &f))
 }
 

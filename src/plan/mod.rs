@@ -6,220 +6,19 @@
 
 pub mod budget;
 pub mod facts;
+mod types;
 
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-use crate::frame::stage::{order, Deps, EffectInfo, MapInfo};
 pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass, Verdict};
+pub use types::*;
+
+use crate::methods::registry::PlanStages;
+use crate::methods::FAMILIES;
 use crate::quality::{Planner, Quality};
 use crate::scene::{LightKind, Scene};
 use facts::ObjectFacts;
-
-/// One cube-mapped object's views: the six faces around its reference point.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct EnvmapPlan {
-    pub mesh: usize,
-    /// Index of the object among the plan's cube-mapped objects.
-    pub layer: u32,
-    pub reference_point: Vec3,
-}
-
-/// One map an object gets.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct ObjectMap {
-    /// The pass that makes it.
-    pub pass: &'static str,
-    /// The object's layer in that pass's map array.
-    pub layer: u32,
-    #[serde(skip)]
-    pub layer_field: Option<crate::frame::stage::LayerField>,
-    pub what: String,
-    pub bytes: u64,
-}
-
-/// One specular object's plan.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct ObjectPlan {
-    pub mesh: usize,
-    pub name: String,
-    pub class: ObjectClass,
-    pub method: Method,
-    /// Why this method: the user's choice, the scene file's, or the planner's rule.
-    pub reason: String,
-    pub reference_point: Vec3,
-    /// The object's own reference point, before a shared map (layered, §4.5) moved
-    /// `reference_point` to the map's: its caustics' cube is centred here, where the
-    /// receiver map it searches does not have the object itself in front of the receivers.
-    #[serde(skip)]
-    pub own_reference_point: Vec3,
-    /// Set when the automatic reference point had to move (or could not).
-    pub reference_note: Option<String>,
-    /// How the object appears in the other objects' distance maps.
-    pub map_shading: MapShading,
-    /// What its own cube maps leave out.
-    pub leaves_out: LeavesOut,
-    pub maps: Vec<ObjectMap>,
-    /// The passes that draw or map this object.
-    pub passes: Vec<&'static str>,
-    /// The knobs its method reads, with their values in force.
-    pub knobs: Vec<(&'static str, String)>,
-}
-
-/// A map pass over all the objects that need that map.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct MapPlan {
-    #[serde(skip)]
-    pub info: MapInfo,
-    pub name: &'static str,
-    /// Meshes, in layer order.
-    pub objects: Vec<usize>,
-    pub bytes: u64,
-}
-
-/// A camera pass over the objects of the methods that share it.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct CameraPlan {
-    #[serde(skip)]
-    pub pass: CameraPass,
-    pub name: &'static str,
-    /// (mesh, push flags of its method).
-    pub objects: Vec<(usize, u32)>,
-}
-
-impl PartialEq for CameraPlan {
-    fn eq(&self, o: &CameraPlan) -> bool {
-        self.name == o.name && self.objects == o.objects
-    }
-}
-
-/// One stage of the frame, in recording order.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-#[serde(tag = "kind", rename_all = "kebab-case")]
-pub enum StageSpec {
-    /// `scene.upload`: textures and the environment map, first frame only.
-    Upload,
-    /// `shadow.generate`.
-    Shadows,
-    /// `scene.direct`.
-    Direct,
-    Map(MapPlan),
-    /// A family's frame effect (caustics, §6), over some objects.
-    Effect(EffectPlan),
-    Camera(CameraPlan),
-}
-
-/// A frame effect over the objects it was planned for.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct EffectPlan {
-    #[serde(skip)]
-    pub info: EffectInfo,
-    pub name: &'static str,
-    /// Meshes it serves (caustics: the generators).
-    pub objects: Vec<usize>,
-}
-
-impl EffectPlan {
-    pub fn new(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
-        StageSpec::Effect(EffectPlan { info, name: info.name, objects })
-    }
-}
-
-impl StageSpec {
-    pub fn name(&self) -> &'static str {
-        match self {
-            StageSpec::Upload => "scene.upload",
-            StageSpec::Shadows => "shadow.generate",
-            StageSpec::Direct => "scene.direct",
-            StageSpec::Map(m) => m.name,
-            StageSpec::Effect(e) => e.name,
-            StageSpec::Camera(c) => c.name,
-        }
-    }
-    fn order(&self) -> u32 {
-        match self {
-            StageSpec::Upload => order::UPLOAD,
-            StageSpec::Shadows => order::SHADOWS,
-            StageSpec::Direct => order::DIRECT,
-            StageSpec::Map(m) => m.info.order,
-            StageSpec::Effect(e) => e.info.order,
-            StageSpec::Camera(c) => c.pass.order,
-        }
-    }
-
-    /// What its output depends on: when a frame must record it again.
-    pub fn deps(&self) -> Deps {
-        match self {
-            StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
-            StageSpec::Shadows => Deps::Shadows,
-            StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
-            StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
-            StageSpec::Map(_) => Deps::World,
-            StageSpec::Effect(e) => e.info.deps,
-        }
-    }
-
-    /// The meshes it was planned for (none for the frame's own stages).
-    pub fn objects(&self) -> Vec<usize> {
-        match self {
-            StageSpec::Map(m) => m.objects.clone(),
-            StageSpec::Effect(e) => e.objects.clone(),
-            StageSpec::Camera(c) => c.objects.iter().map(|(m, _)| *m).collect(),
-            _ => Vec::new(),
-        }
-    }
-
-    /// The profiled passes it records.
-    pub fn passes(&self, p: &Plan) -> Vec<&'static str> {
-        match self {
-            StageSpec::Effect(e) => (e.info.passes)(p),
-            s => vec![s.name()],
-        }
-    }
-}
-
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Plan {
-    /// What was asked for the whole scene (`--method`).
-    pub choice: Choice,
-    pub quality: Quality,
-    /// Lights that get a cube distance map (point and spot), in cube order.
-    pub shadow_cubes: Vec<usize>,
-    /// Directional lights, each with a planar distance map, in layer order.
-    pub shadow_planes: Vec<usize>,
-    /// Every specular object, in mesh order.
-    pub objects: Vec<ObjectPlan>,
-    /// The objects with cube maps around their own reference points (their views).
-    pub envmaps: Vec<EnvmapPlan>,
-    /// The shared layered map's centre (§4.5), when an object takes `layered`: its six
-    /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
-    pub layered_centre: Option<Vec3>,
-    /// What the renderer records, in order.
-    pub stages: Vec<StageSpec>,
-    /// The stages' names, in order: the stable profiler keys.
-    pub passes: Vec<&'static str>,
-    /// Near plane of cube-map rendering (metres), relative to the scene's size.
-    pub cube_near: f32,
-    /// Distance-map cycles per frame (§4.3).
-    pub cycles: u32,
-    /// Whether specular objects in distance maps search their own maps of the previous
-    /// cycle (§4.3): a method asks for it, or methods are mixed and must compose.
-    pub inter_object: bool,
-    /// Inter-object cycles, one per frame, reusing the previous frame's maps.
-    pub frame_latency: bool,
-    /// Proxy geometry (§3.2): sphere radius and box, world space.
-    pub proxy_radius: f32,
-    pub proxy_box: (Vec3, Vec3),
-    /// Planar mirrors (§5), in mesh order, and the most views a frame of them can have
-    /// (within `mirror_budget`): the layers of their views' image.
-    pub mirrors: Vec<usize>,
-    pub mirror_layers: u32,
-    /// Planar mirrors (§5) drawn into the other objects' cube maps by their mirrored views:
-    /// the first `mirror_budget` planar mirrors, when any object has cube maps.
-    pub map_mirrors: Vec<usize>,
-    /// Caustics (§6): the generators and their lights, when the scene has caustics.
-    pub caustics: Option<crate::methods::caustics::CausticsPlan>,
-}
 
 impl Plan {
     pub fn object(&self, mesh: usize) -> Option<&ObjectPlan> {
@@ -287,7 +86,11 @@ impl Plan {
             e.reference_point = f.reference_point;
         }
         self.layered_centre = fresh.layered_centre;
-        crate::methods::caustics::refresh(self);
+        for f in FAMILIES {
+            if let Some(h) = f.refresh {
+                h(self);
+            }
+        }
         self.cube_near = fresh.cube_near;
         self.proxy_radius = fresh.proxy_radius;
         self.proxy_box = fresh.proxy_box;
@@ -524,25 +327,37 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     let composes =
         !whole_scene && p.objects.iter().filter(|o| self_refracting(o)).any(|o| scene_facts.objects.iter().any(|f| f.sees(o.mesh)));
     // Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
-    crate::methods::layered::share_centre(scene, &mut p);
+    for f in FAMILIES {
+        if let Some(h) = f.plan_objects {
+            h(scene, &mut p);
+        }
+    }
     stages(scene, &mut p, composes);
     Ok(p)
 }
 
-/// Derives the frame's stages from the objects' methods.
+/// Derives the frame's stages from the objects' methods and the families' planning hooks
+/// (`registry::Family`).
 fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let q = p.quality.clone();
     let has_diffuse = scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular());
-    let mut stages = Vec::new();
+    let mut st = PlanStages {
+        maps: Vec::new(),
+        stages: Vec::new(),
+        shades_scene: matches!(p.choice, Choice::Method(m) if m.gpu.is_some_and(|g| g.camera.shades_scene)),
+    };
     if !scene.textures.is_empty() || scene.environment.is_some() {
-        stages.push(StageSpec::Upload);
+        st.stages.push(StageSpec::Upload);
+    }
+    for f in FAMILIES {
+        if let Some(h) = f.plan_frame {
+            h(scene, p);
+        }
     }
     // Shadows matter only where a diffuse surface receives light, and not at all where a
     // whole-scene ray tracer shades every pixel with exact shadow rays (survey §2), unless
     // caustic photons need them (occluders between a light and a generator).
-    let traced_everywhere = matches!(p.choice, Choice::Method(m) if m.family == "raytrace");
-    p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q);
-    if has_diffuse && q.shadows && (!traced_everywhere || p.caustics.is_some()) {
+    if has_diffuse && q.shadows && (!st.shades_scene || p.caustics.is_some()) {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),
@@ -551,9 +366,9 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         }
     }
     if !(p.shadow_cubes.is_empty() && p.shadow_planes.is_empty()) {
-        stages.push(StageSpec::Shadows);
+        st.stages.push(StageSpec::Shadows);
     }
-    stages.push(StageSpec::Direct);
+    st.stages.push(StageSpec::Direct);
 
     // Inter-object cycles (§4.3): asked for by a method, or needed so that mixed methods
     // compose (a mirror's map shows the refractor-mapped glass refracting the room).
@@ -571,28 +386,12 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     }
 
     // Maps: one pass per map kind over the objects that need it, layers in mesh order.
-    let mut maps: Vec<MapPlan> = Vec::new();
     let mut cameras: Vec<CameraPlan> = Vec::new();
     for o in &mut p.objects {
         let spec = gpu(o.method);
         o.map_shading = if p.inter_object { spec.map_shading } else { MapShading::Sky };
         for info in spec.maps {
-            let k = match maps.iter().position(|m| m.name == info.name) {
-                Some(k) => k,
-                None => {
-                    maps.push(MapPlan { info: *info, name: info.name, objects: Vec::new(), bytes: 0 });
-                    maps.len() - 1
-                }
-            };
-            o.maps.push(ObjectMap {
-                pass: info.name,
-                layer: maps[k].objects.len() as u32,
-                layer_field: info.layer_field,
-                what: (info.describe)(&q, (0, 0)),
-                bytes: 0,
-            });
-            maps[k].objects.push(o.mesh);
-            o.passes.push(info.name);
+            st.add_map(o, *info, (info.describe)(&q, (0, 0)));
         }
         let cam = spec.camera;
         match cameras.iter_mut().find(|c| c.name == cam.name) {
@@ -601,49 +400,12 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         }
         o.passes.push(cam.name);
     }
-    // Caustics (§6): generators that a light sees; a solid dielectric among them needs its
-    // refractor map for the photons' paths inside it, whatever its own method.
-    if let Some(c) = &p.caustics {
-        let refractor = crate::methods::distance::REFRACTOR_CUBES;
-        for g in &c.generators {
-            let solid =
-                matches!(scene.materials[scene.meshes[g.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. });
-            let o = p.objects.iter_mut().find(|o| o.mesh == g.mesh).expect("generator is a planned object");
-            if !solid || o.maps.iter().any(|m| m.pass == refractor.name) {
-                continue;
-            }
-            let k = match maps.iter().position(|m| m.name == refractor.name) {
-                Some(k) => k,
-                None => {
-                    maps.push(MapPlan { info: refractor, name: refractor.name, objects: Vec::new(), bytes: 0 });
-                    maps.len() - 1
-                }
-            };
-            o.maps.push(ObjectMap {
-                pass: refractor.name,
-                layer: maps[k].objects.len() as u32,
-                layer_field: refractor.layer_field,
-                what: (refractor.describe)(&q, (0, 0)) + " for its caustics",
-                bytes: 0,
-            });
-            maps[k].objects.push(o.mesh);
-            o.passes.push(refractor.name);
-        }
-        let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
-        stages.push(EffectPlan::new(crate::methods::caustics::STAGE, generators.clone()));
-        // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
-        if !traced_everywhere {
-            stages.push(EffectPlan::new(crate::methods::caustics::PROJECT, generators));
-        }
-        for o in &mut p.objects {
-            if c.generators.iter().any(|g| g.mesh == o.mesh) {
-                o.passes.extend(c.passes(&q));
-                if !traced_everywhere {
-                    o.passes.push("caustics.project");
-                }
-            }
+    for f in FAMILIES {
+        if let Some(h) = f.plan_stages {
+            h(scene, p, &mut st);
         }
     }
+    let PlanStages { mut maps, mut stages, .. } = st;
     // The cube-mapped objects and their views.
     for o in &p.objects {
         let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.info.cube));
@@ -660,17 +422,10 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
             om.bytes = m.bytes / m.objects.len().max(1) as u64;
         }
     }
-    // Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
-    // Flat-faced refractors' faces bring two views each (reflection and refraction).
-    let geometry = [crate::methods::PLANAR_MIRROR, crate::methods::PLANAR_REFRACTION];
-    p.mirrors = p.objects.iter().filter(|o| geometry.contains(&o.method)).map(|o| o.mesh).collect();
-    let planes = p.mirrors.iter().map(|&m| crate::methods::geometry::mirror::plane_count(scene, m)).sum();
-    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(planes, q.depth, q.mirror_budget);
-    // Planar mirrors inside cube maps: one mirrored view per cube face per mirror, at most
-    // mirror_budget mirrors (the rest show the environment there, as before).
-    if !p.envmaps.is_empty() && q.map_mirrors {
-        let planar = p.objects.iter().filter(|o| o.method == crate::methods::PLANAR_MIRROR).map(|o| o.mesh);
-        p.map_mirrors = planar.take(q.mirror_budget as usize).collect();
+    for f in FAMILIES {
+        if let Some(h) = f.plan_views {
+            h(scene, p);
+        }
     }
     stages.extend(maps.into_iter().map(StageSpec::Map));
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
@@ -708,8 +463,8 @@ pub fn table(p: &Plan, scene: &Scene) -> String {
         let knobs: Vec<String> = o.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect();
         let _ = writeln!(s, "  knobs      {}", if knobs.is_empty() { "-".into() } else { knobs.join(" ") });
     }
-    if let Some(c) = &p.caustics {
-        let _ = writeln!(s, "\n{}", crate::methods::caustics::describe(c, &p.quality, scene));
+    for d in FAMILIES.iter().filter_map(|f| f.describe).filter_map(|h| h(p, scene)) {
+        let _ = writeln!(s, "\n{d}");
     }
     let _ = writeln!(s, "\nmaps: {:.2} MiB", p.map_bytes() as f64 / (1 << 20) as f64);
     s

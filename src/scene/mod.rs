@@ -9,6 +9,7 @@
 
 pub mod animation;
 mod environment;
+pub mod faces;
 pub mod gltf;
 pub mod shapes;
 pub mod update;

@@ -27,66 +27,10 @@ use crate::vk::Context;
 use crate::Result;
 
 use crate::gpu_scene::{GpuLight, GpuView};
-use crate::plan::{ObjectPlan, Plan};
+use crate::methods::registry::{Family, PlanStages};
+use crate::plan::{CausticCube, CausticsPlan, EffectPlan, Generator, LightViews, ObjectPlan, Plan};
 use crate::quality::{CausticSpace, Caustics, Quality};
 use crate::scene::{LightKind, Scene};
-
-/// One light's views of a generator: layers `first_layer ..` of the photon images.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct LightViews {
-    pub light: usize,
-    pub first_layer: u32,
-    /// 1 (a cone or an orthographic view), or 6 (a cube around a light inside the
-    /// generator's bounding sphere).
-    pub faces: u32,
-    /// 1, or 2 for a dielectric with `caustic_paths=both`: layers `first_layer + b·faces ..`
-    /// hold branch b (0 refracted, 1 reflected).
-    pub branches: u32,
-    /// The caustic cube its photons land in (`CausticsPlan::cubes`).
-    pub cube: u32,
-}
-
-/// One caustic cube: a receiver distance cube and a light cube map around a centre.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct CausticCube {
-    /// Index into `CausticsPlan::generators`.
-    pub generator: usize,
-    /// `Some(light)`: centred at that light (light space); `None`: at the generator's
-    /// reference point (cube-map space).
-    pub light: Option<usize>,
-}
-
-/// One caustic generator.
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct Generator {
-    pub mesh: usize,
-    pub name: String,
-    /// Its light cube map's and receiver distance map's centre: the object's reference point.
-    pub reference_point: Vec3,
-    pub lights: Vec<LightViews>,
-}
-
-/// The structure of a generator (what it renders), not where it is.
-impl PartialEq for Generator {
-    fn eq(&self, o: &Generator) -> bool {
-        self.mesh == o.mesh && self.lights == o.lights
-    }
-}
-
-/// The caustics stage of a plan.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct CausticsPlan {
-    /// `Splat` or `Triangles`.
-    pub filter: Caustics,
-    pub generators: Vec<Generator>,
-    /// The caustic cubes, in layer order of the cube arrays.
-    pub cubes: Vec<CausticCube>,
-    pub space: CausticSpace,
-    /// Layers of the photon images: Σ faces over every generator's lights.
-    pub photon_layers: u32,
-    /// Device memory of its images.
-    pub bytes: u64,
-}
 
 impl CausticsPlan {
     /// Where cube `c` is this frame: its light's position, or its generator's reference point.
@@ -109,9 +53,50 @@ impl CausticsPlan {
     }
 }
 
-/// Caustics' views are their part of a frame; their stages are planned as effects.
-pub const FAMILY: crate::methods::registry::Family =
-    crate::methods::registry::Family { name: "caustics", frame_part: Some(create_frame_part) };
+/// Caustics are an effect over whatever methods render the objects: planned for the whole
+/// frame, with two effect stages, and views of their own.
+pub const FAMILY: Family = Family {
+    name: "caustics",
+    plan_frame: Some(|scene, p| p.caustics = plan(scene, &p.objects, &p.quality)),
+    plan_stages: Some(plan_stages),
+    refresh: Some(refresh),
+    describe: Some(|p, scene| p.caustics.as_ref().map(|c| describe(c, &p.quality, scene))),
+    frame_part: Some(create_frame_part),
+    ..Family::NONE
+};
+
+/// The pass of the refractor maps (§4.4) that solid generators' photons exit through.
+const REFRACTOR_MAP: &str = "refractor.generate";
+
+/// Caustics' stages: generators that a light sees; a solid dielectric among them needs its
+/// refractor map for the photons' paths inside it, whatever its own method.
+fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
+    let Some(c) = p.caustics.clone() else { return };
+    let refractor = crate::methods::registry::map_named(REFRACTOR_MAP).expect("a registered method makes refractor maps");
+    let q = p.quality.clone();
+    for g in &c.generators {
+        let solid =
+            matches!(scene.materials[scene.meshes[g.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. });
+        let o = p.objects.iter_mut().find(|o| o.mesh == g.mesh).expect("generator is a planned object");
+        if solid {
+            st.add_map(o, refractor, (refractor.describe)(&q, (0, 0)) + " for its caustics");
+        }
+    }
+    let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
+    st.stages.push(EffectPlan::new(STAGE, generators.clone()));
+    // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
+    if !st.shades_scene {
+        st.stages.push(EffectPlan::new(PROJECT, generators));
+    }
+    for o in &mut p.objects {
+        if c.generators.iter().any(|g| g.mesh == o.mesh) {
+            o.passes.extend(c.passes(&q));
+            if !st.shades_scene {
+                o.passes.push(PROJECT.name);
+            }
+        }
+    }
+}
 
 /// The caustics stage (§6): receiver maps, photons, light cube maps, their filter.
 pub const STAGE: EffectInfo = EffectInfo {

@@ -48,10 +48,19 @@ const SHADE: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    shades_scene: false,
 };
 
 const fn proxy(flags: u32) -> CameraPass {
-    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA, create: None }
+    CameraPass {
+        name: "proxy.shade",
+        vertex: "scene/mesh.vert",
+        fragment: "envmap/proxy.frag",
+        flags,
+        order: order::CAMERA,
+        create: None,
+        shades_scene: false,
+    }
 }
 
 pub const ENVMAP: Method = Method(&MethodInfo {

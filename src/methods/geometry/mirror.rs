@@ -57,7 +57,7 @@ impl Mirror {
         let kind = scene.materials.get(m.material).map(|mat| mat.kind);
         match kind {
             Some(crate::scene::SurfaceKind::Dielectric { ior, thin: false }) => {
-                let Some(faces) = super::faces::planar_faces(m, super::faces::MAX_FACES) else { return Vec::new() };
+                let Some(faces) = crate::scene::faces::planar_faces(m, crate::scene::faces::MAX_FACES) else { return Vec::new() };
                 let far = m.positions.iter().fold(0.0f32, |a, p| a.max(p.abs().max_element()));
                 faces
                     .into_iter()
@@ -622,7 +622,7 @@ pub fn plane_count(scene: &Scene, mesh: usize) -> u32 {
     let m = &scene.meshes[mesh];
     match scene.materials.get(m.material).map(|mat| &mat.kind) {
         Some(crate::scene::SurfaceKind::Dielectric { thin: false, .. }) => {
-            super::faces::planar_faces(m, super::faces::MAX_FACES).map_or(0, |f| 2 * f.len() as u32)
+            crate::scene::faces::planar_faces(m, crate::scene::faces::MAX_FACES).map_or(0, |f| 2 * f.len() as u32)
         }
         Some(crate::scene::SurfaceKind::Dielectric { thin: true, .. }) => 2,
         _ => 1,

@@ -8,19 +8,35 @@
 //! environment's vertices to their virtual positions instead (`curved`).
 
 pub mod curved;
-pub mod faces;
+
 pub mod mirror;
 pub mod views;
 
 pub use curved::CURVED_REFLECTOR;
 
 use crate::frame::stage::order;
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
+use crate::methods::registry::{CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
 use crate::quality::Quality;
 
-/// Planar mirrors' views (§5) are the geometry family's part of a frame.
-pub const FAMILY: crate::methods::registry::Family =
-    crate::methods::registry::Family { name: "geometry", frame_part: Some(views::create_frame_part) };
+/// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
+pub const FAMILY: Family =
+    Family { name: "geometry", plan_views: Some(plan_views), frame_part: Some(views::create_frame_part), ..Family::NONE };
+
+/// Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
+/// Flat-faced refractors' faces bring two views each (reflection and refraction).
+fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::Plan) {
+    let q = &p.quality;
+    let planar = [PLANAR_MIRROR, PLANAR_REFRACTION];
+    p.mirrors = p.objects.iter().filter(|o| planar.contains(&o.method)).map(|o| o.mesh).collect();
+    let planes = p.mirrors.iter().map(|&m| mirror::plane_count(scene, m)).sum();
+    p.mirror_layers = mirror::layers_needed(planes, q.depth, q.mirror_budget);
+    // Planar mirrors inside cube maps: one mirrored view per cube face per mirror, at most
+    // mirror_budget mirrors (the rest show the environment there, as before).
+    if !p.envmaps.is_empty() && q.map_mirrors {
+        let mirrors = p.objects.iter().filter(|o| o.method == PLANAR_MIRROR).map(|o| o.mesh);
+        p.map_mirrors = mirrors.take(q.mirror_budget as usize).collect();
+    }
+}
 
 const fn one(_: &Quality) -> u32 {
     1
@@ -35,6 +51,7 @@ pub const MIRROR_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    shades_scene: false,
 };
 
 pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
@@ -66,6 +83,7 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    shades_scene: false,
 };
 
 pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {

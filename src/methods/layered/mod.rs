@@ -55,6 +55,7 @@ pub const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    shades_scene: false,
 };
 
 pub const LAYERED: Method = Method(&MethodInfo {
@@ -120,6 +121,10 @@ pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec
         b.center()
     }
 }
+
+/// Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
+pub const FAMILY: crate::methods::registry::Family =
+    crate::methods::registry::Family { name: "layered", plan_objects: Some(share_centre), ..crate::methods::registry::Family::NONE };
 
 /// Gives every layered object of the plan the shared map's reference point.
 pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {

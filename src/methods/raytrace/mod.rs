@@ -54,6 +54,7 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
         flags: 0,
         order: order::RAYTRACE,
         create: Some(create),
+        shades_scene: true,
     }
 }
 

@@ -1,0 +1,273 @@
+//! The plan's data: per specular object its method (a registry handle) and maps, the
+//! frame's stages in recording order, and what the families planned for the whole frame
+//! (shadow maps, planar mirrors' view layers, the shared layered map's centre, the
+//! caustics' generators). Plain data, built by `plan::plan` and the families' planning
+//! hooks (`registry::Family`), read by the renderer and the families' stages.
+
+use glam::Vec3;
+
+use crate::frame::stage::{order, Deps, EffectInfo, MapInfo};
+use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass};
+use crate::quality::{CausticSpace, Caustics, Quality};
+
+/// One cube-mapped object's views: the six faces around its reference point.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct EnvmapPlan {
+    pub mesh: usize,
+    /// Index of the object among the plan's cube-mapped objects.
+    pub layer: u32,
+    pub reference_point: Vec3,
+}
+
+/// One map an object gets.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ObjectMap {
+    /// The pass that makes it.
+    pub pass: &'static str,
+    /// The object's layer in that pass's map array.
+    pub layer: u32,
+    #[serde(skip)]
+    pub layer_field: Option<crate::frame::stage::LayerField>,
+    pub what: String,
+    pub bytes: u64,
+}
+
+/// One specular object's plan.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ObjectPlan {
+    pub mesh: usize,
+    pub name: String,
+    pub class: ObjectClass,
+    pub method: Method,
+    /// Why this method: the user's choice, the scene file's, or the planner's rule.
+    pub reason: String,
+    pub reference_point: Vec3,
+    /// The object's own reference point, before a shared map (layered, §4.5) moved
+    /// `reference_point` to the map's: its caustics' cube is centred here, where the
+    /// receiver map it searches does not have the object itself in front of the receivers.
+    #[serde(skip)]
+    pub own_reference_point: Vec3,
+    /// Set when the automatic reference point had to move (or could not).
+    pub reference_note: Option<String>,
+    /// How the object appears in the other objects' distance maps.
+    pub map_shading: MapShading,
+    /// What its own cube maps leave out.
+    pub leaves_out: LeavesOut,
+    pub maps: Vec<ObjectMap>,
+    /// The passes that draw or map this object.
+    pub passes: Vec<&'static str>,
+    /// The knobs its method reads, with their values in force.
+    pub knobs: Vec<(&'static str, String)>,
+}
+
+/// A map pass over all the objects that need that map.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct MapPlan {
+    #[serde(skip)]
+    pub info: MapInfo,
+    pub name: &'static str,
+    /// Meshes, in layer order.
+    pub objects: Vec<usize>,
+    pub bytes: u64,
+}
+
+/// A camera pass over the objects of the methods that share it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CameraPlan {
+    #[serde(skip)]
+    pub pass: CameraPass,
+    pub name: &'static str,
+    /// (mesh, push flags of its method).
+    pub objects: Vec<(usize, u32)>,
+}
+
+impl PartialEq for CameraPlan {
+    fn eq(&self, o: &CameraPlan) -> bool {
+        self.name == o.name && self.objects == o.objects
+    }
+}
+
+/// One stage of the frame, in recording order.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum StageSpec {
+    /// `scene.upload`: textures and the environment map, first frame only.
+    Upload,
+    /// `shadow.generate`.
+    Shadows,
+    /// `scene.direct`.
+    Direct,
+    Map(MapPlan),
+    /// A family's frame effect (caustics, §6), over some objects.
+    Effect(EffectPlan),
+    Camera(CameraPlan),
+}
+
+/// A frame effect over the objects it was planned for.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct EffectPlan {
+    #[serde(skip)]
+    pub info: EffectInfo,
+    pub name: &'static str,
+    /// Meshes it serves (caustics: the generators).
+    pub objects: Vec<usize>,
+}
+
+impl EffectPlan {
+    pub fn new(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
+        StageSpec::Effect(EffectPlan { info, name: info.name, objects })
+    }
+}
+
+impl StageSpec {
+    pub fn name(&self) -> &'static str {
+        match self {
+            StageSpec::Upload => "scene.upload",
+            StageSpec::Shadows => "shadow.generate",
+            StageSpec::Direct => "scene.direct",
+            StageSpec::Map(m) => m.name,
+            StageSpec::Effect(e) => e.name,
+            StageSpec::Camera(c) => c.name,
+        }
+    }
+    pub fn order(&self) -> u32 {
+        match self {
+            StageSpec::Upload => order::UPLOAD,
+            StageSpec::Shadows => order::SHADOWS,
+            StageSpec::Direct => order::DIRECT,
+            StageSpec::Map(m) => m.info.order,
+            StageSpec::Effect(e) => e.info.order,
+            StageSpec::Camera(c) => c.pass.order,
+        }
+    }
+
+    /// What its output depends on: when a frame must record it again.
+    pub fn deps(&self) -> Deps {
+        match self {
+            StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
+            StageSpec::Shadows => Deps::Shadows,
+            StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
+            StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
+            StageSpec::Map(_) => Deps::World,
+            StageSpec::Effect(e) => e.info.deps,
+        }
+    }
+
+    /// The meshes it was planned for (none for the frame's own stages).
+    pub fn objects(&self) -> Vec<usize> {
+        match self {
+            StageSpec::Map(m) => m.objects.clone(),
+            StageSpec::Effect(e) => e.objects.clone(),
+            StageSpec::Camera(c) => c.objects.iter().map(|(m, _)| *m).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// The profiled passes it records.
+    pub fn passes(&self, p: &Plan) -> Vec<&'static str> {
+        match self {
+            StageSpec::Effect(e) => (e.info.passes)(p),
+            s => vec![s.name()],
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Plan {
+    /// What was asked for the whole scene (`--method`).
+    pub choice: Choice,
+    pub quality: Quality,
+    /// Lights that get a cube distance map (point and spot), in cube order.
+    pub shadow_cubes: Vec<usize>,
+    /// Directional lights, each with a planar distance map, in layer order.
+    pub shadow_planes: Vec<usize>,
+    /// Every specular object, in mesh order.
+    pub objects: Vec<ObjectPlan>,
+    /// The objects with cube maps around their own reference points (their views).
+    pub envmaps: Vec<EnvmapPlan>,
+    /// The shared layered map's centre (§4.5), when an object takes `layered`: its six
+    /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
+    pub layered_centre: Option<Vec3>,
+    /// What the renderer records, in order.
+    pub stages: Vec<StageSpec>,
+    /// The stages' names, in order: the stable profiler keys.
+    pub passes: Vec<&'static str>,
+    /// Near plane of cube-map rendering (metres), relative to the scene's size.
+    pub cube_near: f32,
+    /// Distance-map cycles per frame (§4.3).
+    pub cycles: u32,
+    /// Whether specular objects in distance maps search their own maps of the previous
+    /// cycle (§4.3): a method asks for it, or methods are mixed and must compose.
+    pub inter_object: bool,
+    /// Inter-object cycles, one per frame, reusing the previous frame's maps.
+    pub frame_latency: bool,
+    /// Proxy geometry (§3.2): sphere radius and box, world space.
+    pub proxy_radius: f32,
+    pub proxy_box: (Vec3, Vec3),
+    /// Planar mirrors (§5), in mesh order, and the most views a frame of them can have
+    /// (within `mirror_budget`): the layers of their views' image.
+    pub mirrors: Vec<usize>,
+    pub mirror_layers: u32,
+    /// Planar mirrors (§5) drawn into the other objects' cube maps by their mirrored views:
+    /// the first `mirror_budget` planar mirrors, when any object has cube maps.
+    pub map_mirrors: Vec<usize>,
+    /// Caustics (§6): the generators and their lights, when the scene has caustics.
+    pub caustics: Option<CausticsPlan>,
+}
+
+/// One light's views of a generator: layers `first_layer ..` of the photon images.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LightViews {
+    pub light: usize,
+    pub first_layer: u32,
+    /// 1 (a cone or an orthographic view), or 6 (a cube around a light inside the
+    /// generator's bounding sphere).
+    pub faces: u32,
+    /// 1, or 2 for a dielectric with `caustic_paths=both`: layers `first_layer + b·faces ..`
+    /// hold branch b (0 refracted, 1 reflected).
+    pub branches: u32,
+    /// The caustic cube its photons land in (`CausticsPlan::cubes`).
+    pub cube: u32,
+}
+
+/// One caustic cube: a receiver distance cube and a light cube map around a centre.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CausticCube {
+    /// Index into `CausticsPlan::generators`.
+    pub generator: usize,
+    /// `Some(light)`: centred at that light (light space); `None`: at the generator's
+    /// reference point (cube-map space).
+    pub light: Option<usize>,
+}
+
+/// One caustic generator.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Generator {
+    pub mesh: usize,
+    pub name: String,
+    /// Its light cube map's and receiver distance map's centre: the object's reference point.
+    pub reference_point: Vec3,
+    pub lights: Vec<LightViews>,
+}
+
+/// The structure of a generator (what it renders), not where it is.
+impl PartialEq for Generator {
+    fn eq(&self, o: &Generator) -> bool {
+        self.mesh == o.mesh && self.lights == o.lights
+    }
+}
+
+/// The caustics stage of a plan.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CausticsPlan {
+    /// `Splat` or `Triangles`.
+    pub filter: Caustics,
+    pub generators: Vec<Generator>,
+    /// The caustic cubes, in layer order of the cube arrays.
+    pub cubes: Vec<CausticCube>,
+    pub space: CausticSpace,
+    /// Layers of the photon images: Σ faces over every generator's lights.
+    pub photon_layers: u32,
+    /// Device memory of its images.
+    pub bytes: u64,
+}
