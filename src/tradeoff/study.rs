@@ -139,14 +139,16 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let mut plans: Vec<(String, crate::plan::Plan)> = Vec::new();
     for (method, (knob, variants)) in runs {
         let name = knob.as_ref().map_or_else(|| method.name().to_string(), |k| format!("{} ({k})", method.name()));
-        // A ray tracer in the original geometry (survey §2) makes no maps and no shadow
-        // maps: only the knobs it lists change its image, so variants that agree on those
-        // are measured once and reported for each (the sweeps are usually map knobs). Not
-        // when the frame has caustics (§6): they come from light cube maps, refractor maps
-        // and shadow maps whatever the method, so every map knob can change its image.
-        let raytrace = match method {
+        // A method that shades every pixel in its own stage (its registry entry says so:
+        // ray tracing in the original geometry, survey §2, makes no maps and no shadow
+        // maps) has an image only the knobs it lists and the frame's change, so variants
+        // that agree on those are measured once and reported for each (the sweeps are
+        // usually map knobs). Not when the frame has caustics (§6): they come from light
+        // cube maps, refractor maps and shadow maps whatever the method, so every map knob
+        // can change its image.
+        let decided_by = match method {
             // Its own knobs and the frame's.
-            Choice::Method(m) if m.family == "raytrace" => {
+            Choice::Method(m) if m.gpu.is_some_and(|g| g.shades_every_pixel) => {
                 Some(crate::quality::KNOBS.iter().map(|k| k.name).filter(|k| m.knobs.contains(k) || frame_knob(k)).collect::<Vec<_>>())
             }
             _ => None,
@@ -154,7 +156,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
         let mut measured: Vec<(String, crate::Frame, ImageErrors, Vec<crate::metrics::MaskedError>)> = Vec::new();
         for (label, q) in variants {
             progress(Progress::Begin(format!("{name} {label}")));
-            let reads = raytrace.as_ref().filter(|_| !has_caustics(q));
+            let reads = decided_by.as_ref().filter(|_| !has_caustics(q));
             let key = reads.map(|knobs| knobs.iter().map(|k| q.get(k)).collect::<Vec<_>>().join(" "));
             let done = key.as_ref().and_then(|k| measured.iter().position(|(mk, _, _, _)| mk == k));
             let i = match done {
