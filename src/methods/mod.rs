@@ -71,6 +71,24 @@ mod tests {
     }
 
     #[test]
+    fn registry_refuses_a_method_that_shades_every_pixel_yet_leans_on_others() {
+        use registry::GpuSpec;
+        const fn whole(g: Option<GpuSpec>) -> Option<GpuSpec> {
+            match g {
+                Some(g) => Some(GpuSpec { shades_every_pixel: true, ..g }),
+                None => None,
+            }
+        }
+        // Maps (and no stage of its own): other passes reach its image.
+        static MAPPED: MethodInfo = MethodInfo { name: "other", abi: 78, gpu: whole(DISTANCE.0.gpu), ..*DISTANCE.0 };
+        assert!(registry::check(&[Method(&MAPPED)]).unwrap_err().contains("shades every pixel"));
+        // A fallback: its objects are another method's.
+        static FALLS_BACK: MethodInfo = MethodInfo { name: "other", abi: 78, fallback: Some(DISTANCE), ..*BVH.0 };
+        assert!(registry::check(&[Method(&FALLS_BACK)]).unwrap_err().contains("shades every pixel"));
+        assert!(BVH.gpu.is_some_and(|g| g.shades_every_pixel) && !DISTANCE.gpu.is_some_and(|g| g.shades_every_pixel));
+    }
+
+    #[test]
     fn every_whole_scene_method_covers_every_class() {
         for m in ALL {
             for c in EVERY_CLASS {

@@ -128,6 +128,12 @@ pub struct GpuSpec {
     pub leaves_out: LeavesOut,
     /// Distance-map cycles per frame this method asks for (§4.3).
     pub cycles: fn(&Quality) -> u32,
+    /// Whether, asked for the whole scene (`--method`), it shades every pixel in its own
+    /// stage, diffuse surfaces included (exact shadow rays), from no maps and with no
+    /// fallback: no other family's pass reaches its image, so only the knobs it lists and
+    /// the frame's change it (`tradeoff` measures variants that agree on those once;
+    /// caustics, §6, aside). Ray tracing in the original geometry (§2).
+    pub shades_every_pixel: bool,
 }
 
 /// One method, described once.
@@ -391,7 +397,7 @@ impl From<Method> for Choice {
 
 /// Checks the registry: names and numbers unique, every knob a method reads exists, every
 /// fallback serves what the method does not, methods sharing a camera pass share its
-/// shaders. `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
+/// shaders, a method that shades every pixel has its own stage and no maps or fallback. `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
 pub fn check(all: &[Method]) -> std::result::Result<(), String> {
     for (i, a) in all.iter().enumerate() {
         for b in &all[i + 1..] {
@@ -419,6 +425,11 @@ pub fn check(all: &[Method]) -> std::result::Result<(), String> {
         if let Some(f) = a.fallback {
             if !f.is_gpu() || a.is_gpu() != f.is_gpu() {
                 return Err(format!("'{}' falls back to '{}' of another kind", a.name, f.name));
+            }
+        }
+        if let Some(g) = a.gpu.filter(|g| g.shades_every_pixel) {
+            if !g.maps.is_empty() || a.fallback.is_some() || g.camera.create.is_none() {
+                return Err(format!("'{}' shades every pixel but has maps, a fallback or no stage of its own", a.name));
             }
         }
     }

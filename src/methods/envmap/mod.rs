@@ -38,7 +38,14 @@ const fn one(_: &Quality) -> u32 {
 }
 
 const fn spec(camera: CameraPass) -> GpuSpec {
-    GpuSpec { maps: &[RADIANCE_CUBES], camera, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }
+    GpuSpec {
+        maps: &[RADIANCE_CUBES],
+        camera,
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Itself,
+        cycles: one,
+        shades_every_pixel: false,
+    }
 }
 
 const SHADE: CameraPass = CameraPass {

@@ -68,7 +68,7 @@ pub const LAYERED: Method = Method(&MethodInfo {
     knobs: &[
         "layers", "layered_branches", "depth", "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "search_tolerance",
     ],
-    gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one }),
+    gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, shades_every_pixel: false }),
     fallback: None,
     shape: Shape::Any,
     rule: layered_rule,

@@ -107,7 +107,14 @@ fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
 /// Every ray tracer's GPU side: no maps, its own stage, seen in other objects' maps as the
 /// environment only.
 const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Result<Box<dyn Stage>>) -> GpuSpec {
-    GpuSpec { maps: &[], camera: camera(name, create), map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one }
+    GpuSpec {
+        maps: &[],
+        camera: camera(name, create),
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Nothing,
+        cycles: one,
+        shades_every_pixel: true,
+    }
 }
 
 const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
