@@ -96,11 +96,6 @@ pub struct CameraPass {
     /// with `vertex` and `fragment` (ray tracing in the original geometry: a pipeline of
     /// passes).
     pub create: Option<CreateCamera>,
-    /// Its stage shades every pixel of the frame when its method serves the whole scene,
-    /// diffuse surfaces included, with exact shadow rays and the caustics projected in its
-    /// own kernel (ray tracing in the original geometry, §2): the frame then needs no
-    /// shadow maps (unless caustic photons do) and no `caustics.project`.
-    pub shades_scene: bool,
 }
 
 /// Creates a method's own camera stage for the plan's objects.
@@ -257,7 +252,8 @@ impl Family {
 pub struct PlanStages {
     pub maps: Vec<crate::plan::MapPlan>,
     pub stages: Vec<crate::plan::StageSpec>,
-    /// A whole-scene method shades every pixel itself (`CameraPass::shades_scene`).
+    /// A whole-scene method shades every pixel itself (`GpuSpec::shades_every_pixel`): with
+    /// exact shadow rays and the caustics projected in its own kernel.
     pub shades_scene: bool,
 }
 

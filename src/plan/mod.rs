@@ -344,7 +344,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let mut st = PlanStages {
         maps: Vec::new(),
         stages: Vec::new(),
-        shades_scene: matches!(p.choice, Choice::Method(m) if m.gpu.is_some_and(|g| g.camera.shades_scene)),
+        shades_scene: matches!(p.choice, Choice::Method(m) if m.gpu.is_some_and(|g| g.shades_every_pixel)),
     };
     if !scene.textures.is_empty() || scene.environment.is_some() {
         st.stages.push(StageSpec::Upload);

@@ -94,7 +94,6 @@ const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: Some(create_search),
-    shades_scene: false,
 };
 
 /// `distance.search`, which the test knob `debug_fault=flip_reflection` breaks on purpose.
@@ -207,7 +206,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
-        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None, shades_scene: false },
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None },
         map_shading: MapShading::Refractor,
         leaves_out: LeavesOut::Itself,
         cycles: one,
@@ -256,7 +255,6 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
             flags: 0,
             order: order::CAMERA + 2,
             create: None,
-            shades_scene: false,
         },
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,

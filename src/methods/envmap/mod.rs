@@ -55,19 +55,10 @@ const SHADE: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
-    shades_scene: false,
 };
 
 const fn proxy(flags: u32) -> CameraPass {
-    CameraPass {
-        name: "proxy.shade",
-        vertex: "scene/mesh.vert",
-        fragment: "envmap/proxy.frag",
-        flags,
-        order: order::CAMERA,
-        create: None,
-        shades_scene: false,
-    }
+    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA, create: None }
 }
 
 pub const ENVMAP: Method = Method(&MethodInfo {

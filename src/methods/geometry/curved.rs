@@ -50,7 +50,6 @@ pub const CURVED_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: Some(create),
-    shades_scene: false,
 };
 
 const fn one(_: &Quality) -> u32 {

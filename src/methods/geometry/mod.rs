@@ -51,7 +51,6 @@ pub const MIRROR_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
-    shades_scene: false,
 };
 
 pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
@@ -83,7 +82,6 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
-    shades_scene: false,
 };
 
 pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {

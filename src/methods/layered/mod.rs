@@ -55,7 +55,6 @@ pub const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
-    shades_scene: false,
 };
 
 pub const LAYERED: Method = Method(&MethodInfo {

@@ -54,7 +54,6 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
         flags: 0,
         order: order::RAYTRACE,
         create: Some(create),
-        shades_scene: true,
     }
 }
 
