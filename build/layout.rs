@@ -700,7 +700,9 @@ pub fn merged() -> Result<Layout, String> {
             errors.push(format!("layout: const `{}` is declared twice", c.name));
         }
     }
-    let _ = owners;
+    if let Err(e) = check_flags(&l, &owners) {
+        errors.push(e);
+    }
     if errors.is_empty() {
         Ok(l)
     } else {

@@ -95,7 +95,7 @@ gpu_structs! {
         /// first view of this draw (multiview adds gl_ViewIndex)
         view: uint,
         object: uint,
-        /// FLAG_*
+        /// FLAG_* and the drawing pass's own bits (`flag_bits!`)
         flags: uint,
         light_count: uint,
         search: SearchKnobs,
@@ -137,7 +137,16 @@ gpu_consts! {
     FLAG_HAS_ENVIRONMENT: uint = 2;
     /// `Push.flags` (`shadows=off`): punctual lights reach every diffuse surface facing them
     /// unoccluded (no shadow maps are planned; ray tracers send no shadow rays).
-    FLAG_UNSHADOWED: uint = 8192;
+    FLAG_UNSHADOWED: uint = 32;
+}
+
+// Who owns which bits of `Push.flags`. `every_pass` bits are in the frame-wide flags, so no
+// other owner may use them; `own_passes` bits are set only on the owner's own passes, so
+// families may reuse each other's. build/layout.rs refuses a flag outside its owner's range
+// and any overlap with an `every_pass` range: a pass's own bits never alias a frame-wide flag.
+flag_bits! {
+    every_pass 0..2 { FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT }
+    every_pass 5..6 { FLAG_UNSHADOWED }
 }
 
 descriptor_sets! {

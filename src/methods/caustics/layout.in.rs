@@ -50,11 +50,18 @@ gpu_consts! {
     CAUSTIC_CUBE_SHIFT: uint = 8;
     /// `Push.flags` of the photon pass: this layer's photons take the reflected branch at a
     /// dielectric generator's surface (else the refracted one).
-    CAUSTIC_REFLECTED: uint = 64;
+    CAUSTIC_REFLECTED: uint = 65536;
     CAUSTIC_LIGHT_SHIFT: uint = 20;
     /// Caustic triangles whose corners' distances from the reference point differ by more
     /// than this fraction land on different surfaces (§6.3.2) and are dropped.
     CAUSTIC_GAP: float = 0.1;
+}
+
+flag_bits! {
+    /// `scene.direct` is the frame's pass: the caustics' flag there is frame-wide.
+    every_pass 7..8 { FLAG_CAUSTICS_APART }
+    /// The photon pass's cube, branch and light.
+    own_passes 8..32 { CAUSTIC_CUBE_SHIFT: 8, CAUSTIC_REFLECTED, CAUSTIC_LIGHT_SHIFT: 12 }
 }
 
 descriptor_sets! {

@@ -4,9 +4,12 @@
 
 gpu_consts! {
     /// `Push.flags` of `distance.search` only (`debug_fault=flip_reflection`, a test knob):
-    /// the reflected ray is traced in the opposite direction. Never in the frame-wide flags
-    /// (bits 8–15 of the photon pass's flags are its cube index).
+    /// the reflected ray is traced in the opposite direction.
     FLAG_DEBUG_FLIP_REFLECTION: uint = 16384;
+}
+
+flag_bits! {
+    own_passes 14..15 { FLAG_DEBUG_FLIP_REFLECTION }
 }
 
 descriptor_sets! {

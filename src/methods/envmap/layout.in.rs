@@ -12,6 +12,11 @@ gpu_consts! {
     FLAG_FIRST_CYCLE: uint = 16;
 }
 
+flag_bits! {
+    /// The proxy on its camera draws; the inter-object cycles on the map generation's draws.
+    own_passes 2..5 { FLAG_INTER_OBJECT, FLAG_PROXY_BOX, FLAG_FIRST_CYCLE }
+}
+
 descriptor_sets! {
     BINDINGS = set 0 {
         ENVMAPS = 8: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray envmaps";

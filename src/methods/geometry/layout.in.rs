@@ -38,7 +38,7 @@ gpu_consts! {
     /// in the `(flags >> MIRROR_COUNT_SHIFT)` layers of `mirror_views` from `(flags >>
     /// MIRROR_LAYER_SHIFT) & 0xff` on; without the flag (or for a plane none of them is
     /// of), the budget's fallback (the environment along the ray).
-    FLAG_MIRROR_VIEW: uint = 32;
+    FLAG_MIRROR_VIEW: uint = 32768;
     MIRROR_LAYER_SHIFT: uint = 16;
     MIRROR_COUNT_SHIFT: uint = 24;
 
@@ -57,6 +57,12 @@ gpu_consts! {
     /// Curved reflectors: a reflector pixel its virtual image leaves uncovered takes the
     /// nearest covered pixel within this many pixels (the holes at its silhouette and rim).
     CURVED_FILL: int = 2;
+}
+
+flag_bits! {
+    /// Planar mirrors' child views on `geometry.mirror` and `geometry.refract` draws; the curved
+    /// reflector's layer on `geometry.curved` and `geometry.virtual` draws.
+    own_passes 15..32 { FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT: 8, MIRROR_COUNT_SHIFT: 8, CURVED_REFLECTOR_SHIFT: 16 }
 }
 
 descriptor_sets! {

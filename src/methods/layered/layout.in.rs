@@ -19,7 +19,14 @@ gpu_consts! {
     LAYERED_STACK: uint = 8;
     /// `Push.flags`: a dielectric hit in the layered maps follows only its stronger Fresnel
     /// branch (`layered_branches=strongest`).
-    FLAG_LAYERED_STRONGEST: uint = 4096;
+    FLAG_LAYERED_STRONGEST: uint = 64;
+}
+
+flag_bits! {
+    /// The branch choice is frame-wide: every pass that traces the layered maps reads it.
+    every_pass 6..7 { FLAG_LAYERED_STRONGEST }
+    /// `layered.peel`'s first layer and cube face.
+    own_passes 8..12 { LAYERED_FIRST, LAYERED_FACE_SHIFT: 3 }
 }
 
 descriptor_sets! {
