@@ -568,7 +568,7 @@ pub fn rust(l: &Layout) -> String {
     out.push_str(
         "\n/// Every shared struct as Rust lays it out: (name, size, [(field, offset)]), for the\n\
          /// test that compares it with the generator's std430 offsets (tests/layout.rs).\n\
-         #[doc(hidden)]\npub const RUST_LAYOUTS: &[(&str, usize, &[(&str, usize)])] = &[\n",
+         #[doc(hidden)]\n#[allow(clippy::type_complexity)]\npub const RUST_LAYOUTS: &[(&str, usize, &[(&str, usize)])] = &[\n",
     );
     for s in &l.structs {
         let fields: Vec<String> =
