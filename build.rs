@@ -25,28 +25,33 @@ fn main() {
     println!("cargo:rerun-if-changed=glsl");
     println!("cargo:rerun-if-changed=build/shaderc.rs");
     println!("cargo:rerun-if-changed=build/layout.rs");
-    println!("cargo:rerun-if-changed=src/frame/layout.in.rs");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-env-changed=GLSLANG_VALIDATOR");
 
-    // The shared declaration's GLSL side (`#include "generated/layout.glsl"`), after checking
-    // that std430 and repr(C) agree on every field's offset.
+    // The shared declaration: the frame's and each family's file, concatenated; its Rust side
+    // (`$OUT_DIR/layout.rs`, included by src/frame/layout.rs) and its GLSL side
+    // (`#include "generated/layout.glsl"`), after checking that std430 and repr(C) agree on
+    // every field's offset and that no two owners' push flags collide.
     let generated = out.join("glsl");
-    match layout::glsl(&layout::declared()) {
-        Ok(text) => {
+    let declared = layout_files(&root).and_then(|files| {
+        for f in &files {
+            println!("cargo:rerun-if-changed={f}");
+        }
+        let l = layout::merged()?;
+        Ok((layout::glsl(&l)?, layout::rust(&l)))
+    });
+    match declared {
+        Ok((glsl, rust)) => {
             std::fs::create_dir_all(generated.join("generated")).unwrap();
-            let path = generated.join("generated/layout.glsl");
-            // Rewritten only when it changes, so that its timestamp means something.
-            if std::fs::read_to_string(&path).ok().as_deref() != Some(text.as_str()) {
-                std::fs::write(&path, text).unwrap();
-            }
+            write_if_changed(&generated.join("generated/layout.glsl"), &glsl);
+            write_if_changed(&out.join("layout.rs"), &rust);
         }
         Err(e) => {
             for line in e.lines() {
                 println!("cargo:warning={line}");
             }
             eprintln!("{e}");
-            eprintln!("src/frame/layout.in.rs: the shared layout is refused");
+            eprintln!("src/frame/layout.in.rs, src/methods/*/layout.in.rs: the shared layout is refused");
             std::process::exit(1);
         }
     }
@@ -94,4 +99,34 @@ fn main() {
         std::process::exit(1);
     }
     std::fs::write(out.join("shaders.rs"), table).unwrap();
+}
+
+/// Rewritten only when it changes, so that its timestamp means something.
+fn write_if_changed(path: &std::path::Path, text: &str) {
+    if std::fs::read_to_string(path).ok().as_deref() != Some(text) {
+        std::fs::write(path, text).unwrap();
+    }
+}
+
+/// The declaration files: the frame's and every `src/methods/<family>/layout.in.rs`, which
+/// must be the families build/layout.rs concatenates (it includes them at compile time).
+fn layout_files(root: &std::path::Path) -> Result<Vec<String>, String> {
+    let mut found: Vec<String> = std::fs::read_dir(root.join("src/methods"))
+        .map_err(|e| format!("src/methods: {e}"))?
+        .flatten()
+        .filter(|e| e.path().join("layout.in.rs").is_file())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    found.sort();
+    let mut listed: Vec<String> = layout::families().into_iter().map(String::from).collect();
+    listed.sort();
+    if found != listed {
+        return Err(format!(
+            "layout: src/methods/*/layout.in.rs are {found:?}, build/layout.rs concatenates {listed:?}: \
+             add the family's line to its `declarations!`"
+        ));
+    }
+    let mut files = vec!["src/frame/layout.in.rs".to_string()];
+    files.extend(found.iter().map(|f| format!("src/methods/{f}/layout.in.rs")));
+    Ok(files)
 }

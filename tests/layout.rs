@@ -143,6 +143,91 @@ fn inconsistent_bindings_are_refused() {
     assert!(err.contains("`B` is set 2, expected set 1"), "{err}");
 }
 
+/// Every `src/methods/<family>/layout.in.rs` is one that build/layout.rs concatenates (it
+/// includes them at compile time, so a file it does not list would be silently left out).
+#[test]
+fn every_family_declaration_is_concatenated() {
+    let methods = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/methods");
+    let mut found: Vec<String> = std::fs::read_dir(&methods)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().join("layout.in.rs").is_file())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    found.sort();
+    let mut listed: Vec<String> = layout::families().into_iter().map(String::from).collect();
+    listed.sort();
+    assert_eq!(found, listed);
+    // Each family's part reaches both sides: a binding it adds to the frame's set, a struct.
+    use specula::frame::layout::{binding, GpuRayQuery, BINDINGS};
+    assert!(BINDINGS.iter().any(|&(b, _, _)| b == binding::CAUSTIC_FACES));
+    let text = layout::glsl(&layout::declared()).unwrap();
+    assert!(text.contains("layout(set = 0, binding = 8) uniform samplerCubeArray envmaps;"), "{text}");
+    assert!(text.contains("struct RayQuery {"), "{text}");
+    assert_eq!(std::mem::size_of::<GpuRayQuery>(), 48);
+}
+
+/// The declared push flags: no owner's bits alias a frame-wide flag, and each flag lies in the
+/// range its owner declares.
+#[test]
+fn declared_push_flags_do_not_collide() {
+    let l = layout::merged().unwrap_or_else(|e| panic!("{e}"));
+    let every: Vec<_> = l.flags.iter().filter(|r| r.scope == "every_pass").collect();
+    assert!(every.iter().any(|r| r.owner == "frame") && every.iter().any(|r| r.owner == "layered"));
+    for r in &l.flags {
+        assert!(r.bits.1 <= 32, "{} {:?}", r.owner, r.bits);
+        for e in &every {
+            let overlap = r.bits.0 < e.bits.1 && e.bits.0 < r.bits.1;
+            assert!(std::ptr::eq(r, *e) || !overlap, "{} {:?} and {} {:?}", r.owner, r.bits, e.owner, e.bits);
+        }
+    }
+}
+
+mod frame_flags {
+    gpu_consts! {
+        FLAG_A: uint = 4096;
+        FLAG_C: uint = 3;
+        FLAG_LOOSE: uint = 1;
+    }
+    flag_bits! {
+        every_pass 12..13 { FLAG_A }
+        every_pass 0..2 { FLAG_C }
+    }
+}
+
+mod family_flags {
+    gpu_consts! {
+        B_SHIFT: uint = 8;
+        D_SHIFT: uint = 14;
+    }
+    flag_bits! {
+        own_passes 8..16 { B_SHIFT: 8, D_SHIFT: 4, FLAG_A }
+        own_passes 30..33 {}
+    }
+}
+
+#[test]
+fn colliding_push_flags_are_refused() {
+    let owned = |mut f: Vec<layout::FlagBits>, owner| {
+        f.iter_mut().for_each(|r| r.owner = owner);
+        f
+    };
+    let l = layout::Layout {
+        consts: frame_flags::consts().into_iter().chain(family_flags::consts()).collect(),
+        flags: owned(frame_flags::flag_bits(), "frame").into_iter().chain(owned(family_flags::flag_bits(), "caustics")).collect(),
+        ..Default::default()
+    };
+    let owners = vec![("frame", vec!["FLAG_A", "FLAG_C", "FLAG_LOOSE"]), ("caustics", vec!["B_SHIFT", "D_SHIFT"])];
+    let err = layout::check_flags(&l, &owners).unwrap_err();
+    println!("{err}");
+    assert!(err.contains("caustics flag bits 8..16 (own_passes) overlap frame's bits 12..13 (every_pass)"), "{err}");
+    assert!(err.contains("caustics flag bits 8..16: `D_SHIFT` takes bits 14..18, outside its range"), "{err}");
+    assert!(err.contains("caustics flag bits 8..16: `FLAG_A` is not a uint const declared beside it"), "{err}");
+    assert!(err.contains("frame flag bits 0..2: `FLAG_C` = 3 is not a single bit"), "{err}");
+    assert!(err.contains("caustics flag bits 30..33: not a range of bits 0..32"), "{err}");
+    assert!(err.contains("`FLAG_LOOSE` is in no declared flag range"), "{err}");
+}
+
 fn sources(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap().flatten() {
         let p = e.path();

@@ -310,10 +310,8 @@ impl Stage for CausticsStage {
                     f.bind(ctx, cmd, self.photon);
                     f.bind_maps(ctx, cmd, io.sets.geometry);
                     let reflected = if branch == 1 { CAUSTIC_REFLECTED } else { 0 };
-                    // The frame-wide flags lose bits 8-15, which are the cube index here
-                    // (FLAG_LAYERED_STRONGEST and FLAG_UNSHADOWED would add 16 and 32 to it).
-                    let frame = f.flags & !(0xffu32 << CAUSTIC_CUBE_SHIFT);
-                    let flags = frame | reflected | (lv.cube << CAUSTIC_CUBE_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
+                    // Bits 8-31 are the caustics' own (layout.in.rs), apart from every frame-wide flag.
+                    let flags = f.flags | reflected | (lv.cube << CAUSTIC_CUBE_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
                     for d in f.scene.draws.iter().filter(|d| d.mesh as usize == gen.mesh && d.index_count > 0) {
                         f.push_flags(ctx, cmd, io.views.photons + layer, d.mesh, flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };

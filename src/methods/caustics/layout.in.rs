@@ -1,0 +1,92 @@
+// What caustics (survey §6) share with their shaders: the caustic cubes and parameters,
+// their bindings in the frame's set 0, consts and push flags. Concatenated with the frame's
+// declaration by build.rs (see src/frame/layout.in.rs).
+
+gpu_structs! {
+    /// One caustic cube (survey §6): a light cube map and its receiver distance map, cube
+    /// `index` of `caustic_maps` and `caustic_distances`, around a centre: a generator's
+    /// reference point (`caustic_space=cube`), or a light (`caustic_space=light`).
+    struct GpuCausticCube => struct CausticCube {
+        /// xyz: the centre; w: unused
+        centre: vec4,
+        /// the generator's mesh (its `objects` entry)
+        mesh: uint,
+        pad: [uint; 3],
+    }
+
+    /// What the caustic passes and the projection share (the header of `Caustics`).
+    struct GpuCausticParams => struct CausticParams {
+        /// cubes in `cubes` (0: the scene has no caustics)
+        cube_count: uint,
+        /// edge of the photon hit location images
+        photon_size: uint,
+        /// edge of each face of the light cube and receiver distance maps
+        cube_size: uint,
+        /// CAUSTIC_* flags
+        flags: uint,
+        /// photon splatting: the splat's radius in light-cube texels
+        splat_size: float,
+        /// box filter radius in texels
+        filter_radius: uint,
+        /// caustic triangles: triangles of every photon layer (`caustic_faces` holds six
+        /// flags of each)
+        triangle_count: uint,
+        /// caustic triangles: triangles per photon layer, 2 (photon_size − 1)²
+        layer_triangles: uint,
+    }
+}
+
+gpu_consts! {
+    /// `Push.flags` of the camera's `scene.direct`: the caustics are projected by their own
+    /// pass (`caustics.project`), not inside `shade_diffuse`.
+    FLAG_CAUSTICS_APART: uint = 128;
+
+    /// `CausticParams.flags`: the projection's distance test (§6.3.3).
+    CAUSTIC_DISTANCE_TEST: uint = 1;
+    /// `CausticParams.flags`: the receiver-orientation factor cos α of the projection.
+    CAUSTIC_ORIENTATION: uint = 2;
+    /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
+    /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
+    CAUSTIC_CUBE_SHIFT: uint = 8;
+    /// `Push.flags` of the photon pass: this layer's photons take the reflected branch at a
+    /// dielectric generator's surface (else the refracted one).
+    CAUSTIC_REFLECTED: uint = 65536;
+    CAUSTIC_LIGHT_SHIFT: uint = 20;
+    /// Caustic triangles whose corners' distances from the reference point differ by more
+    /// than this fraction land on different surfaces (§6.3.2) and are dropped.
+    CAUSTIC_GAP: float = 0.1;
+}
+
+flag_bits! {
+    /// `scene.direct` is the frame's pass: the caustics' flag there is frame-wide.
+    every_pass 7..8 { FLAG_CAUSTICS_APART }
+    /// The photon pass's cube, branch and light.
+    own_passes 8..32 { CAUSTIC_CUBE_SHIFT: 8, CAUSTIC_REFLECTED, CAUSTIC_LIGHT_SHIFT: 12 }
+}
+
+descriptor_sets! {
+    BINDINGS = set 0 {
+        /// Caustics (§6): per caustic cube, the distance of the nearest receiver (everything but
+        /// the generator) from its centre, the terminal hits' search map and the projection's
+        /// distance test.
+        CAUSTIC_DISTANCES = 10: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_distances";
+        /// Caustics: per caustic cube, the light cube map: radiant intensity J (W/sr) of the
+        /// caustic as seen from its centre, the projection's input.
+        CAUSTIC_MAPS = 11: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_maps";
+        /// Caustics: photon hit location images, one layer per light view of a generator:
+        /// xyz the hit relative to its cube's centre, w 1 for a photon.
+        PHOTON_HITS = 12: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_hits";
+        /// Caustics: the photons' power (rgb, W).
+        PHOTON_POWER = 13: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_power";
+        CAUSTICS = 14: STORAGE_BUFFER => "readonly buffer Caustics { CausticParams caustic; CausticCube cubes[]; }";
+        /// Caustics: the light cube maps before filtering (the filter pass reads them).
+        CAUSTIC_RAW = 15: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_raw";
+        /// Caustic triangles, set up once (caustics/setup.comp): per triangle of a photon layer
+        /// four vec4: its corners relative to the cube's centre with J's r, g, b in w, and
+        /// (1: a tent around the centroid, 0: the triangle itself).
+        CAUSTIC_TRIANGLES = 16: STORAGE_BUFFER => "buffer CausticTriangles { vec4 caustic_triangles[]; }";
+        /// Caustic triangles: per cube face f and triangle i, `caustic_faces[f · triangle_count
+        /// + i]` is 1 when the face draws it (its frustum may hold it).
+        CAUSTIC_FACES = 17: STORAGE_BUFFER => "buffer CausticFaces { uint caustic_faces[]; }";
+    }
+}

@@ -1,0 +1,167 @@
+// What ray tracing in the original geometry (survey §2) shares with its kernels: the ray,
+// hit, triangle and acceleration structs, their consts and sets 2 and 3. Concatenated with
+// the frame's declaration by build.rs (see src/frame/layout.in.rs).
+
+gpu_structs! {
+    /// One ray of the ray-tracing pipeline's intersection query (survey §2.3.1: the rays
+    /// live in GPU memory; every acceleration scheme answers the same query).
+    struct GpuRayQuery => struct RayQuery {
+        /// xyz origin, w t_min
+        origin: vec4,
+        /// xyz direction (any length), w t_max (+inf: unbounded)
+        direction: vec4,
+        /// the triangle the ray leaves (RAY_NO_TRIANGLE: none)
+        skip: uint,
+        /// RAY_ANY_HIT: the first hit found will do (shadow rays)
+        flags: uint,
+        pad: [uint; 2],
+    }
+
+    /// The answer to one `RayQuery`: the nearest hit, or `triangle` = RAY_NO_TRIANGLE.
+    struct GpuRayHit => struct RayHit {
+        t: float,
+        /// barycentric of v1
+        u: float,
+        /// barycentric of v2
+        v: float,
+        /// index into the triangle list (scene order: mesh by mesh, index by index)
+        triangle: uint,
+    }
+
+    /// One scene triangle in world space, as the intersection kernels read it.
+    struct GpuTriangle => struct Triangle {
+        /// xyz; w: unused
+        v0: vec4,
+        v1: vec4,
+        v2: vec4,
+    }
+
+    /// What a traced ray carries besides its query: whose pixel it lights and how much.
+    struct GpuRayPayload => struct RayPayload {
+        /// rgb: the path's weight (product of Fresnel factors); a: unused
+        weight: vec4,
+        /// y * width + x
+        pixel: uint,
+        pad: [uint; 3],
+    }
+
+    /// The shading attributes of one triangle of the list (the positions are `Triangle`).
+    struct GpuTriangleShading => struct TriangleShading {
+        /// vertex normals (xyz); n0.w: the material index as uint bits
+        n0: vec4,
+        n1: vec4,
+        n2: vec4,
+        /// texture coordinates of v0 (xy) and v1 (zw)
+        uv01: vec4,
+        /// texture coordinates of v2 (xy); z: the mesh index as uint bits
+        uv2: vec4,
+    }
+
+    /// One bounce of the ray pipeline, as its kernels read it (one entry per bounce).
+    struct GpuTraceParams => struct TraceParams {
+        /// camera image size
+        width: uint,
+        height: uint,
+        /// 0: the primary hits; the last bounce spawns no children
+        bounce: uint,
+        last: uint,
+        /// capacity of each ray queue, and of the shadow queue
+        capacity: uint,
+        shadow_capacity: uint,
+        /// secondary and shadow rays start this far from the surface they leave
+        t_min: float,
+        /// the ray engine's ray texture (§2.2): width; its height is capacity / width
+        ray_texture_width: uint,
+        /// the ray hierarchy (§2.2.1): edge of a tile of the ray texture, and tiles per row
+        tile_size: uint,
+        tiles_per_row: uint,
+        /// camera rays per pixel (MSAA samples; 1 without)
+        samples: uint,
+        pad: uint,
+    }
+
+    /// What an acceleration scheme's kernel needs besides its node and reference buffers.
+    struct GpuAccel => struct Accel {
+        /// uniform grid: world-space minimum corner (xyz)
+        grid_min: vec4,
+        /// uniform grid: cells per world unit along each axis (xyz)
+        grid_inv_cell: vec4,
+        /// uniform grid: cells per axis (xyz); w: 1 with empty-cell skipping (KL04)
+        grid_res: uvec4,
+        /// kd-tree: the root node's box, minimum corner (xyz; f32 values the builder split)
+        bounds_min: vec4,
+        /// kd-tree: the root node's box, maximum corner (xyz)
+        bounds_max: vec4,
+        /// unused (the query count is `RAY_COUNT`'s)
+        unused: uint,
+        /// triangles in the triangle list
+        triangle_count: uint,
+        /// nodes of the tree (BVH, kd-tree); 0 for the grid and brute force
+        node_count: uint,
+        pad: uint,
+    }
+}
+
+gpu_consts! {
+    /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
+    RAY_NO_TRIANGLE: uint = 4294967295;
+    /// `RayQuery.flags`: any hit will do (shadow rays).
+    RAY_ANY_HIT: uint = 1;
+    /// `RayQuery.flags`: the hit is already known (a primary hit from rasterisation that the
+    /// exact triangle test confirmed); the intersection kernels leave it.
+    RAY_HIT_KNOWN: uint = 2;
+}
+
+descriptor_sets! {
+    /// Ray tracing in the original geometry (survey §2), set 2: the ray queries and their
+    /// hits, the triangle list, and the acceleration scheme's buffers. Nodes are 16-byte
+    /// words whose meaning is the scheme's (src/methods/raytrace/: BVH nodes, grid cells,
+    /// kd-tree nodes); references index the triangle list.
+    RAY_BINDINGS = set 2 {
+        RAY_QUERIES = 0: STORAGE_BUFFER => "readonly buffer RayQueries { RayQuery queries[]; }";
+        RAY_HITS = 1: STORAGE_BUFFER => "buffer RayHits { RayHit hits[]; }";
+        RAY_TRIANGLES = 2: STORAGE_BUFFER => "readonly buffer Triangles { Triangle triangles[]; }";
+        ACCEL_NODES = 3: STORAGE_BUFFER => "readonly buffer AccelNodes { uvec4 accel_nodes[]; }";
+        ACCEL_REFS = 4: STORAGE_BUFFER => "readonly buffer AccelRefs { uint accel_refs[]; }";
+        /// BVH: the miss link of each node (stackless traversal); grid, kd-tree: unused
+        ACCEL_AUX = 5: STORAGE_BUFFER => "readonly buffer AccelAux { uint accel_aux[]; }";
+        ACCEL_PARAMS = 6: STORAGE_BUFFER => "readonly buffer AccelParams { Accel accel; }";
+        /// The payload of each query (the ray pipeline; unused by the intersection kernels)
+        RAY_PAYLOADS = 7: STORAGE_BUFFER => "readonly buffer RayPayloads { RayPayload payloads[]; }";
+        /// How many queries the buffer holds (written by the GPU in the ray pipeline)
+        RAY_COUNT = 8: STORAGE_BUFFER => "readonly buffer RayCount { uint ray_count; }";
+    }
+
+    /// The ray pipeline's per-bounce outputs (survey §2.3.1), set 3: the next bounce's
+    /// queue and the shadow queue (appended through their counters), the fixed-point
+    /// radiance accumulator, and what shading needs.
+    TRACE_BINDINGS = set 3 {
+        NEXT_QUERIES = 0: STORAGE_BUFFER => "writeonly buffer NextQueries { RayQuery next_queries[]; }";
+        NEXT_PAYLOADS = 1: STORAGE_BUFFER => "writeonly buffer NextPayloads { RayPayload next_payloads[]; }";
+        NEXT_COUNT = 2: STORAGE_BUFFER => "buffer NextCount { uint next_count; }";
+        SHADOW_QUERIES = 3: STORAGE_BUFFER => "writeonly buffer ShadowQueries { RayQuery shadow_queries[]; }";
+        SHADOW_PAYLOADS = 4: STORAGE_BUFFER => "writeonly buffer ShadowPayloads { RayPayload shadow_payloads[]; }";
+        SHADOW_COUNT = 5: STORAGE_BUFFER => "buffer ShadowCount { uint shadow_count; }";
+        /// Per pixel and channel a 64-bit fixed-point sum (lo, hi words): integer atomics,
+        /// so the image does not depend on the order rays are processed in
+        ACCUM = 6: STORAGE_BUFFER => "buffer Accum { uint accum[]; }";
+        SHADING = 7: STORAGE_BUFFER => "readonly buffer Shading { TriangleShading shading[]; }";
+        /// Per mesh: 1 when this stage renders its pixels
+        HANDLED = 8: STORAGE_BUFFER => "readonly buffer Handled { uint handled[]; }";
+        TRACE = 9: STORAGE_BUFFER => "readonly buffer Trace { TraceParams trace; }";
+        /// The primary hits: each pixel's nearest triangle id, from rasterisation
+        VISIBILITY = 10: STORAGE_IMAGE => "layout(r32ui) uniform readonly uimage2DArray visibility";
+        /// Indirect dispatch arguments of the next kernels (args.comp)
+        DISPATCH = 11: STORAGE_BUFFER => "buffer Dispatch { uint dispatch[]; }";
+        /// The first queue's hits (primary.comp writes them from the visibility image)
+        NEXT_HITS = 12: STORAGE_BUFFER => "writeonly buffer NextHits { RayHit next_hits[]; }";
+        /// The ray engine's hit records (t, u, v bits, triangle) per texel of the ray texture
+        ENGINE_HITS = 13: STORAGE_IMAGE => "layout(rgba32ui) uniform readonly uimage2D engine_hits";
+        /// The ray hierarchy's cone per tile: apex (xyz), cos of the half angle (w; 2: no
+        /// cone, test every triangle; 3: empty tile) and axis (xyz), sin of the half angle (w)
+        TILE_CONES = 14: STORAGE_BUFFER => "buffer TileCones { vec4 tile_cones[]; }";
+        /// The ray hierarchy's culling counts (with the ray_stats knob): per bounce and
+        /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
+        CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
+    }
+}
