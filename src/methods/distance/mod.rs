@@ -7,7 +7,7 @@ pub mod image_space;
 pub mod refractor;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
-use crate::methods::envmap::generate::{CubeMaps, MapKind};
+use crate::methods::cube_maps::{distance_images, CubeMaps, MapKind};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
@@ -29,15 +29,6 @@ pub const DISTANCE_CUBES: MapInfo = MapInfo {
 
 fn create_distance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
     Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Distance)?))
-}
-
-/// Images the distance maps need: two for cycles that read the previous cycle's maps.
-pub fn distance_images(p: &Plan) -> u64 {
-    if p.inter_object && (p.cycles > 1 || p.frame_latency) {
-        2
-    } else {
-        1
-    }
 }
 
 fn distance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {

@@ -9,7 +9,7 @@ use ash::vk;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
-use crate::methods::envmap::generate::radiance_format;
+use crate::methods::cube_maps::radiance_format;
 use crate::quality::CubeMode;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};

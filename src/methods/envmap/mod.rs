@@ -3,10 +3,6 @@
 //! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
 //! towards where the ray leaves a proxy of the environment (§3.2).
 
-pub mod generate;
-
-pub use generate::{CubeMaps, MapKind};
-
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Verdict};
@@ -21,7 +17,7 @@ pub const RADIANCE_CUBES: MapInfo = MapInfo {
     order: order::ENVIRONMENT_MAPS,
     cube: true,
     layer_field: Some(LayerField::Envmap),
-    create: generate::create_radiance,
+    create: crate::methods::cube_maps::create_radiance,
     bytes: radiance_bytes,
     describe: |q, _| describe_cube(q),
 };

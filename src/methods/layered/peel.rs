@@ -19,7 +19,7 @@ use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{LAYERED_FACE_SHIFT, LAYERED_FIRST};
 use crate::frame::stage::{cube_texel_bytes, describe_cube, FrameIo, Maps, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs};
-use crate::methods::envmap::generate::radiance_format;
+use crate::methods::cube_maps::radiance_format;
 use crate::quality::{CubeMode, Precision, Quality, MAX_LAYERS};
 use crate::vk::pipeline::{allocate_set, graphics_pipeline, sampler, write_image, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};

@@ -1,4 +1,5 @@
-//! `envmap.generate` / `distance.generate`: one cube map per specular object, rasterised
+//! The cube maps the environment-mapping (§3) and distance-map (§4) families share, owned by
+//! neither: `envmap.generate` / `distance.generate`, one cube map per specular object, rasterised
 //! from its reference point (survey §3.1: "a conventional rendering pass where the
 //! rasterization hardware and the z-buffer identify points visible from the reference point
 //! through the faces of a cube"), the object itself left out.
@@ -13,7 +14,6 @@ use ash::vk;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
-use crate::methods::distance::distance_images;
 use crate::methods::registry::LeavesOut;
 use crate::plan::Plan;
 use crate::quality::{CubeMode, Precision};
@@ -353,5 +353,14 @@ impl Stage for CubeMaps {
 impl Owner for CubeMaps {
     fn destroy(&mut self, ctx: &Context) {
         Stage::destroy(self, ctx)
+    }
+}
+
+/// Images the distance maps need: two for cycles that read the previous cycle's maps.
+pub fn distance_images(p: &Plan) -> u64 {
+    if p.inter_object && (p.cycles > 1 || p.frame_latency) {
+        2
+    } else {
+        1
     }
 }
