@@ -95,6 +95,25 @@ pub struct CameraPass {
     /// with `vertex` and `fragment` (ray tracing in the original geometry: a pipeline of
     /// passes).
     pub create: Option<CreateCamera>,
+    /// The passes its stage records and how the budget charges them.
+    pub profiled: Profiled,
+}
+
+/// The timed passes of a method's camera stage, for the budget (`plan::budget`), which
+/// charges each timed pass to the objects of the stages that record it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Profiled {
+    /// The passes the stage records besides its `name` (and its family's frame work, e.g.
+    /// planar mirrors' views) are named with this prefix; `""`: it records `name` only.
+    pub prefix: &'static str,
+    /// They run over the whole screen whatever the stage serves (a ray tracer's kernels):
+    /// paid once per method a frame uses, not split among its objects.
+    pub shared: bool,
+}
+
+impl Profiled {
+    /// One pass under the stage's own name, per object.
+    pub const OWN: Profiled = Profiled { prefix: "", shared: false };
 }
 
 /// Creates a method's own camera stage for the plan's objects.

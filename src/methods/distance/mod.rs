@@ -8,7 +8,7 @@ pub mod refractor;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
 use crate::methods::envmap::generate::{CubeMaps, MapKind};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::Plan;
@@ -94,6 +94,7 @@ const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    profiled: Profiled::OWN,
 };
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
@@ -196,7 +197,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
-        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None },
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None, profiled: Profiled::OWN },
         map_shading: MapShading::Refractor,
         leaves_out: LeavesOut::Itself,
         cycles: one,
@@ -244,6 +245,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
             flags: 0,
             order: order::CAMERA + 2,
             create: None,
+            profiled: Profiled::OWN,
         },
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,

@@ -14,12 +14,6 @@ pub struct Cost {
     pub screen_ms: f64,
 }
 
-/// Whether a pass runs once for all the objects of its method (a ray tracer's full-screen
-/// kernels) rather than per object.
-pub fn shared_pass(name: &str) -> bool {
-    name.starts_with("raytrace.")
-}
-
 impl Cost {
     /// The cost at `pixels` output pixels, measured at `measured` pixels.
     pub fn at(&self, pixels: f64, measured: f64) -> f64 {
@@ -31,34 +25,52 @@ impl Cost {
     }
 }
 
-/// Whether pass `name` of plan `p` works independently of the output size.
-fn fixed_pass(p: &Plan, name: &str) -> bool {
-    p.stages.iter().any(|s| match s {
-        StageSpec::Map(m) => m.name == name,
-        StageSpec::Upload | StageSpec::Shadows => s.name() == name,
+/// The stages of `p` that record the timed pass `name`: those of that name (the caustics
+/// stage: any of its passes), else the camera stages whose declared prefix it carries
+/// (`Profiled::prefix`: a ray tracer's kernels, planar mirrors' views). None: the frame's
+/// own work outside the plan's stages (resolve, object ids, output).
+fn recorded_by<'p>(p: &'p Plan, name: &str) -> Vec<&'p StageSpec> {
+    let own = |s: &StageSpec| match s {
         StageSpec::Caustics => p.caustics.as_ref().is_some_and(|c| c.passes(&p.quality).contains(&name)),
-        _ => false,
-    })
+        _ => s.name() == name,
+    };
+    let exact: Vec<&StageSpec> = p.stages.iter().filter(|s| own(s)).collect();
+    if !exact.is_empty() {
+        return exact;
+    }
+    let declares = |s: &&StageSpec| matches!(s, StageSpec::Camera(c) if !c.pass.profiled.prefix.is_empty() && name.starts_with(c.pass.profiled.prefix));
+    p.stages.iter().filter(declares).collect()
+}
+
+/// Whether a stage's work is independent of the output size.
+fn fixed(s: &StageSpec) -> bool {
+    matches!(s, StageSpec::Map(_) | StageSpec::Upload | StageSpec::Shadows | StageSpec::Caustics)
 }
 
 /// A frame's GPU time split by object: per mesh (its share, its method's shared kernels
-/// whole), and the rest (base); see the module doc.
+/// whole), and the rest (base); see the module doc. A timed pass belongs to the objects
+/// whose plans list it (`ObjectPlan::passes`), else to those of the camera stages that
+/// record it under their prefix; a frame stage's, or one no stage records, to the base.
 pub fn attribute(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, Cost, Cost)>, Cost) {
     let mut objects: Vec<(usize, Cost, Cost)> = p.objects.iter().map(|o| (o.mesh, Cost::default(), Cost::default())).collect();
     let mut base = Cost::default();
     for (name, ms) in passes {
+        // The standalone frame's copy to the host: no part of the frame's cost.
         if name == "frame.readback" || !ms.is_finite() {
             continue;
         }
-        let part = if fixed_pass(p, name) { Cost { fixed_ms: *ms, screen_ms: 0.0 } } else { Cost { fixed_ms: 0.0, screen_ms: *ms } };
+        let stages = recorded_by(p, name);
+        let part =
+            if stages.iter().any(|s| fixed(s)) { Cost { fixed_ms: *ms, screen_ms: 0.0 } } else { Cost { fixed_ms: 0.0, screen_ms: *ms } };
         let mut owners: Vec<usize> = (0..p.objects.len()).filter(|&i| p.objects[i].passes.iter().any(|q| q == name)).collect();
         if owners.is_empty() {
-            let family = name.split('.').next().unwrap_or("");
-            owners = (0..p.objects.len()).filter(|&i| p.objects[i].method.family == family).collect();
+            let draws = |s: &StageSpec, mesh: usize| matches!(s, StageSpec::Camera(c) if c.objects.iter().any(|(m, _)| *m == mesh));
+            owners = (0..p.objects.len()).filter(|&i| stages.iter().any(|s| draws(s, p.objects[i].mesh))).collect();
         }
+        let shared = stages.iter().any(|s| matches!(s, StageSpec::Camera(c) if c.pass.profiled.shared));
         if owners.is_empty() {
             base.add(part, 1.0);
-        } else if shared_pass(name) {
+        } else if shared {
             owners.iter().for_each(|&i| objects[i].2.add(part, 1.0));
         } else {
             let w = 1.0 / owners.len() as f64;
@@ -81,4 +93,61 @@ pub fn measured_by_object(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, f6
         })
         .collect();
     (per, base.fixed_ms + base.screen_ms)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::{BVH, DISTANCE};
+    use crate::plan::{plan, MapPlan};
+
+    fn one(p: &Plan, name: &str, ms: f64) -> (Vec<(usize, Cost, Cost)>, Cost) {
+        attribute(p, &[(name.to_string(), ms)])
+    }
+
+    /// Every pass goes where its stage declares it: maps split among their objects (fixed),
+    /// camera passes among theirs (screen), the frame's stages and what no stage records to
+    /// the base, a ray tracer's kernels whole to each of its objects.
+    #[test]
+    fn passes_go_to_the_objects_of_the_stages_that_record_them() {
+        let scene = crate::scenes::flat_glass().unwrap();
+        let q = crate::quality::Quality::default();
+        let screen = |ms| Cost { fixed_ms: 0.0, screen_ms: ms };
+
+        let p = plan(&scene, DISTANCE, &q);
+        assert!(p.objects.len() >= 2, "{:?}", p.objects);
+        let n = p.objects.len() as f64;
+        for s in &p.stages {
+            let (objects, base) = one(&p, s.name(), 4.0);
+            match s {
+                StageSpec::Map(MapPlan { objects: meshes, .. }) => {
+                    assert_eq!(base, Cost::default());
+                    for (mesh, own, shared) in objects {
+                        let w = if meshes.contains(&mesh) { 4.0 / meshes.len() as f64 } else { 0.0 };
+                        assert_eq!((own, shared), (Cost { fixed_ms: w, screen_ms: 0.0 }, Cost::default()), "{}", s.name());
+                    }
+                }
+                StageSpec::Camera(_) => {
+                    assert_eq!(base, Cost::default());
+                    objects.iter().for_each(|o| assert_eq!((o.1, o.2), (screen(4.0 / n), Cost::default()), "{}", s.name()));
+                }
+                StageSpec::Direct => assert_eq!(base, screen(4.0)),
+                StageSpec::Upload | StageSpec::Shadows => assert_eq!(base, Cost { fixed_ms: 4.0, screen_ms: 0.0 }),
+                _ => {}
+            }
+        }
+        // A pass no stage records (the frame's resolve, say): the base's.
+        let (objects, base) = one(&p, "frame.resolve", 2.0);
+        assert_eq!(base, screen(2.0));
+        assert!(objects.iter().all(|o| o.1 == Cost::default() && o.2 == Cost::default()));
+
+        // A ray tracer's kernels, named under its declared prefix: each object pays them whole.
+        let p = plan(&scene, BVH, &q);
+        let prefix = BVH.gpu.unwrap().camera.profiled.prefix;
+        assert!(!prefix.is_empty());
+        let (objects, base) = one(&p, &format!("{prefix}kernel"), 3.0);
+        assert_eq!(base, Cost::default());
+        assert_eq!(objects.len(), p.objects.len());
+        objects.iter().for_each(|o| assert_eq!((o.1, o.2), (Cost::default(), screen(3.0))));
+    }
 }

@@ -6,11 +6,14 @@
 //! **Models** come from a calibration run (`specula tradeoff --calibrate`): the study renders
 //! every method × knob variant; per row, each specular object's PSNR on its own pixels (the
 //! reference's object ids) and its share of the GPU time. A pass belongs to the objects whose
-//! plan lists it (`ObjectPlan::passes`; a pass no plan lists, e.g. `geometry.mirror_view`,
-//! to the objects of its family); what belongs to none is the frame's base (direct light,
-//! shadow maps). Map and camera passes work per object (a layer, the object's pixels) and
-//! are split evenly among their objects; a ray tracer's kernels run over the whole screen
-//! whatever it serves, so they are *shared*: paid once per method a frame uses. Each cost
+//! plan lists it (`ObjectPlan::passes`); a pass a stage records under the prefix its
+//! camera pass declares (`Profiled::prefix`: a ray tracer's per-bounce kernels, planar
+//! mirrors' views), to the objects of the camera stages that declare it; what belongs to
+//! none is the frame's base (its own stages: direct light, shadow maps). Map and camera
+//! passes work per object (a layer, the object's pixels) and are split evenly among their
+//! objects; a ray tracer's kernels run over the whole screen whatever it serves, so its
+//! camera pass declares them *shared* (`Profiled::shared`): paid once per method a frame
+//! uses. Each cost
 //! has a fixed part (maps, shadow maps, photons: independent of the output size) and a screen
 //! part, scaled by the pixel count when a frame's size differs from the calibration's. Without a calibration the planner uses the
 //! stored defaults measured on the bundled scenes (`assets/models/`), matched by object class
@@ -39,7 +42,7 @@ mod models;
 mod prediction;
 mod search;
 
-pub use attribute::{attribute, measured_by_object, shared_pass, Cost};
+pub use attribute::{attribute, measured_by_object, Cost};
 pub use choose::choose;
 pub use fit::{fit, Measured};
 pub use models::{stored_defaults, variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};

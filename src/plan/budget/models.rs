@@ -26,7 +26,8 @@ pub struct ObjectModel {
     pub method: String,
     /// Its share of the per-object passes.
     pub cost: Cost,
-    /// Its method's shared kernels, whole (see [`shared_pass`]).
+    /// Its method's shared kernels, whole (a camera pass that declares them shared:
+    /// `Profiled::shared`).
     #[serde(default)]
     pub shared: Cost,
     /// Inter-object cycles of the calibration frame (its maps' share covers that many).
