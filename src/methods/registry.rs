@@ -339,6 +339,10 @@ pub fn check(all: &[Method]) -> std::result::Result<(), String> {
                 if ca.name == cb.name && (ca.vertex != cb.vertex || ca.fragment != cb.fragment) {
                     return Err(format!("'{}' and '{}' share pass {} with different shaders", a.name, b.name, ca.name));
                 }
+                // A shared camera stage keeps the first method's pass, whose declaration the budget reads.
+                if ca.name == cb.name && ca.profiled != cb.profiled {
+                    return Err(format!("'{}' and '{}' share pass {} but declare its timed passes differently", a.name, b.name, ca.name));
+                }
             }
         }
         if a.abi == ABI_AUTO || a.name == "auto" {
