@@ -96,6 +96,25 @@ pub struct CameraPass {
     /// with `vertex` and `fragment` (ray tracing in the original geometry: a pipeline of
     /// passes).
     pub create: Option<CreateCamera>,
+    /// The passes its stage records and how the budget charges them.
+    pub profiled: Profiled,
+}
+
+/// The timed passes of a method's camera stage, for the budget (`plan::budget`), which
+/// charges each timed pass to the objects of the stages that record it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Profiled {
+    /// The passes the stage records besides its `name` (and its family's frame work, e.g.
+    /// planar mirrors' views) are named with this prefix; `""`: it records `name` only.
+    pub prefix: &'static str,
+    /// They run over the whole screen whatever the stage serves (a ray tracer's kernels):
+    /// paid once per method a frame uses, not split among its objects.
+    pub shared: bool,
+}
+
+impl Profiled {
+    /// One pass under the stage's own name, per object.
+    pub const OWN: Profiled = Profiled { prefix: "", shared: false };
 }
 
 /// Creates a method's own camera stage for the plan's objects.
@@ -407,6 +426,10 @@ pub fn check(all: &[Method]) -> std::result::Result<(), String> {
                 let (ca, cb) = (ga.camera, gb.camera);
                 if ca.name == cb.name && (ca.vertex != cb.vertex || ca.fragment != cb.fragment) {
                     return Err(format!("'{}' and '{}' share pass {} with different shaders", a.name, b.name, ca.name));
+                }
+                // A shared camera stage keeps the first method's pass, whose declaration the budget reads.
+                if ca.name == cb.name && ca.profiled != cb.profiled {
+                    return Err(format!("'{}' and '{}' share pass {} but declare its timed passes differently", a.name, b.name, ca.name));
                 }
             }
         }

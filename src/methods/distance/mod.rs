@@ -8,7 +8,7 @@ pub mod refractor;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
 use crate::methods::cube_maps::{distance_images, CubeMaps, MapKind};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::{CameraPlan, Plan};
@@ -85,6 +85,7 @@ const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: Some(create_search),
+    profiled: Profiled::OWN,
 };
 
 /// `distance.search`, which the test knob `debug_fault=flip_reflection` breaks on purpose.
@@ -197,7 +198,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
-        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None },
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None, profiled: Profiled::OWN },
         map_shading: MapShading::Refractor,
         leaves_out: LeavesOut::Itself,
         cycles: one,
@@ -246,6 +247,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
             flags: 0,
             order: order::CAMERA + 2,
             create: None,
+            profiled: Profiled::OWN,
         },
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,

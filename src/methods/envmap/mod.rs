@@ -5,7 +5,7 @@
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
@@ -51,10 +51,19 @@ const SHADE: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    profiled: Profiled::OWN,
 };
 
 const fn proxy(flags: u32) -> CameraPass {
-    CameraPass { name: "proxy.shade", vertex: "scene/mesh.vert", fragment: "envmap/proxy.frag", flags, order: order::CAMERA, create: None }
+    CameraPass {
+        name: "proxy.shade",
+        vertex: "scene/mesh.vert",
+        fragment: "envmap/proxy.frag",
+        flags,
+        order: order::CAMERA,
+        create: None,
+        profiled: Profiled::OWN,
+    }
 }
 
 pub const ENVMAP: Method = Method(&MethodInfo {

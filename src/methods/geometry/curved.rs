@@ -50,6 +50,7 @@ pub const CURVED_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: Some(create),
+    profiled: super::PROFILED,
 };
 
 const fn one(_: &Quality) -> u32 {

@@ -15,7 +15,9 @@ pub mod views;
 pub use curved::CURVED_REFLECTOR;
 
 use crate::frame::stage::order;
-use crate::methods::registry::{CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
+use crate::methods::registry::{
+    CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Shape, Verdict,
+};
 use crate::quality::Quality;
 
 /// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
@@ -42,6 +44,11 @@ const fn one(_: &Quality) -> u32 {
     1
 }
 
+/// The family's camera passes and what they bring besides their own pass: planar mirrors'
+/// and refractors' views (`geometry.mirror_view`, `geometry.stencil`), the curved reflector's
+/// geometry image and virtual objects (`geometry.image`, `geometry.virtual…`).
+pub const PROFILED: Profiled = Profiled { prefix: "geometry.", shared: false };
+
 /// `geometry.mirror`: each planar mirror drawn from the camera (and from every mirrored view
 /// that sees it) with the mirrored view's image at its pixels, weighted by Fresnel.
 pub const MIRROR_PASS: CameraPass = CameraPass {
@@ -51,6 +58,7 @@ pub const MIRROR_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    profiled: PROFILED,
 };
 
 pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
@@ -82,6 +90,7 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    profiled: PROFILED,
 };
 
 pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {

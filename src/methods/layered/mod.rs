@@ -16,7 +16,7 @@ pub mod peel;
 use glam::Vec3;
 
 use crate::frame::stage::{order, MapInfo};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Shape, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
@@ -55,6 +55,7 @@ pub const SEARCH: CameraPass = CameraPass {
     flags: 0,
     order: order::CAMERA,
     create: None,
+    profiled: Profiled::OWN,
 };
 
 pub const LAYERED: Method = Method(&MethodInfo {

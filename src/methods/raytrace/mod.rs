@@ -33,7 +33,7 @@ use glam::Vec3;
 use crate::error::{Error, Result};
 use crate::frame::layout::{GpuAccel, GpuTriangle};
 use crate::frame::stage::{order, Stage, StageInit};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::CameraPlan;
@@ -54,6 +54,9 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
         flags: 0,
         order: order::RAYTRACE,
         create: Some(create),
+        // Its passes (`raytrace.primary`, `raytrace.intersect.<scheme>`, per bounce
+        // `raytrace.spawn` and `raytrace.shade`, `raytrace.resolve`) run over the whole screen.
+        profiled: Profiled { prefix: "raytrace.", shared: true },
     }
 }
 

@@ -1,0 +1,123 @@
+//! Budgets, what the planner predicts for them, and the prediction as a table.
+
+use serde::Serialize;
+
+use crate::error::{Error, Result};
+use crate::plan::Method;
+
+/// A frame budget.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub enum Budget {
+    /// At most this many GPU milliseconds per frame; the least error within it.
+    MaxMs(f64),
+    /// Every specular object at least this PSNR (dB) on its pixels; the least time.
+    MinPsnr(f64),
+}
+
+impl Budget {
+    /// From the CLI's two options (the C ABI passes 0 as absent); at most one may be set.
+    pub fn from_limits(max_ms: Option<f64>, min_psnr: Option<f64>) -> Result<Option<Budget>> {
+        match (max_ms, min_psnr) {
+            (Some(_), Some(_)) => Err(Error::invalid("budget", "a time budget (max-ms) or a PSNR floor (min-psnr), not both")),
+            (Some(ms), None) if !(ms.is_finite() && ms > 0.0) => Err(Error::invalid("max-ms", format!("{ms} is not a positive time"))),
+            (None, Some(db)) if !db.is_finite() => Err(Error::invalid("min-psnr", format!("{db} is not a finite PSNR"))),
+            (Some(ms), None) => Ok(Some(Budget::MaxMs(ms))),
+            (None, Some(db)) => Ok(Some(Budget::MinPsnr(db))),
+            (None, None) => Ok(None),
+        }
+    }
+    pub fn describe(&self) -> String {
+        // Three decimals at most, trailing zeros dropped.
+        let short = |v: f64| format!("{:.3}", v).trim_end_matches('0').trim_end_matches('.').to_string();
+        match self {
+            Budget::MaxMs(ms) => format!("--max-ms {}", short(*ms)),
+            Budget::MinPsnr(db) => format!("--min-psnr {}", short(*db)),
+        }
+    }
+}
+
+/// What the planner predicts for one object.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ObjectPrediction {
+    pub mesh: usize,
+    pub name: String,
+    pub method: Method,
+    pub ms: f64,
+    pub psnr_db: f64,
+    /// Its pixels in the models' frame (weights the specular PSNR).
+    pub pixels: usize,
+    /// The model it came from: the object's own name, or its class.
+    pub model: String,
+}
+
+/// The budgeted planner's choice and prediction.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Prediction {
+    pub budget: Budget,
+    /// The knob variant chosen (`default` or `knob=value …`).
+    pub knobs: String,
+    pub base_ms: f64,
+    pub frame_ms: f64,
+    /// The specular pixels' PSNR (the objects' pixel-weighted mean squared error).
+    pub specular_psnr_db: f64,
+    pub objects: Vec<ObjectPrediction>,
+    /// Whether the prediction meets the budget (otherwise: the nearest it could get).
+    pub met: bool,
+    /// Where the models came from.
+    pub source: String,
+    /// The whole-scene method chosen (its fallbacks serve the objects it cannot), or `None`
+    /// for per-object methods.
+    pub whole_scene: Option<String>,
+}
+
+/// What a frame measured: per object (ms, PSNR) in the prediction's order, then the
+/// frame's (ms, specular PSNR).
+pub type FrameMeasured<'a> = (&'a [(f64, Option<f64>)], (f64, Option<f64>));
+
+/// The prediction as a table, with what a frame measured beside it where given.
+pub fn report(p: &Prediction, actual: Option<FrameMeasured>) -> String {
+    use std::fmt::Write as _;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "budget {}: {} · {} · knobs {} · models: {}",
+        p.budget.describe(),
+        if p.met { "met (predicted)" } else { "NOT reachable with these models: the nearest choice" },
+        p.whole_scene.as_ref().map_or("per-object methods".to_string(), |m| format!("whole-scene --method {m}")),
+        p.knobs,
+        p.source
+    );
+    let _ = writeln!(
+        s,
+        "{:<24} {:<18} {:>12} {:>10} {:>14} {:>12}  model",
+        "object", "method", "predicted ms", "actual ms", "predicted PSNR", "actual PSNR"
+    );
+    let fmt = |v: Option<f64>, prec: usize| v.map_or("-".to_string(), |v| format!("{v:.prec$}"));
+    for (i, o) in p.objects.iter().enumerate() {
+        let a = actual.and_then(|(objs, _)| objs.get(i).copied());
+        let _ = writeln!(
+            s,
+            "{:<24} {:<18} {:>12.3} {:>10} {:>14.2} {:>12}  {}",
+            crate::error::clip(&o.name),
+            o.method.name,
+            o.ms,
+            fmt(a.map(|a| a.0), 3),
+            o.psnr_db,
+            fmt(a.and_then(|a| a.1), 2),
+            o.model
+        );
+    }
+    let a = actual.map(|(_, f)| f);
+    let _ = writeln!(
+        s,
+        "{:<24} {:<18} {:>12.3} {:>10} {:>14.2} {:>12}  (base {:.3} ms; PSNR of all specular pixels)",
+        "frame",
+        "",
+        p.frame_ms,
+        fmt(a.map(|a| a.0), 3),
+        p.specular_psnr_db,
+        fmt(a.and_then(|a| a.1), 2),
+        p.base_ms
+    );
+    s
+}

@@ -1,0 +1,236 @@
+//! A choice's predicted frame time and rank under a budget, and the search over choices.
+
+use super::candidates::Candidate;
+use super::models::{mse_of, psnr_of};
+use super::Budget;
+use crate::plan::facts::SceneFacts;
+use crate::plan::{MapShading, Method};
+use crate::quality::Quality;
+
+/// Past this many (variant × per-object candidate) combinations the search is greedy.
+pub const MAX_COMBINATIONS: u64 = 2_000_000;
+
+/// The frame time of a choice (see the module doc): what composition through inter-object
+/// cycles adds, from the planner's own rule.
+pub(super) struct Timing<'a> {
+    pub(super) base: f64,
+    pub(super) quality: Quality,
+    pub(super) facts: &'a SceneFacts,
+}
+
+impl Timing<'_> {
+    /// Whether every object has the same method (planned as that whole-scene method).
+    pub(super) fn uniform(picks: &[&Candidate]) -> bool {
+        picks.windows(2).all(|w| w[0].method == w[1].method)
+    }
+
+    /// The inter-object cycles `plan_with` runs for these per-object methods.
+    fn cycles(&self, picks: &[&Candidate]) -> u32 {
+        if Self::uniform(picks) {
+            return picks.first().map_or(1, |c| c.cycles);
+        }
+        let gpu = |m: Method| m.gpu.expect("GPU method");
+        let own = picks.iter().map(|c| (gpu(c.method).cycles)(&self.quality)).max().unwrap_or(1).max(1);
+        let composes = picks
+            .iter()
+            .zip(&self.facts.objects)
+            .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
+        let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.frame_latency;
+        if latency {
+            1
+        } else if composes {
+            own.max(2)
+        } else {
+            own
+        }
+    }
+
+    /// The scale of each object's map share: the frame's cycles over its calibration's (1 for
+    /// a whole-scene row, which runs as measured).
+    fn scale(&self, picks: &[&Candidate], c: &Candidate, whole: bool) -> f64 {
+        if whole {
+            1.0
+        } else {
+            self.cycles(picks) as f64 / c.cycles as f64
+        }
+    }
+
+    pub(super) fn frame_ms(&self, picks: &[&Candidate], whole: bool) -> f64 {
+        let own: f64 = picks.iter().map(|c| c.fixed * self.scale(picks, c, whole) + c.screen).sum();
+        let mut methods: Vec<(Method, f64)> = Vec::new();
+        for c in picks {
+            match methods.iter_mut().find(|(m, _)| *m == c.method) {
+                Some((_, s)) => *s = s.max(c.shared),
+                None => methods.push((c.method, c.shared)),
+            }
+        }
+        self.base + own + methods.iter().map(|(_, s)| s).sum::<f64>()
+    }
+
+    /// Object `i`'s part of the frame: its share, and its method's shared kernels split
+    /// among the objects that use it.
+    pub(super) fn object_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
+        let c = picks[i];
+        let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
+        c.fixed * self.scale(picks, c, whole) + c.screen + c.shared / users
+    }
+}
+
+/// Pixel-weighted specular PSNR of a choice.
+pub(super) fn combined_psnr(picks: &[&Candidate]) -> f64 {
+    let n: f64 = picks.iter().map(|c| c.pixels.max(1) as f64).sum();
+    psnr_of(picks.iter().map(|c| c.pixels.max(1) as f64 * mse_of(c.psnr)).sum::<f64>() / n.max(1.0))
+}
+
+/// How a choice ranks under a budget: (meets it, score, tie-break), higher better.
+pub(super) fn rank(budget: Budget, ms: f64, picks: &[&Candidate]) -> (bool, f64, f64) {
+    let min_psnr = picks.iter().map(|c| c.psnr).fold(f64::INFINITY, f64::min);
+    match budget {
+        // Within the floor: the fastest; below it: the highest floor, then the fastest.
+        Budget::MinPsnr(db) => {
+            if min_psnr >= db {
+                (true, -ms, 0.0)
+            } else {
+                (false, min_psnr, -ms)
+            }
+        }
+        // Within the time: the most accurate, then the fastest; over it: the fastest.
+        Budget::MaxMs(t) => {
+            if ms <= t {
+                (true, combined_psnr(picks), -ms)
+            } else {
+                (false, -ms, combined_psnr(picks))
+            }
+        }
+    }
+}
+
+pub(super) fn better(a: (bool, f64, f64), b: (bool, f64, f64)) -> bool {
+    (a.0 && !b.0) || (a.0 == b.0 && (a.1 > b.1 || (a.1 == b.1 && a.2 > b.2)))
+}
+
+/// Per object one candidate index, exhaustively or greedily; `time` is the frame's.
+pub(super) fn search(budget: Budget, time: &dyn Fn(&[&Candidate]) -> f64, per_object: &[Vec<Candidate>]) -> Vec<usize> {
+    let eval = |idx: &[usize]| {
+        let picks: Vec<&Candidate> = idx.iter().zip(per_object).map(|(&i, c)| &c[i]).collect();
+        rank(budget, time(&picks), &picks)
+    };
+    let combos = per_object.iter().try_fold(1u64, |n, c| n.checked_mul(c.len() as u64)).unwrap_or(u64::MAX);
+    if combos <= MAX_COMBINATIONS {
+        let mut idx = vec![0usize; per_object.len()];
+        let mut best = (idx.clone(), eval(&idx));
+        loop {
+            let mut k = 0;
+            while k < idx.len() {
+                idx[k] += 1;
+                if idx[k] < per_object[k].len() {
+                    break;
+                }
+                idx[k] = 0;
+                k += 1;
+            }
+            if k == idx.len() {
+                return best.0;
+            }
+            let r = eval(&idx);
+            if better(r, best.1) {
+                best = (idx.clone(), r);
+            }
+        }
+    }
+    // Greedy: from each object's cheapest, change one object at a time while that helps.
+    let mut idx: Vec<usize> = per_object
+        .iter()
+        .map(|c| {
+            (0..c.len())
+                .min_by(|&a, &b| (c[a].fixed + c[a].screen + c[a].shared).total_cmp(&(c[b].fixed + c[b].screen + c[b].shared)))
+                .unwrap_or(0)
+        })
+        .collect();
+    let mut cur = eval(&idx);
+    loop {
+        let mut step = None;
+        for k in 0..idx.len() {
+            for i in 0..per_object[k].len() {
+                let mut t = idx.clone();
+                t[k] = i;
+                let r = eval(&t);
+                if better(r, step.as_ref().map_or(cur, |(_, s)| *s)) {
+                    step = Some((t, r));
+                }
+            }
+        }
+        match step {
+            Some((t, r)) => {
+                idx = t;
+                cur = r;
+            }
+            None => return idx,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::budget::PSNR_CAP;
+
+    fn cand(ms: f64, psnr: f64) -> Candidate {
+        Candidate {
+            method: crate::methods::ENVMAP,
+            fixed: 0.0,
+            screen: ms,
+            shared: 0.0,
+            cycles: 1,
+            psnr,
+            pixels: 100,
+            model: String::new(),
+        }
+    }
+
+    /// Base 1 ms plus the candidates' screen parts.
+    fn time(p: &[&Candidate]) -> f64 {
+        1.0 + p.iter().map(|c| c.screen).sum::<f64>()
+    }
+
+    /// Three objects × three candidates: the exhaustive search's answers, by hand.
+    #[test]
+    fn search_meets_floors_at_least_time_and_times_at_least_error() {
+        let per = vec![
+            vec![cand(1.0, 20.0), cand(2.0, 30.0), cand(5.0, 40.0)],
+            vec![cand(1.0, 25.0), cand(3.0, 35.0), cand(4.0, 45.0)],
+            vec![cand(0.5, 18.0), cand(1.5, 33.0), cand(6.0, 50.0)],
+        ];
+        // Floor 30: the cheapest per object that reaches it.
+        assert_eq!(search(Budget::MinPsnr(30.0), &time, &per), [1, 1, 1]);
+        // Floor 60: unreachable; the highest floor (40, 45, 50), then the fastest.
+        assert_eq!(search(Budget::MinPsnr(60.0), &time, &per), [2, 2, 2]);
+        // 8 ms with a 1 ms base: 7 ms for the objects; the least pixel-weighted error.
+        let pick = search(Budget::MaxMs(8.0), &time, &per);
+        let ms: f64 = pick.iter().zip(&per).map(|(&i, c)| c[i].screen).sum();
+        assert!(ms <= 7.0, "{pick:?}");
+        let mse = |p: &[usize]| p.iter().zip(&per).map(|(&i, c)| mse_of(c[i].psnr)).sum::<f64>();
+        for a in 0..3 {
+            for b in 0..3 {
+                for c in 0..3 {
+                    let t = [a, b, c];
+                    let tm: f64 = t.iter().zip(&per).map(|(&i, c)| c[i].screen).sum();
+                    if tm <= 7.0 {
+                        assert!(mse(&pick) <= mse(&t) + 1e-15, "{t:?} beats {pick:?}");
+                    }
+                }
+            }
+        }
+        // No time at all: the fastest.
+        assert_eq!(search(Budget::MaxMs(0.1), &time, &per), [0, 0, 0]);
+    }
+
+    #[test]
+    fn combined_psnr_weights_by_pixels() {
+        let a = Candidate { pixels: 300, ..cand(1.0, 20.0) };
+        let b = Candidate { pixels: 100, ..cand(1.0, 40.0) };
+        // MSE 0.01 on 300 px and 0.0001 on 100: mean 0.007525.
+        assert!((combined_psnr(&[&a, &b]) - -10.0 * 0.007525f64.log10()).abs() < 1e-9);
+        assert_eq!(psnr_of(0.0), PSNR_CAP);
+    }
+}
