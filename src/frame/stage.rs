@@ -269,7 +269,7 @@ pub struct MapSets {
     pub geometry: vk::DescriptorSet,
 }
 
-/// Indices into the frame's view table.
+/// Indices into the frame's view table: the frame's own views, then the families' blocks.
 #[derive(Clone, Debug, Default)]
 pub struct ViewLayout {
     pub camera: u32,
@@ -277,24 +277,39 @@ pub struct ViewLayout {
     pub shadow_planes: Vec<u32>,
     /// First of the six views of `plan.envmaps[i]` (its reference point).
     pub envmaps: Vec<u32>,
-    /// First of the planar mirrors' views (§5): view `mirrors + i` is the frame's i-th.
-    pub mirrors: u32,
-    /// Per cube-mapped object (as `envmaps`), the first of its planar mirrors' mirrored
-    /// cube views: six per mirror of `plan.map_mirrors`, in that order.
-    pub map_mirrors: Vec<u32>,
-    /// Caustics (§6): the first of each generator's six cube views around its reference
-    /// point, and the first photon view (one per photon image layer).
-    pub caustic_cubes: Vec<u32>,
-    pub photons: u32,
-    /// The first of the shared layered map's six views (§4.5), around `plan.layered_centre`.
-    pub layered: Option<u32>,
+    /// The families' blocks of views, in table order (`registry::Family::views`).
+    pub blocks: Vec<ViewBlock>,
     pub count: u32,
 }
+
+/// A block of consecutive views a family declares (its cube faces, photon views, mirrored
+/// views), found by its name.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewBlock {
+    pub name: &'static str,
+    pub first: u32,
+    pub count: u32,
+}
+
+/// The block of extra camera views that frame parts render the camera's stages into
+/// (`FramePart::record_views`; `Push.mirror_base` is its first view).
+pub const EXTRA_VIEWS: &str = "frame.extra_views";
 
 impl ViewLayout {
     /// The first cube view of mesh `mesh`'s reference point, if it has cube maps.
     pub fn cube_of(&self, plan: &Plan, mesh: usize) -> Option<u32> {
         plan.envmaps.iter().position(|e| e.mesh == mesh).map(|i| self.envmaps[i])
+    }
+
+    /// Appends a block of `count` views named `name`.
+    pub fn add(&mut self, name: &'static str, count: u32) {
+        self.blocks.push(ViewBlock { name, first: self.count, count });
+        self.count += count;
+    }
+
+    /// The first view of block `name`, if declared.
+    pub fn first(&self, name: &str) -> Option<u32> {
+        self.blocks.iter().find(|b| b.name == name).map(|b| b.first)
     }
 }
 

@@ -12,8 +12,8 @@ use crate::plan::Plan;
 use crate::scene::{LightKind, Scene};
 
 impl ViewLayout {
-    /// Camera first, then six views per shadow cube, one per shadow plane, six per
-    /// cube-mapped object.
+    /// The frame's own views: camera first, then six per shadow cube, one per shadow plane,
+    /// six per cube-mapped object. The families add their blocks after these (`add`).
     pub fn of(plan: &Plan) -> ViewLayout {
         let mut v = ViewLayout { camera: 0, count: 1, ..Default::default() };
         for _ in &plan.shadow_cubes {
@@ -27,26 +27,6 @@ impl ViewLayout {
         for _ in &plan.envmaps {
             v.envmaps.push(v.count);
             v.count += 6;
-        }
-        if plan.layered_centre.is_some() {
-            v.layered = Some(v.count);
-            v.count += 6;
-        }
-        v.mirrors = v.count;
-        v.count += plan.mirror_layers;
-        if !plan.map_mirrors.is_empty() {
-            for _ in &plan.envmaps {
-                v.map_mirrors.push(v.count);
-                v.count += 6 * plan.map_mirrors.len() as u32;
-            }
-        }
-        if let Some(c) = &plan.caustics {
-            for _ in &c.cubes {
-                v.caustic_cubes.push(v.count);
-                v.count += 6;
-            }
-            v.photons = v.count;
-            v.count += c.photon_layers;
         }
         v
     }
@@ -66,8 +46,8 @@ pub fn view(view_proj: Mat4, eye: Vec4, dir: Vec4) -> GpuView {
 
 /// The frame's part of the view table for a camera (`camera_view_proj`, eye), the plan's
 /// lights and maps: the camera, the shadow maps' views and the cube-mapped objects' faces.
-/// The families' own views (planar mirrors', the caustics') are written by their frame parts
-/// (`stage::FramePart::write_views`).
+/// The families' own blocks (the layered map's, planar mirrors', the caustics') are written
+/// by their frame parts (`stage::FramePart::write_views`).
 pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], (camera_view_proj, eye): (Mat4, Vec3)) -> Vec<GpuView> {
     let mut views = vec![GpuView::zeroed(); layout.count as usize];
     views[layout.camera as usize] = view(camera_view_proj, eye.extend(0.0), Vec4::ZERO);
@@ -89,11 +69,6 @@ pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], (camera
         for f in 0..6 {
             views[(base + f) as usize] =
                 view(face_view_proj(f as usize, e.reference_point, near), e.reference_point.extend(0.0), Vec4::ZERO);
-        }
-    }
-    if let (Some(c), Some(base)) = (plan.layered_centre, layout.layered) {
-        for f in 0..6 {
-            views[(base + f) as usize] = view(face_view_proj(f as usize, c, near), c.extend(0.0), Vec4::ZERO);
         }
     }
     views

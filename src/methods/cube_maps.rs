@@ -274,7 +274,13 @@ impl Stage for CubeMaps {
                 };
                 let face_draws = &mut self.face_draws;
                 let map_mirrors = &self.map_mirrors;
-                let mirror_base = io.views.map_mirrors.get(io.plan.envmaps.iter().position(|e| e.mesh == mesh).unwrap_or(usize::MAX));
+                let mirror_base = io
+                    .plan
+                    .envmaps
+                    .iter()
+                    .position(|e| e.mesh == mesh)
+                    .zip(io.views.first(MAP_MIRROR_VIEWS))
+                    .map(|(i, first)| first + (6 * map_mirrors.len() * i) as u32);
                 let (mirror_mask, mirror_weight, surface) = (self.mirror_mask, self.mirror_weight, self.surface);
                 render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
                     // Six passes: each face draws only the objects inside its frustum.
@@ -289,7 +295,7 @@ impl Stage for CubeMaps {
                     // scene from the mirrored reference point drawn there only (no mirror in
                     // it: one reflection deep); the depth cleared for the map's own draws.
                     let mirrored = mirror_base.filter(|_| !map_mirrors.is_empty());
-                    if let Some(&base) = mirrored {
+                    if let Some(base) = mirrored {
                         for (k, &mirror) in map_mirrors.iter().enumerate() {
                             let Some(md) = f.scene.draws.iter().find(|d| d.mesh as usize == mirror).filter(|d| sees(d)) else { continue };
                             clear_depth(ctx, cmd, target.width, 1.0);
@@ -355,6 +361,11 @@ impl Owner for CubeMaps {
         Stage::destroy(self, ctx)
     }
 }
+
+/// The view block of planar mirrors' mirrored cube views inside the maps (§5 inside §3/§4):
+/// per cube-mapped object (as `plan.envmaps`), six per mirror of `plan.map_mirrors`, in
+/// that order. The geometry family declares and writes it.
+pub const MAP_MIRROR_VIEWS: &str = "geometry.map_mirror_views";
 
 /// Images the distance maps need: two for cycles that read the previous cycle's maps.
 pub fn distance_images(p: &Plan) -> u64 {

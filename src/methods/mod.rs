@@ -45,9 +45,9 @@ pub const ALL: &[Method] = &[
     REFERENCE,
 ];
 
-/// Every family with hooks beyond maps and camera passes, in the order the renderer calls
-/// them.
-pub const FAMILIES: &[registry::Family] = &[layered::FAMILY, caustics::FAMILY, geometry::FAMILY];
+/// Every family with hooks beyond maps and camera passes, in the order the planner and the
+/// renderer call them (and their view blocks follow in the view table).
+pub const FAMILIES: &[registry::Family] = &[layered::FAMILY, geometry::FAMILY, caustics::FAMILY];
 
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];

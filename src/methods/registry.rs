@@ -243,6 +243,8 @@ pub struct Family {
     pub plan_stages: Option<fn(&Scene, &mut Plan, &mut PlanStages)>,
     /// After the maps: view layers of its own (planar mirrors', §5).
     pub plan_views: Option<fn(&Scene, &mut Plan)>,
+    /// Its blocks of views in the frame's view table: (name, count), in table order.
+    pub views: Option<fn(&Plan) -> Vec<(&'static str, u32)>>,
     /// After objects moved, with the plan's structure kept: its plan follows them.
     pub refresh: Option<fn(&mut Plan)>,
     /// Its part of `specula plan`'s table, if it planned anything.
@@ -260,6 +262,7 @@ impl Family {
         plan_frame: None,
         plan_stages: None,
         plan_views: None,
+        views: None,
         refresh: None,
         describe: None,
         frame_part: None,

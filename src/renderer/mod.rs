@@ -22,10 +22,11 @@ use crate::error::{Error, Result};
 use crate::frame::camera::CameraShade;
 use crate::frame::direct::SceneDirect;
 use crate::frame::shadow::ShadowMaps;
-use crate::frame::stage::{Deps, FrameIo, FramePart, MapSets, Maps, Stage, StageInit, ViewFrame, ViewLayout, ViewPass};
+use crate::frame::stage::{Deps, FrameIo, FramePart, MapSets, Maps, Stage, StageInit, ViewFrame, ViewLayout, ViewPass, EXTRA_VIEWS};
 use crate::frame::views;
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
 use crate::gpu_scene::{GpuLight, GpuScene};
+use crate::methods::FAMILIES;
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::{Camera, Scene};
@@ -165,6 +166,9 @@ impl Renderer {
     fn init(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
         let plan = &self.plan;
         self.views = ViewLayout::of(plan);
+        for (name, count) in FAMILIES.iter().filter_map(|f| f.views).flat_map(|h| h(plan)) {
+            self.views.add(name, count);
+        }
         self.light_table = views::light_table(scene, plan);
         self.bindings.create(ctx, self.views.count, &bindings::object_table(scene, plan), &self.light_table)?;
         let q = &plan.quality;
@@ -179,7 +183,7 @@ impl Renderer {
             self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.bindings.layout, self.width, self.height)?);
         }
         let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
-        for family in crate::methods::FAMILIES {
+        for family in FAMILIES {
             if let Some(create) = family.frame_part {
                 if let Some(part) = create(&init, &mut self.maps)? {
                     self.parts.push(part);
@@ -279,7 +283,7 @@ impl Renderer {
             tolerance: q.search_tolerance,
             internal_bounces: q.internal_bounces,
             depth: q.depth,
-            mirror_base: self.views.mirrors,
+            mirror_base: self.views.first(EXTRA_VIEWS).unwrap_or(self.views.count),
         };
         let t = &mut self.targets;
         let full = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.target.width, height: t.target.height } };

@@ -59,11 +59,19 @@ pub const FAMILY: Family = Family {
     name: "caustics",
     plan_frame: Some(|scene, p| p.caustics = plan(scene, &p.objects, &p.quality)),
     plan_stages: Some(plan_stages),
+    views: Some(|p| {
+        p.caustics.as_ref().map_or_else(Vec::new, |c| vec![(CUBE_VIEWS, 6 * c.cubes.len() as u32), (PHOTON_VIEWS, c.photon_layers)])
+    }),
     refresh: Some(refresh),
     describe: Some(|p, scene| p.caustics.as_ref().map(|c| describe(c, &p.quality, scene))),
     frame_part: Some(create_frame_part),
     ..Family::NONE
 };
+
+/// The view blocks of the caustic cubes (six faces each, in `CausticsPlan::cubes` order) and
+/// of the photon images (one view per layer).
+pub const CUBE_VIEWS: &str = "caustics.cube_views";
+pub const PHOTON_VIEWS: &str = "caustics.photon_views";
 
 /// The pass of the refractor maps (§4.4) that solid generators' photons exit through.
 const REFRACTOR_MAP: &str = "refractor.generate";
@@ -130,14 +138,16 @@ impl FramePart for CausticViews {
     fn write_views(&mut self, fr: &ViewFrame, table: &mut [GpuView]) {
         let Some(c) = &fr.plan.caustics else { return };
         let near = fr.plan.cube_near;
-        for (k, &base) in fr.layout.caustic_cubes.iter().enumerate() {
+        let (Some(cubes), Some(photons)) = (fr.layout.first(CUBE_VIEWS), fr.layout.first(PHOTON_VIEWS)) else { return };
+        for k in 0..c.cubes.len() {
+            let base = cubes + 6 * k as u32;
             let centre = c.centre(k, fr.lights);
             for f in 0..6 {
                 table[(base + f) as usize] = view(face_view_proj(f as usize, centre, near), centre.extend(0.0), glam::Vec4::ZERO);
             }
         }
         for (i, v) in photon_views(c, fr.scene, fr.lights, &fr.plan.quality, near).into_iter().enumerate() {
-            if let Some(slot) = table.get_mut(fr.layout.photons as usize + i) {
+            if let Some(slot) = table.get_mut(photons as usize + i) {
                 *slot = v;
             }
         }

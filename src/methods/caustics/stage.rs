@@ -216,7 +216,9 @@ impl CausticsStage {
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
         }
         let per_layer = 2 * (self.photons - 1) * (self.photons - 1);
-        for (c, &first_view) in views.caustic_cubes.iter().enumerate().take(self.plan.cubes.len()) {
+        let cubes = views.first(super::CUBE_VIEWS).expect("caustics declare their views");
+        for c in 0..self.plan.cubes.len() {
+            let first_view = cubes + 6 * c as u32;
             for layer in cube_layers(&self.plan, c) {
                 f.push_flags(ctx, cmd, first_view, layer, 0);
                 unsafe { ctx.device.cmd_dispatch(cmd, per_layer.div_ceil(64), 1, 1) };
@@ -265,7 +267,9 @@ impl Stage for CausticsStage {
         else {
             return;
         };
-        let cube_views = &io.views.caustic_cubes;
+        let first = |name| io.views.first(name).expect("caustics declare their views");
+        let (cubes, photons) = (first(super::CUBE_VIEWS), first(super::PHOTON_VIEWS));
+        let cube_views: Vec<u32> = (0..self.plan.cubes.len() as u32).map(|k| cubes + 6 * k).collect();
 
         // The receivers: everything but the generator, from its reference point.
         let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
@@ -313,7 +317,7 @@ impl Stage for CausticsStage {
                     // Bits 8-31 are the caustics' own (layout.in.rs), apart from every frame-wide flag.
                     let flags = f.flags | reflected | (lv.cube << CAUSTIC_CUBE_SHIFT) | ((lv.light as u32) << CAUSTIC_LIGHT_SHIFT);
                     for d in f.scene.draws.iter().filter(|d| d.mesh as usize == gen.mesh && d.index_count > 0) {
-                        f.push_flags(ctx, cmd, io.views.photons + layer, d.mesh, flags);
+                        f.push_flags(ctx, cmd, photons + layer, d.mesh, flags);
                         unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
                     }
                     unsafe { ctx.device.cmd_end_rendering(cmd) };

@@ -21,8 +21,23 @@ use crate::methods::registry::{
 use crate::quality::Quality;
 
 /// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
-pub const FAMILY: Family =
-    Family { name: "geometry", plan_views: Some(plan_views), frame_part: Some(views::create_frame_part), ..Family::NONE };
+pub const FAMILY: Family = Family {
+    name: "geometry",
+    plan_views: Some(plan_views),
+    views: Some(view_blocks),
+    frame_part: Some(views::create_frame_part),
+    ..Family::NONE
+};
+
+/// The planar mirrors' views (the frame's extra camera views, one per layer), and their
+/// mirrored cube views inside other objects' cube maps.
+fn view_blocks(p: &crate::plan::Plan) -> Vec<(&'static str, u32)> {
+    let mut v = vec![(crate::frame::stage::EXTRA_VIEWS, p.mirror_layers)];
+    if !p.map_mirrors.is_empty() {
+        v.push((crate::methods::cube_maps::MAP_MIRROR_VIEWS, (6 * p.map_mirrors.len() * p.envmaps.len()) as u32));
+    }
+    v
+}
 
 /// Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
 /// Flat-faced refractors' faces bring two views each (reflection and refraction).

@@ -11,7 +11,7 @@ use super::mirror::{oblique, reflection, Limits, Mirror, MirrorFrame, Rect};
 use crate::cube::face_view_proj;
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
-use crate::frame::stage::{FramePart, Maps, StageInit, ViewFrame, ViewLayout, ViewPass};
+use crate::frame::stage::{FramePart, Maps, StageInit, ViewFrame, ViewLayout, ViewPass, EXTRA_VIEWS};
 use crate::frame::FrameInputs;
 use crate::gpu_scene::GpuView;
 use crate::plan::Plan;
@@ -230,7 +230,7 @@ impl FramePart for PlanarViews {
         if let Some(m) = self.mirrors.as_mut() {
             m.plan_frame(fr.scene, fr.view_proj, fr.eye, cos_corner(fr.yfov, fr.aspect));
             for (i, v) in m.frame.views.iter().enumerate() {
-                if let Some(slot) = table.get_mut(fr.layout.mirrors as usize + i) {
+                if let Some(slot) = fr.layout.first(EXTRA_VIEWS).and_then(|first| table.get_mut(first as usize + i)) {
                     // Rasterisation clips at the mirror (oblique near plane); pixels unproject
                     // to rays through the plain mirrored projection.
                     *slot = GpuView {
@@ -260,10 +260,11 @@ impl FramePart for PlanarViews {
         camera_stages: &mut dyn FnMut(&mut Recorder, ViewPass),
     ) -> bool {
         let Some(mv) = self.mirrors.as_mut() else { return false };
+        let first = layout.first(EXTRA_VIEWS).expect("planar mirrors declare their views");
         rec.scope = Some("geometry.mirror_view");
         for i in mv.frame.order() {
             let v = mv.frame.views[i].clone();
-            let views = ViewLayout { camera: layout.mirrors + i as u32, ..layout.clone() };
+            let views = ViewLayout { camera: first + i as u32, ..layout.clone() };
             let flags = mv.child_flags(Some(i));
             let area = render_area(v.rect);
             // geometry.stencil: the mirror's pixels (as its parent sees them) marked in the
@@ -271,7 +272,7 @@ impl FramePart for PlanarViews {
             // its whole rectangle: an edge pixel of the mirror averages samples beyond it.
             let masked = mv.samples == 1;
             if masked {
-                let parent_view = v.parent.map_or(layout.camera, |p| layout.mirrors + p as u32);
+                let parent_view = v.parent.map_or(layout.camera, |p| first + p as u32);
                 let mesh = mv.frame.mirrors[v.mirror].mesh;
                 mv.record_stencil(rec, f, parent_view, mesh, area);
             }
@@ -338,7 +339,9 @@ fn map_mirror_views(plan: &Plan, layout: &ViewLayout, scene: &Scene, views: &mut
     // A cube face's corner rays make an angle of arccos(1/√3) with its axis.
     let cos_corner = 1.0 / 3f32.sqrt();
     let mirrors: Vec<Option<Mirror>> = plan.map_mirrors.iter().map(|&m| Mirror::of(scene, m).into_iter().next()).collect();
-    for (e, &base) in plan.envmaps.iter().zip(&layout.map_mirrors) {
+    let Some(first) = layout.first(crate::methods::cube_maps::MAP_MIRROR_VIEWS) else { return };
+    for (i, e) in plan.envmaps.iter().enumerate() {
+        let base = first + (6 * plan.map_mirrors.len() * i) as u32;
         let p = e.reference_point;
         for (k, m) in mirrors.iter().enumerate() {
             let Some(m) = m else { continue };

@@ -15,7 +15,7 @@ pub mod peel;
 
 use glam::Vec3;
 
-use crate::frame::stage::{order, MapInfo};
+use crate::frame::stage::{order, FramePart, MapInfo, ViewFrame};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape, Verdict};
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
@@ -123,8 +123,31 @@ pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec
 }
 
 /// Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
-pub const FAMILY: crate::methods::registry::Family =
-    crate::methods::registry::Family { name: "layered", plan_objects: Some(share_centre), ..crate::methods::registry::Family::NONE };
+pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
+    name: "layered",
+    plan_objects: Some(share_centre),
+    views: Some(|p| if p.layered_centre.is_some() { vec![(VIEWS, 6)] } else { Vec::new() }),
+    frame_part: Some(|init, _| Ok(init.plan.layered_centre.map(|_| Box::new(LayeredViews) as Box<dyn FramePart>))),
+    ..crate::methods::registry::Family::NONE
+};
+
+/// The view block of the shared layered map's six faces, around `plan.layered_centre`.
+pub const VIEWS: &str = "layered.views";
+
+/// The layered map's part of a frame: its six cube views.
+struct LayeredViews;
+
+impl FramePart for LayeredViews {
+    fn write_views(&mut self, fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
+        let (Some(c), Some(base)) = (fr.plan.layered_centre, fr.layout.first(VIEWS)) else { return };
+        for f in 0..6 {
+            let vp = crate::cube::face_view_proj(f as usize, c, fr.plan.cube_near);
+            table[(base + f) as usize] = crate::frame::views::view(vp, c.extend(0.0), glam::Vec4::ZERO);
+        }
+    }
+
+    fn destroy(&mut self, _ctx: &crate::vk::Context) {}
+}
 
 /// Gives every layered object of the plan the shared map's reference point.
 pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {

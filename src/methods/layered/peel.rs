@@ -294,7 +294,7 @@ impl Stage for LayeredMaps {
     /// depth buffer); six passes per layer, or one multiview pass.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let (Some(mut radiance), Some(mut normals)) = (io.maps.layered.take(), io.maps.layered_normals.take()) else { return };
-        let Some(view) = io.views.layered else {
+        let Some(view) = io.views.first(super::VIEWS) else {
             (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
             return;
         };
