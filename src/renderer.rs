@@ -192,7 +192,7 @@ impl<'a> FrameShared<'a> {
 /// sample-rate shading (the per-sample passes, and the ray pipelines' one ray per sample).
 fn camera_multisample(ctx: &Context, plan: &Plan) -> Result<Multisample> {
     let q = &plan.quality;
-    let samples = q.aa.msaa();
+    let samples = q.frame.aa.msaa();
     if samples == 1 {
         return Ok(Multisample::OFF);
     }
@@ -237,7 +237,7 @@ fn camera_multisample(ctx: &Context, plan: &Plan) -> Result<Multisample> {
             ),
         ));
     }
-    Ok(Multisample { samples, per_sample: q.msaa_per_sample })
+    Ok(Multisample { samples, per_sample: q.frame.msaa_per_sample })
 }
 
 impl Renderer {
@@ -252,7 +252,7 @@ impl Renderer {
         }
         let camera = scene.camera_or_default();
         camera.validate()?;
-        let ssaa = plan.quality.aa.ssaa();
+        let ssaa = plan.quality.frame.aa.ssaa();
         if ![1, 2, 4].contains(&ssaa) {
             return Err(Error::invalid("knob aa", format!("{ssaa} samples per axis: supersampling takes 1, 2 or 4")));
         }
@@ -327,10 +327,10 @@ impl Renderer {
         if !self.light_table.is_empty() {
             self.lights = Some(Buffer::with_data(ctx, "scene.lights", &self.light_table, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         }
-        self.flags = if plan.quality.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
+        self.flags = if plan.quality.frame.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
             | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 }
-            | if plan.quality.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
-            | if plan.quality.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
+            | if plan.quality.layered.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
+            | if plan.quality.frame.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
 
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         // The sets are visible to compute too: the ray pipeline's kernels shade with them.
@@ -393,7 +393,7 @@ impl Renderer {
                 self.resolve.push(Image::new(ctx, &desc)?);
             }
         }
-        if self.plan.quality.object_ids {
+        if self.plan.quality.frame.object_ids {
             self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.layout, self.width, self.height)?);
         }
         self.mirrors = MirrorViews::new(ctx, &self.plan, (sw, sh), self.multisample, self.layout, &mut self.maps)?;
@@ -458,7 +458,8 @@ impl Renderer {
                     None => {
                         // The test knob debug_fault=flip_reflection breaks distance.search.
                         let mut c = c.clone();
-                        if c.name == "distance.search" && self.plan.quality.debug_fault == crate::quality::DebugFault::FlipReflection {
+                        if c.name == "distance.search" && self.plan.quality.frame.debug_fault == crate::quality::DebugFault::FlipReflection
+                        {
                             c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
                         }
                         Box::new(CameraShade::new(ctx, self.layout, &c, self.multisample)?)
@@ -583,7 +584,7 @@ impl Renderer {
             let mut why = Vec::new();
             if self.first_frame {
                 why.push("first frame".to_string());
-            } else if q.map_updates_always {
+            } else if q.frame.map_updates_always {
                 why.push("map_updates=always".to_string());
             } else {
                 let geometry = !c.moved.is_empty();
@@ -613,7 +614,7 @@ impl Renderer {
             }
             if !why.is_empty() && self.plan.frame_latency && *deps == Deps::World {
                 // One inter-object cycle per frame: the change needs `cycles` frames.
-                self.latency_left[i] = q.cycles.max(1);
+                self.latency_left[i] = q.distance.cycles.max(1);
             }
             if why.is_empty() && self.latency_left[i] > 0 {
                 why.push(format!("frame latency: {} more cycle(s)", self.latency_left[i]));
@@ -721,9 +722,9 @@ impl Renderer {
             flags: self.flags,
             light_count: self.light_count,
             search: SearchKnobs::of(q),
-            tolerance: q.search_tolerance,
-            internal_bounces: q.internal_bounces,
-            depth: q.depth,
+            tolerance: q.search.search_tolerance,
+            internal_bounces: q.distance.internal_bounces,
+            depth: q.frame.depth,
             mirror_base: self.views.mirrors,
         };
         let full =

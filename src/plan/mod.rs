@@ -6,6 +6,7 @@
 
 pub mod budget;
 pub mod facts;
+pub mod knobs;
 
 use glam::Vec3;
 
@@ -417,7 +418,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     let bounds = scene.bounds();
     let diag = bounds.diagonal();
     let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
-    let proxy_radius = quality.proxy_radius.unwrap_or_else(|| {
+    let proxy_radius = quality.envmap.proxy_radius.unwrap_or_else(|| {
         let half = (bounds.max - bounds.min) * 0.5;
         if bounds.is_empty() {
             1.0
@@ -500,7 +501,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     // caustic photons need them (occluders between a light and a generator).
     let traced_everywhere = matches!(p.choice, Choice::Method(m) if m.family == "raytrace");
     p.caustics = crate::methods::caustics::plan(scene, &p.objects, &q);
-    if has_diffuse && q.shadows && (!traced_everywhere || p.caustics.is_some()) {
+    if has_diffuse && q.frame.shadows && (!traced_everywhere || p.caustics.is_some()) {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),
@@ -519,7 +520,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
     let asks = methods.iter().any(|&m| gpu(m).map_shading == MapShading::Traced);
     p.inter_object = asks || composes;
-    p.frame_latency = asks && q.frame_latency;
+    p.frame_latency = asks && q.distance.frame_latency;
     p.cycles = methods.iter().map(|&m| (gpu(m).cycles)(&q)).max().unwrap_or(1).max(1);
     if composes && !p.frame_latency {
         p.cycles = p.cycles.max(2);
@@ -622,12 +623,12 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let geometry = [crate::methods::PLANAR_MIRROR, crate::methods::PLANAR_REFRACTION];
     p.mirrors = p.objects.iter().filter(|o| geometry.contains(&o.method)).map(|o| o.mesh).collect();
     let planes = p.mirrors.iter().map(|&m| crate::methods::geometry::mirror::plane_count(scene, m)).sum();
-    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(planes, q.depth, q.mirror_budget);
+    p.mirror_layers = crate::methods::geometry::mirror::layers_needed(planes, q.frame.depth, q.geometry.mirror_budget);
     // Planar mirrors inside cube maps: one mirrored view per cube face per mirror, at most
     // mirror_budget mirrors (the rest show the environment there, as before).
-    if !p.envmaps.is_empty() && q.map_mirrors {
+    if !p.envmaps.is_empty() && q.geometry.map_mirrors {
         let planar = p.objects.iter().filter(|o| o.method == crate::methods::PLANAR_MIRROR).map(|o| o.mesh);
-        p.map_mirrors = planar.take(q.mirror_budget as usize).collect();
+        p.map_mirrors = planar.take(q.geometry.mirror_budget as usize).collect();
     }
     stages.extend(maps.into_iter().map(StageSpec::Map));
     stages.extend(cameras.into_iter().map(StageSpec::Camera));

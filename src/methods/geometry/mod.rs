@@ -9,6 +9,7 @@
 
 pub mod curved;
 pub mod faces;
+pub mod knobs;
 pub mod mirror;
 pub mod views;
 
@@ -17,6 +18,7 @@ pub use curved::CURVED_REFLECTOR;
 use crate::frame::stage::order;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
 use crate::quality::Quality;
+use crate::quality::{FrameKnobs, GeometryKnobs};
 
 const fn one(_: &Quality) -> u32 {
     1
@@ -40,7 +42,7 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "planar reflectors by geometry transformation: the scene rendered again from the camera mirrored through the mirror's plane (oblique near plane at the mirror), laid onto the mirror's pixels with its Fresnel weight; mirrors in mirrors recurse up to depth, at most mirror_budget views a frame",
     serves: &[ObjectClass::Mirror],
-    knobs: &["depth", "mirror_budget", "map_mirrors", "fresnel"],
+    knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, GeometryKnobs::map_mirrors, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
@@ -71,7 +73,7 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "flat-faced dielectrics (slabs, prisms, gems; convex) and thin panes by geometry transformation: per face seen, the scene rendered through it by the linearised refraction of the eye ray (GS04: an affine map per face, exact on the face's central ray; exact for thin panes) and reflected in it (exact), recursing through internal reflections to the exit faces up to depth, at most mirror_budget views a frame, with the pixel's own Fresnel split",
     serves: &[ObjectClass::SolidDielectric, ObjectClass::ThinDielectric],
-    knobs: &["depth", "mirror_budget", "fresnel"],
+    knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
