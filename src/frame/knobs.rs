@@ -17,7 +17,14 @@ knobs! {
         /// anti-aliasing of every GPU method's camera passes: multisampling with 2, 4 or 8 samples per pixel at the device's
         /// standard positions (ray-tracing methods trace one ray per sample; the counts a device offers vary: lavapipe has 4 only),
         /// or supersampling on a regular 2×2 (ssaa2) or 4×4 (ssaa4) grid per pixel; resolved by averaging on the GPU
-        aa: Aa = "off", one_of()["off" => Aa::Off, "msaa2" => Aa::Msaa(2), "msaa4" => Aa::Msaa(4), "msaa8" => Aa::Msaa(8), "ssaa2" => Aa::Ssaa(2), "ssaa4" => Aa::Ssaa(4)];
+        aa: Aa = "off", one_of()[
+            "off" => Aa::Off,
+            "msaa2" => Aa::Msaa(2),
+            "msaa4" => Aa::Msaa(4),
+            "msaa8" => Aa::Msaa(8),
+            "ssaa2" => Aa::Ssaa(2),
+            "ssaa4" => Aa::Ssaa(4),
+        ];
         /// debug output (issue 15's masks): each frame also rasterises every object's mesh index + 1 (0: the sky) from the camera
         /// at the output size (pass frame.object_ids) and reads it back beside the colour, so that errors can be measured on one
         /// object's pixels, on the specular ones or on the rest; off: no pass, no image

@@ -42,8 +42,7 @@ pub enum Range {
 }
 
 /// A family of knobs that `Quality` composes: where its struct lives in a `Quality`.
-pub trait Part: Sized + 'static {
-    const KNOBS: &'static [Knob];
+pub trait Part {
     fn of(q: &Quality) -> &Self;
     fn of_mut(q: &mut Quality) -> &mut Self;
 }
@@ -251,13 +250,15 @@ macro_rules! knob_kind {
     (default_text one_of; $def:literal) => { $def };
     (default_text $kind:ident; $def:tt) => { stringify!($def) };
 
-    (values count ($lo:literal ..= $hi:literal $(, $unit:literal)?)) => { concat!(stringify!($lo), "..=", stringify!($hi) $(, " ", $unit)?) };
-    (values real ($lo:literal ..= $hi:literal $(, $unit:literal)?)) => { concat!(stringify!($lo), "..=", stringify!($hi) $(, " ", $unit)?) };
     (values square (..= $hi:literal)) => { concat!("1, 4, 9, ..., ", stringify!($hi)) };
     (values one_of ($($unit:literal)?) [$first:literal => $fv:expr $(, $opt:literal => $val:expr)*]) => {
         concat!($first $(, "|", $opt)* $(, " ", $unit)?)
     };
     (values auto_count ($lo:literal ..= $hi:literal)) => { concat!("auto|", stringify!($lo), "..=", stringify!($hi)) };
+    // count and real
+    (values $kind:ident ($lo:literal ..= $hi:literal $(, $unit:literal)?)) => {
+        concat!(stringify!($lo), "..=", stringify!($hi) $(, " ", $unit)?)
+    };
     (values auto_metres ()) => { "auto|metres" };
     (values auto_point ($unit:literal)) => { concat!("auto|x,y,z (", $unit, ")") };
 
@@ -271,7 +272,9 @@ macro_rules! knob_kind {
 
     (parse count ($lo:literal ..= $hi:literal $(, $unit:literal)?); $v:ident) => { $crate::quality::knob::count($v, $lo, $hi) };
     (parse real ($lo:literal ..= $hi:literal $(, $unit:literal)?); $v:ident) => { $crate::quality::knob::real($v, $lo as f32, $hi as f32) };
-    (parse square (..= $hi:literal); $v:ident) => { $crate::quality::knob::square($v, $hi, $crate::quality::knob::knob_kind!(values square (..= $hi))) };
+    (parse square (..= $hi:literal); $v:ident) => {
+        $crate::quality::knob::square($v, $hi, $crate::quality::knob::knob_kind!(values square (..= $hi)))
+    };
     (parse one_of $args:tt [$($opt:literal => $val:expr),+]; $v:ident) => { $crate::quality::knob::one_of($v, &[$(($opt, $val)),+]) };
     (parse auto_count ($lo:literal ..= $hi:literal); $v:ident) => { $crate::quality::knob::auto_count($v, $lo, $hi) };
     (parse auto_metres (); $v:ident) => { $crate::quality::knob::auto_positive($v) };

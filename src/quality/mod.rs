@@ -31,7 +31,6 @@ macro_rules! compose {
         }
 
         $( impl knob::Part for $T {
-            const KNOBS: &'static [Knob] = <$T>::KNOBS;
             fn of(q: &Quality) -> &Self {
                 &q.$field
             }
