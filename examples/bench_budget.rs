@@ -43,7 +43,11 @@ fn main() -> specula::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let size: u32 = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(96);
     let frames: u32 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(5);
-    let base = Quality { map_updates_always: true, ..Quality::default() };
+    let base = {
+        let mut knobs = Quality::default();
+        knobs.frame.map_updates_always = true;
+        knobs
+    };
     use specula::methods::*;
     let scenes: Vec<(&str, Scene, Vec<Method>, &str)> = vec![
         ("mirror + glass spheres", spheres()?, vec![ENVMAP, DISTANCE, REFRACTOR_MAP, BVH], "cube_size=32,128"),

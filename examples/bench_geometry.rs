@@ -29,7 +29,12 @@ fn main() -> specula::Result<()> {
     let s = specula::scenes::flat_glass()?;
     let ctx = Context::new(&DeviceOptions::default())?;
     let quality = |depth: u32, budget: u32| -> specula::Result<Quality> {
-        let mut q = Quality { depth, spp: 1, ..Quality::default() };
+        let mut q = {
+            let mut knobs = Quality::default();
+            knobs.frame.depth = depth;
+            knobs.reference.spp = 1;
+            knobs
+        };
         q.set("fresnel", "exact")?;
         q.set("mirror_budget", &budget.to_string())?;
         Ok(q)

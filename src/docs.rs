@@ -33,7 +33,7 @@ pub fn knob_table() -> String {
     let mut s = String::from("| knob | values | default | what it does | read by |\n|---|---|---|---|---|\n");
     for k in KNOBS {
         let readers: Vec<&str> = Method::ALL.iter().filter(|m| m.knobs.contains(&k.name)).map(|m| m.name).collect();
-        let readers = if k.name == "planner" {
+        let readers = if k.name == crate::quality::PlanKnobs::planner {
             "auto".to_string()
         } else if readers.is_empty() {
             "every frame".into()

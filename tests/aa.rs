@@ -58,8 +58,23 @@ fn mean(img: &specula::image::ImageData) -> f64 {
 fn ssaa4_approaches_the_16_spp_reference() {
     let ctx = common::gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    let q = Quality { depth: 4, cube_size: 32, shadow_size: 64, ..Quality::default() };
-    let reference = specula::reference::render_reference(&scene, &Quality { spp: 16, ..q.clone() }, (48, 36)).unwrap();
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = 4;
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs
+    };
+    let reference = specula::reference::render_reference(
+        &scene,
+        &{
+            let mut knobs = q.clone();
+            knobs.reference.spp = 16;
+            knobs
+        },
+        (48, 36),
+    )
+    .unwrap();
     let psnr = |img: &specula::image::ImageData| specula::metrics::compare(img, &reference).unwrap().psnr;
     let (off, ssaa2, ssaa4) = ["off", "ssaa2", "ssaa4"].map(|aa| psnr(&render(&ctx, &scene, specula::methods::BVH, &q, aa))).into();
     println!("off {off:.2} dB, ssaa2 {ssaa2:.2} dB, ssaa4 {ssaa4:.2} dB");
@@ -119,8 +134,23 @@ fn rmse(a: &specula::image::ImageData, b: &specula::image::ImageData) -> f64 {
 fn msaa4_anti_aliases_every_method() {
     let ctx = common::gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    let q = Quality { depth: 4, cube_size: 32, shadow_size: 64, ..Quality::default() };
-    let reference = specula::reference::render_reference(&scene, &Quality { spp: 16, ..q.clone() }, (48, 36)).unwrap();
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = 4;
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs
+    };
+    let reference = specula::reference::render_reference(
+        &scene,
+        &{
+            let mut knobs = q.clone();
+            knobs.reference.spp = 16;
+            knobs
+        },
+        (48, 36),
+    )
+    .unwrap();
     let flip = |img: &specula::image::ImageData| specula::metrics::compare(img, &reference).unwrap().flip;
     // Ray tracing traces one ray per sample: four samples at the standard positions.
     let (off, msaa4) = ["off", "msaa4"].map(|aa| flip(&render(&ctx, &scene, specula::methods::BVH, &q, aa))).into();
@@ -169,7 +199,13 @@ fn per_sample_shading_beats_per_pixel_inside_specular_objects() {
     let ctx = common::gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     for (m, pixels, ratio) in [(specula::methods::DISTANCE, 182, 0.5329), (specula::methods::ENVMAP, 181, 0.7516)] {
-        let mut q = Quality { depth: 4, cube_size: 32, shadow_size: 64, ..Quality::default() };
+        let mut q = {
+            let mut knobs = Quality::default();
+            knobs.frame.depth = 4;
+            knobs.cube.cube_size = 32;
+            knobs.frame.shadow_size = 64;
+            knobs
+        };
         let ss = render(&ctx, &scene, m, &q, "ssaa4");
         let sample = render(&ctx, &scene, m, &q, "msaa4");
         q.set("msaa_shading", "pixel").unwrap();
@@ -240,7 +276,11 @@ fn ssaa_refuses_sizes_beyond_the_limit() {
     assert!(e.contains("knob aa") && e.contains("16384"), "{e}");
     assert!(Quality::default().set("aa", "msaa3").unwrap_err().to_string().contains("off, msaa2, msaa4, msaa8, ssaa2, ssaa4"));
     // The field set by hand: only 1, 2 or 4 samples per axis.
-    let plan = specula::plan(&scene, specula::methods::ENVMAP, &Quality { aa: specula::quality::Aa::Ssaa(3), ..Quality::default() });
+    let plan = specula::plan(&scene, specula::methods::ENVMAP, &{
+        let mut knobs = Quality::default();
+        knobs.frame.aa = specula::quality::Aa::Ssaa(3);
+        knobs
+    });
     let e = specula::Renderer::new(&ctx, &scene, plan, 16, 16).err().expect("3 samples per axis are refused").to_string();
     assert!(e.contains("1, 2 or 4"), "{e}");
 }

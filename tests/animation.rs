@@ -165,7 +165,12 @@ fn animated_frames_render_like_fresh_ones() {
     };
     scene.add_light(light).unwrap();
     let ctx = common::gpu();
-    let q = specula::Quality { shadow_size: 32, cube_size: 16, ..Default::default() };
+    let q = {
+        let mut knobs = specula::Quality::default();
+        knobs.frame.shadow_size = 32;
+        knobs.cube.cube_size = 16;
+        knobs
+    };
     let plan = specula::plan(&scene, specula::methods::ENVMAP, &q);
     let mut r = specula::Renderer::new(&ctx, &scene, plan, 24, 16).unwrap();
     // (t, pixels lit as measured, pixels changed from the previous frame as measured): the

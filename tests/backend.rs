@@ -147,7 +147,7 @@ fn cube_faces_follow_vulkan_table(mode: &str) {
     q.set("cube_mode", mode).unwrap();
     q.set("cube_precision", "single").unwrap();
     let p = plan(&scene, specula::methods::ENVMAP, &q);
-    assert_eq!(p.quality.cube_mode, if mode == "six" { CubeMode::SixPasses } else { CubeMode::Multiview });
+    assert_eq!(p.quality.cube.cube_mode, if mode == "six" { CubeMode::SixPasses } else { CubeMode::Multiview });
     let mut r = Renderer::new(&ctx, &scene, p, 16, 16).unwrap();
     r.render(&ctx).unwrap();
     let cubes = read_image(&ctx, r.maps().object_cubes().unwrap()).unwrap();

@@ -18,7 +18,13 @@ const SIZE: (u32, u32) = (48, 48);
 
 fn quality() -> Quality {
     // Maps regenerated every frame: a frame's whole cost (as the CLI times it).
-    Quality { cube_size: 32, shadow_size: 32, map_updates_always: true, ..Quality::default() }
+    {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 32;
+        knobs.frame.map_updates_always = true;
+        knobs
+    }
 }
 
 /// The calibration study of `scene` over `methods` × `sweep`.

@@ -737,7 +737,7 @@ fn total_internal_reflection_paths_reach_the_floor() {
         |bounces: &str| caustic_power(&ctx, &s, &quality(&["caustics=splat", "photons=128", &format!("internal_bounces={bounces}")])).0;
     let (none, some) = (power("0"), power("4"));
     let mut q = quality(&["caustics=splat", "reference_photons=400000"]);
-    q.depth = 16;
+    q.frame.depth = 16;
     let tracer = specula::reference::Tracer::new(&s, &q).unwrap();
     let exact: f64 = tracer.photon_map().unwrap().photons().iter().map(|p| p.power.x).sum();
     eprintln!(

@@ -66,7 +66,12 @@ fn bowl_scene() -> Scene {
 }
 
 fn quality() -> Quality {
-    let mut q = Quality { depth: 1, spp: 1, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = 1;
+        knobs.reference.spp = 1;
+        knobs
+    };
     q.set("fresnel", "exact").unwrap();
     q
 }
@@ -435,7 +440,11 @@ fn two_spheres_and_a_mirror_wall() {
     // mirrored eye (depth 2: the spheres seen in the wall).
     let wall = s.add_material(common::mirror(0.9)).unwrap();
     s.add_mesh(shapes::quad("wall", Vec3::new(-1.5, -1.5, -1.9), Vec3::new(3.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0), 1, wall)).unwrap();
-    let q2 = Quality { depth: 2, ..q.clone() };
+    let q2 = {
+        let mut knobs = q.clone();
+        knobs.frame.depth = 2;
+        knobs
+    };
     let choices = specula::plan::Choices {
         method: specula::Choice::Auto,
         objects: vec![

@@ -114,7 +114,16 @@ fn spot_light_follows_the_gltf_falloff_on_the_gpu_and_in_the_reference() {
     let mut s = floor_scene(false);
     s.add_light(light(LightKind::Spot { inner_cone: inner, outer_cone: outer }, Vec3::new(0.0, 2.0, 0.0), Vec3::NEG_Y, 10.0)).unwrap();
     let gpu = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap().image;
-    let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
+    let reference = specula::reference::render_reference(
+        &s,
+        &{
+            let mut knobs = Quality::default();
+            knobs.reference.spp = 1;
+            knobs
+        },
+        (64, 64),
+    )
+    .unwrap();
     // Floor points inside the inner cone, across the ramp, and outside the outer cone.
     let mut ramp_points = 0;
     let mut worst = [(0.0f32, 0.0f32); 2];
@@ -160,7 +169,16 @@ fn point_light_range_follows_the_gltf_window_on_the_gpu_and_in_the_reference() {
     let mut s = floor_scene(false);
     s.add_light(Light { range: Some(range), ..light(LightKind::Point, position, Vec3::NEG_Y, 4.0) }).unwrap();
     let gpu = specula::render(&ctx, &s, specula::methods::ENVMAP, &Quality::default(), (64, 64), (0, 1)).unwrap().image;
-    let reference = specula::reference::render_reference(&s, &Quality { spp: 1, ..Quality::default() }, (64, 64)).unwrap();
+    let reference = specula::reference::render_reference(
+        &s,
+        &{
+            let mut knobs = Quality::default();
+            knobs.reference.spp = 1;
+            knobs
+        },
+        (64, 64),
+    )
+    .unwrap();
     let (mut window_points, mut beyond) = (0, 0);
     let mut worst = [(0.0f32, 0.0f32); 2];
     for x in [32, 36, 40, 44, 48, 52, 56, 60, 63] {

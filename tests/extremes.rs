@@ -93,7 +93,7 @@ fn glass_of_index_almost_one_is_invisible() {
     let g = open.add_material(glass(1.0001)).unwrap();
     open.add_mesh(shapes::uv_sphere("glass", Vec3::ZERO, 0.5, 96, 48, g)).unwrap();
     open.camera = Some(Camera::look_at(Vec3::new(0.3, 0.5, 1.8), Vec3::ZERO, 45f32.to_radians()));
-    q.spp = 1;
+    q.reference.spp = 1;
     let gpu = specula::render(&ctx, &open, specula::methods::ENVMAP, &q, (64, 64), (0, 1)).unwrap();
     // Without the sphere: the bare sky (a renderer needs a triangle: a speck behind the
     // camera, out of view).

@@ -12,7 +12,13 @@ use specula::{Method, Quality, Renderer};
 const SIZE: (u32, u32) = (40, 30);
 
 fn quality() -> Quality {
-    Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() }
+    {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs.frame.depth = 4;
+        knobs
+    }
 }
 
 fn renderer(ctx: &specula::vk::Context, scene: &Scene, m: Method, q: &Quality) -> Renderer {
@@ -152,7 +158,11 @@ fn only_what_changed_is_rebuilt() {
     r.destroy(&ctx);
 
     // Benchmarks: every frame.
-    let always = Quality { map_updates_always: true, ..q.clone() };
+    let always = {
+        let mut knobs = q.clone();
+        knobs.frame.map_updates_always = true;
+        knobs
+    };
     let mut r = renderer(&ctx, &scene, specula::methods::DISTANCE, &always);
     r.render(&ctx).unwrap();
     let f = r.render(&ctx).unwrap();
@@ -235,7 +245,11 @@ fn cube_faces_draw_only_what_they_see() {
     s.camera = Some(specula::scene::Camera::look_at(Vec3::new(0.0, 1.5, 4.0), Vec3::new(1.0, 1.0, 0.0), 1.0));
     // Caustics off: lavapipe's multiview rasterises the mirror ball's caustic triangles to
     // within 1e-4 of six passes, not bit for bit (tests/caustics.rs compares the two modes).
-    let q = Quality { caustics: specula::quality::Caustics::Off, ..quality() };
+    let q = {
+        let mut knobs = quality();
+        knobs.caustics.caustics = specula::quality::Caustics::Off;
+        knobs
+    };
     let mut r = renderer(&ctx, &s, specula::methods::ENVMAP, &q);
     let f = r.render(&ctx).unwrap();
     let stat = |name: &str| {
@@ -249,7 +263,11 @@ fn cube_faces_draw_only_what_they_see() {
     assert_eq!(env, vec![0, 1, 0, 1, 0, 0], "envmap draws per face");
     r.destroy(&ctx);
     // Multiview renders the six faces in one pass: no per-face culling.
-    let mv = Quality { cube_mode: specula::quality::CubeMode::Multiview, ..q.clone() };
+    let mv = {
+        let mut knobs = q.clone();
+        knobs.cube.cube_mode = specula::quality::CubeMode::Multiview;
+        knobs
+    };
     let mut r = renderer(&ctx, &s, specula::methods::ENVMAP, &mv);
     let g = r.render(&ctx).unwrap();
     let env: Vec<u32> =
@@ -316,7 +334,12 @@ fn frame_latency_restarts_its_cycles_after_a_change() {
     let base = common::mirror_and_glass(16);
     let i = mirror_index(&base);
     let centre = base.meshes[i].bounds().center();
-    let q = Quality { frame_latency: true, cycles: 3, ..quality() };
+    let q = {
+        let mut knobs = quality();
+        knobs.distance.frame_latency = true;
+        knobs.distance.cycles = 3;
+        knobs
+    };
     let m = specula::methods::DISTANCE_MULTI;
     let mut scene = base.clone();
     let mut r = renderer(&ctx, &scene, m, &q);
@@ -388,7 +411,13 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
     }
     // The Rust API says why: the renderer refuses the update with PlanChanged.
     let ctx = common::gpu();
-    let q = Quality { cube_size: 16, shadow_size: 32, depth: 4, ..Quality::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 16;
+        knobs.frame.shadow_size = 32;
+        knobs.frame.depth = 4;
+        knobs
+    };
     let mut r = Renderer::new(&ctx, &scene, specula::plan(&scene, specula::Choice::Auto, &q), w, h).unwrap();
     let mut s = scene.clone();
     s.set_object_transform(sphere as usize, Mat4::from_cols_array(&moved)).unwrap();

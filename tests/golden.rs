@@ -46,7 +46,12 @@ fn every_method_renders_the_recorded_bits() {
     let mut lines = Vec::new();
     for (scene_name, scene) in &scenes {
         for (label, method, knobs, frames) in cases() {
-            let mut q = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+            let mut q = {
+                let mut knobs = Quality::default();
+                knobs.cube.cube_size = 32;
+                knobs.frame.shadow_size = 64;
+                knobs
+            };
             for k in &knobs {
                 q.set_pair(k).unwrap();
             }

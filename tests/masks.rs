@@ -17,7 +17,12 @@ fn demo() -> specula::Scene {
 fn gpu_and_reference_ids_agree_and_cost_nothing_when_off() {
     let ctx = common::gpu();
     let scene = demo();
-    let q = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs
+    };
     let off = specula::render(&ctx, &scene, specula::Choice::Auto, &q, SIZE, (0, 1)).unwrap();
     assert!(off.object_ids.is_none());
     assert!(off.passes.iter().all(|p| p.name != "frame.object_ids"), "no pass when off");
@@ -46,7 +51,13 @@ fn gpu_and_reference_ids_agree_and_cost_nothing_when_off() {
 fn errors_split_by_object() {
     let ctx = common::gpu();
     let scene = demo();
-    let mut q = Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs.frame.depth = 4;
+        knobs
+    };
     q.set("caustics", "off").unwrap();
     let reference = specula::reference::render_reference(&scene, &q, SIZE).unwrap();
     let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
@@ -137,7 +148,13 @@ fn shadows_off_removes_the_shared_shadow_term() {
     let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
     let mut rest = Vec::new();
     for shadows in ["on", "off"] {
-        let mut q = Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() };
+        let mut q = {
+            let mut knobs = Quality::default();
+            knobs.cube.cube_size = 32;
+            knobs.frame.shadow_size = 64;
+            knobs.frame.depth = 4;
+            knobs
+        };
         q.set("caustics", "off").unwrap();
         q.set("shadows", shadows).unwrap();
         q.set("spp", "1").unwrap();
@@ -175,7 +192,12 @@ fn shadows_off_keeps_the_caustics() {
     for flags in [["shadows=on", "layered_branches=both"], ["shadows=off", "layered_branches=strongest"]] {
         let mut frames = Vec::new();
         for caustics in ["triangles", "off"] {
-            let mut q = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+            let mut q = {
+                let mut knobs = Quality::default();
+                knobs.cube.cube_size = 32;
+                knobs.frame.shadow_size = 64;
+                knobs
+            };
             for f in flags {
                 q.set_pair(f).unwrap();
             }

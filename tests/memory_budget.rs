@@ -20,7 +20,11 @@ fn a_configuration_beyond_the_budget_fails_cleanly_and_a_smaller_one_renders() {
     let scene = demo();
     ctx.memory.set_budget(Some(24 << 20));
     // Two 6×1024² RGBA16F distance cubes are 96 MiB.
-    let big = Quality { cube_size: 1024, ..Quality::default() };
+    let big = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 1024;
+        knobs
+    };
     let e = specula::render(&ctx, &scene, specula::methods::DISTANCE, &big, (64, 64), (0, 1)).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::OutOfMemory(_)), "{msg}");
@@ -28,7 +32,12 @@ fn a_configuration_beyond_the_budget_fails_cleanly_and_a_smaller_one_renders() {
     // search them) come before the distance cubes.
     assert!(msg.contains("refractor.cubes") && msg.contains("bytes") && msg.contains("budget"), "{msg}");
     assert_eq!(ctx.memory.total(), 0, "everything allocated before the failure is freed: {:?}", ctx.memory.snapshot());
-    let small = Quality { cube_size: 32, shadow_size: 64, ..Quality::default() };
+    let small = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs
+    };
     let f = specula::render(&ctx, &scene, specula::methods::DISTANCE, &small, (64, 64), (0, 1)).unwrap();
     // The smaller configuration renders after the failure as it does on a context that never
     // had a budget: the same resources and the same image, bit for bit (an allocator left

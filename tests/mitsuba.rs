@@ -141,7 +141,12 @@ fn mitsuba(s: &Scene, name: &str, spp: u32, depth: u32) -> ImageData {
 }
 
 fn reference(s: &Scene, depth: u32) -> ImageData {
-    let mut q = Quality { depth, spp: 16, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = depth;
+        knobs.reference.spp = 16;
+        knobs
+    };
     q.set("fresnel", "exact").unwrap();
     specula::reference::render_reference(s, &q, SIZE).unwrap()
 }
@@ -207,7 +212,11 @@ fn specular_balls_agree_with_mitsuba() {
         save(name, &r);
         let p = psnr(&r, &m);
         // The GPU's exact ray tracer too (4×4 supersampled, as the reference's 16 samples).
-        let mut q = Quality { depth: 16, ..Quality::default() };
+        let mut q = {
+            let mut knobs = Quality::default();
+            knobs.frame.depth = 16;
+            knobs
+        };
         q.set("fresnel", "exact").unwrap();
         q.set("aa", "ssaa4").unwrap();
         let gpu = specula::render(&ctx, &s, specula::methods::BVH, &q, SIZE, (0, 1)).unwrap().image;
@@ -366,7 +375,12 @@ fn emissive_textured_wall_agrees_with_mitsuba() {
     // The GPU's texture sampling too, 4×4 supersampled (2×2 measured 39.6 dB: the wall's and
     // the ball's edges, not the texels).
     let ctx = common::gpu();
-    let q = Quality { depth: 4, aa: specula::quality::Aa::Ssaa(4), ..Quality::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = 4;
+        knobs.frame.aa = specula::quality::Aa::Ssaa(4);
+        knobs
+    };
     let gpu = specula::render(&ctx, &s, specula::methods::BVH, &q, SIZE, (0, 1)).unwrap().image;
     let g = psnr(&gpu, &mi);
     println!("textured wall: reference vs Mitsuba {p:.2} dB, GPU bvh vs Mitsuba {g:.2} dB");

@@ -14,7 +14,12 @@ use specula::vk::{Context, ImageData};
 use specula::{Choice, Method, Quality};
 
 fn quality(pairs: &[&str]) -> Quality {
-    let mut q = Quality { cube_size: 64, shadow_size: 128, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 64;
+        knobs.frame.shadow_size = 128;
+        knobs
+    };
     for p in pairs {
         q.set_pair(p).unwrap();
     }

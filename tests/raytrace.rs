@@ -23,7 +23,11 @@ fn demo() -> Scene {
 }
 
 fn quality(pairs: &[&str]) -> Quality {
-    let mut q = Quality { spp: 1, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.reference.spp = 1;
+        knobs
+    };
     for p in pairs {
         q.set_pair(p).unwrap();
     }

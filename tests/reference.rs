@@ -57,7 +57,11 @@ fn reference_mirror_sphere_matches_closed_form() {
     let yfov = 45f32.to_radians();
     scene.camera = Some(Camera::look_at(eye, Vec3::ZERO, yfov));
     let (w, h) = (64u32, 64u32);
-    let q = Quality { spp: 1, ..Default::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.reference.spp = 1;
+        knobs
+    };
     let img = render_reference(&scene, &q, (w, h)).unwrap();
 
     let cam = scene.camera.unwrap();
@@ -133,7 +137,11 @@ fn reference_matches_the_gpu_where_the_gpu_is_exact() {
     let mut scene = demo();
     scene.meshes.retain(|m| !scene.materials[m.material].kind.is_specular());
     let (w, h) = (96u32, 96u32);
-    let mut q = Quality { spp: 1, ..Default::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.reference.spp = 1;
+        knobs
+    };
     q.set("shadow_size", "1024").unwrap();
     let gpu = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (w, h), (0, 1)).unwrap();
     let cpu = render_reference(&scene, &q, (w, h)).unwrap();

@@ -30,7 +30,12 @@ fn corner_mirror_search_steps_move_the_balls_error() {
     let scene = specula::scenes::corner_mirror().unwrap();
     let ball = scene.meshes.iter().position(|m| m.name == "mirror_ball").unwrap();
     assert_eq!(scene.meshes[ball].reference_point, Some(specula::scenes::ROOM_CENTER));
-    let mut base = Quality { linear_steps: 4, secant_steps: 0, ..Quality::default() };
+    let mut base = {
+        let mut knobs = Quality::default();
+        knobs.search.linear_steps = 4;
+        knobs.search.secant_steps = 0;
+        knobs
+    };
     base.set("spp", "1").unwrap();
     let reference = specula::reference::render_reference(&scene, &base, SIZE).unwrap();
     let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
@@ -89,7 +94,13 @@ fn a_flipped_reflection_shows_on_the_specular_pixels_only() {
     const SIZE: (u32, u32) = (72, 54);
     let ctx = common::gpu();
     let scene = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
-    let mut q = Quality { cube_size: 32, shadow_size: 64, depth: 4, ..Quality::default() };
+    let mut q = {
+        let mut knobs = Quality::default();
+        knobs.cube.cube_size = 32;
+        knobs.frame.shadow_size = 64;
+        knobs.frame.depth = 4;
+        knobs
+    };
     q.set("caustics", "off").unwrap();
     q.set("spp", "1").unwrap();
     let reference = specula::reference::render_reference(&scene, &q, SIZE).unwrap();
@@ -314,7 +325,11 @@ fn the_bundled_scenes_light_clips_no_surface() {
         let (bound, surface) = radiance_bound(&scene);
         eprintln!("{name}: diffuse radiance at most {bound:.3} ({surface})");
         assert!(bound <= 1.0, "{name}: '{surface}' can reach radiance {bound:.3}: a PNG clips it");
-        let mut q = Quality { spp: 1, ..Quality::default() };
+        let mut q = {
+            let mut knobs = Quality::default();
+            knobs.reference.spp = 1;
+            knobs
+        };
         q.set_pair("caustics=off").unwrap();
         let image = specula::reference::render_reference(&scene, &q, (48, 48)).unwrap();
         let max = image.data.chunks_exact(4).map(|p| p[0].max(p[1]).max(p[2])).fold(0.0f32, f32::max);
@@ -336,7 +351,11 @@ impl Setup {
     const SIZE: (u32, u32) = (64, 64);
 
     fn new(scene: Scene) -> Setup {
-        let base = Quality { spp: 1, ..Quality::default() };
+        let base = {
+            let mut knobs = Quality::default();
+            knobs.reference.spp = 1;
+            knobs
+        };
         let reference = specula::reference::render_reference(&scene, &base, Self::SIZE).unwrap();
         let ids = specula::reference::object_ids(&scene, Self::SIZE).unwrap();
         Setup { ctx: common::gpu(), scene, base, reference, ids }

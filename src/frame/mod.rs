@@ -7,6 +7,7 @@
 pub mod camera;
 pub mod direct;
 pub mod ids;
+pub mod knobs;
 pub mod layout;
 pub mod output;
 pub mod shadow;
@@ -24,10 +25,10 @@ use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
 impl SearchKnobs {
     pub fn of(q: &crate::quality::Quality) -> SearchKnobs {
         SearchKnobs {
-            linear_steps: q.linear_steps,
-            secant_steps: q.secant_steps,
-            binary_steps: q.binary_steps,
-            parallax_iterations: q.parallax_iterations,
+            linear_steps: q.search.linear_steps,
+            secant_steps: q.search.secant_steps,
+            binary_steps: q.search.binary_steps,
+            parallax_iterations: q.search.parallax_iterations,
         }
     }
 }

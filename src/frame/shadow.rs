@@ -34,8 +34,8 @@ impl ShadowMaps {
     }
 
     fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, maps: &mut Maps) -> Result<()> {
-        let size = plan.quality.shadow_size;
-        let mode = plan.quality.cube_mode;
+        let size = plan.quality.frame.shadow_size;
+        let mode = plan.quality.cube.cube_mode;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let desc = |name, view_mask| GraphicsDesc {
             name,

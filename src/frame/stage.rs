@@ -525,7 +525,7 @@ pub enum LayerField {
 
 /// Bytes per texel of the cube maps at a precision.
 pub fn cube_texel_bytes(q: &Quality) -> u64 {
-    match q.cube_precision {
+    match q.cube.cube_precision {
         crate::quality::Precision::Half => 8,
         crate::quality::Precision::Single => 16,
     }
@@ -533,9 +533,9 @@ pub fn cube_texel_bytes(q: &Quality) -> u64 {
 
 /// "cube 6×256² RGBA16F"
 pub fn describe_cube(q: &Quality) -> String {
-    let f = match q.cube_precision {
+    let f = match q.cube.cube_precision {
         crate::quality::Precision::Half => "RGBA16F",
         crate::quality::Precision::Single => "RGBA32F",
     };
-    format!("cube 6×{}² {f}", q.cube_size)
+    format!("cube 6×{}² {f}", q.cube.cube_size)
 }

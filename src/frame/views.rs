@@ -79,7 +79,7 @@ pub fn view_table(plan: &Plan, layout: &ViewLayout, lights: &[GpuLight], (camera
 pub fn light_table(scene: &Scene, plan: &Plan) -> Vec<GpuLight> {
     let bounds = scene.bounds();
     let (center, radius) = (bounds.center(), (bounds.diagonal() * 0.5).max(1e-6));
-    let size = plan.quality.shadow_size as f32;
+    let size = plan.quality.frame.shadow_size as f32;
     scene
         .lights
         .iter()

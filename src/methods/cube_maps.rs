@@ -72,7 +72,7 @@ impl CubeMaps {
     pub fn new(init: &StageInit, objects: &[usize], maps: &mut Maps, kind: MapKind) -> Result<CubeMaps> {
         let (ctx, plan) = (init.ctx, init.plan);
         let q = &plan.quality;
-        let format = radiance_format(q.cube_precision);
+        let format = radiance_format(q.cube.cube_precision);
         let inter_object = kind == MapKind::Distance && plan.inter_object;
         let images = if kind == MapKind::Distance { distance_images(plan) as usize } else { 1 };
         let me = CubeMaps {
@@ -84,7 +84,7 @@ impl CubeMaps {
             mirror_mask: vk::Pipeline::null(),
             mirror_weight: vk::Pipeline::null(),
             map_mirrors: plan.map_mirrors.clone(),
-            mode: q.cube_mode,
+            mode: q.cube.cube_mode,
             cycles: plan.cycles.max(1),
             frame_latency: plan.frame_latency && inter_object,
             inter_object,
@@ -112,13 +112,14 @@ impl CubeMaps {
         };
         for i in 0..images {
             let name = if images == 1 { base.to_string() } else { format!("{base}.{}", ["ping", "pong"][i]) };
-            let image = Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube_size, height: q.cube_size, kind, usage })?;
+            let image =
+                Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage })?;
             match self.kind {
                 MapKind::Radiance => maps.radiance = Some(image),
                 MapKind::Distance => maps.distance.push(image),
             }
         }
-        self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube_size, q.cube_mode)?;
+        self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube.cube_size, q.cube.cube_mode)?;
         let (sky, surface) = match self.kind {
             MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
             MapKind::Distance => ("distance/sky.frag", "distance/generate.frag"),
@@ -133,7 +134,7 @@ impl CubeMaps {
             depth_format: Some(DEPTH_FORMAT),
             depth_test,
             depth_write: depth_test,
-            view_mask: view_mask(q.cube_mode),
+            view_mask: view_mask(q.cube.cube_mode),
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend: crate::vk::pipeline::Blend::Replace,

@@ -7,6 +7,7 @@
 //! `glsl/<family>/`, its tests, and one line below.
 
 pub mod caustics;
+pub mod cube_knobs;
 pub mod cube_maps;
 pub mod distance;
 pub mod envmap;

@@ -585,7 +585,7 @@ impl SceneFacts {
             .specular_meshes()
             .filter_map(|(i, m)| {
                 let class = ObjectClass::of(&scene.materials[m.material].kind)?;
-                let (reference_point, reference_note) = match (quality.ref_point, m.reference_point) {
+                let (reference_point, reference_note) = match (quality.cube.ref_point, m.reference_point) {
                     (Some(p), _) => (p, Some("set by the ref_point knob".to_string())),
                     (None, Some(p)) => {
                         (p, Some("set by the scene (Mesh::reference_point; glTF extras.specula.reference_point)".to_string()))

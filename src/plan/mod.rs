@@ -6,6 +6,7 @@
 
 pub mod budget;
 pub mod facts;
+pub mod knobs;
 mod types;
 
 use glam::Vec3;
@@ -262,7 +263,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     let bounds = scene.bounds();
     let diag = bounds.diagonal();
     let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
-    let proxy_radius = quality.proxy_radius.unwrap_or_else(|| {
+    let proxy_radius = quality.envmap.proxy_radius.unwrap_or_else(|| {
         let half = (bounds.max - bounds.min) * 0.5;
         if bounds.is_empty() {
             1.0
@@ -357,7 +358,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     // Shadows matter only where a diffuse surface receives light, and not at all where a
     // whole-scene ray tracer shades every pixel with exact shadow rays (survey §2), unless
     // caustic photons need them (occluders between a light and a generator).
-    if has_diffuse && q.shadows && (!st.shades_scene || p.caustics.is_some()) {
+    if has_diffuse && q.frame.shadows && (!st.shades_scene || p.caustics.is_some()) {
         for (i, l) in scene.lights.iter().enumerate() {
             match l.kind {
                 LightKind::Point | LightKind::Spot { .. } => p.shadow_cubes.push(i),
@@ -376,7 +377,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
     let asks = methods.iter().any(|&m| gpu(m).map_shading == MapShading::Traced);
     p.inter_object = asks || composes;
-    p.frame_latency = asks && q.frame_latency;
+    p.frame_latency = asks && q.distance.frame_latency;
     p.cycles = methods.iter().map(|&m| (gpu(m).cycles)(&q)).max().unwrap_or(1).max(1);
     if composes && !p.frame_latency {
         p.cycles = p.cycles.max(2);

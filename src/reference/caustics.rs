@@ -135,16 +135,16 @@ impl<'l> Emitter<'l> {
 }
 
 impl PhotonMap {
-    /// Traces `quality.reference_photons` photons per light and caustic generator of the
+    /// Traces `quality.reference.reference_photons` photons per light and caustic generator of the
     /// tracer's scene and sorts the stored ones into the grid.
     pub(super) fn build(tracer: &Tracer, quality: &Quality) -> Result<PhotonMap> {
-        let n = quality.reference_photons;
+        let n = quality.reference.reference_photons;
         if n == 0 {
             return Err(Error::invalid("knob reference_photons", "must be at least 1"));
         }
         let scene_box = tracer.scene.bounds();
         let diag = scene_box.diagonal() as f64;
-        let radius = quality.caustic_radius.map_or(0.005 * diag, |r| r as f64);
+        let radius = quality.reference.caustic_radius.map_or(0.005 * diag, |r| r as f64);
         if !(radius > 0.0 && radius.is_finite()) {
             return Err(Error::invalid("knob caustic_radius", format!("{radius} m is not a radius > 0")));
         }
@@ -281,12 +281,13 @@ mod tests {
     }
 
     fn quality(photons: u32, radius: f32) -> Quality {
-        Quality {
-            caustics: Caustics::Splat,
-            reference_photons: photons,
-            caustic_radius: Some(radius),
-            fresnel: FresnelMode::Exact,
-            ..Default::default()
+        {
+            let mut knobs = Quality::default();
+            knobs.caustics.caustics = Caustics::Splat;
+            knobs.reference.reference_photons = photons;
+            knobs.reference.caustic_radius = Some(radius);
+            knobs.frame.fresnel = FresnelMode::Exact;
+            knobs
         }
     }
 
@@ -341,7 +342,11 @@ mod tests {
         }
         s.add_mesh(shapes::uv_sphere("ball", Vec3::new(0.0, 1.0, 0.0), 0.5, 128, 64, glass)).unwrap();
         s.add_light(point_light(Vec3::new(0.0, 3.0, 0.0), Vec3::ONE)).unwrap();
-        let q = Quality { depth: 4, ..quality(200_000, 0.05) };
+        let q = {
+            let mut knobs = quality(200_000, 0.05);
+            knobs.frame.depth = 4;
+            knobs
+        };
         let t = Tracer::new(&s, &q).unwrap();
         let photons = t.photon_map().unwrap().photons();
         let sum = |f: &dyn Fn(&Photon) -> bool| photons.iter().filter(|p| f(p)).map(|p| p.power.x).sum::<f64>();
@@ -457,14 +462,23 @@ mod tests {
     /// map is built. With caustics on the image changes (the floor under the ball).
     #[test]
     fn off_is_the_old_reference_bit_for_bit() {
-        let off = Quality { caustics: Caustics::Off, ..Default::default() };
+        let off = {
+            let mut knobs = Quality::default();
+            knobs.caustics.caustics = Caustics::Off;
+            knobs
+        };
         assert_eq!(image_hash(&off), 0xd946_45ca_2b44_3afc);
         let s = golden_scene();
         let t = Tracer::new(&s, &off).unwrap();
         assert!(t.photon_map().is_none());
         assert_eq!(t.caustic_irradiance(DVec3::ZERO, DVec3::Y), DVec3::ZERO);
         assert_ne!(
-            image_hash(&Quality { caustics: Caustics::Splat, reference_photons: 20_000, ..Default::default() }),
+            image_hash(&{
+                let mut knobs = Quality::default();
+                knobs.caustics.caustics = Caustics::Splat;
+                knobs.reference.reference_photons = 20_000;
+                knobs
+            }),
             0xd946_45ca_2b44_3afc
         );
     }
@@ -482,7 +496,17 @@ mod tests {
         dark.lights.clear();
         assert!(Tracer::new(&dark, &q).unwrap().photon_map().unwrap().photons().is_empty());
         // Bad knobs are errors, not panics.
-        assert!(Tracer::new(&s, &Quality { reference_photons: 0, ..q.clone() }).is_err());
-        assert!(Tracer::new(&s, &Quality { caustic_radius: Some(-1.0), ..q }).is_err());
+        assert!(Tracer::new(&s, &{
+            let mut knobs = q.clone();
+            knobs.reference.reference_photons = 0;
+            knobs
+        })
+        .is_err());
+        assert!(Tracer::new(&s, &{
+            let mut knobs = q;
+            knobs.reference.caustic_radius = Some(-1.0);
+            knobs
+        })
+        .is_err());
     }
 }

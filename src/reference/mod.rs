@@ -23,6 +23,7 @@
 
 pub mod bvh;
 pub mod caustics;
+pub mod knobs;
 pub mod shade;
 
 use glam::{DVec2, DVec3};
@@ -31,6 +32,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::image::ImageData;
 use crate::quality::{Caustics, FresnelMode, Quality};
+use crate::quality::{CausticsKnobs, FrameKnobs, ReferenceKnobs};
 use crate::scene::{Camera, Scene, SurfaceKind};
 use bvh::{Bvh, Hit};
 use caustics::PhotonMap;
@@ -45,7 +47,7 @@ pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::met
     family: "reference",
     summary: "the exact CPU reference (f64, SAH BVH, Möller–Trumbore): Whitted recursion through both the reflected and the refracted branch weighted by Fresnel, up to `depth` bounces, the GPU's non-specular shading with exact shadow rays, `spp` stratified samples per pixel, both cores (rayon). Ground truth for the tests and `specula tradeoff`",
     serves: crate::methods::EVERY_CLASS,
-    knobs: &["depth", "spp", "fresnel", "caustics", "reference_photons", "caustic_radius"],
+    knobs: &[FrameKnobs::depth, ReferenceKnobs::spp, FrameKnobs::fresnel, CausticsKnobs::caustics, ReferenceKnobs::reference_photons, ReferenceKnobs::caustic_radius],
     gpu: None,
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -146,8 +148,8 @@ impl<'a> Tracer<'a> {
     pub fn new(scene: &'a Scene, quality: &Quality) -> Result<Tracer<'a>> {
         scene.validate()?;
         scene.check_renderable()?;
-        if !(1..=64).contains(&quality.depth) {
-            return Err(Error::invalid("knob depth", format!("{} is outside 1..=64", quality.depth)));
+        if !(1..=64).contains(&quality.frame.depth) {
+            return Err(Error::invalid("knob depth", format!("{} is outside 1..=64", quality.frame.depth)));
         }
         let diag = scene.bounds().diagonal() as f64;
         let mut tracer = Tracer {
@@ -156,13 +158,13 @@ impl<'a> Tracer<'a> {
             textures: Textures::new(&scene.textures),
             sky: Sky::new(scene.environment.as_ref()),
             lights: scene.lights.iter().map(ShadeLight::new).collect(),
-            fresnel: quality.fresnel,
-            depth: quality.depth,
+            fresnel: quality.frame.fresnel,
+            depth: quality.frame.depth,
             epsilon: diag.max(f64::MIN_POSITIVE) * 1e-9,
             caustics: None,
-            shadows: quality.shadows,
+            shadows: quality.frame.shadows,
         };
-        if quality.caustics != Caustics::Off {
+        if quality.caustics.caustics != Caustics::Off {
             tracer.caustics = Some(PhotonMap::build(&tracer, quality)?);
         }
         Ok(tracer)
@@ -264,13 +266,13 @@ struct Surface {
 }
 
 /// Renders `scene` exactly at `width`×`height` (camera: the scene's, or the default one
-/// that frames it, as the GPU renderer takes it) with `quality.spp` samples per pixel and
-/// `quality.depth` specular bounces. Linear radiance RGBA32F, alpha 1.
+/// that frames it, as the GPU renderer takes it) with `quality.reference.spp` samples per pixel and
+/// `quality.frame.depth` specular bounces. Linear radiance RGBA32F, alpha 1.
 pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32, u32)) -> Result<ImageData> {
     if width == 0 || height == 0 || width > 16384 || height > 16384 {
         return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
     }
-    let spp = quality.spp;
+    let spp = quality.reference.spp;
     if !(1..=1024).contains(&spp) || spp.isqrt().pow(2) != spp {
         return Err(Error::invalid("knob spp", format!("{spp} is not a perfect square in 1..=1024")));
     }
@@ -373,7 +375,11 @@ mod tests {
         let m = s.add_material(Material { base_color: Vec3::ZERO, emissive: Vec3::new(0.25, 0.5, 2.0), ..Default::default() }).unwrap();
         s.add_mesh(shapes::quad("q", Vec3::new(-1.0, -1.0, -1.0), Vec3::new(2.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0), 2, m)).unwrap();
         s.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.0), Vec3::ZERO, 0.5));
-        let q = Quality { spp: 4, ..Default::default() };
+        let q = {
+            let mut knobs = Quality::default();
+            knobs.reference.spp = 4;
+            knobs
+        };
         let img = render_reference(&s, &q, (8, 8)).unwrap();
         for p in img.data.chunks_exact(4) {
             assert_eq!(p, [0.25, 0.5, 2.0, 1.0]);

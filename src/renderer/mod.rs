@@ -172,14 +172,14 @@ impl Renderer {
         self.light_table = views::light_table(scene, plan);
         self.bindings.create(ctx, self.views.count, &bindings::object_table(scene, plan), &self.light_table)?;
         let q = &plan.quality;
-        self.flags = if q.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
+        self.flags = if q.frame.fresnel == FresnelMode::Exact { FLAG_FRESNEL_EXACT } else { 0 }
             | if scene.environment.is_some() { FLAG_HAS_ENVIRONMENT } else { 0 }
-            | if q.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
-            | if q.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
+            | if q.layered.layered_both { 0 } else { crate::frame::layout::FLAG_LAYERED_STRONGEST }
+            | if q.frame.shadows { 0 } else { crate::frame::layout::FLAG_UNSHADOWED };
         self.create_stages(ctx, scene)?;
         self.bindings.allocate_map_sets(ctx, &self.maps)?;
         self.targets.create(ctx, self.width, self.height)?;
-        if self.plan.quality.object_ids {
+        if self.plan.quality.frame.object_ids {
             self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.bindings.layout, self.width, self.height)?);
         }
         let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
@@ -280,9 +280,9 @@ impl Renderer {
             flags: self.flags,
             light_count: self.light_table.len() as u32,
             search: SearchKnobs::of(q),
-            tolerance: q.search_tolerance,
-            internal_bounces: q.internal_bounces,
-            depth: q.depth,
+            tolerance: q.search.search_tolerance,
+            internal_bounces: q.distance.internal_bounces,
+            depth: q.frame.depth,
             mirror_base: self.views.first(EXTRA_VIEWS).unwrap_or(self.views.count),
         };
         let t = &mut self.targets;

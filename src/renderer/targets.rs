@@ -31,7 +31,7 @@ impl Targets {
 
     /// Checks the plan's `aa` for a `width`×`height` output on this device.
     pub fn check(ctx: &Context, plan: &Plan, width: u32, height: u32) -> Result<(u32, Multisample)> {
-        let ssaa = plan.quality.aa.ssaa();
+        let ssaa = plan.quality.frame.aa.ssaa();
         if ![1, 2, 4].contains(&ssaa) {
             return Err(Error::invalid("knob aa", format!("{ssaa} samples per axis: supersampling takes 1, 2 or 4")));
         }
@@ -152,7 +152,7 @@ impl Targets {
 /// sample-rate shading (the per-sample passes, and the ray pipelines' one ray per sample).
 fn camera_multisample(ctx: &Context, plan: &Plan) -> Result<Multisample> {
     let q = &plan.quality;
-    let samples = q.aa.msaa();
+    let samples = q.frame.aa.msaa();
     if samples == 1 {
         return Ok(Multisample::OFF);
     }
@@ -197,5 +197,5 @@ fn camera_multisample(ctx: &Context, plan: &Plan) -> Result<Multisample> {
             ),
         ));
     }
-    Ok(Multisample { samples, per_sample: q.msaa_per_sample })
+    Ok(Multisample { samples, per_sample: q.frame.msaa_per_sample })
 }

@@ -82,7 +82,7 @@ impl Updates {
             let mut why = Vec::new();
             if self.first_frame {
                 why.push("first frame".to_string());
-            } else if q.map_updates_always {
+            } else if q.frame.map_updates_always {
                 why.push("map_updates=always".to_string());
             } else {
                 let geometry = !c.moved.is_empty();
@@ -114,7 +114,7 @@ impl Updates {
             }
             if !why.is_empty() && plan.frame_latency && *deps == Deps::World {
                 // One inter-object cycle per frame: the change needs `cycles` frames.
-                self.latency_left[i] = q.cycles.max(1);
+                self.latency_left[i] = q.distance.cycles.max(1);
             }
             if why.is_empty() && self.latency_left[i] > 0 {
                 why.push(format!("frame latency: {} more cycle(s)", self.latency_left[i]));

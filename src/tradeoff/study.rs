@@ -121,7 +121,7 @@ pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let runs: Vec<(Choice, &Series)> = methods.iter().flat_map(|m| of(m).iter().filter(|s| reads(m, &s.0)).map(move |s| (*m, s))).collect();
     let steps: usize = runs.iter().map(|(_, (_, v))| v.len()).sum();
     progress(Progress::Start { steps: (1 + steps) as u64 });
-    progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.spp, cfg.quality.depth)));
+    progress(Progress::Begin(format!("reference ({} spp, depth {})", cfg.quality.reference.spp, cfg.quality.frame.depth)));
     let t = std::time::Instant::now();
     let reference = crate::reference::render_reference(&cfg.scene, &cfg.quality, (w, h))?;
     let reference_ms = t.elapsed().as_secs_f64() * 1e3;

@@ -18,7 +18,7 @@ impl Sweep {
         let (knob, values) = s.split_once('=').ok_or_else(|| Error::invalid("--sweep", format!("'{s}' is not knob=v1,v2,...")))?;
         let knob = knob.trim().to_string();
         // ref_point values contain commas themselves: split them on ';' instead.
-        let sep = if knob == "ref_point" { ';' } else { ',' };
+        let sep = if knob == crate::quality::CubeKnobs::ref_point { ';' } else { ',' };
         let values: Vec<String> = values.split(sep).map(|v| v.trim().to_string()).filter(|v| !v.is_empty()).collect();
         if values.is_empty() {
             return Err(Error::invalid("--sweep", format!("'{s}' lists no values")));
@@ -80,14 +80,19 @@ mod tests {
     #[test]
     fn each_sweep_is_a_series_of_its_own() {
         let s = [Sweep::parse("secant_steps=0,1").unwrap(), Sweep::parse("linear_steps=4,8,16").unwrap()];
-        let base = Quality { linear_steps: 4, secant_steps: 0, ..Quality::default() };
+        let base = {
+            let mut knobs = Quality::default();
+            knobs.search.linear_steps = 4;
+            knobs.search.secant_steps = 0;
+            knobs
+        };
         let v = series(&base, &s, true).unwrap();
         assert_eq!(v.len(), 2);
         assert_eq!(v[0].0.as_deref(), Some("secant_steps"));
         assert_eq!(v[1].1.iter().map(|(l, _)| l.as_str()).collect::<Vec<_>>(), ["linear_steps=4", "linear_steps=8", "linear_steps=16"]);
         // The other knobs stay at the base.
-        assert!(v[0].1.iter().all(|(_, q)| q.linear_steps == 4) && v[1].1.iter().all(|(_, q)| q.secant_steps == 0));
-        assert_eq!(v[0].1[1].1.secant_steps, 1);
+        assert!(v[0].1.iter().all(|(_, q)| q.search.linear_steps == 4) && v[1].1.iter().all(|(_, q)| q.search.secant_steps == 0));
+        assert_eq!(v[0].1[1].1.search.secant_steps, 1);
         let product = series(&base, &s, false).unwrap();
         assert_eq!((product.len(), product[0].0.clone(), product[0].1.len()), (1, None, 6));
     }
@@ -106,7 +111,7 @@ mod tests {
                 "cube_size=64 cube_precision=single"
             ]
         );
-        assert_eq!(v[3].1.cube_size, 64);
+        assert_eq!(v[3].1.cube.cube_size, 64);
         assert_eq!(variants(&Quality::default(), &[]).unwrap()[0].0, "default");
         assert!(Sweep::parse("cube_size=8").is_err());
         assert!(Sweep::parse("nonsense=1").is_err());

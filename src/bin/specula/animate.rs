@@ -22,8 +22,8 @@ pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, out: &Path) -> sp
         ));
     }
     // Frames over time: maps are regenerated when what they see moved, unless asked otherwise.
-    if !args.quality.iter().any(|q| q.trim_start().starts_with("map_updates")) {
-        job.quality.map_updates_always = false;
+    if !args.quality.iter().any(|q| q.trim_start().starts_with(specula::quality::FrameKnobs::map_updates)) {
+        job.quality.frame.map_updates_always = false;
     }
     let duration = duration.unwrap_or_else(|| job.scene.animation.as_ref().map_or(2.0, |a| a.duration.max(1.0 / fps)));
     if !(duration > 0.0 && duration <= 3600.0) {

@@ -219,7 +219,11 @@ pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
     }
     // These commands time a static scene's frames: its maps are regenerated every frame
     // (what a frame costs) unless `-q map_updates=on_change` asks for steady state.
-    let mut quality = Quality { map_updates_always: true, ..Quality::default() };
+    let mut quality = {
+        let mut knobs = Quality::default();
+        knobs.frame.map_updates_always = true;
+        knobs
+    };
     for q in &a.quality {
         quality.set_pair(q)?;
     }
@@ -256,8 +260,8 @@ pub fn reference_summary(q: &Quality, w: u32, h: u32, ms: f64) -> String {
     format!(
         "reference on the CPU ({} threads), {w}x{h}, {} spp, depth {}, fresnel {:?}: {ms:.1} ms",
         rayon::current_num_threads(),
-        q.spp,
-        q.depth,
-        q.fresnel
+        q.reference.spp,
+        q.frame.depth,
+        q.frame.fresnel
     )
 }

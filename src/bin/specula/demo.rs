@@ -19,7 +19,11 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
     std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
     let ctx = context(validate, device)?;
     // Each method's whole frame, maps included, is what the timing table shows.
-    let q = Quality { map_updates_always: true, ..Quality::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.frame.map_updates_always = true;
+        knobs
+    };
     let mut report = format!("specula demo: {} at {w}x{h} on {} ({})\n\n", scene_path.display(), ctx.device_name, ctx.driver_info);
 
     // The exact reference first: every tile's label carries its error against it.
@@ -140,7 +144,7 @@ fn flat_glass(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: 
     std::fs::create_dir_all(outdir).map_err(|e| specula::Error::io(outdir, e))?;
     let mut report = format!("\n== flat glass (survey §5): a slab and a prism of ν 1.5 at {w}x{h}\n");
     let mut q = q.clone();
-    q.depth = 4;
+    q.frame.depth = 4;
     let (reference, ref_ms) = render_reference(&scene, &q, (w, h))?;
     write_image(&outdir.join("reference.png"), &reference)?;
     report += &format!("reference (depth 4): {ref_ms:.0} ms CPU\n");
@@ -152,7 +156,7 @@ fn flat_glass(ctx: &specula::vk::Context, outdir: &Path, (w, h): (u32, u32), q: 
     ];
     for (name, method, budget) in runs {
         let mut qm = q.clone();
-        qm.mirror_budget = budget;
+        qm.geometry.mirror_budget = budget;
         let frame = specula::render(ctx, &scene, method, &qm, (w, h), (1, 3))?;
         write_image(&outdir.join(format!("{name}.png")), &frame.image)?;
         let e = specula::metrics::compare(&frame.image, &reference)?;
@@ -254,7 +258,11 @@ fn showcase(outdir: &Path, (w, h): (u32, u32), validate: bool, device: &Option<S
     for study in STUDIES {
         let out = outdir.join(study.scene);
         let scene = specula::scenes::builtin(study.scene).expect("a built-in scene")?;
-        let mut quality = Quality { map_updates_always: true, ..Quality::default() };
+        let mut quality = {
+            let mut knobs = Quality::default();
+            knobs.frame.map_updates_always = true;
+            knobs
+        };
         for q in study.base {
             quality.set_pair(q)?;
         }

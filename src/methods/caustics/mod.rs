@@ -15,6 +15,7 @@
 //!   photons into the light cube map, radiant intensity seen from the reference point;
 //! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0).
 
+pub mod knobs;
 pub mod project;
 pub mod stage;
 
@@ -23,6 +24,7 @@ use glam::{Mat4, Vec3};
 use crate::cube::face_view_proj;
 use crate::frame::stage::{order, Deps, EffectInfo, FramePart, Maps, StageInit, ViewFrame};
 use crate::frame::views::view;
+use crate::quality::{CubeKnobs, DistanceKnobs, FrameKnobs, SearchKnobs};
 use crate::vk::Context;
 use crate::Result;
 
@@ -46,7 +48,7 @@ impl CausticsPlan {
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
         v.push(if self.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" });
-        if q.caustic_filter > 0 {
+        if q.caustics.caustic_filter > 0 {
             v.push("caustics.filter");
         }
         v
@@ -179,15 +181,15 @@ fn light_sees(kind: LightKind, position: Vec3, direction: Vec3, centre: Vec3, ra
 /// search, the shadow maps that occlude them, the Fresnel weights along a path): with
 /// caustics, every method's image depends on them.
 pub const MAP_KNOBS: &[&str] = &[
-    "cube_size",
-    "cube_precision",
-    "fresnel",
-    "shadow_size",
-    "linear_steps",
-    "secant_steps",
-    "binary_steps",
-    "search_tolerance",
-    "internal_bounces",
+    CubeKnobs::cube_size,
+    CubeKnobs::cube_precision,
+    FrameKnobs::fresnel,
+    FrameKnobs::shadow_size,
+    SearchKnobs::linear_steps,
+    SearchKnobs::secant_steps,
+    SearchKnobs::binary_steps,
+    SearchKnobs::search_tolerance,
+    DistanceKnobs::internal_bounces,
 ];
 
 /// A mesh's bounding sphere: its box's centre, and the farthest vertex from it (tighter
@@ -209,7 +211,7 @@ fn light_inside(position: Vec3, centre: Vec3, radius: f32) -> bool {
 /// surface receives them, no punctual light, or no specular object a light sees. Every
 /// method's diffuse shading projects them, the ray tracers' (§2) shading kernels too.
 pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<CausticsPlan> {
-    if q.caustics == Caustics::Off || scene.lights.is_empty() {
+    if q.caustics.caustics == Caustics::Off || scene.lights.is_empty() {
         return None;
     }
     if !scene.meshes.iter().any(|m| !scene.materials[m.material].kind.is_specular()) {
@@ -221,7 +223,7 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
     for o in objects {
         let (centre, radius) = bounding_sphere(scene, o.mesh);
         let dielectric = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
-        let branches = if dielectric && q.caustic_reflections { 2 } else { 1 };
+        let branches = if dielectric && q.caustics.caustic_reflections { 2 } else { 1 };
         let mut lights = Vec::new();
         let g = generators.len();
         let first_cube = cubes.len();
@@ -232,7 +234,7 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
             let faces = if l.kind != LightKind::Directional && light_inside(l.position, centre, radius) { 6 } else { 1 };
             // Light space centres a cube at each point or spot light; everything else shares
             // the generator's cube around its reference point.
-            let light = (q.caustic_space == CausticSpace::Light && l.kind != LightKind::Directional).then_some(i);
+            let light = (q.caustics.caustic_space == CausticSpace::Light && l.kind != LightKind::Directional).then_some(i);
             let cube = match cubes[first_cube..].iter().position(|c| c.light == light) {
                 Some(k) => first_cube + k,
                 None => {
@@ -250,7 +252,8 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
     if generators.is_empty() {
         return None;
     }
-    let mut p = CausticsPlan { filter: q.caustics, generators, cubes, space: q.caustic_space, photon_layers: layers, bytes: 0 };
+    let mut p =
+        CausticsPlan { filter: q.caustics.caustics, generators, cubes, space: q.caustics.caustic_space, photon_layers: layers, bytes: 0 };
     p.bytes = bytes(&p, q);
     Some(p)
 }
@@ -260,10 +263,10 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
 /// depth buffer), the receivers' depth buffer, and for caustic triangles their set-up
 /// buffers (64 bytes and six face flags per triangle).
 pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
-    let s = q.cube_size as u64;
-    let n = q.photons as u64;
+    let s = q.cube.cube_size as u64;
+    let n = q.caustics.photons as u64;
     let g = p.cubes.len() as u64;
-    let light_cubes = if q.caustic_filter > 0 { 2 } else { 1 };
+    let light_cubes = if q.caustics.caustic_filter > 0 { 2 } else { 1 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
     let triangles = if p.filter == Caustics::Triangles { p.photon_layers as u64 * 2 * (n - 1) * (n - 1) * (64 + 24) } else { 0 };
     g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles
@@ -273,12 +276,12 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
 pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
     let mut s = format!(
         "caustics ({}, {} space): {} photons² per light view, {} light cube(s) 6×{}² RGBA32F{}, {:.2} MiB",
-        if p.filter == Caustics::Splat { format!("splat, splat_size {}", q.splat_size) } else { "triangles".into() },
+        if p.filter == Caustics::Splat { format!("splat, splat_size {}", q.caustics.splat_size) } else { "triangles".into() },
         if p.space == CausticSpace::Light { "light" } else { "cube-map" },
-        q.photons,
+        q.caustics.photons,
         p.cubes.len(),
-        q.cube_size,
-        if q.caustic_filter > 0 { format!(", box filter radius {}", q.caustic_filter) } else { String::new() },
+        q.cube.cube_size,
+        if q.caustics.caustic_filter > 0 { format!(", box filter radius {}", q.caustics.caustic_filter) } else { String::new() },
         p.bytes as f64 / (1 << 20) as f64
     );
     for g in &p.generators {
@@ -304,7 +307,7 @@ pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
 /// (w 1); `dir` is the view's axis and, in w, one texel's solid angle on the axis
 /// ((2 tan θ / N)², θ the half angle) or, orthographic, one texel's area (m²).
 pub fn photon_views(p: &CausticsPlan, scene: &Scene, lights: &[GpuLight], q: &Quality, near_scale: f32) -> Vec<GpuView> {
-    let n = q.photons as f32;
+    let n = q.caustics.photons as f32;
     let mut views = Vec::with_capacity(p.photon_layers as usize);
     for g in &p.generators {
         let (centre, radius) = bounding_sphere(scene, g.mesh);

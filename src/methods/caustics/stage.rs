@@ -40,17 +40,17 @@ pub struct CausticsStage {
 
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
 pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (GpuCausticParams, Vec<GpuCausticCube>) {
-    let flags =
-        if q.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 } | if q.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 };
+    let flags = if q.caustics.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 }
+        | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 };
     let params = GpuCausticParams {
         cube_count: plan.cubes.len() as u32,
-        photon_size: q.photons,
-        cube_size: q.cube_size,
+        photon_size: q.caustics.photons,
+        cube_size: q.cube.cube_size,
         flags,
-        splat_size: q.splat_size,
-        filter_radius: q.caustic_filter,
-        triangle_count: plan.photon_layers * 2 * (q.photons - 1) * (q.photons - 1),
-        layer_triangles: 2 * (q.photons - 1) * (q.photons - 1),
+        splat_size: q.caustics.splat_size,
+        filter_radius: q.caustics.caustic_filter,
+        triangle_count: plan.photon_layers * 2 * (q.caustics.photons - 1) * (q.caustics.photons - 1),
+        layer_triangles: 2 * (q.caustics.photons - 1) * (q.caustics.photons - 1),
     };
     let cubes = plan
         .cubes
@@ -85,8 +85,8 @@ impl CausticsStage {
         let q = &init.plan.quality;
         let me = CausticsStage {
             plan,
-            photons: q.photons,
-            filter: q.caustic_filter,
+            photons: q.caustics.photons,
+            filter: q.caustics.caustic_filter,
             // Six passes whatever `cube_mode` says: with multiview, lavapipe (Mesa 22.3)
             // scatters the receivers' triangles over the wrong faces of the cube (measured:
             // tests/caustics.rs, multiview_and_six_passes_make_the_same_caustic).
@@ -105,7 +105,7 @@ impl CausticsStage {
 
     fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
         let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
-        let (s, n) = (q.cube_size, q.photons);
+        let (s, n) = (q.cube.cube_size, q.caustics.photons);
         let cubes = self.plan.cubes.len() as u32;
         let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let cube = |name, format| {

@@ -4,6 +4,7 @@
 //! Wyman's image-space double refraction (§4.4).
 
 pub mod image_space;
+pub mod knobs;
 pub mod refractor;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
@@ -13,6 +14,7 @@ use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::{CameraPlan, Plan};
 use crate::quality::Quality;
+use crate::quality::{CubeKnobs, DistanceKnobs, FrameKnobs, SearchKnobs};
 use crate::Result;
 
 /// `distance.generate`: the distance cube maps (two images, ping-pong, for inter-object
@@ -32,7 +34,7 @@ fn create_distance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Resu
 }
 
 fn distance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {
-    let s = p.quality.cube_size as u64;
+    let s = p.quality.cube.cube_size as u64;
     6 * s * s * cube_texel_bytes(&p.quality) * objects as u64 * distance_images(p)
 }
 
@@ -44,7 +46,7 @@ pub const REFRACTOR_CUBES: MapInfo = MapInfo {
     layer_field: Some(LayerField::Refractor),
     create: refractor::create,
     bytes: |p, n, _| {
-        let s = p.quality.cube_size as u64;
+        let s = p.quality.cube.cube_size as u64;
         6 * s * s * cube_texel_bytes(&p.quality) * n as u64
     },
     describe: |q, _| describe_cube(q) + " (normal, distance)",
@@ -62,16 +64,16 @@ pub const BACKFACES: MapInfo = MapInfo {
 };
 
 const SEARCH_KNOBS: &[&str] = &[
-    "cube_size",
-    "cube_precision",
-    "cube_mode",
-    "fresnel",
-    "ref_point",
-    "linear_steps",
-    "secant_steps",
-    "binary_steps",
-    "parallax_iterations",
-    "search_tolerance",
+    CubeKnobs::cube_size,
+    CubeKnobs::cube_precision,
+    CubeKnobs::cube_mode,
+    FrameKnobs::fresnel,
+    CubeKnobs::ref_point,
+    SearchKnobs::linear_steps,
+    SearchKnobs::secant_steps,
+    SearchKnobs::binary_steps,
+    SearchKnobs::parallax_iterations,
+    SearchKnobs::search_tolerance,
 ];
 
 const fn one(_: &Quality) -> u32 {
@@ -91,7 +93,7 @@ const SEARCH: CameraPass = CameraPass {
 /// `distance.search`, which the test knob `debug_fault=flip_reflection` breaks on purpose.
 fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
     let mut c = c.clone();
-    if init.plan.quality.debug_fault == crate::quality::DebugFault::FlipReflection {
+    if init.plan.quality.frame.debug_fault == crate::quality::DebugFault::FlipReflection {
         c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
     }
     Ok(Box::new(crate::frame::camera::CameraShade::new(init.ctx, init.layout, &c, init.multisample)?))
@@ -125,7 +127,7 @@ fn distance_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
         ObjectClass::SolidDielectric => {
             Some(Verdict { score: 1.5, reason: "distance map: refracts once at the entry surface only".into() })
         }
-        _ if q.planner.speed() => {
+        _ if q.plan.planner.speed() => {
             Some(Verdict { score: 3.0, reason: format!("{}: distance map, one search per ray (planner=speed){convex}", f.class.label()) })
         }
         _ if f.specular_coverage() >= MIN_COVERAGE => Some(Verdict {
@@ -155,14 +157,14 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
     summary: "inter-object reflections and refractions: each object's distance map regenerated in `cycles` cycles, specular objects in maps searching their own previous-cycle maps; `frame_latency=on` does one cycle per frame instead",
     serves: EVERY_CLASS,
     knobs: &[
-        "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "parallax_iterations", "search_tolerance", "cycles", "frame_latency",
+        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::cycles, DistanceKnobs::frame_latency,
     ],
     gpu: Some(GpuSpec {
         maps: &[DISTANCE_CUBES],
         camera: SEARCH,
         map_shading: MapShading::Traced,
         leaves_out: LeavesOut::Itself,
-        cycles: |q| if q.frame_latency { 1 } else { q.cycles },
+        cycles: |q| if q.distance.frame_latency { 1 } else { q.distance.cycles },
         shades_every_pixel: false,
     }),
     fallback: None,
@@ -172,7 +174,7 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
 
 fn multi_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
     let coverage = f.specular_coverage();
-    if f.class == ObjectClass::SolidDielectric || coverage < MIN_COVERAGE || q.planner.speed() {
+    if f.class == ObjectClass::SolidDielectric || coverage < MIN_COVERAGE || q.plan.planner.speed() {
         return None;
     }
     Some(Verdict {
@@ -194,7 +196,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     summary: "self refraction: each solid refractor's own normal + distance cube map, the refracted ray searched inside it, refracted out (Snell) or internally reflected up to `internal_bounces` times, then traced in the environment's distance map",
     serves: SOLIDS,
     knobs: &[
-        "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "parallax_iterations", "search_tolerance", "internal_bounces",
+        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::internal_bounces,
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
@@ -211,7 +213,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
 
 fn refractor_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
     let convex = f.visible_fraction >= 0.98 && f.watertight;
-    let score = if q.planner.speed() {
+    let score = if q.plan.planner.speed() {
         2.0
     } else if convex {
         4.0
@@ -258,7 +260,7 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
     shape: crate::methods::registry::Shape::Any,
     rule: |_, q| {
         Some(Verdict {
-            score: if q.planner.speed() { 3.0 } else { 2.0 },
+            score: if q.plan.planner.speed() { 3.0 } else { 2.0 },
             reason: "solid dielectric: image-space double refraction, two interfaces from one extra camera pass (§4.4)".into(),
         })
     },

@@ -32,17 +32,21 @@ pub fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Bo
 impl RefractorMaps {
     pub fn new(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<RefractorMaps> {
         let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
-        let format = radiance_format(q.cube_precision);
-        let me =
-            RefractorMaps { objects: objects.to_vec(), depth: Image::placeholder(), pipeline: vk::Pipeline::null(), mode: q.cube_mode };
+        let format = radiance_format(q.cube.cube_precision);
+        let me = RefractorMaps {
+            objects: objects.to_vec(),
+            depth: Image::placeholder(),
+            pipeline: vk::Pipeline::null(),
+            mode: q.cube.cube_mode,
+        };
         build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let kind = ImageKind::CubeArray { cubes: me.objects.len() as u32 };
             maps.refractor = Some(Image::new(
                 ctx,
-                &ImageDesc { name: "refractor.cubes", format, width: q.cube_size, height: q.cube_size, kind, usage },
+                &ImageDesc { name: "refractor.cubes", format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage },
             )?);
-            me.depth = cube_depth(ctx, "refractor.cubes.depth", q.cube_size, q.cube_mode)?;
+            me.depth = cube_depth(ctx, "refractor.cubes.depth", q.cube.cube_size, q.cube.cube_mode)?;
             me.pipeline = graphics_pipeline(
                 ctx,
                 layout,
@@ -55,7 +59,7 @@ impl RefractorMaps {
                     depth_format: Some(DEPTH_FORMAT),
                     depth_test: true,
                     depth_write: true,
-                    view_mask: view_mask(q.cube_mode),
+                    view_mask: view_mask(q.cube.cube_mode),
                     cull: vk::CullModeFlags::NONE,
                     multisample: Multisample::OFF,
                     blend: crate::vk::pipeline::Blend::Replace,

@@ -3,6 +3,7 @@
 //! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
 //! towards where the ray leaves a proxy of the environment (§3.2).
 
+pub mod knobs;
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Verdict};
@@ -10,6 +11,7 @@ use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
 use crate::quality::Quality;
+use crate::quality::{CubeKnobs, EnvmapKnobs, FrameKnobs};
 
 /// `envmap.generate`: the radiance cube maps.
 pub const RADIANCE_CUBES: MapInfo = MapInfo {
@@ -23,11 +25,11 @@ pub const RADIANCE_CUBES: MapInfo = MapInfo {
 };
 
 fn radiance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {
-    let s = p.quality.cube_size as u64;
+    let s = p.quality.cube.cube_size as u64;
     6 * s * s * cube_texel_bytes(&p.quality) * objects as u64
 }
 
-const KNOBS: &[&str] = &["cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point"];
+const KNOBS: &[&str] = &[CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point];
 
 const fn one(_: &Quality) -> u32 {
     1
@@ -87,7 +89,7 @@ pub const PROXY_SPHERE: Method = Method(&MethodInfo {
     family: "envmap",
     summary: "localised environment mapping: the ray is intersected with a sphere around the reference point (`proxy_radius`) and the cube map looked up towards the hit",
     serves: EVERY_CLASS,
-    knobs: &["cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "proxy_radius"],
+    knobs: &[CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, EnvmapKnobs::proxy_radius],
     gpu: Some(spec(proxy(0))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,

@@ -33,6 +33,7 @@ use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Metho
 use crate::plan::facts::Curvature;
 use crate::plan::CameraPlan;
 use crate::quality::Quality;
+use crate::quality::{FrameKnobs, GeometryKnobs};
 use crate::scene::{Mesh, Scene};
 use crate::vk::pipeline::{compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, write_image};
 use crate::vk::pipeline::{sampler, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
@@ -77,14 +78,14 @@ pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors are refused",
     serves: &[ObjectClass::Mirror],
-    knobs: &["geometry_image", "curved_search", "tessellation", "fresnel"],
+    knobs: &[GeometryKnobs::geometry_image, GeometryKnobs::curved_search, GeometryKnobs::tessellation, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::ConvexOrConcave,
     rule: |f, q| {
         let shaped = matches!(f.curvature, Curvature::Convex | Curvature::Concave) && !f.planar;
-        let fine = f.edge_angle / q.tessellation.max(1) as f32;
-        (shaped && f.depth_ratio >= DEEP_ENVIRONMENT && fine <= FINE_EDGE && !q.planner.speed()).then(|| Verdict {
+        let fine = f.edge_angle / q.geometry.tessellation.max(1) as f32;
+        (shaped && f.depth_ratio >= DEEP_ENVIRONMENT && fine <= FINE_EDGE && !q.plan.planner.speed()).then(|| Verdict {
             // Above the proxy box's 3.5 for box rooms: near objects are not the box.
             score: 3.6,
             reason: format!(
@@ -287,9 +288,9 @@ impl CurvedReflectors {
         CurvedReflectors {
             name: plan.name,
             reflectors: plan.objects.iter().map(|(m, _)| *m).collect(),
-            size: q.geometry_image,
-            levels: q.curved_search,
-            tessellation: q.tessellation,
+            size: q.geometry.geometry_image,
+            levels: q.geometry.curved_search,
+            tessellation: q.geometry.tessellation,
             width: init.width,
             height: init.height,
             multisample: init.multisample,

@@ -9,6 +9,7 @@
 
 pub mod curved;
 
+pub mod knobs;
 pub mod mirror;
 pub mod views;
 
@@ -19,6 +20,7 @@ use crate::methods::registry::{
     CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Shape, Verdict,
 };
 use crate::quality::Quality;
+use crate::quality::{FrameKnobs, GeometryKnobs};
 
 /// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
 pub const FAMILY: Family = Family {
@@ -46,12 +48,12 @@ fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::Plan) {
     let planar = [PLANAR_MIRROR, PLANAR_REFRACTION];
     p.mirrors = p.objects.iter().filter(|o| planar.contains(&o.method)).map(|o| o.mesh).collect();
     let planes = p.mirrors.iter().map(|&m| mirror::plane_count(scene, m)).sum();
-    p.mirror_layers = mirror::layers_needed(planes, q.depth, q.mirror_budget);
+    p.mirror_layers = mirror::layers_needed(planes, q.frame.depth, q.geometry.mirror_budget);
     // Planar mirrors inside cube maps: one mirrored view per cube face per mirror, at most
     // mirror_budget mirrors (the rest show the environment there, as before).
-    if !p.envmaps.is_empty() && q.map_mirrors {
+    if !p.envmaps.is_empty() && q.geometry.map_mirrors {
         let mirrors = p.objects.iter().filter(|o| o.method == PLANAR_MIRROR).map(|o| o.mesh);
-        p.map_mirrors = mirrors.take(q.mirror_budget as usize).collect();
+        p.map_mirrors = mirrors.take(q.geometry.mirror_budget as usize).collect();
     }
 }
 
@@ -83,7 +85,7 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "planar reflectors by geometry transformation: the scene rendered again from the camera mirrored through the mirror's plane (oblique near plane at the mirror), laid onto the mirror's pixels with its Fresnel weight; mirrors in mirrors recurse up to depth, at most mirror_budget views a frame",
     serves: &[ObjectClass::Mirror],
-    knobs: &["depth", "mirror_budget", "map_mirrors", "fresnel"],
+    knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, GeometryKnobs::map_mirrors, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
@@ -115,7 +117,7 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     family: "geometry",
     summary: "flat-faced dielectrics (slabs, prisms, gems; convex) and thin panes by geometry transformation: per face seen, the scene rendered through it by the linearised refraction of the eye ray (GS04: an affine map per face, exact on the face's central ray; exact for thin panes) and reflected in it (exact), recursing through internal reflections to the exit faces up to depth, at most mirror_budget views a frame, with the pixel's own Fresnel split",
     serves: &[ObjectClass::SolidDielectric, ObjectClass::ThinDielectric],
-    knobs: &["depth", "mirror_budget", "fresnel"],
+    knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,

@@ -56,7 +56,7 @@ impl MirrorViews {
         let kind = if samples > 1 { ImageKind::D2Multisample { samples } } else { ImageKind::D2 };
         let mut me = MirrorViews {
             meshes: plan.mirrors.clone(),
-            limits: Limits { depth: plan.quality.depth, budget: plan.quality.mirror_budget, layers },
+            limits: Limits { depth: plan.quality.frame.depth, budget: plan.quality.geometry.mirror_budget, layers },
             scratch: Image::placeholder(),
             depth: Image::placeholder(),
             samples,

@@ -11,6 +11,7 @@
 //! bounding box (or the `ref_point` knob), the number of layers L the scene's depth
 //! complexity from there (`layers=auto`, counted on the GPU) or the `layers` knob.
 
+pub mod knobs;
 pub mod peel;
 
 use glam::Vec3;
@@ -20,6 +21,7 @@ use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Metho
 use crate::methods::EVERY_CLASS;
 use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
+use crate::quality::{CubeKnobs, FrameKnobs, LayeredKnobs, SearchKnobs};
 use crate::quality::{Quality, MAX_LAYERS};
 
 /// `layered.peel`: the layers of the whole scene's map (see `peel`).
@@ -32,6 +34,7 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
     bytes: |p, objects, _| if objects == 0 { 0 } else { peel::bytes(&p.quality, planned_layers(&p.quality)) },
     describe: |q, _| {
         let layers = q
+            .layered
             .layers
             .map_or(format!("auto (the depth complexity, at most {MAX_LAYERS}; memory counted at {MAX_LAYERS})"), |l| l.to_string());
         format!("one map of the whole scene, shared: layers {layers}, each {}", peel::describe_layer(q))
@@ -41,7 +44,7 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
 /// The layers the plan budgets: the knob, or for `auto` the most there can be (the stage
 /// allocates what it measured; `layered.layers` in the frame's stats).
 pub fn planned_layers(q: &Quality) -> u32 {
-    q.layers.unwrap_or(MAX_LAYERS)
+    q.layered.layers.unwrap_or(MAX_LAYERS)
 }
 
 const fn one(_: &Quality) -> u32 {
@@ -66,7 +69,7 @@ pub const LAYERED: Method = Method(&MethodInfo {
     summary: "layered distance maps of the whole scene by depth peeling (layers = its depth complexity from one reference point); recursive ray tracing in the fragment shader: every layer searched (linear + secant), the nearest hit wins, specular hits reflected and refracted with Fresnel up to depth",
     serves: EVERY_CLASS,
     knobs: &[
-        "layers", "layered_branches", "depth", "cube_size", "cube_precision", "cube_mode", "fresnel", "ref_point", "linear_steps", "secant_steps", "binary_steps", "search_tolerance",
+        LayeredKnobs::layers, LayeredKnobs::layered_branches, FrameKnobs::depth, CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::search_tolerance,
     ],
     gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, shades_every_pixel: false }),
     fallback: None,
@@ -100,7 +103,7 @@ fn layered_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
         why.push(format!("{:.0} % of its surface faces its reference point (concave: it sees itself)", 100.0 * f.self_facing));
     }
     Some(Verdict {
-        score: if q.planner.speed() { 2.5 } else { 4.5 },
+        score: if q.plan.planner.speed() { 2.5 } else { 4.5 },
         reason: format!("{}: {}; layered maps of the whole scene, traced recursively (§4.5)", f.class.label(), why.join(", ")),
     })
 }
@@ -108,7 +111,7 @@ fn layered_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
 /// The layered map's reference point: the `ref_point` knob, else the centre of the
 /// bounding box of the objects that take the method (`meshes`).
 pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec3 {
-    if let Some(p) = q.ref_point {
+    if let Some(p) = q.cube.ref_point {
         return p;
     }
     let mut b = crate::scene::Aabb::EMPTY;
@@ -159,7 +162,7 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
     p.layered_centre = Some(c);
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
-        o.reference_note = Some(if p.quality.ref_point.is_some() {
+        o.reference_note = Some(if p.quality.cube.ref_point.is_some() {
             "the layered map's, set by the ref_point knob".into()
         } else {
             "the layered map's: the centre of its objects' bounding box".into()

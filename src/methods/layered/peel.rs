@@ -27,7 +27,7 @@ use crate::Result;
 
 /// Device memory of `layers` layers (both images) and the two peeling depth buffers.
 pub fn bytes(q: &Quality, layers: u32) -> u64 {
-    let face = q.cube_size as u64 * q.cube_size as u64;
+    let face = q.cube.cube_size as u64 * q.cube.cube_size as u64;
     layers as u64 * 6 * face * 2 * cube_texel_bytes(q) + 2 * 6 * face * 4
 }
 
@@ -66,7 +66,7 @@ pub fn create(init: &StageInit, _objects: &[usize], maps: &mut Maps) -> Result<B
         peel: vk::Pipeline::null(),
         nearest: vk::Sampler::null(),
         sets: Vec::new(),
-        mode: init.plan.quality.cube_mode,
+        mode: init.plan.quality.cube.cube_mode,
     };
     Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
 }
@@ -86,8 +86,8 @@ impl LayeredMaps {
             let desc = ImageDesc {
                 name: &name,
                 format: DEPTH_FORMAT,
-                width: q.cube_size,
-                height: q.cube_size,
+                width: q.cube.cube_size,
+                height: q.cube.cube_size,
                 kind: ImageKind::D2Array { layers: 6 },
                 usage,
             };
@@ -116,7 +116,7 @@ impl LayeredMaps {
             }
             crate::vk::pipeline::write_buffer(ctx, set, binding::THICKNESS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
         }
-        let formats = [radiance_format(q.cube_precision), normal_format(q, init.scene.materials.len())];
+        let formats = [radiance_format(q.cube.cube_precision), normal_format(q, init.scene.materials.len())];
         self.peel = graphics_pipeline(
             ctx,
             init.layout,
@@ -129,7 +129,7 @@ impl LayeredMaps {
                 depth_format: Some(DEPTH_FORMAT),
                 depth_test: true,
                 depth_write: true,
-                view_mask: crate::frame::view_mask(q.cube_mode),
+                view_mask: crate::frame::view_mask(q.cube.cube_mode),
                 cull: vk::CullModeFlags::NONE,
                 multisample: Multisample::OFF,
                 blend: Blend::Replace,
@@ -142,7 +142,7 @@ impl LayeredMaps {
     /// The knob, or the depth complexity counted now (at least one layer).
     fn layer_count(&mut self, init: &StageInit) -> Result<u32> {
         let q = &init.plan.quality;
-        if let Some(l) = q.layers {
+        if let Some(l) = q.layered.layers {
             self.measured = None;
             return Ok(l);
         }
@@ -150,7 +150,7 @@ impl LayeredMaps {
         let (count, gpu) = if init.ctx.queue.is_some() {
             (count_on_gpu(init, centre)?, true)
         } else {
-            (count_on_cpu(init.scene, centre, q.cube_size.min(64)), false)
+            (count_on_cpu(init.scene, centre, q.cube.cube_size.min(64)), false)
         };
         self.measured = Some((count, gpu));
         Ok(count.clamp(1, MAX_LAYERS))
@@ -161,8 +161,9 @@ impl LayeredMaps {
         let (ctx, q) = (init.ctx, &init.plan.quality);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let kind = ImageKind::CubeArray { cubes: self.layers };
-        let s = q.cube_size;
-        let radiance = ImageDesc { name: "layered.cubes", format: radiance_format(q.cube_precision), width: s, height: s, kind, usage };
+        let s = q.cube.cube_size;
+        let radiance =
+            ImageDesc { name: "layered.cubes", format: radiance_format(q.cube.cube_precision), width: s, height: s, kind, usage };
         maps.layered = Some(Image::new(ctx, &radiance)?);
         let normals =
             ImageDesc { name: "layered.normals", format: normal_format(q, init.scene.materials.len()), width: s, height: s, kind, usage };
@@ -172,7 +173,7 @@ impl LayeredMaps {
 }
 
 fn normal_format(q: &Quality, materials: usize) -> vk::Format {
-    match q.cube_precision {
+    match q.cube.cube_precision {
         Precision::Half if materials <= HALF_MATERIALS => vk::Format::R16G16B16A16_SFLOAT,
         _ => vk::Format::R32G32B32A32_SFLOAT,
     }
@@ -182,7 +183,7 @@ fn normal_format(q: &Quality, materials: usize) -> vk::Format {
 /// additive blending (one per surface along each texel's ray), read back, the maximum.
 fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
     let ctx = init.ctx;
-    let size = init.plan.quality.cube_size;
+    let size = init.plan.quality.cube.cube_size;
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
     let desc = ImageDesc {
         name: "layered.count",
@@ -365,7 +366,7 @@ impl Stage for LayeredMaps {
     /// Objects moved: with `layers=auto` the depth complexity is counted again, and the
     /// layers are reallocated when it changed (the renderer rewrites the descriptors).
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
-        if changes.moved.is_empty() || init.plan.quality.layers.is_some() {
+        if changes.moved.is_empty() || init.plan.quality.layered.layers.is_some() {
             return Ok(());
         }
         let layers = self.layer_count(init)?;

@@ -150,7 +150,12 @@ pub struct Config {
 /// (`table1.svg`) and the rows (`table1.csv`) into `out`.
 pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     let methods = [BVH, KD_TREE, GRID, RAY_HIERARCHY, RAY_ENGINE];
-    let q = Quality { depth: c.depth, map_updates_always: true, ..Quality::default() };
+    let q = {
+        let mut knobs = Quality::default();
+        knobs.frame.depth = c.depth;
+        knobs.frame.map_updates_always = true;
+        knobs
+    };
     let mut rows: Vec<Row> = Vec::new();
     let mut md = String::new();
     if c.parts.contains(&Part::Table1) {
@@ -219,7 +224,12 @@ fn culling(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()
     let _ = writeln!(md, "| tile | frame ms | culling per bounce: rays / shadow rays |");
     let _ = writeln!(md, "|---:|---:|---|");
     for tile in [8u32, 16, 32] {
-        let qt = Quality { tile_size: tile, ray_stats: true, ..q.clone() };
+        let qt = {
+            let mut knobs = q.clone();
+            knobs.raytrace.tile_size = tile;
+            knobs.raytrace.ray_stats = true;
+            knobs
+        };
         let f = crate::render(ctx, &c.demo, RAY_HIERARCHY, &qt, c.size, (0, 1))?;
         let mut per = Vec::new();
         for k in 0..=c.depth {
@@ -237,7 +247,15 @@ fn culling(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()
 fn headline(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()> {
     // The headline: sampled geometry against ray tracing in the original geometry.
     let (w, h) = c.headline_size;
-    let reference = crate::reference::render_reference(&c.demo, &Quality { spp: 1, ..q.clone() }, (w, h))?;
+    let reference = crate::reference::render_reference(
+        &c.demo,
+        &{
+            let mut knobs = q.clone();
+            knobs.reference.spp = 1;
+            knobs
+        },
+        (w, h),
+    )?;
     let mut head = Vec::new();
     for m in [DISTANCE, BVH] {
         let f = crate::render(ctx, &c.demo, m, q, (w, h), (1, c.frames))?;
@@ -269,7 +287,15 @@ fn mutual(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()>
     let _ = writeln!(md, "|---:|---|---:|---:|---:|");
     for k in 1..=5usize {
         let scene = mutual_scene(&c.demo, k)?;
-        let reference = crate::reference::render_reference(&scene, &Quality { spp: 1, ..q.clone() }, (w, h))?;
+        let reference = crate::reference::render_reference(
+            &scene,
+            &{
+                let mut knobs = q.clone();
+                knobs.reference.spp = 1;
+                knobs
+            },
+            (w, h),
+        )?;
         let mut got = Vec::new();
         for m in [DISTANCE, DISTANCE_MULTI, BVH] {
             let f = crate::render(ctx, &scene, m, q, (w, h), (1, c.frames))?;

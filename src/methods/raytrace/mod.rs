@@ -26,6 +26,7 @@ pub mod bvh;
 pub mod gpu;
 pub mod grid;
 pub mod kdtree;
+pub mod knobs;
 pub mod stage;
 
 use glam::Vec3;
@@ -38,6 +39,7 @@ use crate::methods::EVERY_CLASS;
 use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
 use crate::plan::CameraPlan;
 use crate::quality::Quality;
+use crate::quality::{FrameKnobs, RaytraceKnobs};
 use crate::scene::Scene;
 
 const fn one(_: &Quality) -> u32 {
@@ -75,7 +77,7 @@ pub const MUTUAL_VIEW_OBJECTS: usize = 2;
 /// the distance maps 37 and 34 dB at k = 1, 2 and 17–24 dB from k = 3 (two others in view)
 /// on, while bvh stays at 60 dB and its frame flat in k.
 fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    if q.planner.speed() {
+    if q.plan.planner.speed() {
         return None;
     }
     let others = f.sees_specular.iter().filter(|(_, c)| *c >= MIN_COVERAGE).count();
@@ -84,7 +86,7 @@ fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
             score: 4.5, // above distance-multi's 4.0 for objects in mutual view
             reason: format!(
                 "sees {others} other specular objects: exact ray tracing through a BVH (inter-object paths to depth {})",
-                q.depth
+                q.frame.depth
             ),
         });
     }
@@ -119,11 +121,19 @@ const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> R
     }
 }
 
-const RAY_KNOBS_BVH: &[&str] = &["depth", "fresnel", "ray_budget", "bvh_traversal"];
-const RAY_KNOBS_KD: &[&str] = &["depth", "fresnel", "ray_budget", "kd_max_depth", "kd_leaf_size", "kd_traversal"];
-const RAY_KNOBS_ENGINE: &[&str] = &["depth", "fresnel", "ray_budget"];
-const RAY_KNOBS_HIERARCHY: &[&str] = &["depth", "fresnel", "ray_budget", "tile_size"];
-const RAY_KNOBS_GRID: &[&str] = &["depth", "fresnel", "ray_budget", "grid_density", "grid_skip"];
+const RAY_KNOBS_BVH: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::bvh_traversal];
+const RAY_KNOBS_KD: &[&str] = &[
+    FrameKnobs::depth,
+    FrameKnobs::fresnel,
+    RaytraceKnobs::ray_budget,
+    RaytraceKnobs::kd_max_depth,
+    RaytraceKnobs::kd_leaf_size,
+    RaytraceKnobs::kd_traversal,
+];
+const RAY_KNOBS_ENGINE: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget];
+const RAY_KNOBS_HIERARCHY: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::tile_size];
+const RAY_KNOBS_GRID: &[&str] =
+    &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::grid_density, RaytraceKnobs::grid_skip];
 
 pub const BVH: Method = Method(&MethodInfo {
     name: "bvh",
@@ -135,7 +145,7 @@ pub const BVH: Method = Method(&MethodInfo {
     knobs: RAY_KNOBS_BVH,
     gpu: Some(ray_tracer("raytrace.bvh", |init, plan| {
             let q = &init.plan.quality;
-            stage::create(init, plan, Scheme::Bvh { stackless: q.bvh_stackless })
+            stage::create(init, plan, Scheme::Bvh { stackless: q.raytrace.bvh_stackless })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -165,7 +175,7 @@ pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_HIERARCHY,
     gpu: Some(ray_tracer("raytrace.ray-hierarchy", |init, plan| {
-            stage::create(init, plan, Scheme::RayHierarchy { tile: init.plan.quality.tile_size })
+            stage::create(init, plan, Scheme::RayHierarchy { tile: init.plan.quality.raytrace.tile_size })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -182,7 +192,7 @@ pub const KD_TREE: Method = Method(&MethodInfo {
     knobs: RAY_KNOBS_KD,
     gpu: Some(ray_tracer("raytrace.kd-tree", |init, plan| {
             let q = &init.plan.quality;
-            stage::create(init, plan, Scheme::KdTree { max_depth: q.kd_max_depth, leaf_size: q.kd_leaf_size, restart: q.kd_restart })
+            stage::create(init, plan, Scheme::KdTree { max_depth: q.raytrace.kd_max_depth, leaf_size: q.raytrace.kd_leaf_size, restart: q.raytrace.kd_restart })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -199,7 +209,7 @@ pub const GRID: Method = Method(&MethodInfo {
     knobs: RAY_KNOBS_GRID,
     gpu: Some(ray_tracer("raytrace.grid", |init, plan| {
             let q = &init.plan.quality;
-            stage::create(init, plan, Scheme::Grid { density: q.grid_density, skip_empty: q.grid_skip })
+            stage::create(init, plan, Scheme::Grid { density: q.raytrace.grid_density, skip_empty: q.raytrace.grid_skip })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,

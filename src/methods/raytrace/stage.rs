@@ -155,7 +155,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
     let mut me = RayTrace {
         name: plan.name,
         scheme,
-        depth: q.depth,
+        depth: q.frame.depth,
         width: init.width,
         height: init.height,
         samples: init.multisample.samples,
@@ -175,7 +175,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         engine_depth: None,
         cones: Buffer::placeholder(),
         cull_stats: Buffer::placeholder(),
-        stats: q.ray_stats,
+        stats: q.raytrace.ray_stats,
         capacity: 0,
         lights: 1,
         ray_texture: (0, 0),
@@ -245,7 +245,7 @@ impl RayTrace {
 
         // One camera ray per sample: each (pixel, sample) pair accumulates on its own.
         let pixels = self.width as u64 * self.height as u64 * self.samples as u64;
-        let capacity = pixels * q.ray_budget as u64;
+        let capacity = pixels * q.raytrace.ray_budget as u64;
         let lights = scene.lights.len().max(1) as u64;
         if capacity > u32::MAX as u64 / 2 || capacity * lights > u32::MAX as u64 / 2 {
             return Err(Error::invalid(

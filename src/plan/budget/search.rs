@@ -35,7 +35,7 @@ impl Timing<'_> {
             .iter()
             .zip(&self.facts.objects)
             .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
-        let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.frame_latency;
+        let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
         if latency {
             1
         } else if composes {

@@ -1,0 +1,58 @@
+//! Caustics' knobs (§6).
+
+use crate::quality::knob::knobs;
+
+knobs! {
+    /// Caustics (§6).
+    pub struct CausticsKnobs {
+        /// caustics (§6): photons from each punctual light traced through each caustic generator in its maps, stored as hits in
+        /// cube-map space, then splatted (photon splatting) or meshed into caustic triangles (flux over area) into a light cube map
+        /// around the generator, filtered, and projected onto diffuse surfaces with a distance test; the CPU reference adds
+        /// light-traced caustics
+        caustics: Caustics = "triangles", one_of()["off" => Caustics::Off, "splat" => Caustics::Splat, "triangles" => Caustics::Triangles];
+        /// caustics: edge of each photon hit location image (photons² per light and generator view); caustic triangles keep 64
+        /// bytes per triangle in one storage buffer, within the device's maxStorageBufferRange (lavapipe's 128 MiB: 1024² photons
+        /// for one photon layer, 592² for three)
+        photons: u32 = 128, count(32..=2048, "texels");
+        /// caustics=splat: radius of each photon's splat (an Epanechnikov kernel normalised to the photon's power) in light-cube
+        /// texels
+        splat_size: f32 = 2, real(0.5..=16, "texels");
+        /// caustics: radius of the box filter over each light cube face before projection (0: none)
+        caustic_filter: u32 = 1, count(0..=8, "texels");
+        /// caustics: a diffuse point takes the light cube map's irradiance only where its distance from the generator matches the
+        /// receiver distance map (off: light leaks behind occluders, for comparison)
+        caustic_distance_test: bool = "on", one_of()["on" => true, "off" => false];
+        /// caustics: the receiver-orientation factor of the projection, E = J·cos α/D² (off: cos α = 1, every receiver taken as
+        /// facing the generator; wrong at grazing angles)
+        caustic_orientation: bool = "on", one_of()["on" => true, "off" => false];
+        /// caustics: photon hits stored and projected in cube-map space, one light cube map per generator around its reference
+        /// point (UPSK08), or in light space, one per generator and point or spot light around the light (the shadow-map space of
+        /// SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md)
+        caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light];
+        /// caustics: a dielectric generator's photons follow both Fresnel branches, each its own photon image (the reflected one is
+        /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way
+        caustic_reflections as caustic_paths: bool = "both", one_of()["both" => true, "refracted" => false];
+    }
+}
+
+/// Where caustic photon hits are stored and projected from (survey §6.1.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CausticSpace {
+    /// Cube-map space (UPSK08): one cube per generator, around its reference point.
+    Cube,
+    /// Light space (the shadow-map space of SP07): one cube per generator and point or spot
+    /// light, around the light; directional lights stay in cube-map space.
+    Light,
+}
+
+/// How caustics are rendered (survey §6.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Caustics {
+    Off,
+    /// Photon splatting (§6.3.1).
+    Splat,
+    /// Caustic triangles (§6.3.2).
+    Triangles,
+}

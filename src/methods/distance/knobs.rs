@@ -1,0 +1,32 @@
+//! The distance family's knobs: the distance-map search (§4.1, shared with layered and
+//! caustics), inter-object cycles (§4.3) and self refraction (§4.4).
+
+use crate::quality::knob::knobs;
+
+knobs! {
+    /// The distance-map search (§4.1).
+    pub struct SearchKnobs {
+        /// distance-map linear search steps (§4.1.2); 0: parallax correction only
+        linear_steps: u32 = 16, count(0..=256);
+        /// secant (false position) refinement steps after the linear search (survey eq. 5)
+        secant_steps: u32 = 2, count(0..=64);
+        /// binary refinement steps after the linear search (§4.1.4)
+        binary_steps: u32 = 0, count(0..=64);
+        /// parallax-correction iterations (survey eq. 4) when linear_steps = 0
+        parallax_iterations: u32 = 1, count(1..=64);
+        /// search stops once ‖l‖/‖l′‖ is within this of 1
+        search_tolerance: f32 = 0.001, real(0..=1);
+    }
+}
+
+knobs! {
+    /// Inter-object reflections (§4.3) and self refraction (§4.4).
+    pub struct DistanceKnobs {
+        /// distance-multi: distance-map generation cycles per frame (§4.3); cycle k shows k specular bounces in the maps
+        cycles: u32 = 4, count(1..=16, "cycles");
+        /// refractor-map: total internal reflections followed inside a refractor (§4.4)
+        internal_bounces: u32 = 2, count(0..=16);
+        /// distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)
+        frame_latency: bool = "off", one_of()["on" => true, "off" => false];
+    }
+}
