@@ -244,7 +244,7 @@ pub struct Family {
     /// After the maps: view layers of its own (planar mirrors', §5).
     pub plan_views: Option<fn(&Scene, &mut Plan)>,
     /// Its blocks of views in the frame's view table: (name, count), in table order.
-    pub views: Option<fn(&Plan) -> Vec<(&'static str, u32)>>,
+    pub views: Option<ViewBlocks>,
     /// After objects moved, with the plan's structure kept: its plan follows them.
     pub refresh: Option<fn(&mut Plan)>,
     /// Its part of `specula plan`'s table, if it planned anything.
@@ -253,6 +253,9 @@ pub struct Family {
     /// (planar mirrors), push flags of the camera's objects, stats (`stage::FramePart`).
     pub frame_part: Option<CreateFramePart>,
 }
+
+/// A family's blocks of views for a plan: (name, count), in table order.
+pub type ViewBlocks = fn(&Plan) -> Vec<(&'static str, u32)>;
 
 impl Family {
     /// A family with no hooks, to set the ones it needs over.

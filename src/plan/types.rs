@@ -114,7 +114,8 @@ pub struct EffectPlan {
 }
 
 impl EffectPlan {
-    pub fn new(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
+    /// The stage of effect `info` over `objects`.
+    pub fn stage(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
         StageSpec::Effect(EffectPlan { info, name: info.name, objects })
     }
 }

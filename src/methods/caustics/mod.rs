@@ -93,10 +93,10 @@ fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
         }
     }
     let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
-    st.stages.push(EffectPlan::new(STAGE, generators.clone()));
+    st.stages.push(EffectPlan::stage(STAGE, generators.clone()));
     // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
     if !st.shades_scene {
-        st.stages.push(EffectPlan::new(PROJECT, generators));
+        st.stages.push(EffectPlan::stage(PROJECT, generators));
     }
     for o in &mut p.objects {
         if c.generators.iter().any(|g| g.mesh == o.mesh) {
