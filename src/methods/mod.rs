@@ -4,7 +4,9 @@
 //! passes' machinery) live in `crate::frame`.
 //!
 //! Adding a method: its descriptor and passes in its family's folder, its shaders in
-//! `glsl/<family>/`, its tests, and one line below.
+//! `glsl/<family>/`, its tests, and its name in its family's `FAMILY`. Adding a family: its
+//! folders, its tests, `pub mod` and one line of `FAMILIES` below (with knobs, one line of
+//! `quality::compose!`; with GPU declarations, one of `build/layout.rs`'s `declarations!`).
 
 pub mod caustics;
 pub mod cube_knobs;
@@ -24,31 +26,16 @@ pub use layered::LAYERED;
 pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{Choice, Method, MethodInfo, ObjectClass};
 
-/// Every registered method, GPU methods first: the CLI's list, `specula knobs`, the C
-/// header's constants, the README tables, `tradeoff` and the demo read this.
-pub const ALL: &[Method] = &[
-    ENVMAP,
-    PROXY_SPHERE,
-    PROXY_BOX,
-    DISTANCE,
-    DISTANCE_MULTI,
-    REFRACTOR_MAP,
-    IMAGE_SPACE_REFRACTION,
-    LAYERED,
-    BVH,
-    KD_TREE,
-    GRID,
-    RAY_ENGINE,
-    RAY_HIERARCHY,
-    PLANAR_MIRROR,
-    PLANAR_REFRACTION,
-    CURVED_REFLECTOR,
-    REFERENCE,
-];
+/// Every registered method, family by family (`FAMILIES`), the GPU families first: the CLI's
+/// list, `specula knobs`, the C header's constants, the README tables, `tradeoff` and the
+/// demo read this.
+pub const ALL: &[Method] = &registry::all_methods::<{ registry::method_count(FAMILIES) }>(FAMILIES);
 
-/// Every family with hooks beyond maps and camera passes, in the order the planner and the
-/// renderer call them (and their view blocks follow in the view table).
-pub const FAMILIES: &[registry::Family] = &[layered::FAMILY, geometry::FAMILY, caustics::FAMILY];
+/// Every family, one line each: its methods (in the order `ALL` lists them) and its hooks
+/// beyond maps and camera passes, called by the planner and the renderer in this order
+/// (their view blocks follow in the view table in this order too).
+pub const FAMILIES: &[registry::Family] =
+    &[envmap::FAMILY, distance::FAMILY, layered::FAMILY, raytrace::FAMILY, geometry::FAMILY, caustics::FAMILY, crate::reference::FAMILY];
 
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
@@ -60,6 +47,18 @@ mod tests {
     #[test]
     fn registry_is_consistent() {
         registry::check(ALL).unwrap();
+    }
+
+    #[test]
+    fn every_method_is_listed_by_its_own_family() {
+        for f in FAMILIES {
+            for m in f.methods {
+                assert_eq!(m.family, f.name, "{} is listed by family {}", m.name, f.name);
+            }
+        }
+        // GPU methods first, the reference last (the CLI's and the README's order).
+        let first_cpu = ALL.iter().position(|m| !m.is_gpu()).unwrap();
+        assert!(ALL[first_cpu..].iter().all(|m| !m.is_gpu()) && ALL.last() == Some(&REFERENCE));
     }
 
     #[test]

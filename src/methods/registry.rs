@@ -232,6 +232,8 @@ impl Shape {
 pub struct Family {
     /// The folder's name, as `MethodInfo::family` names it.
     pub name: &'static str,
+    /// Its methods, in the order `methods::ALL` lists them.
+    pub methods: &'static [Method],
     /// Before the frame's stages are derived: moves the objects' reference points (the
     /// shared layered map's centre, §4.5).
     pub plan_objects: Option<fn(&Scene, &mut Plan)>,
@@ -261,6 +263,7 @@ impl Family {
     /// A family with no hooks, to set the ones it needs over.
     pub const NONE: Family = Family {
         name: "",
+        methods: &[],
         plan_objects: None,
         plan_frame: None,
         plan_stages: None,
@@ -270,6 +273,33 @@ impl Family {
         describe: None,
         frame_part: None,
     };
+}
+
+/// How many methods `families` register.
+pub const fn method_count(families: &[Family]) -> usize {
+    let (mut i, mut n) = (0, 0);
+    while i < families.len() {
+        n += families[i].methods.len();
+        i += 1;
+    }
+    n
+}
+
+/// Every method of `families`, family by family (`N`: their `method_count`).
+pub const fn all_methods<const N: usize>(families: &[Family]) -> [Method; N] {
+    let mut out = [families[0].methods[0]; N];
+    let (mut i, mut n) = (0, 0);
+    while i < families.len() {
+        let mut j = 0;
+        while j < families[i].methods.len() {
+            out[n] = families[i].methods[j];
+            n += 1;
+            j += 1;
+        }
+        i += 1;
+    }
+    assert!(n == N, "N is the families' method count");
+    out
 }
 
 /// What the planner has derived when `Family::plan_stages` runs: the map passes (one per

@@ -38,6 +38,10 @@ use bvh::{Bvh, Hit};
 use caustics::PhotonMap;
 use shade::{ShadeLight, Sky, Textures};
 
+/// The reference as the registry's last family: one CPU method, no hooks.
+pub const FAMILY: crate::methods::registry::Family =
+    crate::methods::registry::Family { name: "reference", methods: &[REFERENCE], ..crate::methods::registry::Family::NONE };
+
 /// The exact CPU reference as a registered method: it has no GPU passes (`Renderer::new`
 /// refuses its plan); `reference::render_reference` renders it.
 pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::methods::MethodInfo {

@@ -59,6 +59,7 @@ impl CausticsPlan {
 /// frame, with two effect stages, and views of their own.
 pub const FAMILY: Family = Family {
     name: "caustics",
+    methods: &[],
     plan_frame: Some(|scene, p| p.caustics = plan(scene, &p.objects, &p.quality)),
     plan_stages: Some(plan_stages),
     views: Some(|p| {

@@ -101,6 +101,13 @@ fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 
+/// Ray tracing in the sampled geometry (§4.1–§4.4): maps and camera passes only, no hooks.
+pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
+    name: "distance",
+    methods: &[DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP, IMAGE_SPACE_REFRACTION],
+    ..crate::methods::registry::Family::NONE
+};
+
 pub const DISTANCE: Method = Method(&MethodInfo {
     name: "distance",
     abi: 3,

@@ -25,6 +25,7 @@ use crate::quality::{FrameKnobs, GeometryKnobs};
 /// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
 pub const FAMILY: Family = Family {
     name: "geometry",
+    methods: &[PLANAR_MIRROR, PLANAR_REFRACTION, CURVED_REFLECTOR],
     plan_views: Some(plan_views),
     views: Some(view_blocks),
     frame_part: Some(views::create_frame_part),

@@ -135,6 +135,14 @@ const RAY_KNOBS_HIERARCHY: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, R
 const RAY_KNOBS_GRID: &[&str] =
     &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::grid_density, RaytraceKnobs::grid_skip];
 
+/// Ray tracing in the original geometry (§2): each method's camera stage is the whole ray
+/// pipeline; no hooks.
+pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
+    name: "raytrace",
+    methods: &[BVH, KD_TREE, GRID, RAY_ENGINE, RAY_HIERARCHY],
+    ..crate::methods::registry::Family::NONE
+};
+
 pub const BVH: Method = Method(&MethodInfo {
     name: "bvh",
     abi: 7,
