@@ -8,6 +8,7 @@ pub mod camera;
 pub mod direct;
 pub mod ids;
 pub mod layout;
+pub mod maps;
 pub mod output;
 pub mod shadow;
 pub mod stage;

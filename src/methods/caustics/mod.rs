@@ -16,6 +16,7 @@
 //! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0).
 
 pub mod project;
+pub mod slots;
 pub mod stage;
 
 use glam::{Mat4, Vec3};

@@ -3,6 +3,8 @@
 //! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
 //! towards where the ray leaves a proxy of the environment (§3.2).
 
+pub mod slots;
+
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Verdict};

@@ -10,6 +10,7 @@
 pub mod curved;
 
 pub mod mirror;
+pub mod slots;
 pub mod views;
 
 pub use curved::CURVED_REFLECTOR;

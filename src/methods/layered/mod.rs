@@ -12,6 +12,7 @@
 //! complexity from there (`layers=auto`, counted on the GPU) or the `layers` knob.
 
 pub mod peel;
+pub mod slots;
 
 use glam::Vec3;
 
