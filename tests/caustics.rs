@@ -122,7 +122,7 @@ fn caustic_power(ctx: &specula::vk::Context, scene: &Scene, q: &Quality) -> (f64
     assert!(p.caustics.is_some(), "caustics planned: {:?}", p.passes);
     let mut r = Renderer::new(ctx, scene, p, 16, 16).unwrap();
     let f = r.render(ctx).unwrap();
-    let cube = read_image(ctx, r.maps().caustic_maps.as_ref().unwrap()).unwrap();
+    let cube = read_image(ctx, r.maps().image(&specula::methods::caustics::slots::CAUSTIC_MAPS).unwrap()).unwrap();
     let power = cube_power(&cube, 0);
     assert!(power.is_finite(), "{power}");
     r.destroy(ctx);

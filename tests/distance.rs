@@ -415,7 +415,7 @@ fn image_space_first_pass_sees_back_faces() {
     let size = 64;
     let mut r = specula::Renderer::new(&ctx, &scene, plan, size, size).unwrap();
     r.render(&ctx).unwrap();
-    let map = specula::vk::read_image(&ctx, r.maps().backfaces.as_ref().unwrap()).unwrap();
+    let map = specula::vk::read_image(&ctx, r.maps().image(&specula::methods::distance::slots::BACKFACES).unwrap()).unwrap();
     let cam = scene.camera.unwrap();
     let (px, py) = (size / 2, size / 2);
     let t = map.texel(0, px, py);

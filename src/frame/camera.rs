@@ -66,7 +66,7 @@ impl Stage for CameraShade {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, false);
         f.bind(ctx, cmd, self.pipeline);
-        if let Some(&set) = io.sets.camera.get(io.maps.distance_latest) {
+        if let Some(&set) = io.sets.camera.get(io.maps.latest) {
             f.bind_maps(ctx, cmd, set);
         }
         for d in f.scene.draws.iter() {

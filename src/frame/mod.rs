@@ -9,6 +9,7 @@ pub mod direct;
 pub mod ids;
 pub mod knobs;
 pub mod layout;
+pub mod maps;
 pub mod output;
 pub mod shadow;
 pub mod stage;

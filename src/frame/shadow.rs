@@ -4,6 +4,7 @@
 
 use ash::vk;
 
+use super::maps::{Sampler, Slot};
 use super::stage::{FrameIo, Maps, Stage, StageInit};
 use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::plan::Plan;
@@ -15,7 +16,17 @@ use crate::Result;
 /// Clear value of distance maps: nothing in that direction.
 pub const FAR: f32 = 3.0e38;
 
-/// The shadow pass; its maps live in `Maps::shadow_cubes` and `Maps::shadow_planes`.
+/// Set 0: shadow distance cubes of point and spot lights, sampled wherever diffuse
+/// surfaces are shaded.
+pub const SHADOW_CUBES: Slot =
+    Slot { shading: true, ..Slot::image("shadow.cubes", 0, super::layout::binding::SHADOW_CUBES, Sampler::Nearest) };
+/// Set 0: planar shadow distance maps of directional lights.
+pub const SHADOW_PLANES: Slot =
+    Slot { shading: true, ..Slot::image("shadow.planes", 0, super::layout::binding::SHADOW_PLANES, Sampler::Nearest) };
+/// The frame's own map slots (`maps::all_slots` lists them before the families').
+pub const SLOTS: &[Slot] = &[SHADOW_CUBES, SHADOW_PLANES];
+
+/// The shadow pass; its maps live in the slots `SHADOW_CUBES` and `SHADOW_PLANES`.
 #[derive(Default)]
 pub struct ShadowMaps {
     cube_depth: Option<Image>,
@@ -54,20 +65,26 @@ impl ShadowMaps {
         };
         if !plan.shadow_cubes.is_empty() {
             let kind = ImageKind::CubeArray { cubes: plan.shadow_cubes.len() as u32 };
-            maps.shadow_cubes = Some(Image::new(
-                ctx,
-                &ImageDesc { name: "shadow.cubes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
-            )?);
+            maps.set_image(
+                &SHADOW_CUBES,
+                Image::new(
+                    ctx,
+                    &ImageDesc { name: "shadow.cubes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
+                )?,
+            );
             self.cube_depth = Some(cube_depth(ctx, "shadow.cubes.depth", size, mode)?);
             self.cube_pipeline = graphics_pipeline(ctx, layout, &desc("shadow.cube", view_mask(mode)))?;
             self.mode = Some(mode);
         }
         if !plan.shadow_planes.is_empty() {
             let kind = ImageKind::D2Array { layers: plan.shadow_planes.len() as u32 };
-            maps.shadow_planes = Some(Image::new(
-                ctx,
-                &ImageDesc { name: "shadow.planes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
-            )?);
+            maps.set_image(
+                &SHADOW_PLANES,
+                Image::new(
+                    ctx,
+                    &ImageDesc { name: "shadow.planes", format: vk::Format::R32_SFLOAT, width: size, height: size, kind, usage },
+                )?,
+            );
             let dk = ImageDesc {
                 name: "shadow.planes.depth",
                 format: vk::Format::D32_SFLOAT,
@@ -95,21 +112,22 @@ impl Stage for ShadowMaps {
     }
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
-        let maps = &mut *io.maps;
-        if maps.shadow_cubes.is_none() && maps.shadow_planes.is_none() {
+        // Taken out of the table while recorded (both are written at once), put back after.
+        let (mut cubes, mut planes) = (io.maps.take_image(&SHADOW_CUBES), io.maps.take_image(&SHADOW_PLANES));
+        if cubes.is_none() && planes.is_none() {
             return;
         }
         let mut pass = rec.pass("shadow.generate");
-        if let Some(c) = maps.shadow_cubes.as_mut() {
+        if let Some(c) = cubes.as_mut() {
             pass = pass.writes(c, Access::ColorAttachment);
         }
-        if let Some(p) = maps.shadow_planes.as_mut() {
+        if let Some(p) = planes.as_mut() {
             pass = pass.writes(p, Access::ColorAttachment);
         }
         let open = pass.begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let clear = [FAR, 0.0, 0.0, 0.0];
-        if let (Some(cubes), Some(depth), Some(mode)) = (maps.shadow_cubes.as_ref(), self.cube_depth.as_mut(), self.mode) {
+        if let (Some(cubes), Some(depth), Some(mode)) = (cubes.as_ref(), self.cube_depth.as_mut(), self.mode) {
             self.face_draws = [0; 6];
             let (eyes, six, face_draws) = (io.view_eyes, mode == CubeMode::SixPasses, &mut self.face_draws);
             for (k, &view) in io.views.shadow_cubes.iter().enumerate() {
@@ -127,7 +145,7 @@ impl Stage for ShadowMaps {
                 });
             }
         }
-        if let (Some(planes), Some(depth)) = (maps.shadow_planes.as_ref(), self.plane_depth.as_mut()) {
+        if let (Some(planes), Some(depth)) = (planes.as_ref(), self.plane_depth.as_mut()) {
             for (j, &view) in io.views.shadow_planes.iter().enumerate() {
                 rec.barrier(depth, Access::DepthAttachment);
                 let colors = [planes.layer_view(j as u32)];
@@ -150,6 +168,11 @@ impl Stage for ShadowMaps {
             }
         }
         rec.end(open);
+        for (slot, image) in [(&SHADOW_CUBES, cubes), (&SHADOW_PLANES, planes)] {
+            if let Some(image) = image {
+                io.maps.set_image(slot, image);
+            }
+        }
     }
 
     fn destroy(&mut self, ctx: &Context) {

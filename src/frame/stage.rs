@@ -1,6 +1,6 @@
 //! What the renderer runs: a plan's stages, each one profiled pass with its own resources.
 //! The renderer creates the stages the plan lists, records them in order and frees them; it
-//! knows the frame's shared map slots (the descriptor bindings every shader sees) but no
+//! holds the frame's shared map slots (`maps`, declared by their owners) but names no
 //! method.
 
 use ash::vk;
@@ -10,7 +10,9 @@ use crate::gpu_scene::GpuScene;
 use crate::plan::Plan;
 use crate::quality::Quality;
 use crate::scene::Scene;
-use crate::vk::{Buffer, Context, Image, Recorder};
+use crate::vk::{Context, Image, Recorder};
+
+pub use super::maps::{MapSets, Maps, Slot};
 use crate::Result;
 
 /// Positions of the frame's passes: a plan's stages are recorded in this order.
@@ -62,214 +64,7 @@ pub trait Stage {
     }
 }
 
-/// The frame's shared maps, one per descriptor slot (`binding::*`, src/frame/layout.in.rs).
-/// A map stage creates the images of its slot; the camera passes and later map stages sample
-/// them; the renderer writes the descriptors and frees the images.
-#[derive(Default)]
-pub struct Maps {
-    /// Set 0, binding 6: shadow distance cubes of point and spot lights.
-    pub shadow_cubes: Option<Image>,
-    /// Set 0, binding 7: planar shadow distance maps of directional lights.
-    pub shadow_planes: Option<Image>,
-    /// Set 0, binding 8: radiance cube maps (§3), one cube per object.
-    pub radiance: Option<Image>,
-    /// Set 1, binding 0: distance cube maps (§4), one cube per object; two images
-    /// (ping-pong) for inter-object cycles.
-    pub distance: Vec<Image>,
-    /// Which distance image the last cycle wrote: the one the camera passes read.
-    pub distance_latest: usize,
-    /// Set 1, binding 1: refractor maps (§4.4).
-    pub refractor: Option<Image>,
-    /// Set 1, binding 2: camera-space back faces (image-space refraction, §4.4).
-    pub backfaces: Option<Image>,
-    /// Set 1, binding 3: per-vertex thickness of image-space refraction.
-    pub thickness: Option<Buffer>,
-    /// Set 0, binding 9: planar mirrors' views (§5), one layer per view of a frame.
-    pub mirror_views: Option<Image>,
-    /// Set 0, binding 10: caustic generators' receiver distance cubes (§6).
-    pub caustic_distances: Option<Image>,
-    /// Set 0, binding 11: caustic generators' light cube maps (filtered, when filtering).
-    pub caustic_maps: Option<Image>,
-    /// Set 0, binding 15: the light cube maps before filtering (only with a filter).
-    pub caustic_raw: Option<Image>,
-    /// Set 0, bindings 12 and 13: photon hit location images and the photons' power.
-    pub photon_hits: Option<Image>,
-    pub photon_power: Option<Image>,
-    /// Set 0, binding 14: the caustics' parameters and cube table.
-    pub caustics: Option<Buffer>,
-    /// Set 0, bindings 16 and 17: caustic triangles set up once, and per face which of them
-    /// it draws.
-    pub caustic_triangles: Option<Buffer>,
-    pub caustic_faces: Option<Buffer>,
-    /// Set 1, bindings 4 and 5: the layered distance map of the whole scene (§4.5), one cube
-    /// per layer: radiance and distance, normal and material.
-    pub layered: Option<Image>,
-    pub layered_normals: Option<Image>,
-}
-
-impl Maps {
-    /// The environment- or distance-map cube array the camera passes read (one cube per
-    /// object of that map), if planned.
-    pub fn object_cubes(&self) -> Option<&Image> {
-        self.distance.get(self.distance_latest).or(self.radiance.as_ref())
-    }
-
-    /// Caustics: the photon hit location images (xyz hit relative to the reference point,
-    /// w 1 for a photon) and the photons' power, one layer per light view.
-    pub fn photon_images(&self) -> Option<(&Image, &Image)> {
-        self.photon_hits.as_ref().zip(self.photon_power.as_ref())
-    }
-
-    /// Every map image the camera passes sample: the current one of each slot.
-    pub fn camera_reads(&self) -> Vec<&Image> {
-        let mut v: Vec<&Image> = Vec::new();
-        v.extend(self.radiance.iter());
-        v.extend(self.distance.get(self.distance_latest));
-        v.extend(self.refractor.iter());
-        v.extend(self.backfaces.iter());
-        v.extend(self.mirror_views.iter());
-        v.extend(self.layered.iter());
-        v.extend(self.layered_normals.iter());
-        v
-    }
-
-    /// Distance-image slots of the set-1 sets: one per distance image, or one (holding no
-    /// distance map) for the layered maps alone.
-    fn map_slots(&self) -> usize {
-        self.distance.len().max(usize::from(self.layered.is_some()))
-    }
-
-    /// How many set-1 descriptor sets the maps need: per distance image one for map
-    /// generation and one for the camera passes, an all-null one and one of the refractor
-    /// maps alone; none without set-1 maps.
-    pub fn set_count(&self) -> usize {
-        // Caustic photons bind set 1 (a refractor map, or nothing for a mirror).
-        if self.map_slots() == 0 && self.refractor.is_none() && self.backfaces.is_none() && self.caustic_distances.is_none() {
-            0
-        } else {
-            2 * self.map_slots() + 2
-        }
-    }
-
-    /// Assigns `set_count()` allocated sets to their roles.
-    pub fn sets(&self, sets: &[vk::DescriptorSet]) -> MapSets {
-        let n = self.map_slots();
-        if sets.len() < 2 * n + 2 {
-            return MapSets::default();
-        }
-        MapSets { generate: sets[..n].to_vec(), camera: sets[n..2 * n].to_vec(), empty: sets[2 * n], geometry: sets[2 * n + 1] }
-    }
-
-    /// Writes every map slot's descriptors: set 0's shadow and radiance maps into `frame`,
-    /// and each set-1 set of `sets`. Generation sets sample the refractor maps (made first)
-    /// but no camera-space map; camera sets sample everything; the empty set nothing.
-    /// What the scene does not need gets a null descriptor.
-    pub fn write_descriptors(&self, ctx: &Context, frame: vk::DescriptorSet, sets: &MapSets, linear: vk::Sampler, nearest: vk::Sampler) {
-        use crate::frame::layout::binding;
-        use crate::vk::pipeline::{write_buffer, write_image};
-        let sb = vk::DescriptorType::STORAGE_BUFFER;
-        let cis = vk::DescriptorType::COMBINED_IMAGE_SAMPLER;
-        let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-        let view = |i: Option<&Image>| i.map_or(vk::ImageView::null(), |i| i.view);
-        write_image(ctx, frame, binding::SHADOW_CUBES, 0, cis, view(self.shadow_cubes.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::SHADOW_PLANES, 0, cis, view(self.shadow_planes.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::ENVMAPS, 0, cis, view(self.radiance.as_ref()), linear, ro);
-        write_image(ctx, frame, binding::MIRROR_VIEWS, 0, cis, view(self.mirror_views.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::CAUSTIC_DISTANCES, 0, cis, view(self.caustic_distances.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::CAUSTIC_MAPS, 0, cis, view(self.caustic_maps.as_ref()), linear, ro);
-        write_image(ctx, frame, binding::CAUSTIC_RAW, 0, cis, view(self.caustic_raw.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::PHOTON_HITS, 0, cis, view(self.photon_hits.as_ref()), nearest, ro);
-        write_image(ctx, frame, binding::PHOTON_POWER, 0, cis, view(self.photon_power.as_ref()), nearest, ro);
-        let raw = |b: &Option<Buffer>| b.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
-        write_buffer(ctx, frame, binding::CAUSTICS, sb, raw(&self.caustics));
-        write_buffer(ctx, frame, binding::CAUSTIC_TRIANGLES, sb, raw(&self.caustic_triangles));
-        write_buffer(ctx, frame, binding::CAUSTIC_FACES, sb, raw(&self.caustic_faces));
-        let refractor = view(self.refractor.as_ref());
-        let backfaces = view(self.backfaces.as_ref());
-        let thickness = self.thickness.as_ref().map_or(vk::Buffer::null(), |b| b.raw);
-        let null_image = vk::ImageView::null();
-        let (layered, layered_normals) = (view(self.layered.as_ref()), view(self.layered_normals.as_ref()));
-        let none = (null_image, null_image);
-        let mut all = Vec::new();
-        for i in 0..self.map_slots() {
-            let d = self.distance.get(i).map_or(null_image, |d| d.view);
-            if i < sets.generate.len() {
-                all.push((sets.generate[i], d, refractor, null_image, vk::Buffer::null(), none));
-                all.push((sets.camera[i], d, refractor, backfaces, thickness, (layered, layered_normals)));
-            }
-        }
-        if sets.empty != vk::DescriptorSet::null() {
-            all.push((sets.empty, null_image, null_image, null_image, vk::Buffer::null(), none));
-        }
-        if sets.geometry != vk::DescriptorSet::null() {
-            all.push((sets.geometry, null_image, refractor, null_image, vk::Buffer::null(), none));
-        }
-        // The layered maps hold materials and silhouettes: sampled nearest, never blended.
-        for (set, distance, refractor, backfaces, thickness, (lm, ln)) in all {
-            write_image(ctx, set, binding::DISTANCE_MAPS, 0, cis, distance, linear, ro);
-            write_image(ctx, set, binding::REFRACTOR_MAPS, 0, cis, refractor, linear, ro);
-            write_image(ctx, set, binding::BACKFACE_MAP, 0, cis, backfaces, nearest, ro);
-            write_buffer(ctx, set, binding::THICKNESS, sb, thickness);
-            write_image(ctx, set, binding::LAYERED_MAPS, 0, cis, lm, nearest, ro);
-            write_image(ctx, set, binding::LAYERED_NORMALS, 0, cis, ln, nearest, ro);
-            write_image(ctx, set, binding::LAYERED_PREVIOUS, 0, cis, null_image, nearest, ro);
-        }
-    }
-
-    /// What shading a diffuse surface samples: the shadow maps, and the caustics'
-    /// receiver distances and light cube maps (§6.3.3).
-    pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
-        self.shadow_cubes.iter().chain(self.shadow_planes.iter()).chain(self.caustic_distances.iter()).chain(self.caustic_maps.iter())
-    }
-
-    pub fn destroy(&mut self, ctx: &Context) {
-        for i in self.shadow_cubes.iter_mut().chain(self.shadow_planes.iter_mut()).chain(self.radiance.iter_mut()) {
-            i.destroy(ctx);
-        }
-        for i in
-            self.distance.iter_mut().chain(self.refractor.iter_mut()).chain(self.backfaces.iter_mut()).chain(self.mirror_views.iter_mut())
-        {
-            i.destroy(ctx);
-        }
-        for i in [
-            &mut self.caustic_distances,
-            &mut self.caustic_maps,
-            &mut self.caustic_raw,
-            &mut self.photon_hits,
-            &mut self.photon_power,
-            &mut self.layered,
-            &mut self.layered_normals,
-        ]
-        .into_iter()
-        .flatten()
-        {
-            i.destroy(ctx);
-        }
-        for b in self
-            .thickness
-            .iter_mut()
-            .chain(self.caustics.iter_mut())
-            .chain(self.caustic_triangles.iter_mut())
-            .chain(self.caustic_faces.iter_mut())
-        {
-            b.destroy(ctx);
-        }
-        *self = Maps::default();
-    }
-}
-
-/// Set-1 descriptor sets over the maps: `generate[i]` for map generation reading distance
-/// image `i` (no camera-space maps), `camera[i]` for the camera passes, `empty` all null.
-#[derive(Default)]
-pub struct MapSets {
-    pub generate: Vec<vk::DescriptorSet>,
-    pub camera: Vec<vk::DescriptorSet>,
-    pub empty: vk::DescriptorSet,
-    /// The refractor maps alone (caustic photons search them, §6).
-    pub geometry: vk::DescriptorSet,
-}
-
-/// Indices into the frame's view table: the frame's own views, then the families' blocks.
+/// Indices into the frame's view table.
 #[derive(Clone, Debug, Default)]
 pub struct ViewLayout {
     pub camera: u32,

@@ -12,7 +12,7 @@
 use ash::vk;
 
 use crate::frame::direct::DEPTH_FORMAT;
-use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
+use crate::frame::stage::{FrameIo, Maps, Slot, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
 use crate::methods::registry::LeavesOut;
 use crate::plan::Plan;
@@ -29,7 +29,17 @@ pub enum MapKind {
     Distance,
 }
 
-/// The cube-map pass of one kind; its images are `Maps::radiance` or `Maps::distance`
+impl MapKind {
+    /// The slot of the frame's maps its images fill.
+    pub fn slot(self) -> &'static Slot {
+        match self {
+            MapKind::Radiance => &crate::methods::envmap::slots::RADIANCE,
+            MapKind::Distance => &crate::methods::distance::slots::DISTANCE,
+        }
+    }
+}
+
+/// The cube-map pass of one kind; its images are its kind's slot (`MapKind::slot`)
 /// (one cube per object, layer = position in `objects`; two distance images only for
 /// inter-object cycles).
 pub struct CubeMaps {
@@ -114,10 +124,7 @@ impl CubeMaps {
             let name = if images == 1 { base.to_string() } else { format!("{base}.{}", ["ping", "pong"][i]) };
             let image =
                 Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage })?;
-            match self.kind {
-                MapKind::Radiance => maps.radiance = Some(image),
-                MapKind::Distance => maps.distance.push(image),
-            }
+            maps.push_image(self.kind.slot(), image);
         }
         self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube.cube_size, q.cube.cube_mode)?;
         let (sky, surface) = match self.kind {
@@ -175,17 +182,11 @@ impl CubeMaps {
 
     /// The images of this kind in the frame's maps.
     fn images(&self, maps: &mut Maps) -> Vec<Image> {
-        match self.kind {
-            MapKind::Radiance => maps.radiance.take().into_iter().collect(),
-            MapKind::Distance => std::mem::take(&mut maps.distance),
-        }
+        maps.take_images(self.kind.slot())
     }
 
-    fn put_back(&self, maps: &mut Maps, mut images: Vec<Image>) {
-        match self.kind {
-            MapKind::Radiance => maps.radiance = images.pop(),
-            MapKind::Distance => maps.distance = images,
-        }
+    fn put_back(&self, maps: &mut Maps, images: Vec<Image>) {
+        maps.set_images(self.kind.slot(), images);
     }
 }
 
@@ -243,8 +244,9 @@ impl Stage for CubeMaps {
         for m in &mut images {
             pass = pass.writes(m, Access::ColorAttachment);
         }
-        let refractor = io.maps.refractor.as_ref().filter(|_| self.kind == MapKind::Distance);
-        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(refractor) {
+        // Distance maps bind the generation sets: what they hold besides these images.
+        let generation = io.maps.generation_reads().filter(|_| self.kind == MapKind::Distance);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(generation) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
@@ -343,7 +345,7 @@ impl Stage for CubeMaps {
         rec.end(open);
         self.put_back(io.maps, images);
         if self.kind == MapKind::Distance {
-            io.maps.distance_latest = latest;
+            io.maps.latest = latest;
         }
     }
 
@@ -374,5 +376,13 @@ pub fn distance_images(p: &Plan) -> u64 {
         2
     } else {
         1
+    }
+}
+
+impl Maps {
+    /// The environment- or distance-map cube array the camera passes read (one cube per
+    /// object of that map), if planned.
+    pub fn object_cubes(&self) -> Option<&Image> {
+        self.image(MapKind::Distance.slot()).or(self.image(MapKind::Radiance.slot()))
     }
 }

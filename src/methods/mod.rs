@@ -37,6 +37,11 @@ pub const ALL: &[Method] = &registry::all_methods::<{ registry::method_count(FAM
 pub const FAMILIES: &[registry::Family] =
     &[envmap::FAMILY, distance::FAMILY, layered::FAMILY, raytrace::FAMILY, geometry::FAMILY, caustics::FAMILY, crate::reference::FAMILY];
 
+/// Every family's slots in the frame's maps (`frame::maps`), after the frame's own: the
+/// order the camera passes and diffuse shading list their reads in.
+pub const SLOTS: &[&[crate::frame::maps::Slot]] =
+    &[envmap::slots::SLOTS, distance::slots::SLOTS, geometry::slots::SLOTS, layered::slots::SLOTS, caustics::slots::SLOTS];
+
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
 

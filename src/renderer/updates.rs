@@ -223,11 +223,12 @@ impl Renderer {
         }
         if !c.is_empty() {
             let init: StageInit = stage_init(ctx, cpu, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+            let puts = self.maps.changes();
             for s in &mut self.stages {
                 s.update(&init, c, &mut self.maps)?;
             }
             // A stage may have reallocated its maps (the layered maps' layer count).
-            if !c.moved.is_empty() && self.maps.layered.is_some() {
+            if self.maps.changes() != puts {
                 self.bindings.write(ctx, &self.scene, &self.maps);
             }
         }

@@ -17,6 +17,7 @@
 
 pub mod knobs;
 pub mod project;
+pub mod slots;
 pub mod stage;
 
 use glam::{Mat4, Vec3};

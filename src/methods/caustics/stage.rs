@@ -6,11 +6,13 @@
 
 use ash::vk;
 
+use super::slots::{CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_HITS, PHOTON_POWER};
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_REFLECTED};
 use crate::frame::shadow::FAR;
+use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::quality::{Caustics, CubeMode, Quality};
@@ -111,17 +113,17 @@ impl CausticsStage {
         let cube = |name, format| {
             Image::new(ctx, &ImageDesc { name, format, width: s, height: s, kind: ImageKind::CubeArray { cubes }, usage: attach })
         };
-        maps.caustic_distances = Some(cube("caustics.receivers", vk::Format::R32_SFLOAT)?);
-        maps.caustic_maps = Some(cube("caustics.light_cubes", LIGHT_FORMAT)?);
+        maps.set_image(&CAUSTIC_DISTANCES, cube("caustics.receivers", vk::Format::R32_SFLOAT)?);
+        maps.set_image(&CAUSTIC_MAPS, cube("caustics.light_cubes", LIGHT_FORMAT)?);
         if self.filter > 0 {
-            maps.caustic_raw = Some(cube("caustics.light_cubes.unfiltered", LIGHT_FORMAT)?);
+            maps.set_image(&CAUSTIC_RAW, cube("caustics.light_cubes.unfiltered", LIGHT_FORMAT)?);
         }
         let layers = ImageKind::D2Array { layers: self.plan.photon_layers };
         let photon = |name| Image::new(ctx, &ImageDesc { name, format: HIT_FORMAT, width: n, height: n, kind: layers, usage: attach });
-        maps.photon_hits = Some(photon("caustics.photon_hits")?);
-        maps.photon_power = Some(photon("caustics.photon_power")?);
+        maps.set_image(&PHOTON_HITS, photon("caustics.photon_hits")?);
+        maps.set_image(&PHOTON_POWER, photon("caustics.photon_power")?);
         let bytes = table_bytes(&self.plan, q, init.scene);
-        maps.caustics = Some(Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
+        maps.set_buffer(&CAUSTICS, Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         self.cube_depth = cube_depth(ctx, "caustics.depth", s, self.mode)?;
         self.photon_depth = Image::new(
             ctx,
@@ -187,8 +189,8 @@ impl CausticsStage {
                     ),
                 ));
             }
-            maps.caustic_triangles = Some(Buffer::new(ctx, "caustics.triangles", count * 64, storage, gpu)?);
-            maps.caustic_faces = Some(Buffer::new(ctx, "caustics.triangle_faces", count * 6 * 4, storage, gpu)?);
+            maps.set_buffer(&CAUSTIC_TRIANGLES, Buffer::new(ctx, "caustics.triangles", count * 64, storage, gpu)?);
+            maps.set_buffer(&CAUSTIC_FACES, Buffer::new(ctx, "caustics.triangle_faces", count * 6 * 4, storage, gpu)?);
             self.setup = crate::vk::pipeline::compute_pipeline(ctx, layout, "caustics/setup.comp")?;
         }
         if self.filter > 0 {
@@ -253,18 +255,40 @@ impl Stage for CausticsStage {
                 g.reference_point = fresh.reference_point;
             }
         }
-        if let Some(b) = maps.caustics.as_mut() {
+        if let Some(b) = maps.buffer_mut(&CAUSTICS) {
             b.write(&table_bytes(&self.plan, &init.plan.quality, init.scene))?;
         }
         Ok(())
     }
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        // Taken out of the frame's maps while recorded (several are written at once), put
+        // back after.
+        let own = [&CAUSTIC_DISTANCES, &PHOTON_HITS, &PHOTON_POWER, &CAUSTIC_MAPS, &CAUSTIC_RAW];
+        let mut images = own.map(|s| io.maps.take_image(s));
+        self.record_images(rec, f, io, &mut images);
+        for (slot, image) in own.into_iter().zip(images) {
+            if let Some(image) = image {
+                io.maps.set_image(slot, image);
+            }
+        }
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        self.cube_depth.destroy(ctx);
+        self.photon_depth.destroy(ctx);
+        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
+    }
+}
+
+impl CausticsStage {
+    /// Records the passes into the caustics' own images: receiver distances, photon hits
+    /// and power, light cube maps and their unfiltered twins (`own` in `record`'s order).
+    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 5]) {
         let ctx = rec.ctx;
-        let maps = &mut *io.maps;
-        let (Some(distances), Some(hits), Some(power)) =
-            (maps.caustic_distances.as_mut(), maps.photon_hits.as_mut(), maps.photon_power.as_mut())
-        else {
+        let maps = &*io.maps;
+        let [distances, hits, power, light_image, raw_image] = images;
+        let (Some(distances), Some(hits), Some(power)) = (distances.as_mut(), hits.as_mut(), power.as_mut()) else {
             return;
         };
         let first = |name| io.views.first(name).expect("caustics declare their views");
@@ -287,9 +311,9 @@ impl Stage for CausticsStage {
         // The photon hit location images.
         let mut pass = rec.pass("caustics.photons").writes(hits, Access::ColorAttachment).writes(power, Access::ColorAttachment);
         pass = pass.reads(distances, Access::FragmentSampled);
-        for img in
-            io.scene_images.iter().copied().chain(maps.shadow_cubes.iter()).chain(maps.shadow_planes.iter()).chain(maps.refractor.iter())
-        {
+        // The shadow maps, and what the geometry set the photons bind holds (refractor maps).
+        let shadows = [&SHADOW_CUBES, &SHADOW_PLANES].into_iter().filter_map(|s| maps.image(s));
+        for img in io.scene_images.iter().copied().chain(shadows).chain(maps.geometry_reads()) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
@@ -329,9 +353,8 @@ impl Stage for CausticsStage {
         // Splats or triangles into the light cube maps (the unfiltered ones with a filter).
         let name = if self.plan.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" };
         let filtering = self.filter > 0;
-        let (light, raw) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_mut());
-        let Some(light) = light else { return };
-        let target: &mut Image = match raw {
+        let Some(light) = light_image.as_mut() else { return };
+        let target: &mut Image = match raw_image.as_mut() {
             Some(r) if filtering => r,
             _ => light,
         };
@@ -359,7 +382,7 @@ impl Stage for CausticsStage {
         rec.end(open);
 
         if filtering {
-            let (Some(light), Some(raw)) = (maps.caustic_maps.as_mut(), maps.caustic_raw.as_ref()) else { return };
+            let (Some(light), Some(raw)) = (light_image.as_mut(), raw_image.as_ref()) else { return };
             let open = rec.pass("caustics.filter").writes(light, Access::ColorAttachment).reads(raw, Access::FragmentSampled).begin();
             for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.cubes.len()) {
                 render_cube_faces(rec, light, &mut self.cube_depth, g as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
@@ -370,12 +393,6 @@ impl Stage for CausticsStage {
             }
             rec.end(open);
         }
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        self.cube_depth.destroy(ctx);
-        self.photon_depth.destroy(ctx);
-        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
     }
 }
 

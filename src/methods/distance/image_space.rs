@@ -7,6 +7,7 @@
 use ash::vk;
 use glam::DVec3;
 
+use super::slots::{BACKFACES, THICKNESS};
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs};
@@ -16,8 +17,8 @@ use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexIn
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
 
-/// The pass; its images are `Maps::backfaces` (camera-sized: xyz back-face normal, w its
-/// distance from the eye, 0: no refractor) and `Maps::thickness` (d_N per vertex of the
+/// The pass; its images are the slots `BACKFACES` (camera-sized: xyz back-face normal, w its
+/// distance from the eye, 0: no refractor) and `THICKNESS` (d_N per vertex of the
 /// scene's vertex buffer, 0 for other meshes).
 pub struct Backfaces {
     objects: Vec<usize>,
@@ -62,8 +63,8 @@ impl Backfaces {
         build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let format = vk::Format::R32G32B32A32_SFLOAT;
-            maps.backfaces =
-                Some(Image::new(ctx, &ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage })?);
+            let backfaces = ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage };
+            maps.set_image(&BACKFACES, Image::new(ctx, &backfaces)?);
             me.depth = Image::new(
                 ctx,
                 &ImageDesc {
@@ -75,12 +76,15 @@ impl Backfaces {
                     usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
                 },
             )?;
-            maps.thickness = Some(Buffer::with_data(
-                ctx,
-                "image_space.thickness",
-                &vertex_thickness(scene, &me.objects),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            )?);
+            maps.set_buffer(
+                &THICKNESS,
+                Buffer::with_data(
+                    ctx,
+                    "image_space.thickness",
+                    &vertex_thickness(scene, &me.objects),
+                    vk::BufferUsageFlags::STORAGE_BUFFER,
+                )?,
+            );
             me.pipeline = graphics_pipeline(
                 ctx,
                 layout,
@@ -115,7 +119,7 @@ impl Stage for Backfaces {
         if !changes.moved.iter().any(|m| self.objects.contains(m)) {
             return Ok(());
         }
-        match maps.thickness.as_mut() {
+        match maps.buffer_mut(&THICKNESS) {
             Some(t) => t.write(bytemuck::cast_slice(&vertex_thickness(init.scene, &self.objects))),
             None => Ok(()),
         }
@@ -123,7 +127,7 @@ impl Stage for Backfaces {
 
     /// The nearest back face of this pass's refractors, from the camera.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
-        let Some(map) = io.maps.backfaces.as_mut() else { return };
+        let Some(map) = io.maps.image_mut(&BACKFACES) else { return };
         let open =
             rec.pass("image_space.backfaces").writes(map, Access::ColorAttachment).writes(&mut self.depth, Access::DepthAttachment).begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);

@@ -6,6 +6,7 @@
 pub mod image_space;
 pub mod knobs;
 pub mod refractor;
+pub mod slots;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
 use crate::methods::cube_maps::{distance_images, CubeMaps, MapKind};

@@ -15,7 +15,7 @@ use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexIn
 use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};
 use crate::Result;
 
-/// The pass; its images are `Maps::refractor`, one cube per refractor (layer = position in
+/// The pass; its images are the slot `slots::REFRACTOR`, one cube per refractor (layer = position in
 /// `objects`): xyz normal, w distance.
 pub struct RefractorMaps {
     objects: Vec<usize>,
@@ -42,10 +42,13 @@ impl RefractorMaps {
         build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let kind = ImageKind::CubeArray { cubes: me.objects.len() as u32 };
-            maps.refractor = Some(Image::new(
-                ctx,
-                &ImageDesc { name: "refractor.cubes", format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage },
-            )?);
+            maps.set_image(
+                &super::slots::REFRACTOR,
+                Image::new(
+                    ctx,
+                    &ImageDesc { name: "refractor.cubes", format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage },
+                )?,
+            );
             me.depth = cube_depth(ctx, "refractor.cubes.depth", q.cube.cube_size, q.cube.cube_mode)?;
             me.pipeline = graphics_pipeline(
                 ctx,
@@ -78,7 +81,7 @@ impl Stage for RefractorMaps {
 
     /// Each refractor alone, from its reference point (its cube views).
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
-        let Some(maps) = io.maps.refractor.as_mut() else { return };
+        let Some(maps) = io.maps.image_mut(&super::slots::REFRACTOR) else { return };
         let open = rec.pass("refractor.generate").writes(maps, Access::ColorAttachment).begin();
         let ctx = rec.ctx;
         for (k, &mesh) in self.objects.iter().enumerate() {

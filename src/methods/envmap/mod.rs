@@ -4,6 +4,8 @@
 //! towards where the ray leaves a proxy of the environment (§3.2).
 
 pub mod knobs;
+pub mod slots;
+
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Verdict};

@@ -11,6 +11,7 @@ pub mod curved;
 
 pub mod knobs;
 pub mod mirror;
+pub mod slots;
 pub mod views;
 
 pub use curved::CURVED_REFLECTOR;

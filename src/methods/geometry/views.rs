@@ -51,7 +51,7 @@ impl MirrorViews {
         let usage = vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST;
         let desc =
             ImageDesc { name: "geometry.mirror_views", format: TARGET_FORMAT, width, height, kind: ImageKind::D2Array { layers }, usage };
-        maps.mirror_views = Some(Image::new(ctx, &desc)?);
+        maps.set_image(&super::slots::MIRROR_VIEWS, Image::new(ctx, &desc)?);
         let samples = multisample.samples;
         let kind = if samples > 1 { ImageKind::D2Multisample { samples } } else { ImageKind::D2 };
         let mut me = MirrorViews {
@@ -286,7 +286,7 @@ impl FramePart for PlanarViews {
                 depth_masked: masked,
             };
             camera_stages(rec, pass);
-            if let Some(dst) = maps.mirror_views.as_mut() {
+            if let Some(dst) = maps.image_mut(&super::slots::MIRROR_VIEWS) {
                 mv.record_store(rec, dst, v.layer, v.rect);
             }
         }

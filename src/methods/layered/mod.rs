@@ -13,6 +13,7 @@
 
 pub mod knobs;
 pub mod peel;
+pub mod slots;
 
 use glam::Vec3;
 

@@ -15,6 +15,7 @@
 use ash::vk;
 use glam::{DVec3, Vec3};
 
+use super::slots::{LAYERED, LAYERED_NORMALS};
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{LAYERED_FACE_SHIFT, LAYERED_FIRST};
 use crate::frame::stage::{cube_texel_bytes, describe_cube, FrameIo, Maps, Stage, StageInit};
@@ -164,10 +165,10 @@ impl LayeredMaps {
         let s = q.cube.cube_size;
         let radiance =
             ImageDesc { name: "layered.cubes", format: radiance_format(q.cube.cube_precision), width: s, height: s, kind, usage };
-        maps.layered = Some(Image::new(ctx, &radiance)?);
+        maps.set_image(&LAYERED, Image::new(ctx, &radiance)?);
         let normals =
             ImageDesc { name: "layered.normals", format: normal_format(q, init.scene.materials.len()), width: s, height: s, kind, usage };
-        maps.layered_normals = Some(Image::new(ctx, &normals)?);
+        maps.set_image(&LAYERED_NORMALS, Image::new(ctx, &normals)?);
         Ok(())
     }
 }
@@ -294,9 +295,11 @@ impl Stage for LayeredMaps {
     /// Peels the layers: layer k tests against layer k−1's depth (sampled from the other
     /// depth buffer); six passes per layer, or one multiview pass.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
-        let (Some(mut radiance), Some(mut normals)) = (io.maps.layered.take(), io.maps.layered_normals.take()) else { return };
+        // Taken out of the frame's maps while written, put back after.
+        let (Some(mut radiance), Some(mut normals)) = (io.maps.take_image(&LAYERED), io.maps.take_image(&LAYERED_NORMALS)) else { return };
         let Some(view) = io.views.first(super::VIEWS) else {
-            (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
+            io.maps.set_image(&LAYERED, radiance);
+            io.maps.set_image(&LAYERED_NORMALS, normals);
             return;
         };
         let mut pass =
@@ -351,7 +354,8 @@ impl Stage for LayeredMaps {
             }
         }
         rec.end(open);
-        (io.maps.layered, io.maps.layered_normals) = (Some(radiance), Some(normals));
+        io.maps.set_image(&LAYERED, radiance);
+        io.maps.set_image(&LAYERED_NORMALS, normals);
     }
 
     fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
@@ -371,7 +375,7 @@ impl Stage for LayeredMaps {
         }
         let layers = self.layer_count(init)?;
         if layers != self.layers {
-            for i in [maps.layered.take(), maps.layered_normals.take()].iter_mut().flatten() {
+            for i in [maps.take_image(&LAYERED), maps.take_image(&LAYERED_NORMALS)].iter_mut().flatten() {
                 i.destroy(init.ctx);
             }
             self.layers = layers;

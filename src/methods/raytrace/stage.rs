@@ -670,7 +670,8 @@ impl Stage for RayTrace {
         // 1. Primary hits by rasterisation, then the first queue. The shading kernels
         // project the caustics (§6.3.3): their maps are read by compute.
         let mut pass = rec.pass("raytrace.primary");
-        for img in [io.maps.caustic_distances.as_ref(), io.maps.caustic_maps.as_ref()].into_iter().flatten() {
+        use crate::methods::caustics::slots::{CAUSTIC_DISTANCES, CAUSTIC_MAPS};
+        for img in [&CAUSTIC_DISTANCES, &CAUSTIC_MAPS].into_iter().filter_map(|s| io.maps.image(s)) {
             pass = pass.reads(img, Access::ComputeSampled);
         }
         let open = pass.after_buffer_writes().writes(vis, Access::ColorAttachment).writes(vis_depth, Access::DepthAttachment).begin();

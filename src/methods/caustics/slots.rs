@@ -1,0 +1,40 @@
+//! The caustics' slots in the frame's maps (`frame::maps`), all in set 0: the photon and
+//! light images live there since the splat and filter passes sample them through it.
+
+use crate::frame::layout::binding;
+use crate::frame::maps::{Sampler, Slot};
+
+/// Generators' receiver distance cubes (§6), sampled wherever diffuse surfaces are shaded.
+/// Its presence means caustic photons, which bind set 1 (a refractor map, or nothing for a
+/// mirror).
+pub const CAUSTIC_DISTANCES: Slot =
+    Slot { shading: true, needs_sets: true, ..Slot::image("caustics.receivers", 0, binding::CAUSTIC_DISTANCES, Sampler::Nearest) };
+
+/// Generators' light cube maps (filtered, when filtering), sampled where diffuse surfaces
+/// are shaded (§6.3.3).
+pub const CAUSTIC_MAPS: Slot = Slot { shading: true, ..Slot::image("caustics.light_cubes", 0, binding::CAUSTIC_MAPS, Sampler::Linear) };
+
+/// The light cube maps before filtering (only with a filter).
+pub const CAUSTIC_RAW: Slot = Slot::image("caustics.light_cubes.unfiltered", 0, binding::CAUSTIC_RAW, Sampler::Nearest);
+
+/// Photon hit location images and the photons' power, one layer per light view.
+pub const PHOTON_HITS: Slot = Slot::image("caustics.photon_hits", 0, binding::PHOTON_HITS, Sampler::Nearest);
+pub const PHOTON_POWER: Slot = Slot::image("caustics.photon_power", 0, binding::PHOTON_POWER, Sampler::Nearest);
+
+/// The caustics' parameters and cube table.
+pub const CAUSTICS: Slot = Slot::buffer("caustics.generators", 0, binding::CAUSTICS);
+
+/// Caustic triangles set up once, and per face which of them it draws.
+pub const CAUSTIC_TRIANGLES: Slot = Slot::buffer("caustics.triangles", 0, binding::CAUSTIC_TRIANGLES);
+pub const CAUSTIC_FACES: Slot = Slot::buffer("caustics.triangle_faces", 0, binding::CAUSTIC_FACES);
+
+pub const SLOTS: &[Slot] =
+    &[CAUSTIC_DISTANCES, CAUSTIC_MAPS, CAUSTIC_RAW, PHOTON_HITS, PHOTON_POWER, CAUSTICS, CAUSTIC_TRIANGLES, CAUSTIC_FACES];
+
+impl crate::frame::maps::Maps {
+    /// Caustics: the photon hit location images (xyz hit relative to the reference point,
+    /// w 1 for a photon) and the photons' power, one layer per light view.
+    pub fn photon_images(&self) -> Option<(&crate::vk::Image, &crate::vk::Image)> {
+        self.image(&PHOTON_HITS).zip(self.image(&PHOTON_POWER))
+    }
+}

@@ -1,0 +1,9 @@
+//! The geometry family's slot in the frame's maps (`frame::maps`).
+
+use crate::frame::layout::binding;
+use crate::frame::maps::{Sampler, Slot};
+
+/// Set 0: planar mirrors' views (§5), one layer per view of a frame.
+pub const MIRROR_VIEWS: Slot = Slot { camera: true, ..Slot::image("geometry.mirror_views", 0, binding::MIRROR_VIEWS, Sampler::Nearest) };
+
+pub const SLOTS: &[Slot] = &[MIRROR_VIEWS];
