@@ -191,8 +191,9 @@ impl Maps {
         all_slots().filter(|s| s.camera).filter_map(|s| self.image(s)).collect()
     }
 
-    /// What shading a diffuse surface samples: the shadow maps, and the caustics'
-    /// receiver distances and light cube maps (§6.3.3).
+    /// What shading a diffuse surface samples (`Slot::shading`): the shadow maps, and
+    /// light a family adds there (the caustics' receiver distances and light cube maps,
+    /// §6.3.3).
     pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
         all_slots().filter(|s| s.shading).filter_map(|s| self.image(s))
     }
@@ -210,7 +211,7 @@ impl Maps {
 
     /// Generation/camera set pairs of set 1: one per image of a ping-pong slot, or one
     /// (holding no ping-pong image) for a slot that needs one.
-    fn map_slots(&self) -> usize {
+    fn set_pairs(&self) -> usize {
         all_slots()
             .map(|s| match (s.ping_pong, s.needs_pair) {
                 (true, _) => self.images(s).len(),
@@ -225,16 +226,16 @@ impl Maps {
     /// one for the camera passes, an all-null one and one of the geometry maps alone; none
     /// without set-1 maps.
     pub fn set_count(&self) -> usize {
-        if self.map_slots() == 0 && !all_slots().any(|s| s.needs_sets && self.has(s)) {
+        if self.set_pairs() == 0 && !all_slots().any(|s| s.needs_sets && self.has(s)) {
             0
         } else {
-            2 * self.map_slots() + 2
+            2 * self.set_pairs() + 2
         }
     }
 
     /// Assigns `set_count()` allocated sets to their roles.
     pub fn sets(&self, sets: &[vk::DescriptorSet]) -> MapSets {
-        let n = self.map_slots();
+        let n = self.set_pairs();
         if sets.len() < 2 * n + 2 {
             return MapSets::default();
         }
@@ -251,7 +252,7 @@ impl Maps {
             self.write(ctx, frame, s, true, self.latest, (linear, nearest));
         }
         let mut roles: Vec<(vk::DescriptorSet, Role)> = Vec::new();
-        for i in 0..self.map_slots() {
+        for i in 0..self.set_pairs() {
             if i < sets.generate.len() {
                 roles.push((sets.generate[i], Role::Generate(i)));
                 roles.push((sets.camera[i], Role::Camera(i)));
