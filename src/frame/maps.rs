@@ -1,7 +1,8 @@
 //! The frame's shared maps: a table of slots, each a descriptor binding of set 0 or set 1
 //! that some pass fills with an image or a buffer and others sample. Every slot is declared
 //! once by its owner (the frame's shadow maps in `frame::shadow`, each family's in its own
-//! folder) and listed in [`crate::methods::SLOTS`]; the renderer writes the descriptors, the
+//! folder, listed by its `registry::Family::slots`), handed to `Maps::new` by the renderer,
+//! which writes the descriptors, the
 //! passes' reads and the frees by walking the declarations, so it names no slot.
 
 use std::collections::BTreeMap;
@@ -81,14 +82,10 @@ impl Slot {
         Slot { kind: Kind::Buffer, ..Slot::image(name, set, binding, Sampler::Nearest) }
     }
 
-    fn key(&self) -> (u32, u32) {
+    /// (set, binding): what identifies a slot.
+    pub fn key(&self) -> (u32, u32) {
         (self.set, self.binding)
     }
-}
-
-/// Every declared slot: the frame's, then each family's (`methods::SLOTS`), in that order.
-pub fn all_slots() -> impl Iterator<Item = &'static Slot> {
-    crate::frame::shadow::SLOTS.iter().chain(crate::methods::SLOTS.iter().flat_map(|s| s.iter()))
 }
 
 /// The frame's shared maps, keyed by slot. A map stage creates the images of its slots; the
@@ -96,6 +93,8 @@ pub fn all_slots() -> impl Iterator<Item = &'static Slot> {
 /// frees them.
 #[derive(Default)]
 pub struct Maps {
+    /// Every declared slot: the frame's, then each family's (`registry::Family::slots`).
+    slots: Vec<&'static Slot>,
     images: BTreeMap<(u32, u32), Vec<Image>>,
     buffers: BTreeMap<(u32, u32), Buffer>,
     /// Which image of each ping-pong slot the last cycle wrote: the one the camera passes
@@ -106,6 +105,15 @@ pub struct Maps {
 }
 
 impl Maps {
+    /// An empty table over the declared `slots`.
+    pub fn new(slots: Vec<&'static Slot>) -> Maps {
+        Maps { slots, ..Maps::default() }
+    }
+
+    fn all_slots(&self) -> impl Iterator<Item = &'static Slot> + '_ {
+        self.slots.iter().copied()
+    }
+
     /// The slot's image: for a ping-pong slot the one the last cycle wrote.
     pub fn image(&self, slot: &Slot) -> Option<&Image> {
         let v = self.images.get(&slot.key())?;
@@ -188,31 +196,31 @@ impl Maps {
 
     /// Every map image the camera passes sample: the current one of each slot.
     pub fn camera_reads(&self) -> Vec<&Image> {
-        all_slots().filter(|s| s.camera).filter_map(|s| self.image(s)).collect()
+        self.all_slots().filter(|s| s.camera).filter_map(|s| self.image(s)).collect()
     }
 
     /// What shading a diffuse surface samples (`Slot::shading`): the shadow maps, and
     /// light a family adds there (the caustics' receiver distances and light cube maps,
     /// §6.3.3).
     pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
-        all_slots().filter(|s| s.shading).filter_map(|s| self.image(s))
+        self.all_slots().filter(|s| s.shading).filter_map(|s| self.image(s))
     }
 
     /// What map generation samples through a generation set besides the ping-pong images
     /// it writes itself (the refractor maps, made first).
     pub fn generation_reads(&self) -> impl Iterator<Item = &Image> {
-        all_slots().filter(|s| s.set == 1 && s.generation && !s.ping_pong).filter_map(|s| self.image(s))
+        self.all_slots().filter(|s| s.set == 1 && s.generation && !s.ping_pong).filter_map(|s| self.image(s))
     }
 
     /// What the geometry set holds (passes that bind it sample these).
     pub fn geometry_reads(&self) -> impl Iterator<Item = &Image> {
-        all_slots().filter(|s| s.set == 1 && s.geometry).filter_map(|s| self.image(s))
+        self.all_slots().filter(|s| s.set == 1 && s.geometry).filter_map(|s| self.image(s))
     }
 
     /// Generation/camera set pairs of set 1: one per image of a ping-pong slot, or one
     /// (holding no ping-pong image) for a slot that needs one.
     fn set_pairs(&self) -> usize {
-        all_slots()
+        self.all_slots()
             .map(|s| match (s.ping_pong, s.needs_pair) {
                 (true, _) => self.images(s).len(),
                 (false, true) => usize::from(self.has(s)),
@@ -226,7 +234,7 @@ impl Maps {
     /// one for the camera passes, an all-null one and one of the geometry maps alone; none
     /// without set-1 maps.
     pub fn set_count(&self) -> usize {
-        if self.set_pairs() == 0 && !all_slots().any(|s| s.needs_sets && self.has(s)) {
+        if self.set_pairs() == 0 && !self.all_slots().any(|s| s.needs_sets && self.has(s)) {
             0
         } else {
             2 * self.set_pairs() + 2
@@ -247,7 +255,7 @@ impl Maps {
     /// the empty set none; a ping-pong slot gives set pair i its image i). What the scene
     /// does not need gets a null descriptor.
     pub fn write_descriptors(&self, ctx: &Context, frame: vk::DescriptorSet, sets: &MapSets, linear: vk::Sampler, nearest: vk::Sampler) {
-        let slots: Vec<&Slot> = all_slots().collect();
+        let slots: Vec<&Slot> = self.all_slots().collect();
         for s in slots.iter().filter(|s| s.set == 0) {
             self.write(ctx, frame, s, true, self.latest, (linear, nearest));
         }
@@ -311,7 +319,7 @@ impl Maps {
         for b in self.buffers.values_mut() {
             b.destroy(ctx);
         }
-        *self = Maps::default();
+        *self = Maps::new(std::mem::take(&mut self.slots));
     }
 }
 
@@ -333,38 +341,4 @@ pub struct MapSets {
     pub empty: vk::DescriptorSet,
     /// The geometry maps alone (caustic photons search them, §6).
     pub geometry: vk::DescriptorSet,
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::frame::layout::{BINDINGS, MAP_BINDINGS};
-
-    /// Every slot binds a declared binding of its kind, no two the same, and every map
-    /// binding of set 1 (and of set 0 past the frame's own inputs) has a slot, so that
-    /// `write_descriptors` leaves none unwritten.
-    #[test]
-    fn slots_cover_the_map_bindings() {
-        let slots: Vec<&Slot> = all_slots().collect();
-        for (i, s) in slots.iter().enumerate() {
-            assert!(!slots[..i].iter().any(|o| o.key() == s.key()), "{} binds a slot already taken", s.name);
-            let table = if s.set == 0 { BINDINGS } else { MAP_BINDINGS };
-            assert!(s.set <= 1, "{}: slots live in set 0 or 1", s.name);
-            let (_, ty, _) = table.iter().find(|b| b.0 == s.binding).unwrap_or_else(|| panic!("{}: no binding {}", s.name, s.binding));
-            let want = match s.kind {
-                Kind::Image(_) => vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
-                Kind::Buffer => vk::DescriptorType::STORAGE_BUFFER,
-            };
-            assert_eq!(*ty, want, "{}", s.name);
-            assert!(s.set == 1 || !(s.generation || s.geometry || s.ping_pong || s.needs_pair), "{}: set-1 roles on set 0", s.name);
-        }
-        for b in MAP_BINDINGS {
-            assert!(slots.iter().any(|s| s.key() == (1, b.0)), "set 1 binding {} has no slot", b.0);
-        }
-        use crate::frame::layout::binding::{ENVIRONMENT_MAP, SHADOW_CUBES};
-        for b in BINDINGS.iter().filter(|b| b.0 > ENVIRONMENT_MAP) {
-            assert!(slots.iter().any(|s| s.key() == (0, b.0)), "set 0 binding {} has no slot", b.0);
-        }
-        assert!(slots.iter().any(|s| s.key() == (0, SHADOW_CUBES)));
-    }
 }

@@ -37,10 +37,12 @@ pub const ALL: &[Method] = &registry::all_methods::<{ registry::method_count(FAM
 pub const FAMILIES: &[registry::Family] =
     &[envmap::FAMILY, distance::FAMILY, layered::FAMILY, raytrace::FAMILY, geometry::FAMILY, caustics::FAMILY, crate::reference::FAMILY];
 
-/// Every family's slots in the frame's maps (`frame::maps`), after the frame's own: the
-/// order the camera passes and diffuse shading list their reads in.
-pub const SLOTS: &[&[crate::frame::maps::Slot]] =
-    &[envmap::slots::SLOTS, distance::slots::SLOTS, geometry::slots::SLOTS, layered::slots::SLOTS, caustics::slots::SLOTS];
+/// Every slot of the frame's maps (`frame::maps`): the frame's own, then each family's
+/// (`registry::Family::slots`), the order the camera passes and diffuse shading list their
+/// reads in.
+pub fn all_slots() -> Vec<&'static crate::frame::maps::Slot> {
+    crate::frame::shadow::SLOTS.iter().chain(FAMILIES.iter().flat_map(|f| f.slots.iter())).collect()
+}
 
 /// Every object class, for methods that serve them all.
 pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
@@ -52,6 +54,35 @@ mod tests {
     #[test]
     fn registry_is_consistent() {
         registry::check(ALL).unwrap();
+    }
+
+    /// Every slot binds a declared binding of its kind, no two the same, and every map
+    /// binding of set 1 (and of set 0 past the frame's own inputs) has a slot, so that
+    /// `write_descriptors` leaves none unwritten.
+    #[test]
+    fn slots_cover_the_map_bindings() {
+        let slots = all_slots();
+        for (i, s) in slots.iter().enumerate() {
+            assert!(!slots[..i].iter().any(|o| o.key() == s.key()), "{} binds a slot already taken", s.name);
+            let table = if s.set == 0 { BINDINGS } else { MAP_BINDINGS };
+            assert!(s.set <= 1, "{}: slots live in set 0 or 1", s.name);
+            let (_, ty, _) = table.iter().find(|b| b.0 == s.binding).unwrap_or_else(|| panic!("{}: no binding {}", s.name, s.binding));
+            let want = match s.kind {
+                crate::frame::maps::Kind::Image(_) => ash::vk::DescriptorType::COMBINED_IMAGE_SAMPLER,
+                crate::frame::maps::Kind::Buffer => ash::vk::DescriptorType::STORAGE_BUFFER,
+            };
+            assert_eq!(*ty, want, "{}", s.name);
+            assert!(s.set == 1 || !(s.generation || s.geometry || s.ping_pong || s.needs_pair), "{}: set-1 roles on set 0", s.name);
+        }
+        for b in MAP_BINDINGS {
+            assert!(slots.iter().any(|s| s.key() == (1, b.0)), "set 1 binding {} has no slot", b.0);
+        }
+        use crate::frame::layout::binding::{ENVIRONMENT_MAP, SHADOW_CUBES};
+        use crate::frame::layout::{BINDINGS, MAP_BINDINGS};
+        for b in BINDINGS.iter().filter(|b| b.0 > ENVIRONMENT_MAP) {
+            assert!(slots.iter().any(|s| s.key() == (0, b.0)), "set 0 binding {} has no slot", b.0);
+        }
+        assert!(slots.iter().any(|s| s.key() == (0, SHADOW_CUBES)));
     }
 
     #[test]

@@ -234,6 +234,8 @@ pub struct Family {
     pub name: &'static str,
     /// Its methods, in the order `methods::ALL` lists them.
     pub methods: &'static [Method],
+    /// Its slots in the frame's maps (`frame::maps::Slot`: binding, sampler, who reads it).
+    pub slots: &'static [crate::frame::maps::Slot],
     /// Before the frame's stages are derived: moves the objects' reference points (the
     /// shared layered map's centre, §4.5).
     pub plan_objects: Option<fn(&Scene, &mut Plan)>,
@@ -264,6 +266,7 @@ impl Family {
     pub const NONE: Family = Family {
         name: "",
         methods: &[],
+        slots: &[],
         plan_objects: None,
         plan_frame: None,
         plan_stages: None,

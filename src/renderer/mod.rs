@@ -148,7 +148,7 @@ impl Renderer {
             stages: Vec::new(),
             deps: Vec::new(),
             parts: Vec::new(),
-            maps: Maps::default(),
+            maps: Maps::new(crate::methods::all_slots()),
             targets: Targets::empty(ssaa, multisample),
             readback: None,
             profiler: Profiler::placeholder(),

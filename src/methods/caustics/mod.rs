@@ -60,6 +60,7 @@ impl CausticsPlan {
 /// frame, with two effect stages, and views of their own.
 pub const FAMILY: Family = Family {
     name: "caustics",
+    slots: slots::SLOTS,
     methods: &[],
     plan_frame: Some(|scene, p| p.caustics = plan(scene, &p.objects, &p.quality)),
     plan_stages: Some(plan_stages),

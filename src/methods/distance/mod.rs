@@ -105,6 +105,7 @@ const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 /// Ray tracing in the sampled geometry (§4.1–§4.4): maps and camera passes only, no hooks.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "distance",
+    slots: slots::SLOTS,
     methods: &[DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP, IMAGE_SPACE_REFRACTION],
     ..crate::methods::registry::Family::NONE
 };

@@ -73,6 +73,7 @@ const fn proxy(flags: u32) -> CameraPass {
 /// Environment mapping (§3): maps and camera passes only, no hooks.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "envmap",
+    slots: slots::SLOTS,
     methods: &[ENVMAP, PROXY_SPHERE, PROXY_BOX],
     ..crate::methods::registry::Family::NONE
 };

@@ -26,6 +26,7 @@ use crate::quality::{FrameKnobs, GeometryKnobs};
 /// Planar mirrors' and refractors' views (§5) are the geometry family's part of a frame.
 pub const FAMILY: Family = Family {
     name: "geometry",
+    slots: slots::SLOTS,
     methods: &[PLANAR_MIRROR, PLANAR_REFRACTION, CURVED_REFLECTOR],
     plan_views: Some(plan_views),
     views: Some(view_blocks),

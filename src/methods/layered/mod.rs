@@ -129,6 +129,7 @@ pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec
 /// Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "layered",
+    slots: slots::SLOTS,
     methods: &[LAYERED],
     plan_objects: Some(share_centre),
     views: Some(|p| if p.layered_centre.is_some() { vec![(VIEWS, 6)] } else { Vec::new() }),
