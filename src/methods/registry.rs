@@ -451,7 +451,8 @@ impl From<Method> for Choice {
 
 /// Checks the registry: names and numbers unique, every knob a method reads exists, every
 /// fallback serves what the method does not, methods sharing a camera pass share its
-/// shaders, a method that shades every pixel has its own stage and no maps or fallback. `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
+/// shaders, a method that shades every pixel has its own stage and no maps or fallback.
+/// `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
 pub fn check(all: &[Method]) -> std::result::Result<(), String> {
     for (i, a) in all.iter().enumerate() {
         for b in &all[i + 1..] {
