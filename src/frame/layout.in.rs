@@ -105,8 +105,8 @@ gpu_structs! {
         internal_bounces: uint,
         /// specular recursion depth R (`depth`): layered maps (§4.5) trace this many bounces
         depth: uint,
-        /// the view table's first planar-mirror view (`ViewLayout::mirrors`): layer L of
-        /// `mirror_views` is view `mirror_base + L`
+        /// the view table's first extra camera view (the `frame::stage::EXTRA_VIEWS` block,
+        /// planar mirrors'): layer L of `mirror_views` is view `mirror_base + L`
         mirror_base: uint,
     }
 }

@@ -48,7 +48,7 @@ pub struct FrameInputs<'a> {
     pub tolerance: f32,
     pub internal_bounces: u32,
     pub depth: u32,
-    /// `ViewLayout::mirrors`.
+    /// The first extra camera view (`stage::EXTRA_VIEWS`, planar mirrors' views).
     pub mirror_base: u32,
 }
 
