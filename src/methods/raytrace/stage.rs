@@ -667,11 +667,11 @@ impl Stage for RayTrace {
         let compute = vk::PipelineBindPoint::COMPUTE;
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
 
-        // 1. Primary hits by rasterisation, then the first queue. The shading kernels
-        // project the caustics (§6.3.3): their maps are read by compute.
+        // 1. Primary hits by rasterisation, then the first queue. The shading kernels shade
+        // diffuse surfaces as every pass does (the caustics projected there, §6.3.3): what
+        // diffuse shading samples is read by compute.
         let mut pass = rec.pass("raytrace.primary");
-        use crate::methods::caustics::slots::{CAUSTIC_DISTANCES, CAUSTIC_MAPS};
-        for img in [&CAUSTIC_DISTANCES, &CAUSTIC_MAPS].into_iter().filter_map(|s| io.maps.image(s)) {
+        for img in io.maps.shadow_reads() {
             pass = pass.reads(img, Access::ComputeSampled);
         }
         let open = pass.after_buffer_writes().writes(vis, Access::ColorAttachment).writes(vis_depth, Access::DepthAttachment).begin();
