@@ -8,7 +8,7 @@
 use crate::error::{Error, Result};
 use crate::frame::stage::{CreateFramePart, MapInfo};
 use crate::plan::facts::ObjectFacts;
-use crate::plan::Plan;
+use crate::plan::{Plan, PlanStages};
 use crate::quality::Quality;
 use crate::scene::{Scene, SurfaceKind};
 
@@ -303,41 +303,6 @@ pub const fn all_methods<const N: usize>(families: &[Family]) -> [Method; N] {
     }
     assert!(n == N, "N is the families' method count");
     out
-}
-
-/// What the planner has derived when `Family::plan_stages` runs: the map passes (one per
-/// map kind, layers in mesh order) and the frame's stages so far.
-pub struct PlanStages {
-    pub maps: Vec<crate::plan::MapPlan>,
-    pub stages: Vec<crate::plan::StageSpec>,
-    /// A whole-scene method shades every pixel itself (`GpuSpec::shades_every_pixel`): with
-    /// exact shadow rays and the caustics projected in its own kernel.
-    pub shades_scene: bool,
-}
-
-impl PlanStages {
-    /// Gives `object` map `info` (its layer the next of that map's array), unless it has it.
-    pub fn add_map(&mut self, object: &mut crate::plan::ObjectPlan, info: MapInfo, what: String) {
-        if object.maps.iter().any(|m| m.pass == info.name) {
-            return;
-        }
-        let k = match self.maps.iter().position(|m| m.name == info.name) {
-            Some(k) => k,
-            None => {
-                self.maps.push(crate::plan::MapPlan { info, name: info.name, objects: Vec::new(), bytes: 0 });
-                self.maps.len() - 1
-            }
-        };
-        object.maps.push(crate::plan::ObjectMap {
-            pass: info.name,
-            layer: self.maps[k].objects.len() as u32,
-            layer_field: info.layer_field,
-            what,
-            bytes: 0,
-        });
-        self.maps[k].objects.push(object.mesh);
-        object.passes.push(info.name);
-    }
 }
 
 /// The map kind named `name` that some registered method needs (a family that needs

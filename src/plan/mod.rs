@@ -15,7 +15,6 @@ use crate::error::{Error, Result};
 pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass, Verdict};
 pub use types::*;
 
-use crate::methods::registry::PlanStages;
 use crate::methods::FAMILIES;
 use crate::quality::{Planner, Quality};
 use crate::scene::{LightKind, Scene};

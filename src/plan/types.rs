@@ -272,3 +272,38 @@ pub struct CausticsPlan {
     /// Device memory of its images.
     pub bytes: u64,
 }
+
+/// What the planner has derived when `Family::plan_stages` runs: the map passes (one per
+/// map kind, layers in mesh order) and the frame's stages so far.
+pub struct PlanStages {
+    pub maps: Vec<MapPlan>,
+    pub stages: Vec<StageSpec>,
+    /// A whole-scene method shades every pixel itself (`GpuSpec::shades_every_pixel`): with
+    /// exact shadow rays and the caustics projected in its own kernel.
+    pub shades_scene: bool,
+}
+
+impl PlanStages {
+    /// Gives `object` map `info` (its layer the next of that map's array), unless it has it.
+    pub fn add_map(&mut self, object: &mut ObjectPlan, info: MapInfo, what: String) {
+        if object.maps.iter().any(|m| m.pass == info.name) {
+            return;
+        }
+        let k = match self.maps.iter().position(|m| m.name == info.name) {
+            Some(k) => k,
+            None => {
+                self.maps.push(MapPlan { info, name: info.name, objects: Vec::new(), bytes: 0 });
+                self.maps.len() - 1
+            }
+        };
+        object.maps.push(ObjectMap {
+            pass: info.name,
+            layer: self.maps[k].objects.len() as u32,
+            layer_field: info.layer_field,
+            what,
+            bytes: 0,
+        });
+        self.maps[k].objects.push(object.mesh);
+        object.passes.push(info.name);
+    }
+}

@@ -30,8 +30,8 @@ use crate::vk::Context;
 use crate::Result;
 
 use crate::gpu_scene::{GpuLight, GpuView};
-use crate::methods::registry::{Family, PlanStages};
-use crate::plan::{CausticCube, CausticsPlan, EffectPlan, Generator, LightViews, ObjectPlan, Plan};
+use crate::methods::registry::Family;
+use crate::plan::{CausticCube, CausticsPlan, EffectPlan, Generator, LightViews, ObjectPlan, Plan, PlanStages};
 use crate::quality::{CausticSpace, Caustics, Quality};
 use crate::scene::{LightKind, Scene};
 
