@@ -33,6 +33,10 @@ pub struct ObjectFacts {
     /// Farthest over nearest distance of the surfaces around the reference point (2048 rays;
     /// 1 without deep facts): the environment's depth variation.
     pub depth_ratio: f32,
+    /// The nearest surface of the environment from the reference point over the object's
+    /// bounding radius (same rays; 0 without deep facts): how far what it reflects lies
+    /// relative to its size (a map's parallax error grows as this falls).
+    pub near_ratio: f32,
     /// The largest angle (radians) an edge of another object's triangles subtends from the
     /// reference point: how coarsely the environment is tessellated as seen from the
     /// object (geometry transformation bends only vertices, survey Table 1). 0 without deep
@@ -491,7 +495,7 @@ fn self_facing(m: &Mesh, x: Vec3) -> f32 {
 /// itself) reach first: the other specular objects with the fraction of directions that
 /// reach each, and the fraction of directions whose hit lies on the scene's bounding box
 /// (within 1 % of its diagonal: the environment is then its own proxy box, §3.2).
-fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usize, f32)>, f32, f32) {
+fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usize, f32)>, f32, f32, f32) {
     let mut hits: HashMap<usize, u32> = HashMap::new();
     let (mut nearest, mut farthest) = (f64::INFINITY, 0.0f64);
     let mut on_box = 0u32;
@@ -532,7 +536,7 @@ fn visible_specular(scene: &Scene, bvh: &Bvh, mesh: usize, x: Vec3) -> (Vec<(usi
     let mut out: Vec<(usize, f32)> = hits.into_iter().map(|(m, k)| (m, k as f32 / n as f32)).collect();
     out.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     let ratio = if nearest > 0.0 && farthest.is_finite() && farthest >= nearest { (farthest / nearest) as f32 } else { 1.0 };
-    (out, on_box as f32 / n as f32, ratio)
+    (out, on_box as f32 / n as f32, ratio, if nearest.is_finite() { nearest as f32 } else { 0.0 })
 }
 
 /// The largest angle an edge of a triangle of any other mesh subtends from `x`.
@@ -593,10 +597,11 @@ impl SceneFacts {
                     (None, None) => reference_point(scene, i),
                 };
                 let mf = mesh_facts(m);
-                let (visible, (sees, box_fraction, depth_ratio)) = match &bvh {
+                let (visible, (sees, box_fraction, depth_ratio, nearest)) = match &bvh {
                     Some(b) => (visible_fraction_cached(m, reference_point), visible_specular(scene, b, i, reference_point)),
-                    None => (1.0, (Vec::new(), 0.0, 1.0)),
+                    None => (1.0, (Vec::new(), 0.0, 1.0, 0.0)),
                 };
+                let radius = 0.5 * m.bounds().diagonal();
                 Some(ObjectFacts {
                     mesh: i,
                     class,
@@ -605,6 +610,7 @@ impl SceneFacts {
                     watertight: mf.watertight,
                     curvature: mf.curvature,
                     depth_ratio,
+                    near_ratio: if radius > 0.0 { nearest / radius } else { 0.0 },
                     edge_angle: if bvh.is_some() { edge_angle(scene, i, reference_point) } else { 0.0 },
                     visible_fraction: visible,
                     sees_specular: sees,

@@ -7,6 +7,7 @@
 pub mod budget;
 pub mod facts;
 pub mod knobs;
+pub mod predict;
 mod types;
 
 use glam::Vec3;
@@ -134,9 +135,9 @@ pub fn plan(scene: &Scene, method: impl Into<Choice>, quality: &Quality) -> Plan
     let choices = Choices::all(method);
     // A whole-scene method cannot fail (the registry checks that every method serves every
     // class or falls back to one that does), nor can the planner without the scene's hints.
-    plan_inner(scene, &choices, quality, true).or_else(|_| plan_inner(scene, &choices, quality, false)).unwrap_or_else(|e| {
+    plan_inner(scene, &choices, quality, true, None).or_else(|_| plan_inner(scene, &choices, quality, false, None)).unwrap_or_else(|e| {
         // Unreachable by the registry's checks; a plan that renders nothing but says why.
-        let mut p = plan_inner(scene, &Choices::all(crate::methods::REFERENCE), quality, false).unwrap_or_else(|_| empty_plan(quality));
+        let mut p = plan_inner(scene, &Choices::all(crate::methods::REFERENCE), quality, false, None).unwrap_or_else(|_| empty_plan(quality));
         p.objects.iter_mut().for_each(|o| o.reason = format!("no GPU plan: {e}"));
         p
     })
@@ -167,7 +168,7 @@ fn empty_plan(quality: &Quality) -> Plan {
 }
 
 /// Which method an object gets, and why (`hints`: honour the scene file's methods).
-fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quality, hints: bool) -> Result<(Method, String)> {
+fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, hints: bool, auto: Option<&predict::AutoPlan>) -> Result<(Method, String)> {
     let mesh = &scene.meshes[facts.mesh];
     let class = facts.class;
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
@@ -200,22 +201,16 @@ fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, quality: &Quali
         let m = Method::parse(name).map_err(|e| Error::invalid(format!("object '{}' extras.specula.method", mesh.name), e.to_string()))?;
         return check(m, "the scene file's extras.specula.method");
     }
-    auto(facts, quality)
-}
-
-/// The planner: every GPU method that serves the object says how well it fits; the best
-/// score wins (registry order breaks ties).
-pub fn auto(facts: &ObjectFacts, quality: &Quality) -> Result<(Method, String)> {
-    let mut best: Option<(Method, Verdict)> = None;
-    for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(facts)) {
-        if let Some(v) = (m.rule)(facts, quality) {
-            if best.as_ref().is_none_or(|(_, b)| v.score > b.score) {
-                best = Some((m, v));
-            }
-        }
+    let picked = auto.and_then(|a| match a.choices.method {
+        Choice::Method(m) if a.choices.objects.is_empty() => Some((a, m)),
+        _ => a.choices.objects.iter().find(|(n, _)| names_object(scene, facts.mesh, n)).map(|(_, m)| (a, *m)),
+    });
+    match picked {
+        Some((a, m)) => Ok((m, a.reason(&mesh.name, m))),
+        // No prediction covers the object (no stored models): the exact tracer serves every
+        // class.
+        None => Ok((crate::methods::BVH, "auto: no prediction covers this object: the exact tracer".into())),
     }
-    best.map(|(m, v)| (m, format!("auto: {}", v.reason)))
-        .ok_or_else(|| Error::invalid(format!("object {}", facts.mesh), format!("no method serves a {}", facts.class.label())))
 }
 
 /// Whether `name` addresses mesh `m` (its node or mesh name; meshes imported from glTF
@@ -252,12 +247,49 @@ fn check_names(scene: &Scene, choices: &Choices) -> Result<()> {
     Ok(())
 }
 
-/// The plan for per-object choices.
+/// The plan for per-object choices (`auto` predicted for a nominal frame on the stored
+/// calibration's device: [`plan_for`] names the frame).
 pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<Plan> {
-    plan_inner(scene, choices, quality, true)
+    plan_inner(scene, choices, quality, true, None)
 }
 
-fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) -> Result<Plan> {
+/// The plan for per-object choices, `auto` predicted for `target` (the frame's size and the
+/// device's unit costs).
+pub fn plan_for(scene: &Scene, choices: &Choices, quality: &Quality, target: Option<&predict::Target>) -> Result<Plan> {
+    plan_inner(scene, choices, quality, true, target)
+}
+
+/// `auto`'s choice for the objects `choices` and (with `hints`) the scene file leave to it.
+fn auto_plan(
+    scene: &Scene,
+    facts: &facts::SceneFacts,
+    choices: &Choices,
+    quality: &Quality,
+    hints: bool,
+    target: Option<&predict::Target>,
+) -> Result<Option<predict::AutoPlan>> {
+    if choices.method != Choice::Auto {
+        return Ok(None);
+    }
+    let mut forced = choices.clone();
+    for f in facts.objects.iter().filter(|_| hints) {
+        let mesh = &scene.meshes[f.mesh];
+        let named = forced.objects.iter().any(|(n, _)| names_object(scene, f.mesh, n));
+        if let (false, Some(Ok(m))) = (named, mesh.method.as_deref().map(Method::parse)) {
+            forced.objects.push((mesh.name.clone(), m));
+        }
+    }
+    if facts.objects.iter().all(|f| forced.objects.iter().any(|(n, _)| names_object(scene, f.mesh, n))) {
+        return Ok(None);
+    }
+    let nominal = predict::Target::nominal();
+    match target.or(nominal.as_ref()) {
+        Some(t) => predict::auto(scene, facts, &forced, quality, t),
+        None => Ok(None),
+    }
+}
+
+fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, target: Option<&predict::Target>) -> Result<Plan> {
     check_names(scene, choices)?;
     let bounds = scene.bounds();
     let diag = bounds.diagonal();
@@ -274,9 +306,10 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool) 
     // whose composition depends on who sees whom; a whole-scene method needs none.
     let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();
     let scene_facts = facts::SceneFacts::new(scene, quality, !whole_scene);
+    let auto = auto_plan(scene, &scene_facts, choices, quality, hints, target)?;
     let mut objects = Vec::new();
     for f in &scene_facts.objects {
-        let (method, reason) = choose(scene, f, choices, quality, hints)?;
+        let (method, reason) = choose(scene, f, choices, hints, auto.as_ref())?;
         objects.push(ObjectPlan {
             mesh: f.mesh,
             name: scene.meshes[f.mesh].name.clone(),

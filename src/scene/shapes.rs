@@ -119,6 +119,115 @@ pub fn prism(name: &str, center: Vec3, axis: Vec3, length: f32, corners: [Vec3; 
     m
 }
 
+/// A torus around `axis` (unit) through `center`: ring radius `major`, tube radius `minor`,
+/// `segments` around the ring and `sides` around the tube (a closed, non-convex solid:
+/// part of its surface hides another part from its centre).
+pub fn torus(name: &str, center: Vec3, axis: Vec3, major: f32, minor: f32, segments: u32, sides: u32, material: usize) -> Mesh {
+    let (segments, sides) = (segments.max(3), sides.max(3));
+    let axis = axis.normalize();
+    let (u, v) = axis.any_orthonormal_pair();
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    for i in 0..=segments {
+        let phi = 2.0 * std::f32::consts::PI * i as f32 / segments as f32;
+        let radial = u * phi.cos() + v * phi.sin();
+        for j in 0..=sides {
+            let theta = 2.0 * std::f32::consts::PI * j as f32 / sides as f32;
+            let n = radial * theta.cos() + axis * theta.sin();
+            m.positions.push(center + radial * major + n * minor);
+            m.normals.push(n);
+            m.uvs.push(Vec2::new(i as f32 / segments as f32, j as f32 / sides as f32));
+        }
+    }
+    let row = sides + 1;
+    for i in 0..segments {
+        for j in 0..sides {
+            let (a, b, c, d) = (i * row + j, (i + 1) * row + j, i * row + j + 1, (i + 1) * row + j + 1);
+            // Counter-clockwise seen from outside (n = radial·cos θ + axis·sin θ).
+            m.indices.extend([a, b, d, a, d, c]);
+        }
+    }
+    fix_winding(&mut m);
+    m
+}
+
+/// A spherical cap of `radius` around `center` opening towards `opening` (unit): the
+/// directions within `half_angle` of `−opening` (a bowl; `half_angle` π/2 is a hemisphere),
+/// normals pointing inward (its concave side faces its centre), one-sided and open.
+pub fn bowl(name: &str, center: Vec3, opening: Vec3, radius: f32, half_angle: f32, segments: u32, rings: u32, material: usize) -> Mesh {
+    let (segments, rings) = (segments.max(3), rings.max(1));
+    let down = -opening.normalize();
+    let (u, v) = down.any_orthonormal_pair();
+    let mut m = Mesh { name: name.into(), material, ..Default::default() };
+    for r in 0..=rings {
+        let theta = half_angle * r as f32 / rings as f32;
+        for s in 0..=segments {
+            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+            let d = down * theta.cos() + (u * phi.cos() + v * phi.sin()) * theta.sin();
+            m.positions.push(center + d * radius);
+            m.normals.push(-d);
+            m.uvs.push(Vec2::new(s as f32 / segments as f32, r as f32 / rings as f32));
+        }
+    }
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b, c, d) = (r * row + s, r * row + s + 1, (r + 1) * row + s, (r + 1) * row + s + 1);
+            if r != 0 {
+                m.indices.extend([a, b, c]);
+            }
+            m.indices.extend([b, d, c]);
+        }
+    }
+    fix_winding(&mut m);
+    m
+}
+
+/// A lumpy closed solid: a UV sphere whose radius varies by up to `amount` (a fraction)
+/// with a few low-frequency lobes set by `seed`; normals from the surface. Non-convex for
+/// `amount` above about 0.15 (a stand-in for scanned models such as the bunny).
+pub fn blob(name: &str, center: Vec3, radius: f32, amount: f32, seed: u32, segments: u32, rings: u32, material: usize) -> Mesh {
+    let mut m = uv_sphere(name, Vec3::ZERO, 1.0, segments, rings, material);
+    let k = |i: u32| ((seed.wrapping_mul(2654435761).wrapping_add(i.wrapping_mul(40503))) % 1000) as f32 / 1000.0;
+    let lobes: Vec<(Vec3, f32)> = (0..5)
+        .map(|i| {
+            let (a, b) = (k(3 * i) * std::f32::consts::TAU, k(3 * i + 1) * 2.0 - 1.0);
+            let r = (1.0 - b * b).sqrt();
+            (Vec3::new(r * a.cos(), b, r * a.sin()), 0.5 + k(3 * i + 2))
+        })
+        .collect();
+    let f = |d: Vec3| 1.0 + amount * lobes.iter().map(|(c, w)| w * (4.0 * (d.dot(*c) - 1.0)).exp()).sum::<f32>();
+    for p in m.positions.iter_mut() {
+        let d = p.normalize_or_zero();
+        *p = center + d * radius * f(d);
+    }
+    // Area-weighted face normals per vertex, welded across the seam by position.
+    let mut acc = vec![Vec3::ZERO; m.positions.len()];
+    for t in m.indices.chunks_exact(3) {
+        let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+        let n = (b - a).cross(c - a);
+        t.iter().for_each(|&i| acc[i as usize] += n);
+    }
+    let mut welded: std::collections::HashMap<[u32; 3], Vec3> = std::collections::HashMap::new();
+    for (p, n) in m.positions.iter().zip(&acc) {
+        *welded.entry([p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]).or_default() += *n;
+    }
+    for (p, n) in m.positions.iter().zip(m.normals.iter_mut()) {
+        *n = welded[&[p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]].normalize_or_zero();
+    }
+    m
+}
+
+/// Winds every triangle counter-clockwise around its vertex normals (glTF's convention).
+fn fix_winding(m: &mut Mesh) {
+    for t in m.indices.chunks_exact_mut(3) {
+        let (a, b, c) = (m.positions[t[0] as usize], m.positions[t[1] as usize], m.positions[t[2] as usize]);
+        let n = m.normals[t[0] as usize] + m.normals[t[1] as usize] + m.normals[t[2] as usize];
+        if (b - a).cross(c - a).dot(n) < 0.0 {
+            t.swap(1, 2);
+        }
+    }
+}
+
 /// The six inward-facing walls of an axis-aligned box room, in the order
 /// +X, −X, +Y, −Y, +Z, −Z, each split into 2×2 quadrants (24 meshes). Quadrant q of a
 /// wall covers the signs (bit 1: second in-plane axis > 0, bit 0: first > 0) of the two
@@ -187,6 +296,9 @@ mod tests {
     fn shapes_wind_counter_clockwise_around_their_normals() {
         assert!(outward_ccw(&uv_sphere("s", Vec3::ZERO, 1.0, 16, 8, 0)));
         assert!(outward_ccw(&quad("q", Vec3::ZERO, Vec3::X, Vec3::Y, 3, 0)));
+        assert!(outward_ccw(&torus("t", Vec3::ZERO, Vec3::Y, 1.0, 0.3, 16, 8, 0)));
+        assert!(outward_ccw(&bowl("b", Vec3::ZERO, Vec3::Y, 1.0, 1.5, 16, 6, 0)));
+        assert!(outward_ccw(&blob("l", Vec3::ZERO, 1.0, 0.3, 7, 16, 8, 0)));
         for m in quadrant_room(Vec3::ZERO, 1.0, 2, |_, _| 0) {
             assert!(outward_ccw(&m), "{}", m.name);
         }

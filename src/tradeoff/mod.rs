@@ -8,6 +8,8 @@
 //! metric, the Pareto front, the panels), `csv.rs`, `plot.rs` (the figure, its point
 //! labels in `labels.rs` and its axes' ticks in `ticks.rs`) and `study.rs` (the driver).
 
+pub mod calibrate;
+pub mod corpus;
 mod csv;
 mod labels;
 mod plot;
@@ -23,3 +25,5 @@ pub use plot::{plot, Figure};
 pub use rows::{pareto_front, region_panels, Metric, Panel, Row};
 pub use study::{run, Config, Progress, Report};
 pub use sweep::{series, variants, Series, Sweep};
+pub use calibrate::{calibrate, costs_for, device_key, Source};
+pub use corpus::{gpu_methods, measure, Measure};

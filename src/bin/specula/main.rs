@@ -7,6 +7,7 @@ mod args;
 mod bench;
 mod budget;
 mod compare;
+mod corpus;
 mod demo;
 mod info;
 mod knobs;
@@ -111,6 +112,35 @@ enum Command {
         /// Where --calibrate writes the models.
         #[arg(long, requires = "calibrate")]
         models: Option<PathBuf>,
+    },
+    /// Measure the measuring planner's corpus (scenes generated in code): every method and
+    /// knob variant against the exact tracer, object by object; writes the corpus file the
+    /// error models are fitted on and prints their leave-one-scene-out accuracy.
+    Corpus {
+        /// The corpus file to write.
+        #[arg(long, default_value = "assets/models/corpus.json")]
+        out: PathBuf,
+        /// Frame size WIDTHxHEIGHT.
+        #[arg(long, default_value = "128x128")]
+        size: String,
+        /// Only these corpus scene numbers (comma-separated); default all.
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<usize>,
+        #[arg(long)]
+        validate: bool,
+        #[arg(long)]
+        device: Option<String>,
+    },
+    /// Measure this device's unit costs for the planner (a few corpus scenes, every method,
+    /// two sizes) and cache them (SPECULA_CACHE_DIR, else the user cache directory) or write
+    /// them to --out. Runs by itself the first time `auto` meets a device.
+    Calibrate {
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[arg(long)]
+        validate: bool,
+        #[arg(long)]
+        device: Option<String>,
     },
     /// Survey Table 1 measured for ray tracing in the original geometry: per scheme and
     /// scene size the CPU build, the GPU frame and the structure's memory (table1.csv,
@@ -248,6 +278,8 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, parts, out, device } => {
             raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
+        Command::Corpus { out, size, scenes, validate, device } => corpus::run_corpus(&out, &size, &scenes, validate, &device),
+        Command::Calibrate { out, validate, device } => corpus::run_calibrate(out.as_deref(), validate, &device),
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())

@@ -22,22 +22,34 @@ pub fn choose(
     size: (u32, u32),
     sources: &[(&Models, String)],
 ) -> Result<Option<(Choices, Quality, Prediction)>> {
-    let facts = SceneFacts::new(scene, quality, true);
+    choose_with(scene, &SceneFacts::new(scene, quality, true), choices, quality, budget, size, sources)
+}
+
+/// [`choose`] with the scene's (deep) facts already computed.
+pub fn choose_with(
+    scene: &Scene,
+    facts: &SceneFacts,
+    choices: &Choices,
+    quality: &Quality,
+    budget: Budget,
+    size: (u32, u32),
+    sources: &[(&Models, String)],
+) -> Result<Option<(Choices, Quality, Prediction)>> {
     if facts.objects.is_empty() {
         return Ok(None);
     }
     for (models, source) in sources {
-        let Some(variants) = candidates(scene, &facts, choices, models, size) else { continue };
+        let Some(variants) = candidates(scene, facts, choices, models, size) else { continue };
         // (variant, whole-scene method or None for mixed, picks, rank)
         let mut best: Option<Best> = None;
         for (k, v) in variants.iter().enumerate() {
-            let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts: &facts };
+            let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts };
             let idx = search(budget, &|p| timing.frame_ms(p, false), &v.per_object);
             let mixed: Vec<Candidate> = idx.iter().zip(&v.per_object).map(|(&i, c)| c[i].clone()).collect();
             let options = std::iter::once((None, v.base, mixed)).chain(v.wholes.iter().map(|(m, b, list)| (Some(*m), *b, list.clone())));
             for (whole, base, picks) in options {
                 let refs: Vec<&Candidate> = picks.iter().collect();
-                let t = Timing { base, quality: timing.quality.clone(), facts: &facts };
+                let t = Timing { base, quality: timing.quality.clone(), facts };
                 let r = rank(budget, t.frame_ms(&refs, whole.is_some()), &refs);
                 if best.as_ref().is_none_or(|b| better(r, b.4)) {
                     best = Some((k, whole, base, picks, r));
@@ -47,7 +59,7 @@ pub fn choose(
         let Some((k, whole, base, picks, r)) = best else { continue };
         let v = &variants[k];
         let q = variant_quality(quality, &v.knobs)?;
-        let timing = Timing { base, quality: q.clone(), facts: &facts };
+        let timing = Timing { base, quality: q.clone(), facts };
         let refs: Vec<&Candidate> = picks.iter().collect();
         let objects: Vec<ObjectPrediction> = facts
             .objects

@@ -43,7 +43,7 @@ mod prediction;
 mod search;
 
 pub use attribute::{attribute, measured_by_object, Cost};
-pub use choose::choose;
+pub use choose::{choose, choose_with};
 pub use fit::{fit, Measured};
 pub use models::{stored_defaults, variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};
 pub use prediction::{report, Budget, FrameMeasured, ObjectPrediction, Prediction};

@@ -12,6 +12,10 @@ pub enum Budget {
     MaxMs(f64),
     /// Every specular object at least this PSNR (dB) on its pixels; the least time.
     MinPsnr(f64),
+    /// `auto`'s default: at most `max_ms` (the exact tracer's predicted frame), and within
+    /// that the fastest choice whose specular PSNR reaches `floor_db` (the best reachable
+    /// within `max_ms` less a tolerance).
+    Near { max_ms: f64, floor_db: f64 },
 }
 
 impl Budget {
@@ -32,6 +36,9 @@ impl Budget {
         match self {
             Budget::MaxMs(ms) => format!("--max-ms {}", short(*ms)),
             Budget::MinPsnr(db) => format!("--min-psnr {}", short(*db)),
+            Budget::Near { max_ms, floor_db } => {
+                format!("default (at most the exact tracer's {} ms, the fastest reaching {} dB)", short(*max_ms), short(*floor_db))
+            }
         }
     }
 }

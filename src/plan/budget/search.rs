@@ -94,6 +94,18 @@ pub(super) fn rank(budget: Budget, ms: f64, picks: &[&Candidate]) -> (bool, f64,
                 (false, min_psnr, -ms)
             }
         }
+        // Within the time and the floor: the fastest; else the most accurate within the
+        // time, then anything over it, the fastest first.
+        Budget::Near { max_ms, floor_db } => {
+            let psnr = combined_psnr(picks);
+            if ms <= max_ms && psnr >= floor_db {
+                (true, -ms, psnr)
+            } else if ms <= max_ms {
+                (false, psnr, -ms)
+            } else {
+                (false, -1e9 - ms, psnr)
+            }
+        }
         // Within the time: the most accurate, then the fastest; over it: the fastest.
         Budget::MaxMs(t) => {
             if ms <= t {

@@ -1,6 +1,8 @@
 //! Scenes built in code for the demo and the benchmarks (the bundled glTF scenes are in
 //! `assets/`).
 
+pub mod corpus;
+
 use glam::Vec3;
 
 use crate::error::Result;
@@ -54,6 +56,9 @@ pub const BUILTIN: &[&str] =
 /// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
 /// `caustic-ball`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
+    if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < corpus::SIZE) {
+        return Some(corpus::scene(i));
+    }
     Some(match name {
         "corner-mirror" => corner_mirror(),
         "concave-occluder" => concave_occluder(),
@@ -73,7 +78,7 @@ pub const ROOM_HALF: f32 = 2.0;
 /// An emissive checkerboard texture: `cells`×`cells` squares of `a` and `b` (linear
 /// colours, stored sRGB-encoded as textures are), 8 texels per square so that bilinear
 /// filtering blurs only a square's rim.
-fn checker_texture(name: &str, cells: u32, a: Vec3, b: Vec3) -> crate::scene::Texture {
+pub fn checker_texture(name: &str, cells: u32, a: Vec3, b: Vec3) -> crate::scene::Texture {
     let n = cells * 8;
     let enc = |c: f32| -> u8 {
         let c = c.clamp(0.0, 1.0);

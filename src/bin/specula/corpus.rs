@@ -1,0 +1,76 @@
+//! `specula corpus` (measure the generated corpus: the measuring planner's error data) and
+//! `specula calibrate` (this device's unit costs, cached).
+
+use std::path::Path;
+
+use specula::plan::predict::error_model;
+use specula::scenes::corpus;
+use specula::tradeoff::{self, Measure};
+use specula::vk::{Context, DeviceOptions};
+
+use crate::args::parse_size;
+
+/// Measures corpus scenes `scenes` (every one when empty) and writes the corpus file; prints
+/// the error models' leave-one-scene-out accuracy.
+pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, device: &Option<String>) -> specula::Result<()> {
+    let size = parse_size(size)?;
+    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })?;
+    let cfg = Measure {
+        scenes: if scenes.is_empty() { (0..corpus::SIZE).collect() } else { scenes.to_vec() },
+        sizes: vec![size],
+        variants: vec!["default".into(), "cube_size=128".into(), "cube_size=512".into()],
+        methods: tradeoff::gpu_methods(),
+        sparse: vec![(specula::methods::RAY_ENGINE, 12), (specula::methods::RAY_HIERARCHY, 12)],
+        warmup: 1,
+        frames: 1,
+        base: specula::Quality::default(),
+    };
+    let t = std::time::Instant::now();
+    let c = tradeoff::measure(&ctx, &cfg, &mut |s| eprintln!("[{:7.1} s] {s}", t.elapsed().as_secs_f64()))?;
+    specula::output::write_file(out, c.to_json().as_bytes())?;
+    let held = error_model::leave_one_scene_out(&c.samples);
+    let (median, p90) = error_model::abs_error_quantiles(&held);
+    println!(
+        "{} samples of {} scenes at {}x{} on {} in {:.0} s; wrote {}",
+        c.samples.len(),
+        c.scenes().len(),
+        size.0,
+        size.1,
+        c.device.label(),
+        t.elapsed().as_secs_f64(),
+        out.display()
+    );
+    println!("error models, leave-one-scene-out: |predicted − measured| median {median:.2} dB, 90th percentile {p90:.2} dB ({} predictions)", held.len());
+    let validation = (ctx.validation.error_count(), ctx.validation.warning_count());
+    if validation.0 > 0 {
+        return Err(specula::Error::invalid("validation", format!("{} validation errors", validation.0)));
+    }
+    Ok(())
+}
+
+/// Calibrates this device's unit costs and writes them to `out`, or to the cache.
+pub fn run_calibrate(out: Option<&Path>, validate: bool, device: &Option<String>) -> specula::Result<()> {
+    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })?;
+    let t = std::time::Instant::now();
+    let c = tradeoff::calibrate(&ctx, &mut |s| eprintln!("[{:6.1} s] {s}", t.elapsed().as_secs_f64()))?;
+    let path = match out {
+        Some(p) => {
+            specula::output::write_file(p, c.to_json().as_bytes())?;
+            p.to_path_buf()
+        }
+        None => {
+            let dir = specula::plan::predict::cost_model::cache_dir()
+                .ok_or_else(|| specula::Error::invalid("cache", "no SPECULA_CACHE_DIR, XDG_CACHE_HOME or HOME to cache into: pass --out"))?;
+            specula::plan::predict::cost_model::store(&dir, &c)?
+        }
+    };
+    println!("calibrated {} in {:.1} s; wrote {}", c.key.label(), c.calibration_s, path.display());
+    println!("{:<24} {:>10} {:>12} {:>12} {:>12} {:>12} {:>12}", "method", "ms/object", "ms/Mtexel·kTri", "ms/Mtexel", "ms/10⁴ px", "ms/10⁴ scr", "ms/10⁴ scr·d");
+    for (m, u) in &c.methods {
+        println!(
+            "{:<24} {:>10.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3}",
+            m, u.fixed[0], u.fixed[1], u.fixed[2], u.screen[0], u.shared[0], u.shared[1]
+        );
+    }
+    Ok(())
+}

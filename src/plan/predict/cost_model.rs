@@ -1,0 +1,228 @@
+//! Cost models: per method, an object's GPU milliseconds on one device as non-negative
+//! unit costs times its workload (`features::cost_features`), split as the frame spends
+//! them: map passes (a constant per object, cube-map rasterisation per texel × scene
+//! triangle, per texel), camera passes (per covered pixel) and whole-screen kernels (per
+//! screen pixel, and per pixel × hierarchy depth), and the frame's base (per frame, per
+//! screen pixel, per light, per light × scene triangle). The unit costs are fitted
+//! (non-negative least squares) on a calibration run on the device itself
+//! (`tradeoff::calibrate`), keyed by the device and cached on disk.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::features::{cost_features, Workload};
+use super::linear;
+use super::samples::Corpus;
+use crate::error::{Error, Result};
+
+/// The first line of every cost file's `format` field.
+pub const FORMAT: &str = "specula-costs 1";
+
+/// Which cost features (`features::COST_FEATURES` indices) each part reads.
+const FIXED: [usize; 3] = [0, 3, 4];
+const SCREEN: [usize; 1] = [1];
+const SHARED: [usize; 2] = [2, 5];
+
+/// A device as the cost cache knows it: PCI vendor and device ids, the driver's version
+/// and its name (`VkPhysicalDeviceProperties`), and the driver's own description
+/// (`VkPhysicalDeviceDriverProperties`: lavapipe reports driver version 1 whatever Mesa
+/// release it is, and names the release there).
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct DeviceKey {
+    pub vendor: u32,
+    pub device: u32,
+    pub driver: u32,
+    pub name: String,
+    pub driver_info: String,
+}
+
+impl DeviceKey {
+    /// How files and reports name it.
+    pub fn label(&self) -> String {
+        format!("{} ({}) [{:04x}:{:04x} driver {:#x}]", self.name, self.driver_info, self.vendor, self.device, self.driver)
+    }
+
+    /// Its cache file's name.
+    pub fn file_name(&self) -> String {
+        // FNV-1a of the driver's description.
+        let h = self.driver_info.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
+        format!("costs-{:04x}-{:04x}-{:08x}-{:016x}.json", self.vendor, self.device, self.driver, h)
+    }
+}
+
+/// Unit costs of one method.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MethodCost {
+    pub fixed: Vec<f64>,
+    pub screen: Vec<f64>,
+    pub shared: Vec<f64>,
+    /// Inter-object cycles of the frames it was measured in (the map part covers that many).
+    pub cycles: u32,
+    pub samples: usize,
+}
+
+/// One device's unit costs.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CostModel {
+    pub format: String,
+    pub key: DeviceKey,
+    pub methods: BTreeMap<String, MethodCost>,
+    /// Over `[1, screen pixels (1e4), lights, lights × scene triangles (1e4)]`.
+    pub base: Vec<f64>,
+    /// Seconds the calibration took.
+    pub calibration_s: f64,
+}
+
+fn pick(x: &[f64], idx: &[usize]) -> Vec<f64> {
+    idx.iter().map(|&i| x[i]).collect()
+}
+
+fn base_features(w: &Workload) -> Vec<f64> {
+    vec![1.0, w.screen / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
+}
+
+impl CostModel {
+    /// Fits unit costs from a measurement run on the device `key`.
+    pub fn fit(corpus: &Corpus, key: DeviceKey, calibration_s: f64) -> CostModel {
+        let mut by: BTreeMap<&str, Vec<&super::samples::Sample>> = BTreeMap::new();
+        for s in &corpus.samples {
+            by.entry(s.method.as_str()).or_default().push(s);
+        }
+        let methods = by
+            .into_iter()
+            .map(|(m, ss)| {
+                let x: Vec<Vec<f64>> = ss.iter().map(|s| cost_features(&s.work)).collect();
+                // Relative error matters (a 1 ms part beside a 100 ms one): weight by 1/y.
+                let part = |idx: &[usize], y: &dyn Fn(&super::samples::Sample) -> f64| {
+                    let xs: Vec<Vec<f64>> = x.iter().map(|r| pick(r, idx)).collect();
+                    let ys: Vec<f64> = ss.iter().map(|s| y(s)).collect();
+                    let mean = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
+                    let w: Vec<f64> = ys.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
+                    linear::fit(&xs, &ys, &w, 1e-4, true)
+                };
+                let cost = MethodCost {
+                    fixed: part(&FIXED, &|s| s.fixed_ms),
+                    screen: part(&SCREEN, &|s| s.screen_ms),
+                    shared: part(&SHARED, &|s| s.shared_ms),
+                    cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
+                    samples: ss.len(),
+                };
+                (m.to_string(), cost)
+            })
+            .collect();
+        let xb: Vec<Vec<f64>> = corpus.frames.iter().map(|f| base_features(&f.work)).collect();
+        let yb: Vec<f64> = corpus.frames.iter().map(|f| f.base_ms).collect();
+        let wb = vec![1.0; yb.len()];
+        let base = linear::fit(&xb, &yb, &wb, 1e-4, true);
+        CostModel { format: FORMAT.into(), key, methods, base, calibration_s }
+    }
+
+    /// Predicted (map, camera, whole-screen) milliseconds of `method` for an object of this
+    /// workload; `None` for a method the calibration did not measure.
+    pub fn predict(&self, method: &str, w: &Workload) -> Option<(f64, f64, f64)> {
+        let c = self.methods.get(method)?;
+        let x = cost_features(w);
+        Some((linear::dot(&c.fixed, &pick(&x, &FIXED)), linear::dot(&c.screen, &pick(&x, &SCREEN)), linear::dot(&c.shared, &pick(&x, &SHARED))))
+    }
+
+    /// The frame's base (what belongs to no object) at this workload's screen and lights.
+    pub fn base_ms(&self, w: &Workload) -> f64 {
+        linear::dot(&self.base, &base_features(w))
+    }
+
+    pub fn parse(text: &str, what: &str) -> Result<CostModel> {
+        let c: CostModel = serde_json::from_str(text).map_err(|e| Error::invalid(what.to_string(), format!("not a cost file: {e}")))?;
+        if c.format != FORMAT {
+            return Err(Error::invalid(format!("{what} format"), format!("'{}', expected '{FORMAT}'", crate::error::clip(&c.format))));
+        }
+        let ok = |v: &[f64], n: usize| v.len() == n && v.iter().all(|x| x.is_finite() && *x >= 0.0);
+        for (m, mc) in &c.methods {
+            crate::plan::Method::parse(m).map_err(|e| Error::invalid(format!("{what} methods"), e.to_string()))?;
+            if !ok(&mc.fixed, FIXED.len()) || !ok(&mc.screen, SCREEN.len()) || !ok(&mc.shared, SHARED.len()) || mc.cycles == 0 {
+                return Err(Error::invalid(format!("{what} methods.{m}"), "unit costs must be finite, non-negative and complete".to_string()));
+            }
+        }
+        if !ok(&c.base, 4) {
+            return Err(Error::invalid(format!("{what} base"), format!("{:?}: 4 finite non-negative unit costs expected", c.base)));
+        }
+        Ok(c)
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).unwrap_or_default()
+    }
+}
+
+/// Where cost files are cached: `SPECULA_CACHE_DIR`, else `$XDG_CACHE_HOME/specula`, else
+/// `$HOME/.cache/specula`; `None` when none is set (nothing is cached then).
+pub fn cache_dir() -> Option<PathBuf> {
+    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    var("SPECULA_CACHE_DIR").or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("specula"))).or_else(|| var("HOME").map(|h| h.join(".cache/specula")))
+}
+
+/// The cached unit costs of `key` in `dir`: `Ok(None)` when none are cached; an error naming
+/// the file when it cannot be read or is not a cost file of that device.
+pub fn load_cached(dir: &Path, key: &DeviceKey) -> Result<Option<CostModel>> {
+    let path = dir.join(key.file_name());
+    let text = match std::fs::read_to_string(&path) {
+        Ok(t) => t,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(Error::io(&path, e)),
+    };
+    let c = CostModel::parse(&text, &path.display().to_string())?;
+    if &c.key != key {
+        return Err(Error::invalid(path.display().to_string(), format!("holds the costs of {}, not {}", c.key.label(), key.label())));
+    }
+    Ok(Some(c))
+}
+
+/// Writes `c` into `dir` (created) under its device's file name, atomically (a reader never
+/// sees half a file).
+pub fn store(dir: &Path, c: &CostModel) -> Result<PathBuf> {
+    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    let path = dir.join(c.key.file_name());
+    let tmp = dir.join(format!(".{}.{}", c.key.file_name(), std::process::id()));
+    std::fs::write(&tmp, c.to_json()).map_err(|e| Error::io(&tmp, e))?;
+    std::fs::rename(&tmp, &path).map_err(|e| Error::io(&path, e))?;
+    Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(device: u32) -> DeviceKey {
+        DeviceKey { vendor: 0x10005, device, driver: 1, name: format!("fake {device}"), driver_info: "fake driver".into() }
+    }
+
+    fn model(device: u32) -> CostModel {
+        CostModel { format: FORMAT.into(), key: key(device), methods: BTreeMap::new(), base: vec![1.0, 0.5, 0.0, 0.0], calibration_s: 1.0 }
+    }
+
+    /// Two device keys side by side in one cache; a corrupt or truncated file is an error
+    /// naming it (the caller re-calibrates), never a panic; a file of another device is
+    /// refused.
+    #[test]
+    fn cache_holds_devices_apart_and_refuses_corrupt_files() {
+        let dir = std::env::temp_dir().join(format!("specula-costs-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(load_cached(&dir, &key(1)).unwrap(), None);
+        store(&dir, &model(1)).unwrap();
+        store(&dir, &model(2)).unwrap();
+        assert_eq!(load_cached(&dir, &key(1)).unwrap(), Some(model(1)));
+        assert_eq!(load_cached(&dir, &key(2)).unwrap(), Some(model(2)));
+        let path = dir.join(key(1).file_name());
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, &text[..text.len() / 2]).unwrap();
+        let e = load_cached(&dir, &key(1)).unwrap_err().to_string();
+        assert!(e.contains(&key(1).file_name()) && e.contains("not a cost file"), "{e}");
+        std::fs::write(&path, text.replace("\"fake 1\"", "\"fake 3\"")).unwrap();
+        let e = load_cached(&dir, &key(1)).unwrap_err().to_string();
+        assert!(e.contains("not fake 1"), "{e}");
+        std::fs::write(&path, text.replace("0.5", "-0.5")).unwrap();
+        assert!(load_cached(&dir, &key(1)).is_err());
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

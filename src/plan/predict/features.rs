@@ -1,0 +1,108 @@
+//! What the models see of an object: the planner's facts (`plan::facts`) and the knobs, as
+//! named numbers. Error features describe how hard the object is for a method (how
+//! non-convex, how close what it reflects, how strongly it bends light, what else specular
+//! it sees); workload features say how much work a method does for it (pixels, triangles,
+//! map texels).
+
+use serde::{Deserialize, Serialize};
+
+use crate::methods::registry::ObjectClass;
+use crate::plan::facts::{Curvature, ObjectFacts};
+use crate::quality::Quality;
+use crate::scene::{Scene, SurfaceKind};
+
+/// Names of the error features, in the order [`error_features`] returns them.
+pub const ERROR_FEATURES: [&str; 16] = [
+    "bias",
+    "non_convex",
+    "self_facing",
+    "log_depth_ratio",
+    "box_fraction",
+    "edge_angle",
+    "sees_specular",
+    "sees_planar_mirror",
+    "nu_minus_1",
+    "log_near_ratio",
+    "planar",
+    "concave",
+    "saddle",
+    "solid",
+    "thin",
+    "log2_cube_size",
+];
+
+/// An object's error features.
+pub fn error_features(f: &ObjectFacts, scene: &Scene, q: &Quality) -> Vec<f64> {
+    let nu = match scene.materials[scene.meshes[f.mesh].material].kind {
+        SurfaceKind::Dielectric { ior, .. } => ior as f64,
+        _ => 1.0,
+    };
+    let b = |x: bool| x as u8 as f64;
+    vec![
+        1.0,
+        1.0 - f.visible_fraction as f64,
+        f.self_facing as f64,
+        (f.depth_ratio.max(1.0) as f64).ln(),
+        f.box_fraction as f64,
+        f.edge_angle as f64,
+        f.specular_coverage() as f64,
+        b(f.sees_planar_mirror),
+        // Refraction's strength, saturating (ν 2.4 bends little more than 1.8 does).
+        (nu - 1.0).min(1.0),
+        (f.near_ratio.max(0.05) as f64).ln(),
+        b(f.planar),
+        b(f.curvature == Curvature::Concave),
+        b(f.curvature == Curvature::Saddle),
+        b(f.class == ObjectClass::SolidDielectric),
+        b(f.class == ObjectClass::ThinDielectric),
+        (q.cube.cube_size.max(1) as f64 / 256.0).log2(),
+    ]
+}
+
+/// The work a frame does for an object (inputs of the cost model), at a frame size.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Workload {
+    /// The object's pixels in the frame.
+    pub pixels: f64,
+    /// The frame's pixels.
+    pub screen: f64,
+    /// Triangles of the whole scene (what a cube map rasterises per face, what rays search).
+    pub scene_triangles: f64,
+    /// The object's own triangles.
+    pub triangles: f64,
+    /// Texels of one cube map (6 faces of `cube_size`²).
+    pub cube_texels: f64,
+    /// Punctual lights (one shadow map each).
+    pub lights: f64,
+}
+
+/// Names of the cost features, in the order [`cost_features`] returns them.
+pub const COST_FEATURES: [&str; 6] = ["object", "pixels", "screen", "cube_raster", "cube_texels", "screen_log_triangles"];
+
+/// The cost features of a workload: a constant per object, its pixels (1e4), the frame's
+/// pixels (1e4: kernels over the whole screen), cube-map rasterisation (texels × scene
+/// triangles, 1e9), cube texels (1e6), and rays over the screen times the depth of a
+/// hierarchy over the scene's triangles.
+pub fn cost_features(w: &Workload) -> Vec<f64> {
+    vec![
+        1.0,
+        w.pixels / 1e4,
+        w.screen / 1e4,
+        w.cube_texels * w.scene_triangles / 1e9,
+        w.cube_texels / 1e6,
+        w.screen / 1e4 * w.scene_triangles.max(2.0).log2() / 16.0,
+    ]
+}
+
+/// The workload of object `f` at `size` covering `pixels` of it.
+pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), pixels: f64) -> Workload {
+    let visible = |m: &&crate::scene::Mesh| !m.hidden;
+    Workload {
+        pixels,
+        screen: size.0 as f64 * size.1 as f64,
+        scene_triangles: scene.meshes.iter().filter(visible).map(|m| m.triangle_count() as f64).sum(),
+        triangles: f.triangles as f64,
+        cube_texels: 6.0 * (q.cube.cube_size as f64).powi(2),
+        lights: scene.lights.len() as f64,
+    }
+}

@@ -1,0 +1,218 @@
+//! The measuring planner (issue 31): per specular object, the method whose predicted error
+//! is lowest for the frame's predicted time on this device.
+//!
+//! * **Error** is predicted from the object, not its class: per method a ridge regression
+//!   over the planner's facts and the knobs (`features`, `error_model`), fitted on a corpus
+//!   of scenes generated in code (`scenes::corpus`, measured by `specula corpus` against the exact
+//!   tracer into `assets/models/corpus.json`); held-out scenes measure how well it
+//!   generalises (`error_model::leave_one_scene_out`).
+//! * **Cost** is measured on the device: unit costs per method and workload term
+//!   (`cost_model`), fitted on a calibration run of a few corpus scenes (`specula calibrate`,
+//!   or automatically the first time a device is seen), cached per device; the stored
+//!   calibration of the machine the corpus was measured on ships in
+//!   `assets/models/costs.json`.
+//! * **The choice** is the budgeted planner's search (`plan::budget`) over per-object
+//!   candidates built from these predictions: shared passes paid once, composition cycles
+//!   counted, dominated candidates dropped. Without a budget, `auto` spends at most what the
+//!   exact tracer (`bvh`) is predicted to cost, and within that takes the fastest choice
+//!   within [`TOLERANCE_DB`] of the most accurate one.
+
+pub mod cost_model;
+pub mod error_model;
+pub mod features;
+mod linear;
+pub mod samples;
+
+use std::sync::{Arc, OnceLock};
+
+use cost_model::CostModel;
+use error_model::ErrorModel;
+use features::{error_features, workload};
+use samples::Corpus;
+
+use super::budget::{self, Budget, Cost, Models, ObjectModel, Prediction, VariantModel};
+use super::facts::SceneFacts;
+use super::{Choices, Method};
+use crate::error::{Error, Result};
+use crate::methods::BVH;
+use crate::quality::Quality;
+use crate::scene::Scene;
+
+/// `auto`'s tolerance: choices predicted within this many dB of the most accurate one are
+/// as good, and the fastest of them wins (`planner=speed`: [`SPEED_TOLERANCE_DB`]).
+pub const TOLERANCE_DB: f64 = 0.5;
+pub const SPEED_TOLERANCE_DB: f64 = 3.0;
+/// The frame size predictions assume when the caller does not say (`Target::nominal`).
+pub const NOMINAL_SIZE: u32 = 512;
+
+const CORPUS_FILE: &str = "assets/models/corpus.json";
+const COSTS_FILE: &str = "assets/models/costs.json";
+
+/// The stored corpus (the error models' data).
+pub fn stored_corpus() -> Result<&'static Corpus> {
+    static C: OnceLock<std::result::Result<Corpus, String>> = OnceLock::new();
+    C.get_or_init(|| Corpus::parse(include_str!("../../../assets/models/corpus.json"), CORPUS_FILE).map_err(|e| e.to_string()))
+        .as_ref()
+        .map_err(|e| Error::invalid(CORPUS_FILE, e.clone()))
+}
+
+/// The error models fitted on the stored corpus (empty if it cannot be read, which its own
+/// test rules out).
+pub fn error_model() -> &'static ErrorModel {
+    static M: OnceLock<ErrorModel> = OnceLock::new();
+    M.get_or_init(|| stored_corpus().map(|c| ErrorModel::fit(&c.samples, &|_| true)).unwrap_or_default())
+}
+
+/// The stored calibration (of the device the corpus was measured on).
+pub fn stored_costs() -> Option<&'static CostModel> {
+    static C: OnceLock<Option<CostModel>> = OnceLock::new();
+    C.get_or_init(|| CostModel::parse(include_str!("../../../assets/models/costs.json"), COSTS_FILE).ok()).as_ref()
+}
+
+/// What a plan is predicted for: the frame's size and the device's unit costs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Target {
+    pub size: (u32, u32),
+    pub costs: Arc<CostModel>,
+}
+
+impl Target {
+    /// [`NOMINAL_SIZE`]², on the stored calibration's device.
+    pub fn nominal() -> Option<Target> {
+        stored_costs().map(|c| Target { size: (NOMINAL_SIZE, NOMINAL_SIZE), costs: Arc::new(c.clone()) })
+    }
+}
+
+/// Each specular object's pixels at `size`, from the exact first hits of a frame of at
+/// most 128 pixels across (scaled up).
+fn coverage(scene: &Scene, size: (u32, u32)) -> Vec<f64> {
+    let scale = (128.0 / size.0.max(size.1) as f64).min(1.0);
+    let small = (((size.0 as f64 * scale).round() as u32).max(1), ((size.1 as f64 * scale).round() as u32).max(1));
+    let up = (size.0 as f64 * size.1 as f64) / (small.0 as f64 * small.1 as f64);
+    let mut px = vec![0.0; scene.meshes.len()];
+    if let Ok(ids) = crate::reference::object_ids(scene, small) {
+        for id in ids.into_iter().filter(|&id| id > 0) {
+            if let Some(p) = px.get_mut(id as usize - 1) {
+                *p += up;
+            }
+        }
+    }
+    px
+}
+
+/// Per object and method, the predicted cost and error at `target`, in the budgeted
+/// planner's format (one variant per entry of `variants`).
+pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, variants: &[String]) -> Result<Models> {
+    let errors = error_model();
+    let px = coverage(scene, target.size);
+    let mut out = Vec::new();
+    for v in variants {
+        let q = budget::variant_quality(quality, v)?;
+        let mut objects = Vec::new();
+        let mut base = 0.0;
+        for f in &facts.objects {
+            let name = &scene.meshes[f.mesh].name;
+            let work = workload(f, scene, &q, target.size, px[f.mesh]);
+            base = target.costs.base_ms(&work);
+            let feats = error_features(f, scene, &q);
+            for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
+                let (Some(psnr), Some((fixed, screen, shared))) = (errors.predict(m.name, &feats), target.costs.predict(m.name, &work)) else {
+                    continue;
+                };
+                let cycles = target.costs.methods.get(m.name).map_or(1, |c| c.cycles);
+                objects.push(ObjectModel {
+                    object: name.clone(),
+                    class: f.class.label().to_string(),
+                    pixels: work.pixels.round() as usize,
+                    method: m.name.to_string(),
+                    cost: Cost { fixed_ms: fixed, screen_ms: screen },
+                    shared: Cost { fixed_ms: 0.0, screen_ms: shared },
+                    cycles,
+                    row: String::new(),
+                    psnr_db: psnr,
+                });
+            }
+        }
+        out.push(VariantModel { knobs: v.clone(), base: Cost { fixed_ms: base, screen_ms: 0.0 }, row_bases: Vec::new(), objects });
+    }
+    Ok(Models {
+        format: budget::FORMAT.into(),
+        scene: "predicted".into(),
+        device: target.costs.key.label(),
+        size: [target.size.0, target.size.1],
+        variants: out,
+    })
+}
+
+/// Where predictions come from, for reports.
+pub fn source(target: &Target) -> String {
+    let n = stored_corpus().map_or(0, |c| c.scenes().len());
+    format!("predicted (errors: {n} corpus scenes; costs: {})", target.costs.key.label())
+}
+
+/// The budgeted choice from predictions: per object a method (and, over `variants`, the
+/// frame's knobs), with the prediction. `None` when some object has no candidate.
+pub fn choose(
+    scene: &Scene,
+    choices: &Choices,
+    quality: &Quality,
+    budget: Budget,
+    target: &Target,
+    variants: &[String],
+) -> Result<Option<(Choices, Quality, Prediction)>> {
+    let facts = SceneFacts::new(scene, quality, true);
+    let models = predict_models(scene, &facts, quality, target, variants)?;
+    budget::choose_with(scene, &facts, choices, quality, budget, target.size, &[(&models, source(target))])
+}
+
+/// `auto`'s choice for a scene: per object its method, the prediction, and the candidates
+/// it was chosen from.
+#[derive(Clone, Debug)]
+pub struct AutoPlan {
+    pub choices: Choices,
+    pub prediction: Prediction,
+    pub models: Models,
+}
+
+impl AutoPlan {
+    /// Why object `name` got `method`: its prediction and the runner-up (the most accurate
+    /// other candidate).
+    pub fn reason(&self, name: &str, method: Method) -> String {
+        let b = &self.prediction.budget;
+        let Some(o) = self.prediction.objects.iter().find(|o| o.name == name) else {
+            return format!("auto ({})", b.describe());
+        };
+        let others = self.models.variants.first().map(|v| v.objects.iter().filter(|c| c.object == name && c.method != method.name));
+        let runner = others.and_then(|it| it.max_by(|a, b| a.psnr_db.total_cmp(&b.psnr_db).then(b.cost.fixed_ms.total_cmp(&a.cost.fixed_ms))));
+        let runner = runner.map_or(String::new(), |r| {
+            let ms = r.cost.fixed_ms + r.cost.screen_ms + r.shared.screen_ms;
+            format!("; runner-up {} ({:.1} dB, {:.1} ms)", r.method, r.psnr_db, ms)
+        });
+        format!("auto: predicted {:.1} dB, {:.1} ms{runner}; budget {}", o.psnr_db, o.ms, b.describe())
+    }
+}
+
+/// `auto` without a budget: the exact tracer's predicted frame is the budget; within it,
+/// the fastest choice within the tolerance of the most accurate. `None` when some object
+/// has no prediction.
+pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Quality, target: &Target) -> Result<Option<AutoPlan>> {
+    if facts.objects.is_empty() {
+        return Ok(None);
+    }
+    let models = predict_models(scene, facts, quality, target, &["default".to_string()])?;
+    let src = [(&models, source(target))];
+    let run = |c: &Choices, b: Budget| budget::choose_with(scene, facts, c, quality, b, target.size, &src);
+    // The exact tracer for every object the caller left to auto.
+    let mut exact = choices.clone();
+    for f in &facts.objects {
+        if !choices.objects.iter().any(|(n, _)| super::names_object(scene, f.mesh, n)) {
+            exact.objects.push((scene.meshes[f.mesh].name.clone(), BVH));
+        }
+    }
+    let Some((_, _, exact)) = run(&exact, Budget::MaxMs(f64::INFINITY))? else { return Ok(None) };
+    let max_ms = exact.frame_ms;
+    let Some((_, _, best)) = run(choices, Budget::MaxMs(max_ms))? else { return Ok(None) };
+    let tolerance = if quality.plan.planner.speed() { SPEED_TOLERANCE_DB } else { TOLERANCE_DB };
+    let floor_db = best.specular_psnr_db - tolerance;
+    Ok(run(choices, Budget::Near { max_ms, floor_db })?.map(|(choices, _, prediction)| AutoPlan { choices, prediction, models }))
+}

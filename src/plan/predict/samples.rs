@@ -1,0 +1,117 @@
+//! Measurements the models are fitted on: per corpus scene, method and knob variant, each
+//! specular object's error against the exact tracer and its share of the frame's GPU time,
+//! with the facts and workload the models predict from; per frame the base (what belongs
+//! to no object). Written by `specula corpus` (every scene, the error models' data, stored
+//! in `assets/models/corpus.json`) and `specula calibrate` (a subset at two sizes on the
+//! device at hand, for its cost model).
+
+use serde::{Deserialize, Serialize};
+
+use super::features::{Workload, ERROR_FEATURES};
+use crate::error::{Error, Result};
+use crate::plan::Method;
+
+/// The first line of every corpus file's `format` field.
+pub const FORMAT: &str = "specula-corpus 1";
+/// Measured PSNR is stored and fitted capped here: beyond it an image equals the exact
+/// tracer's to within float rounding (every exact scheme measures above it).
+pub const PSNR_CAP: f64 = 60.0;
+
+/// One object under one method and knob variant.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sample {
+    /// Corpus scene number (`corpus::scene`).
+    pub scene: usize,
+    pub object: String,
+    /// The method the object got (a whole-scene method's fallback where it did not serve it).
+    pub method: String,
+    /// `default` or `knob=value …` over the defaults.
+    pub knobs: String,
+    /// [`ERROR_FEATURES`], in order.
+    pub features: Vec<f64>,
+    pub work: Workload,
+    /// PSNR on its own pixels against the exact tracer, capped at [`PSNR_CAP`].
+    pub psnr_db: f64,
+    /// Its share of the map passes (independent of the output size).
+    pub fixed_ms: f64,
+    /// Its share of the camera passes.
+    pub screen_ms: f64,
+    /// Its method's whole-screen kernels, whole (paid once per method a frame uses).
+    pub shared_ms: f64,
+    /// Inter-object cycles of the frame it was measured in.
+    pub cycles: u32,
+}
+
+/// One frame's base: the GPU time that belongs to no object.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameSample {
+    pub scene: usize,
+    pub method: String,
+    pub knobs: String,
+    pub work: Workload,
+    pub base_ms: f64,
+}
+
+/// A measurement run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Corpus {
+    pub format: String,
+    /// Where it was measured.
+    pub device: super::cost_model::DeviceKey,
+    pub samples: Vec<Sample>,
+    pub frames: Vec<FrameSample>,
+}
+
+impl Corpus {
+    pub fn new(device: super::cost_model::DeviceKey) -> Corpus {
+        Corpus { format: FORMAT.into(), device, samples: Vec::new(), frames: Vec::new() }
+    }
+
+    /// Parses and checks a corpus file (`what` names it in errors).
+    pub fn parse(text: &str, what: &str) -> Result<Corpus> {
+        let c: Corpus = serde_json::from_str(text).map_err(|e| Error::invalid(what.to_string(), format!("not a corpus file: {e}")))?;
+        if c.format != FORMAT {
+            return Err(Error::invalid(format!("{what} format"), format!("'{}', expected '{FORMAT}'", crate::error::clip(&c.format))));
+        }
+        for (k, s) in c.samples.iter().enumerate() {
+            let field = |f: &str| format!("{what} samples[{k}].{f}");
+            Method::parse(&s.method).map_err(|e| Error::invalid(field("method"), e.to_string()))?;
+            if s.features.len() != ERROR_FEATURES.len() || s.features.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(field("features"), format!("{} finite values expected, got {:?}", ERROR_FEATURES.len(), s.features)));
+            }
+            for (name, v) in [("psnr_db", s.psnr_db), ("fixed_ms", s.fixed_ms), ("screen_ms", s.screen_ms), ("shared_ms", s.shared_ms)] {
+                if !v.is_finite() || v < 0.0 {
+                    return Err(Error::invalid(field(name), format!("{v} is not a finite non-negative number")));
+                }
+            }
+            check_work(&s.work, &field("work"))?;
+        }
+        for (k, f) in c.frames.iter().enumerate() {
+            if !f.base_ms.is_finite() || f.base_ms < 0.0 {
+                return Err(Error::invalid(format!("{what} frames[{k}].base_ms"), format!("{} is not a finite non-negative number", f.base_ms)));
+            }
+            check_work(&f.work, &format!("{what} frames[{k}].work"))?;
+        }
+        Ok(c)
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).unwrap_or_default()
+    }
+
+    /// The scene numbers it measured.
+    pub fn scenes(&self) -> Vec<usize> {
+        let mut s: Vec<usize> = self.samples.iter().map(|s| s.scene).collect();
+        s.sort();
+        s.dedup();
+        s
+    }
+}
+
+fn check_work(w: &Workload, what: &str) -> Result<()> {
+    let all = [w.pixels, w.screen, w.scene_triangles, w.triangles, w.cube_texels, w.lights];
+    if all.iter().any(|x| !x.is_finite() || *x < 0.0) {
+        return Err(Error::invalid(what.to_string(), format!("{w:?}: every count must be finite and non-negative")));
+    }
+    Ok(())
+}

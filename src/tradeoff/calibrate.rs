@@ -1,0 +1,109 @@
+//! A device's unit costs for the measuring planner: measured by rendering a few corpus
+//! scenes with every method at two sizes (`specula calibrate`, or automatically the first
+//! time a device is seen), fitted (`plan::predict::cost_model`), cached on disk per device
+//! (`cost_model::cache_dir`, overridable) and kept in memory per process.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, OnceLock};
+
+use super::corpus::{gpu_methods, measure, Measure};
+use crate::error::Result;
+use crate::methods::{RAY_ENGINE, RAY_HIERARCHY};
+use crate::plan::predict::cost_model::{cache_dir, load_cached, store, CostModel, DeviceKey};
+use crate::quality::Quality;
+use crate::vk::Context;
+
+/// The corpus scenes a calibration renders: one of each object kind, near and far rooms, an
+/// occluder, a light, two objects, and tessellations from 600 to 10⁴ triangles.
+pub const SCENES: [usize; 6] = [0, 3, 5, 7, 14, 22];
+/// Its two frame sizes (screen-proportional costs are told from fixed ones by the pair).
+pub const SIZES: [(u32, u32); 2] = [(64, 64), (128, 128)];
+
+/// The key of `ctx`'s device.
+pub fn device_key(ctx: &Context) -> DeviceKey {
+    let p = &ctx.properties;
+    DeviceKey { vendor: p.vendor_id, device: p.device_id, driver: p.driver_version, name: ctx.device_name.clone(), driver_info: ctx.driver_info.clone() }
+}
+
+/// What a calibration renders.
+pub fn plan() -> Measure {
+    Measure {
+        scenes: SCENES.to_vec(),
+        sizes: SIZES.to_vec(),
+        variants: vec!["default".into(), "cube_size=128".into()],
+        methods: gpu_methods(),
+        // The software ray engine and ray hierarchy take 50–100× bvh's time on lavapipe:
+        // two scenes give their unit costs.
+        sparse: vec![(RAY_ENGINE, 7), (RAY_HIERARCHY, 7)],
+        warmup: 1,
+        frames: 2,
+        base: Quality::default(),
+    }
+}
+
+/// Measures and fits `ctx`'s unit costs.
+pub fn calibrate(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<CostModel> {
+    let t = std::time::Instant::now();
+    let corpus = measure(ctx, &plan(), progress)?;
+    Ok(CostModel::fit(&corpus, device_key(ctx), t.elapsed().as_secs_f64()))
+}
+
+/// Where `ctx`'s costs came from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Source {
+    /// This process measured them.
+    Memory,
+    /// Read from this cache file.
+    Cache(PathBuf),
+    /// The stored corpus was measured on this very device (driver included).
+    Stored,
+    /// Calibrated now (and written to this cache file, if any).
+    Calibrated(Option<PathBuf>),
+}
+
+type Known = Mutex<Vec<(DeviceKey, Arc<CostModel>)>>;
+
+fn known() -> &'static Known {
+    static K: OnceLock<Known> = OnceLock::new();
+    K.get_or_init(|| Mutex::new(Vec::new()))
+}
+
+/// `ctx`'s unit costs: from this process, the cache (`dir`, else `cost_model::cache_dir`),
+/// the stored corpus when it was measured on this device, or a calibration run now (and
+/// cached). A cache file that cannot be read is reported through `warn` and replaced.
+pub fn costs_for(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(String)) -> Result<(Arc<CostModel>, Source)> {
+    let key = device_key(ctx);
+    if let Some((_, c)) = known().lock().ok().and_then(|k| k.iter().find(|(k2, _)| *k2 == key).cloned()) {
+        return Ok((c, Source::Memory));
+    }
+    let dir = dir.or_else(cache_dir);
+    let remember = |c: CostModel| {
+        let c = Arc::new(c);
+        if let Ok(mut k) = known().lock() {
+            k.push((key.clone(), c.clone()));
+        }
+        c
+    };
+    if let Some(d) = &dir {
+        match load_cached(d, &key) {
+            Ok(Some(c)) => return Ok((remember(c), Source::Cache(d.join(key.file_name())))),
+            Ok(None) => {}
+            Err(e) => warn(format!("{e}: re-calibrating")),
+        }
+    }
+    if let Some(c) = crate::plan::predict::stored_costs().filter(|c| c.key.label() == key.label()) {
+        return Ok((remember(c.clone()), Source::Stored));
+    }
+    let c = calibrate(ctx, &mut |_| {})?;
+    let written = match &dir {
+        Some(d) => match store(d, &c) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                warn(format!("could not cache the calibration: {e}"));
+                None
+            }
+        },
+        None => None,
+    };
+    Ok((remember(c), Source::Calibrated(written)))
+}

@@ -1,0 +1,107 @@
+//! Measuring the corpus (`plan::predict::corpus`) for the measuring planner: per scene, size
+//! and knob variant, the exact tracer's image (`bvh`) once, then every method rendered,
+//! timed and compared with it object by object; each object's error, its share of the GPU
+//! time (`plan::budget::attribute`), its facts and its workload become a `Sample`, each
+//! frame's base a `FrameSample`. `specula corpus` runs it over every scene (the error
+//! models' data); `specula calibrate` over a few at two sizes (a device's unit costs).
+
+use crate::error::Result;
+use crate::methods::{Choice, Method, BVH};
+use crate::scenes::corpus;
+use crate::plan::predict::features::{error_features, workload};
+use crate::plan::predict::samples::{Corpus, FrameSample, Sample, PSNR_CAP};
+use crate::plan::{plan_with, Choices};
+use crate::quality::Quality;
+use crate::vk::Context;
+
+/// What [`measure`] renders.
+#[derive(Clone, Debug)]
+pub struct Measure {
+    /// Corpus scene numbers.
+    pub scenes: Vec<usize>,
+    pub sizes: Vec<(u32, u32)>,
+    /// `default` or `knob=value …` over the base knobs; a method is measured in a variant
+    /// only when it reads every knob the variant sets (else the variant is its default).
+    pub variants: Vec<String>,
+    pub methods: Vec<Method>,
+    /// Methods measured on every n-th scene only (the slow exact schemes: their cost per
+    /// ray is what the calibration needs, not their error, which is the exact tracer's).
+    pub sparse: Vec<(Method, usize)>,
+    pub warmup: u32,
+    pub frames: u32,
+    pub base: Quality,
+}
+
+/// Every GPU method of the registry.
+pub fn gpu_methods() -> Vec<Method> {
+    Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect()
+}
+
+/// Renders and measures `cfg`; `progress` hears each step's name.
+pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> Result<Corpus> {
+    let mut out = Corpus::new(super::calibrate::device_key(ctx));
+    for &i in &cfg.scenes {
+        let scene = corpus::scene(i)?;
+        let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();
+        let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
+        for &size in &cfg.sizes {
+            let ids = crate::reference::object_ids(&scene, size)?;
+            for v in &cfg.variants {
+                let q = crate::plan::budget::variant_quality(&cfg.base, v)?;
+                let set: Vec<&str> = if v == "default" { Vec::new() } else { v.split_whitespace().filter_map(|p| p.split('=').next()).collect() };
+                progress(&format!("{} {}x{} {v}: bvh (reference)", corpus::name(i), size.0, size.1));
+                let reference = crate::render(ctx, &scene, BVH, &q, size, (1, 1))?;
+                let facts = crate::plan::facts::SceneFacts::new(&scene, &q, true);
+                for &m in &cfg.methods {
+                    if !set.iter().all(|k| m.knobs.contains(k)) {
+                        continue;
+                    }
+                    if cfg.sparse.iter().any(|(s, n)| *s == m && i % (*n).max(1) != 0) {
+                        continue;
+                    }
+                    progress(&format!("{} {}x{} {v}: {}", corpus::name(i), size.0, size.1, m.name));
+                    let plan = plan_with(&scene, &Choices::all(Choice::Method(m)), &q)?;
+                    let frame = if m == BVH && cfg.warmup <= 1 && cfg.frames <= 1 {
+                        reference.clone()
+                    } else {
+                        crate::render_plan(ctx, &scene, plan.clone(), size, (cfg.warmup.max(1), cfg.frames.max(1)))?
+                    };
+                    let regions = crate::metrics::errors_by_object(&frame.image, &reference.image, &ids, &specular, &names)?;
+                    let passes: Vec<(String, f64)> = frame.passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
+                    let (costs, base) = crate::plan::budget::attribute(&plan, &passes);
+                    let mut any = None;
+                    for (o, (mesh, own, shared)) in plan.objects.iter().zip(costs) {
+                        let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
+                        let pixels = regions.iter().find(|r| r.name == o.name).map_or(0, |r| r.pixels);
+                        let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
+                        let work = workload(f, &scene, &q, size, pixels as f64);
+                        any = Some(work);
+                        let dup = out.samples.iter().any(|s| {
+                            s.scene == i && s.object == o.name && s.method == o.method.name && s.knobs == *v && s.work.screen == work.screen
+                        });
+                        if dup {
+                            continue;
+                        }
+                        out.samples.push(Sample {
+                            scene: i,
+                            object: o.name.clone(),
+                            method: o.method.name.to_string(),
+                            knobs: v.clone(),
+                            features: error_features(f, &scene, &q),
+                            work,
+                            psnr_db: if psnr.is_finite() { psnr.min(PSNR_CAP) } else { PSNR_CAP },
+                            fixed_ms: own.fixed_ms,
+                            screen_ms: own.screen_ms,
+                            shared_ms: shared.fixed_ms + shared.screen_ms,
+                            cycles: plan.cycles.max(1),
+                        });
+                    }
+                    if let Some(work) = any {
+                        out.frames.push(FrameSample { scene: i, method: m.name.to_string(), knobs: v.clone(), work, base_ms: base.fixed_ms + base.screen_ms });
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
+}
