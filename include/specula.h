@@ -79,6 +79,10 @@
 // height): still accepted, as no budget.
 #define SPECULA_RENDER_DESC_SIZE_V1 20
 
+// The size of SpeculaRenderDesc before `cache_dir` (through `models_path`): still
+// accepted, as the default cache.
+#define SPECULA_RENDER_DESC_SIZE_V2 48
+
 // Opaque context: a device (own or the host's), a scene, knobs and a configured renderer.
 typedef struct SpeculaContext SpeculaContext;
 
@@ -259,12 +263,19 @@ typedef struct {
   // per specular object a method and for the frame the knob values, from per-object error
   // and cost models, so that a frame takes at most `max_ms` GPU milliseconds at the least
   // predicted error, or every specular object reaches `min_psnr_db` on its pixels at the
-  // least predicted time. specula_get_predictions reports the prediction.
+  // least predicted time. Without either, SPECULA_METHOD_AUTO spends at most the exact
+  // tracer's predicted frame and takes the fastest choice within 0.5 dB of the most
+  // accurate. specula_get_predictions reports the prediction.
   double max_ms;
   double min_psnr_db;
-  // The models (JSON from `specula tradeoff --calibrate`), or NULL: the stored defaults
-  // measured on the bundled scenes.
+  // A scene's own calibration (JSON from `specula tradeoff --calibrate`), or NULL:
+  // predictions from the objects' facts and the device's unit costs.
   const char *models_path;
+  // Where the device's unit costs are cached (the directory; created), or NULL: the
+  // SPECULA_CACHE_DIR environment variable, else the user's cache directory. A device
+  // seen for the first time is calibrated there (a few seconds on a GPU, about three
+  // minutes on lavapipe).
+  const char *cache_dir;
 } SpeculaRenderDesc;
 
 // What the budgeted planner predicted for one specular object (specula_get_predictions);

@@ -16,7 +16,7 @@ fn serves(m: Method) -> String {
 /// The README's method table (Markdown).
 pub fn method_table() -> String {
     let mut s = String::from("| `--method` | C ABI | survey | serves | what it does |\n|---|---|---|---|---|\n");
-    s += "| `auto` | `SPECULA_METHOD_AUTO` | | any | the planner: per specular object the method whose rule fits it best (`specula plan SCENE` says which and why); `planner=speed` takes cheaper rungs |\n";
+    s += "| `auto` | `SPECULA_METHOD_AUTO` | | any | the measuring planner: per specular object the method with the best predicted error for the frame's predicted time on this device (`specula plan SCENE --candidates` says which, why and what else) |\n";
     for m in Method::ALL {
         s += &format!("| `{}` | `SPECULA_METHOD_{}` | {} | {} | {} |\n", m.name, abi_name(*m), m.section, serves(*m), m.summary);
     }

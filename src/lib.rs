@@ -43,7 +43,22 @@ pub fn render(
     frames: (u32, u32),
 ) -> Result<Frame> {
     let choices = Choices::all(method);
-    render_plan(ctx, scene, plan_with(scene, &choices, quality)?, size, frames)
+    let target = target_for(ctx, size);
+    render_plan(ctx, scene, plan::plan_for(scene, &choices, quality, target.as_ref())?, size, frames)
+}
+
+/// What `auto` predicts for on `ctx` at `size`: the device's unit costs (cached, stored or
+/// calibrated now: `tradeoff::costs_for`; a cache file that cannot be read is said on
+/// stderr and replaced). `None` when the device cannot be calibrated (the nominal target
+/// serves, and the error is said on stderr).
+pub fn target_for(ctx: &vk::Context, size: (u32, u32)) -> Option<plan::predict::Target> {
+    match tradeoff::costs_for(ctx, None, &mut |w| eprintln!("specula: {w}")) {
+        Ok((costs, _)) => Some(plan::predict::Target { size, costs }),
+        Err(e) => {
+            eprintln!("specula: no unit costs for {}: {e}; auto predicts with the stored calibration's", ctx.device_name);
+            None
+        }
+    }
 }
 
 /// Renders a plan (per-object methods: `plan_with`), as `render`.

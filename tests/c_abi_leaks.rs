@@ -134,6 +134,7 @@ unsafe fn cycle() {
         max_ms: 0.0,
         min_psnr_db: 0.0,
         models_path: std::ptr::null(),
+        cache_dir: std::ptr::null(),
     };
     ok(specula_context_configure(ctx, &rd), ctx);
     let mut px = [0u8; 16 * 16 * 4];

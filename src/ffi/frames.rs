@@ -10,7 +10,7 @@ use super::types::*;
 use crate::methods::registry::ABI_AUTO;
 use crate::methods::{Choice, Method};
 use crate::plan::budget::{self, Budget, Models};
-use crate::plan::{plan_with, Choices};
+use crate::plan::Choices;
 use crate::renderer::Renderer;
 use crate::vk::Image;
 
@@ -40,7 +40,7 @@ pub unsafe extern "C" fn specula_context_set_knob(ctx: *mut SpeculaContext, key:
 /// Plans and creates everything a frame of the scene needs with the given method and size.
 /// With a budget (`max_ms` or `min_psnr_db`, SPECULA_METHOD_AUTO only) the budgeted planner
 /// chooses per object a method and the knobs (see SpeculaRenderDesc); it returns
-/// SPECULA_WARNING_NO_MODELS when no models cover the scene (the rules chose). A desc of
+/// SPECULA_WARNING_NO_MODELS when no models cover the scene (auto's default chose). A desc of
 /// SPECULA_RENDER_DESC_SIZE_V1 bytes (before the budget fields) is read as no budget.
 /// Reconfiguring destroys the previous renderer: needs an idle GPU in host-device mode.
 #[no_mangle]
@@ -48,12 +48,18 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
     with_ctx(ctx, |c| {
         let v1 = header(desc as *const RenderDescV1, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
         let (method, width, height) = (v1.method, v1.width, v1.height);
-        let (max_ms, min_psnr, models_path) = if v1.size == SPECULA_RENDER_DESC_SIZE_V1 {
-            (0.0, 0.0, std::ptr::null())
+        let (max_ms, min_psnr, models_path, cache_dir) = if v1.size == SPECULA_RENDER_DESC_SIZE_V1 {
+            (0.0, 0.0, std::ptr::null(), std::ptr::null())
+        } else if v1.size == SPECULA_RENDER_DESC_SIZE_V2 {
+            let d = &*(desc as *const RenderDescV2);
+            (d.max_ms, d.min_psnr_db, d.models_path, std::ptr::null())
         } else {
             let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
-            (d.max_ms, d.min_psnr_db, d.models_path)
+            (d.max_ms, d.min_psnr_db, d.models_path, d.cache_dir)
         };
+        if !cache_dir.is_null() {
+            c.cache_dir = Some(std::path::PathBuf::from(cstr(cache_dir, "render desc.cache_dir")?));
+        }
         let choice = match method {
             ABI_AUTO => Choice::Auto,
             m => match Method::by_abi(m).filter(|m| m.is_gpu()) {
@@ -84,17 +90,20 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                         format!("render desc: a budget needs SPECULA_METHOD_AUTO (method {method} = {})", choice.name()),
                     );
                 }
-                let mut sources: Vec<(Models, String)> = Vec::new();
-                if !models_path.is_null() {
-                    let p = std::path::PathBuf::from(cstr(models_path, "render desc.models_path")?);
-                    sources.push((Models::load(&p)?, format!("calibration {}", p.display())));
-                }
-                let d = budget::stored_defaults()?;
-                let from = format!("stored defaults ({})", d.scene);
-                sources.push((d, from));
-                let refs: Vec<(&Models, String)> = sources.iter().map(|(m, s)| (m, s.clone())).collect();
                 let choices = Choices { method: Choice::Auto, objects: c.object_methods.clone() };
-                let r = budget::choose(&c.scene, &choices, &c.quality, b, (width, height), &refs)?;
+                let r = if models_path.is_null() {
+                    // Predicted from the object's facts and this device's unit costs.
+                    match target(c, (width, height)) {
+                        Some(t) => {
+                            crate::plan::predict::choose(&c.scene, &choices, &c.quality, b, &t, &crate::plan::predict::budget_variants())?
+                        }
+                        None => None,
+                    }
+                } else {
+                    let p = std::path::PathBuf::from(cstr(models_path, "render desc.models_path")?);
+                    let m = Models::load(&p)?;
+                    budget::choose(&c.scene, &choices, &c.quality, b, (width, height), &[(&m, format!("calibration {}", p.display()))])?
+                };
                 no_models = r.is_none();
                 r
             }
@@ -108,6 +117,30 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
     })
 }
 
+/// What `auto` predicts for: the device's unit costs (from the context's cache directory, a
+/// calibration said through the log) at this size; the stored calibration's when the device
+/// has none.
+fn target(c: &mut SpeculaContext, size: (u32, u32)) -> Option<crate::plan::predict::Target> {
+    let mut warnings = Vec::new();
+    let found = crate::tradeoff::costs_for(&c.vk, c.cache_dir.clone(), &mut |w| warnings.push(w));
+    for w in warnings {
+        c.log(SPECULA_LOG_WARNING, &w);
+    }
+    match found {
+        Ok((costs, source)) => {
+            if let crate::tradeoff::Source::Calibrated(path) = source {
+                let to = path.map_or("not cached".to_string(), |p| format!("cached in {}", p.display()));
+                c.log(SPECULA_LOG_INFO, &format!("calibrated this device's unit costs for auto ({to})"));
+            }
+            Some(crate::plan::predict::Target { size, costs })
+        }
+        Err(e) => {
+            c.log(SPECULA_LOG_WARNING, &format!("no unit costs for this device ({e}): auto predicts with the stored calibration's"));
+            crate::plan::predict::Target::nominal().map(|t| crate::plan::predict::Target { size, ..t })
+        }
+    }
+}
+
 /// Plans the scene as it is now for `choice` (with the per-object methods, or the budgeted
 /// planner's choices and knobs) and replaces the renderer by one of `width`×`height`. A
 /// planning error keeps the previous renderer; a creation error leaves none.
@@ -116,7 +149,8 @@ fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) ->
         Some((choices, quality, _)) => (choices.clone(), quality.clone()),
         None => (Choices { method: choice, objects: c.object_methods.clone() }, c.quality.clone()),
     };
-    let p = plan_with(&c.scene, &choices, &quality)?;
+    let target = target(c, (width, height));
+    let p = crate::plan::plan_for(&c.scene, &choices, &quality, target.as_ref())?;
     c.destroy_renderer();
     let r = Renderer::new(&c.vk, &c.scene, p, width, height)?;
     c.choice = choice;

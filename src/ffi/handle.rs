@@ -42,6 +42,9 @@ pub struct SpeculaContext {
     pub(super) renderer_version: u64,
     /// A standalone context's update changed the plan: the next render reconfigures.
     pub(super) replan: bool,
+    /// Where `auto`'s unit costs are cached (`SpeculaRenderDesc::cache_dir`); `None`: the
+    /// default (`plan::predict::cost_model::cache_dir`).
+    pub(super) cache_dir: Option<std::path::PathBuf>,
     /// NUL-terminated message of the last failed call, overwritten in place so that a
     /// pointer the caller holds stays valid for the context's lifetime.
     last_error: [u8; MESSAGE_BYTES],
@@ -294,6 +297,7 @@ fn create(out: *mut *mut SpeculaContext, make: impl FnOnce() -> FfiResult<Contex
             scene_version: 0,
             renderer_version: 0,
             replan: false,
+            cache_dir: None,
             last_error: [0; MESSAGE_BYTES],
             log: None,
             log_user: std::ptr::null_mut(),

@@ -246,17 +246,43 @@ pub struct SpeculaRenderDesc {
     /// per specular object a method and for the frame the knob values, from per-object error
     /// and cost models, so that a frame takes at most `max_ms` GPU milliseconds at the least
     /// predicted error, or every specular object reaches `min_psnr_db` on its pixels at the
-    /// least predicted time. specula_get_predictions reports the prediction.
+    /// least predicted time. Without either, SPECULA_METHOD_AUTO spends at most the exact
+    /// tracer's predicted frame and takes the fastest choice within 0.5 dB of the most
+    /// accurate. specula_get_predictions reports the prediction.
     pub max_ms: f64,
     pub min_psnr_db: f64,
-    /// The models (JSON from `specula tradeoff --calibrate`), or NULL: the stored defaults
-    /// measured on the bundled scenes.
+    /// A scene's own calibration (JSON from `specula tradeoff --calibrate`), or NULL:
+    /// predictions from the objects' facts and the device's unit costs.
     pub models_path: *const c_char,
+    /// Where the device's unit costs are cached (the directory; created), or NULL: the
+    /// SPECULA_CACHE_DIR environment variable, else the user's cache directory. A device
+    /// seen for the first time is calibrated there (a few seconds on a GPU, about three
+    /// minutes on lavapipe).
+    pub cache_dir: *const c_char,
 }
 
 /// The size of SpeculaRenderDesc before the budget fields (type, size, method, width,
 /// height): still accepted, as no budget.
 pub const SPECULA_RENDER_DESC_SIZE_V1: u32 = 20;
+
+/// The size of SpeculaRenderDesc before `cache_dir` (through `models_path`): still
+/// accepted, as the default cache.
+pub const SPECULA_RENDER_DESC_SIZE_V2: u32 = 48;
+
+/// SpeculaRenderDesc through `models_path`, all a caller of the second version passes.
+#[repr(C)]
+pub(super) struct RenderDescV2 {
+    pub r#type: SpeculaStructType,
+    pub size: u32,
+    pub method: SpeculaMethod,
+    pub width: u32,
+    pub height: u32,
+    pub max_ms: f64,
+    pub min_psnr_db: f64,
+    pub models_path: *const c_char,
+}
+
+const _: () = assert!(std::mem::size_of::<RenderDescV2>() == SPECULA_RENDER_DESC_SIZE_V2 as usize);
 
 /// The first fields of SpeculaRenderDesc, all a caller of the first version passes.
 #[repr(C)]

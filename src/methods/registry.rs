@@ -1,7 +1,7 @@
 //! The method registry. Every method is described once, in its family's folder, by one
 //! `MethodInfo`: its CLI name, its stable C ABI number, its survey section, the objects it
 //! can serve, the knobs it reads, how it plans (the maps it needs, its camera pass, its
-//! map cycles) and its rule for `--method auto`. Everything that lists methods — the CLI,
+//! map cycles). `--method auto` chooses among them by prediction (`plan::predict`). Everything that lists methods — the CLI,
 //! `specula knobs`, the C header's `SPECULA_METHOD_*`, the README tables, `tradeoff`, the
 //! demo — reads `methods::ALL`.
 
@@ -120,15 +120,6 @@ impl Profiled {
 /// Creates a method's own camera stage for the plan's objects.
 pub type CreateCamera = fn(&crate::frame::stage::StageInit, &crate::plan::CameraPlan) -> crate::Result<Box<dyn crate::frame::stage::Stage>>;
 
-/// What the planner's rule says about one object: a score (higher wins) and why.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct Verdict {
-    pub score: f32,
-    pub reason: String,
-}
-
-pub type Rule = fn(&ObjectFacts, &Quality) -> Option<Verdict>;
-
 /// How a GPU method plans an object.
 #[derive(Clone, Copy)]
 pub struct GpuSpec {
@@ -172,8 +163,6 @@ pub struct MethodInfo {
     pub fallback: Option<Method>,
     /// What shape of object it can serve beyond its class (planar-mirror: planar only).
     pub shape: Shape,
-    /// The planner's rule: when this method is the right choice for an object, and why.
-    pub rule: Rule,
 }
 
 /// The object shapes a method serves.

@@ -13,7 +13,7 @@ mod types;
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass, Verdict};
+pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass};
 pub use types::*;
 
 use crate::methods::FAMILIES;
@@ -59,12 +59,24 @@ impl Plan {
                 && fresh.caustics == self.caustics
         };
         // The plan a fresh renderer would get; if the planner would now choose otherwise for
-        // some object, the same plan with every object kept on its method.
-        let mut fresh = plan(scene, self.choice, &self.quality);
-        if !same(&fresh) {
-            let choices = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
-            if let Ok(kept) = plan_with(scene, &choices, &self.quality) {
-                fresh = kept;
+        // some object, the same plan with every object kept on its method — unless `auto`
+        // predicts the new choice better by more than its hysteresis (then a new renderer).
+        let asked = Choices { method: self.choice, objects: self.overrides.clone() };
+        let kept = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
+        let mut fresh = plan_inner(scene, &asked, &self.quality, true, self.target.as_ref())?;
+        if methods(&fresh) != methods(self) {
+            if self.choice == Choice::Auto {
+                let nominal = predict::Target::nominal();
+                if let Some(t) = self.target.as_ref().or(nominal.as_ref()) {
+                    let facts = facts::SceneFacts::new(scene, &self.quality, true);
+                    let now = Choices { method: self.choice, objects: fresh.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
+                    if let Some(why) = predict::switch(scene, &facts, &kept, &now, &self.quality, t)? {
+                        return Err(Error::PlanChanged(format!("auto: {why}")));
+                    }
+                }
+            }
+            if let Ok(k) = plan_inner(scene, &kept, &self.quality, true, self.target.as_ref()) {
+                fresh = k;
             }
         }
         if !same(&fresh) {
@@ -137,7 +149,8 @@ pub fn plan(scene: &Scene, method: impl Into<Choice>, quality: &Quality) -> Plan
     // class or falls back to one that does), nor can the planner without the scene's hints.
     plan_inner(scene, &choices, quality, true, None).or_else(|_| plan_inner(scene, &choices, quality, false, None)).unwrap_or_else(|e| {
         // Unreachable by the registry's checks; a plan that renders nothing but says why.
-        let mut p = plan_inner(scene, &Choices::all(crate::methods::REFERENCE), quality, false, None).unwrap_or_else(|_| empty_plan(quality));
+        let mut p =
+            plan_inner(scene, &Choices::all(crate::methods::REFERENCE), quality, false, None).unwrap_or_else(|_| empty_plan(quality));
         p.objects.iter_mut().for_each(|o| o.reason = format!("no GPU plan: {e}"));
         p
     })
@@ -146,6 +159,9 @@ pub fn plan(scene: &Scene, method: impl Into<Choice>, quality: &Quality) -> Plan
 fn empty_plan(quality: &Quality) -> Plan {
     Plan {
         choice: Choice::Method(crate::methods::REFERENCE),
+        overrides: Vec::new(),
+        target: None,
+        prediction: None,
         quality: quality.clone(),
         shadow_cubes: Vec::new(),
         shadow_planes: Vec::new(),
@@ -168,7 +184,13 @@ fn empty_plan(quality: &Quality) -> Plan {
 }
 
 /// Which method an object gets, and why (`hints`: honour the scene file's methods).
-fn choose(scene: &Scene, facts: &ObjectFacts, choices: &Choices, hints: bool, auto: Option<&predict::AutoPlan>) -> Result<(Method, String)> {
+fn choose(
+    scene: &Scene,
+    facts: &ObjectFacts,
+    choices: &Choices,
+    hints: bool,
+    auto: Option<&predict::AutoPlan>,
+) -> Result<(Method, String)> {
     let mesh = &scene.meshes[facts.mesh];
     let class = facts.class;
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
@@ -328,6 +350,9 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
     }
     let mut p = Plan {
         choice: choices.method,
+        overrides: choices.objects.clone(),
+        target: target.cloned(),
+        prediction: auto.as_ref().map(|a| a.prediction.clone()),
         quality: quality.clone(),
         shadow_cubes: Vec::new(),
         shadow_planes: Vec::new(),

@@ -177,6 +177,16 @@ impl StageSpec {
 pub struct Plan {
     /// What was asked for the whole scene (`--method`).
     pub choice: Choice,
+    /// What was asked per object (by name), over `choice`.
+    pub overrides: Vec<(String, crate::methods::registry::Method)>,
+    /// What `auto` predicted for (the frame's size, the device's unit costs); `None`: the
+    /// nominal target.
+    #[serde(skip)]
+    pub target: Option<super::predict::Target>,
+    /// What `auto` predicted per object and for the frame (`None` when no object was left
+    /// to it).
+    #[serde(skip)]
+    pub prediction: Option<super::budget::Prediction>,
     pub quality: Quality,
     /// Lights that get a cube distance map (point and spot), in cube order.
     pub shadow_cubes: Vec<usize>,

@@ -55,7 +55,6 @@ pub const REFERENCE: crate::methods::Method = crate::methods::Method(&crate::met
     gpu: None,
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| None,
 });
 
 /// Path weights below this (every channel) are not traced further.

@@ -149,7 +149,10 @@ impl Renderer {
             return Ok(c);
         }
         let mut plan = self.plan.clone();
-        if !c.moved.is_empty() {
+        // Objects moved: the maps' reference points follow; under `auto` a camera move
+        // changes what each object covers too, so its choice is predicted again (kept within
+        // the hysteresis, `plan::predict::switch`).
+        if !c.moved.is_empty() || (c.camera && plan.choice == crate::plan::Choice::Auto && !plan.objects.is_empty()) {
             plan.refresh_geometry(scene)?;
         }
         let camera = if c.camera { Some(scene.camera_or_default()) } else { None };

@@ -122,7 +122,7 @@ pub fn prism(name: &str, center: Vec3, axis: Vec3, length: f32, corners: [Vec3; 
 /// A torus around `axis` (unit) through `center`: ring radius `major`, tube radius `minor`,
 /// `segments` around the ring and `sides` around the tube (a closed, non-convex solid:
 /// part of its surface hides another part from its centre).
-pub fn torus(name: &str, center: Vec3, axis: Vec3, major: f32, minor: f32, segments: u32, sides: u32, material: usize) -> Mesh {
+pub fn torus(name: &str, center: Vec3, axis: Vec3, (major, minor): (f32, f32), (segments, sides): (u32, u32), material: usize) -> Mesh {
     let (segments, sides) = (segments.max(3), sides.max(3));
     let axis = axis.normalize();
     let (u, v) = axis.any_orthonormal_pair();
@@ -153,7 +153,14 @@ pub fn torus(name: &str, center: Vec3, axis: Vec3, major: f32, minor: f32, segme
 /// A spherical cap of `radius` around `center` opening towards `opening` (unit): the
 /// directions within `half_angle` of `−opening` (a bowl; `half_angle` π/2 is a hemisphere),
 /// normals pointing inward (its concave side faces its centre), one-sided and open.
-pub fn bowl(name: &str, center: Vec3, opening: Vec3, radius: f32, half_angle: f32, segments: u32, rings: u32, material: usize) -> Mesh {
+pub fn bowl(
+    name: &str,
+    center: Vec3,
+    opening: Vec3,
+    (radius, half_angle): (f32, f32),
+    (segments, rings): (u32, u32),
+    material: usize,
+) -> Mesh {
     let (segments, rings) = (segments.max(3), rings.max(1));
     let down = -opening.normalize();
     let (u, v) = down.any_orthonormal_pair();
@@ -185,7 +192,7 @@ pub fn bowl(name: &str, center: Vec3, opening: Vec3, radius: f32, half_angle: f3
 /// A lumpy closed solid: a UV sphere whose radius varies by up to `amount` (a fraction)
 /// with a few low-frequency lobes set by `seed`; normals from the surface. Non-convex for
 /// `amount` above about 0.15 (a stand-in for scanned models such as the bunny).
-pub fn blob(name: &str, center: Vec3, radius: f32, amount: f32, seed: u32, segments: u32, rings: u32, material: usize) -> Mesh {
+pub fn blob(name: &str, center: Vec3, (radius, amount): (f32, f32), seed: u32, (segments, rings): (u32, u32), material: usize) -> Mesh {
     let mut m = uv_sphere(name, Vec3::ZERO, 1.0, segments, rings, material);
     let k = |i: u32| ((seed.wrapping_mul(2654435761).wrapping_add(i.wrapping_mul(40503))) % 1000) as f32 / 1000.0;
     let lobes: Vec<(Vec3, f32)> = (0..5)
@@ -296,9 +303,9 @@ mod tests {
     fn shapes_wind_counter_clockwise_around_their_normals() {
         assert!(outward_ccw(&uv_sphere("s", Vec3::ZERO, 1.0, 16, 8, 0)));
         assert!(outward_ccw(&quad("q", Vec3::ZERO, Vec3::X, Vec3::Y, 3, 0)));
-        assert!(outward_ccw(&torus("t", Vec3::ZERO, Vec3::Y, 1.0, 0.3, 16, 8, 0)));
-        assert!(outward_ccw(&bowl("b", Vec3::ZERO, Vec3::Y, 1.0, 1.5, 16, 6, 0)));
-        assert!(outward_ccw(&blob("l", Vec3::ZERO, 1.0, 0.3, 7, 16, 8, 0)));
+        assert!(outward_ccw(&torus("t", Vec3::ZERO, Vec3::Y, (1.0, 0.3), (16, 8), 0)));
+        assert!(outward_ccw(&bowl("b", Vec3::ZERO, Vec3::Y, (1.0, 1.5), (16, 6), 0)));
+        assert!(outward_ccw(&blob("l", Vec3::ZERO, (1.0, 0.3), 7, (16, 8), 0)));
         for m in quadrant_room(Vec3::ZERO, 1.0, 2, |_, _| 0) {
             assert!(outward_ccw(&m), "{}", m.name);
         }

@@ -56,7 +56,7 @@ pub const BUILTIN: &[&str] =
 /// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
 /// `caustic-ball`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
-    if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < corpus::SIZE) {
+    if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < 10_000) {
         return Some(corpus::scene(i));
     }
     Some(match name {

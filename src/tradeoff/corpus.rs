@@ -7,11 +7,11 @@
 
 use crate::error::Result;
 use crate::methods::{Choice, Method, BVH};
-use crate::scenes::corpus;
 use crate::plan::predict::features::{error_features, workload};
 use crate::plan::predict::samples::{Corpus, FrameSample, Sample, PSNR_CAP};
 use crate::plan::{plan_with, Choices};
 use crate::quality::Quality;
+use crate::scenes::corpus;
 use crate::vk::Context;
 
 /// What [`measure`] renders.
@@ -48,9 +48,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
             let ids = crate::reference::object_ids(&scene, size)?;
             for v in &cfg.variants {
                 let q = crate::plan::budget::variant_quality(&cfg.base, v)?;
-                let set: Vec<&str> = if v == "default" { Vec::new() } else { v.split_whitespace().filter_map(|p| p.split('=').next()).collect() };
+                let set: Vec<&str> =
+                    if v == "default" { Vec::new() } else { v.split_whitespace().filter_map(|p| p.split('=').next()).collect() };
                 progress(&format!("{} {}x{} {v}: bvh (reference)", corpus::name(i), size.0, size.1));
-                let reference = crate::render(ctx, &scene, BVH, &q, size, (1, 1))?;
+                let reference = crate::render_plan(ctx, &scene, plan_with(&scene, &Choices::all(Choice::Method(BVH)), &q)?, size, (1, 1))?;
                 let facts = crate::plan::facts::SceneFacts::new(&scene, &q, true);
                 for &m in &cfg.methods {
                     if !set.iter().all(|k| m.knobs.contains(k)) {
@@ -97,7 +98,13 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                         });
                     }
                     if let Some(work) = any {
-                        out.frames.push(FrameSample { scene: i, method: m.name.to_string(), knobs: v.clone(), work, base_ms: base.fixed_ms + base.screen_ms });
+                        out.frames.push(FrameSample {
+                            scene: i,
+                            method: m.name.to_string(),
+                            knobs: v.clone(),
+                            work,
+                            base_ms: base.fixed_ms + base.screen_ms,
+                        });
                     }
                 }
             }

@@ -21,7 +21,7 @@ pub struct Figure {
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
 
 /// Registers the bundled font as plotters' `sans-serif` (once).
-fn register_font() -> Result<()> {
+pub(super) fn register_font() -> Result<()> {
     static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
     let ok = *DONE.get_or_init(|| plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT).is_ok());
     if ok {
@@ -109,16 +109,16 @@ const COLOURS: [(u8, u8, u8); 10] = [
     (23, 190, 207),
 ];
 
-fn colour(k: usize) -> plotters::style::RGBColor {
+pub(super) fn colour(k: usize) -> plotters::style::RGBColor {
     let (r, g, b) = COLOURS[k % COLOURS.len()];
     plotters::style::RGBColor(r, g, b)
 }
 
-fn font(size: f64) -> plotters::style::FontDesc<'static> {
+pub(super) fn font(size: f64) -> plotters::style::FontDesc<'static> {
     plotters::style::FontDesc::new(plotters::style::FontFamily::SansSerif, size, plotters::style::FontStyle::Normal)
 }
 
-fn draw_marker<DB: plotters::prelude::DrawingBackend>(
+pub(super) fn draw_marker<DB: plotters::prelude::DrawingBackend>(
     area: &plotters::drawing::DrawingArea<DB, plotters::coord::Shift>,
     k: usize,
     (x, y): (i32, i32),

@@ -166,6 +166,7 @@ pub fn render_desc(method: specula::Method, width: u32, height: u32) -> specula:
         max_ms: 0.0,
         min_psnr_db: 0.0,
         models_path: std::ptr::null(),
+        cache_dir: std::ptr::null(),
     }
 }
 

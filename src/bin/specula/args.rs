@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use specula::image::ImageData;
-use specula::plan::{plan_with, Choices, Plan};
+use specula::plan::{Choices, Plan};
 use specula::scene::{self, Camera};
 use specula::vk::{Context, DeviceOptions, PassTiming};
 use specula::{Choice, Method, Quality, Scene};
@@ -119,6 +119,8 @@ pub struct Job {
     pub quality: Quality,
     pub width: u32,
     pub height: u32,
+    /// The device's unit costs for `auto` (found once, by `budget::target`).
+    pub target: std::sync::OnceLock<Option<specula::plan::predict::Target>>,
 }
 
 impl Job {
@@ -131,7 +133,8 @@ impl Job {
     }
 
     pub fn plan(&self, quality: &Quality) -> specula::Result<Plan> {
-        plan_with(&self.scene, &self.choices, quality)
+        let target = crate::budget::target(self);
+        specula::plan::plan_for(&self.scene, &self.choices, quality, target.as_ref())
     }
 
     /// What was asked for, for headings: the method or `auto`, plus the overrides.
@@ -164,7 +167,7 @@ pub fn load_scene(path: &Path) -> specula::Result<Scene> {
         Err(specula::Error::invalid(
             "scene",
             format!(
-                "'builtin:{}' names no built-in scene (known: {})",
+                "'builtin:{}' names no built-in scene (known: {}, and the planner's corpus builtin:corpus-N, N 0..=9999)",
                 specula::error::clip(name),
                 specula::scenes::BUILTIN.iter().map(|n| format!("builtin:{n}")).collect::<Vec<_>>().join(", ")
             ),
@@ -230,7 +233,7 @@ pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
     let (width, height) = parse_size(&a.size)?;
     let objects = a.objects.iter().map(|o| parse_object(o)).collect::<specula::Result<Vec<_>>>()?;
     let choices = Choices { method: Choice::parse(&a.method)?, objects };
-    Ok(Job { scene, choices, quality, width, height })
+    Ok(Job { scene, choices, quality, width, height, target: Default::default() })
 }
 
 pub fn context(validate: bool, device: &Option<String>) -> specula::Result<Context> {

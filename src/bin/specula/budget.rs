@@ -42,24 +42,52 @@ pub fn apply(job: &mut Job, scene_path: &Path, a: &BudgetArgs) -> specula::Resul
     if job.choices.method != Choice::Auto {
         return Err(specula::Error::invalid(b.describe(), format!("needs --method auto (got '{}')", job.choices.method.name())));
     }
-    let mut sources: Vec<(Models, String)> = Vec::new();
     let own = a.models.clone().or_else(|| Some(default_models_path(scene_path)).filter(|p| p.exists()));
-    if let Some(p) = own {
-        sources.push((Models::load(&p)?, format!("calibration {}", p.display())));
-    }
-    let defaults = budget::stored_defaults()?;
-    let from = format!("stored defaults ({}, {}x{}, {})", defaults.scene, defaults.size[0], defaults.size[1], defaults.device);
-    sources.push((defaults, from));
-    let refs: Vec<(&Models, String)> = sources.iter().map(|(m, s)| (m, s.clone())).collect();
-    match budget::choose(&job.scene, &job.choices, &job.quality, b, (job.width, job.height), &refs)? {
+    let chosen = match own {
+        // A calibration of this very scene (specula tradeoff --calibrate).
+        Some(p) => {
+            let m = Models::load(&p)?;
+            budget::choose(
+                &job.scene,
+                &job.choices,
+                &job.quality,
+                b,
+                (job.width, job.height),
+                &[(&m, format!("calibration {}", p.display()))],
+            )?
+        }
+        // Predicted from the objects' facts and the device's unit costs.
+        None => match target(job) {
+            Some(t) => {
+                specula::plan::predict::choose(&job.scene, &job.choices, &job.quality, b, &t, &specula::plan::predict::budget_variants())?
+            }
+            None => None,
+        },
+    };
+    match chosen {
         Some((choices, quality, prediction)) => {
             job.choices = choices;
             job.quality = quality;
             Ok(Some(prediction))
         }
         None => {
-            eprintln!("specula: no models cover this scene's specular objects: the registry's rules choose ({} ignored)", b.describe());
+            eprintln!(
+                "specula: no prediction covers this scene's specular objects: auto without a budget chooses ({} ignored)",
+                b.describe()
+            );
             Ok(None)
         }
     }
+}
+
+/// What `auto` predicts for: the job's size on the first device that opens (its unit costs),
+/// else on the stored calibration's device.
+pub fn target(job: &Job) -> Option<specula::plan::predict::Target> {
+    let t = job.target.get_or_init(|| {
+        let ctx = specula::vk::Context::new(&specula::vk::DeviceOptions::default()).ok();
+        ctx.as_ref().and_then(|c| specula::target_for(c, (1, 1)))
+    });
+    t.clone().map(|t| specula::plan::predict::Target { size: (job.width, job.height), ..t }).or_else(|| {
+        specula::plan::predict::Target::nominal().map(|n| specula::plan::predict::Target { size: (job.width, job.height), ..n })
+    })
 }

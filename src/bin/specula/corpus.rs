@@ -40,7 +40,10 @@ pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, devi
         t.elapsed().as_secs_f64(),
         out.display()
     );
-    println!("error models, leave-one-scene-out: |predicted − measured| median {median:.2} dB, 90th percentile {p90:.2} dB ({} predictions)", held.len());
+    println!(
+        "error models, leave-one-scene-out: |predicted − measured| median {median:.2} dB, 90th percentile {p90:.2} dB ({} predictions)",
+        held.len()
+    );
     let validation = (ctx.validation.error_count(), ctx.validation.warning_count());
     if validation.0 > 0 {
         return Err(specula::Error::invalid("validation", format!("{} validation errors", validation.0)));
@@ -59,18 +62,63 @@ pub fn run_calibrate(out: Option<&Path>, validate: bool, device: &Option<String>
             p.to_path_buf()
         }
         None => {
-            let dir = specula::plan::predict::cost_model::cache_dir()
-                .ok_or_else(|| specula::Error::invalid("cache", "no SPECULA_CACHE_DIR, XDG_CACHE_HOME or HOME to cache into: pass --out"))?;
+            let dir = specula::plan::predict::cost_model::cache_dir().ok_or_else(|| {
+                specula::Error::invalid("cache", "no SPECULA_CACHE_DIR, XDG_CACHE_HOME or HOME to cache into: pass --out")
+            })?;
             specula::plan::predict::cost_model::store(&dir, &c)?
         }
     };
     println!("calibrated {} in {:.1} s; wrote {}", c.key.label(), c.calibration_s, path.display());
-    println!("{:<24} {:>10} {:>12} {:>12} {:>12} {:>12} {:>12}", "method", "ms/object", "ms/Mtexel·kTri", "ms/Mtexel", "ms/10⁴ px", "ms/10⁴ scr", "ms/10⁴ scr·d");
+    println!(
+        "{:<24} {:>10} {:>12} {:>12} {:>12} {:>12} {:>12}",
+        "method", "ms/object", "ms/Mtexel·kTri", "ms/Mtexel", "ms/10⁴ px", "ms/10⁴ scr", "ms/10⁴ scr·d"
+    );
     for (m, u) in &c.methods {
         println!(
             "{:<24} {:>10.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3}",
             m, u.fixed[0], u.fixed[1], u.fixed[2], u.screen[0], u.shared[0], u.shared[1]
         );
     }
+    Ok(())
+}
+
+/// `specula corpus --evaluate FILE`: the error models' leave-one-scene-out accuracy on a
+/// measured corpus, per ridge penalty and per method at the chosen one, and the
+/// predicted-against-measured scatter into `figure` (SVG and PNG).
+pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
+    let text = std::fs::read_to_string(path).map_err(|e| specula::Error::io(path, e))?;
+    let c = specula::plan::predict::samples::Corpus::parse(&text, &path.display().to_string())?;
+    println!("{} samples of {} scenes measured on {}", c.samples.len(), c.scenes().len(), c.device.label());
+    println!("ridge     median |err| dB   90th pct dB");
+    for ridge in [0.001, 0.003, 0.01, 0.03, 0.1, 0.3, 1.0] {
+        let (m, p) = error_model::abs_error_quantiles(&error_model::leave_one_scene_out_with(&c.samples, ridge));
+        println!("{ridge:<9} {m:>15.2} {p:>13.2}{}", if ridge == error_model::RIDGE { "   (used)" } else { "" });
+    }
+    let held = error_model::leave_one_scene_out(&c.samples);
+    println!("\nper method at ridge {} (held-out scenes):", error_model::RIDGE);
+    println!("{:<24} {:>6} {:>14} {:>12} {:>10}", "method", "n", "median |err|", "90th pct", "bias");
+    let mut methods: Vec<&str> = held.iter().map(|h| h.method.as_str()).collect();
+    methods.sort();
+    methods.dedup();
+    for m in methods {
+        let hs: Vec<error_model::Held> = held.iter().filter(|h| h.method == m).cloned().collect();
+        let (med, p90) = error_model::abs_error_quantiles(&hs);
+        let bias = hs.iter().map(|h| h.predicted_db - h.measured_db).sum::<f64>() / hs.len() as f64;
+        println!("{m:<24} {:>6} {med:>14.2} {p90:>12.2} {bias:>10.2}", hs.len());
+    }
+    let (med, p90) = error_model::abs_error_quantiles(&held);
+    println!("{:<24} {:>6} {med:>14.2} {p90:>12.2}", "all", held.len());
+    let points: Vec<(f64, f64, String)> = held.iter().map(|h| (h.measured_db, h.predicted_db, h.method.clone())).collect();
+    let title = format!("Held-out PSNR per object: predicted against measured ({} scenes, leave-one-scene-out)", c.scenes().len());
+    let f = specula::tradeoff::scatter(
+        figure,
+        &points,
+        (0.0, 62.0),
+        3.0,
+        &title,
+        "measured PSNR against the exact tracer (dB)",
+        "predicted (dB)",
+    )?;
+    println!("wrote {} and {}", f.svg.display(), f.png.display());
     Ok(())
 }

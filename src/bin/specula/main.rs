@@ -54,6 +54,10 @@ enum Command {
         /// Print JSON instead of the table.
         #[arg(long)]
         json: bool,
+        /// Also print, per specular object, the candidates `auto` chose from: every method's
+        /// predicted ms and PSNR on the Pareto front (none faster and more accurate).
+        #[arg(long)]
+        candidates: bool,
         #[command(flatten)]
         budget: budget::BudgetArgs,
     },
@@ -126,6 +130,13 @@ enum Command {
         /// Only these corpus scene numbers (comma-separated); default all.
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<usize>,
+        /// Measure nothing: evaluate the error models on this corpus file (leave-one-scene-out
+        /// per ridge penalty and per method) and write the scatter to --figure.
+        #[arg(long)]
+        evaluate: Option<PathBuf>,
+        /// With --evaluate: the scatter's path without extension (.svg and .png).
+        #[arg(long, default_value = "docs/predicted-vs-measured")]
+        figure: PathBuf,
         #[arg(long)]
         validate: bool,
         #[arg(long)]
@@ -272,13 +283,14 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Render { args, out, profile, budget } => render::run(&args, &out, profile.as_deref(), &budget),
         Command::Info { scene } => info::run(&scene),
         Command::Animate { args, fps, duration, out } => animate::run(&args, fps, duration, &out),
-        Command::Plan { args, json, budget } => plan::run(&args, json, &budget),
+        Command::Plan { args, json, candidates, budget } => plan::run(&args, json, candidates, &budget),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),
         Command::RaytraceBench { triangles, size, depth, budget_s, frames, headline_size, parts, out, device } => {
             raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
-        Command::Corpus { out, size, scenes, validate, device } => corpus::run_corpus(&out, &size, &scenes, validate, &device),
+        Command::Corpus { evaluate: Some(file), figure, .. } => corpus::run_evaluate(&file, &figure),
+        Command::Corpus { out, size, scenes, validate, device, .. } => corpus::run_corpus(&out, &size, &scenes, validate, &device),
         Command::Calibrate { out, validate, device } => corpus::run_calibrate(out.as_deref(), validate, &device),
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image, scene, mask } => {

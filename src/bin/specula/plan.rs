@@ -5,8 +5,11 @@
 use crate::args::{prepare, RenderArgs};
 use crate::budget::BudgetArgs;
 
-pub fn run(args: &RenderArgs, json: bool, budget: &BudgetArgs) -> specula::Result<()> {
+pub fn run(args: &RenderArgs, json: bool, candidates: bool, budget: &BudgetArgs) -> specula::Result<()> {
     let mut job = prepare(args)?;
+    if candidates {
+        print_candidates(&job)?;
+    }
     let prediction = crate::budget::apply(&mut job, &args.scene, budget)?;
     let p = job.plan(&job.quality)?;
     if json {
@@ -20,5 +23,29 @@ pub fn run(args: &RenderArgs, json: bool, budget: &BudgetArgs) -> specula::Resul
         }
         print!("{}", specula::plan::table(&p, &job.scene));
     }
+    Ok(())
+}
+
+/// `--candidates`: per object the Pareto set of (predicted ms, predicted dB) the planner
+/// chose from.
+fn print_candidates(job: &crate::args::Job) -> specula::Result<()> {
+    use specula::plan::predict;
+    let Some(t) = crate::budget::target(job) else {
+        return Err(specula::Error::invalid("--candidates", "no unit costs: run specula calibrate"));
+    };
+    let facts = specula::plan::facts::SceneFacts::new(&job.scene, &job.quality, true);
+    let models = predict::predict_models(&job.scene, &facts, &job.quality, &t, &["default".to_string()])?;
+    println!("candidates at {}x{}, {}:", t.size.0, t.size.1, predict::source(&t));
+    for (name, front, dominated) in predict::pareto(&models) {
+        println!("{name}: {} on the Pareto front, {dominated} dominated", front.len());
+        for o in front {
+            let ms = o.cost.fixed_ms + o.cost.screen_ms + o.shared.screen_ms;
+            println!(
+                "  {:<24} {:>10.2} ms {:>8.1} dB   (maps {:.2} ms, camera {:.2} ms, whole-screen {:.2} ms)",
+                o.method, ms, o.psnr_db, o.cost.fixed_ms, o.cost.screen_ms, o.shared.screen_ms
+            );
+        }
+    }
+    println!();
     Ok(())
 }

@@ -10,9 +10,9 @@ pub mod slots;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit};
 use crate::methods::cube_maps::{distance_images, CubeMaps, MapKind};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled};
 use crate::methods::EVERY_CLASS;
-use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
+
 use crate::plan::{CameraPlan, Plan};
 use crate::quality::Quality;
 use crate::quality::{CubeKnobs, DistanceKnobs, FrameKnobs, SearchKnobs};
@@ -122,41 +122,7 @@ pub const DISTANCE: Method = Method(&MethodInfo {
         leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: distance_rule,
 });
-
-fn distance_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    let fraction = f.visible_fraction;
-    let convex = if fraction < 0.98 {
-        format!("; only {:.0} % of it is visible from its reference point (a single layer misses the rest)", 100.0 * fraction)
-    } else {
-        String::new()
-    };
-    match f.class {
-        ObjectClass::SolidDielectric => {
-            Some(Verdict { score: 1.5, reason: "distance map: refracts once at the entry surface only".into() })
-        }
-        _ if q.plan.planner.speed() => {
-            Some(Verdict { score: 3.0, reason: format!("{}: distance map, one search per ray (planner=speed){convex}", f.class.label()) })
-        }
-        _ if f.specular_coverage() >= MIN_COVERAGE => Some(Verdict {
-            score: 2.0,
-            reason: format!("{}: distance map; other specular objects in view want inter-object cycles{convex}", f.class.label()),
-        }),
-        _ => {
-            let few = f.specular_coverage();
-            let note = if few > 0.0 {
-                format!("; other specular objects cover only {:.1} % of its directions, not worth inter-object cycles", 100.0 * few)
-            } else {
-                String::new()
-            };
-            Some(Verdict {
-                score: 3.0,
-                reason: format!("{}: distance map, the ray traced in the sampled geometry (§4.1){convex}{note}", f.class.label()),
-            })
-        }
-    }
-}
 
 pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
     name: "distance-multi",
@@ -178,24 +144,7 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
     }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: multi_rule,
 });
-
-fn multi_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    let coverage = f.specular_coverage();
-    if f.class == ObjectClass::SolidDielectric || coverage < MIN_COVERAGE || q.plan.planner.speed() {
-        return None;
-    }
-    Some(Verdict {
-        score: 4.0,
-        reason: format!(
-            "{} that sees {} other specular object(s) over {:.1} % of its directions: distance maps in inter-object cycles (§4.3)",
-            f.class.label(),
-            f.sees_specular.iter().filter(|(_, c)| *c >= MIN_COVERAGE).count(),
-            100.0 * coverage
-        ),
-    })
-}
 
 pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     name: "refractor-map",
@@ -217,29 +166,7 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
-    rule: refractor_rule,
 });
-
-fn refractor_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    let convex = f.visible_fraction >= 0.98 && f.watertight;
-    let score = if q.plan.planner.speed() {
-        2.0
-    } else if convex {
-        4.0
-    } else {
-        2.5
-    };
-    let why = if convex {
-        "solid convex dielectric: self refraction in its refractor map, with total internal reflection (§4.4)".to_string()
-    } else {
-        format!(
-            "solid dielectric, {} and {:.0} % visible from its reference point: the refractor map sees only part of it, but it is the best self-refraction method available",
-            if f.watertight { "closed" } else { "open" },
-            100.0 * f.visible_fraction
-        )
-    };
-    Some(Verdict { score, reason: why })
-}
 
 pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
     name: "image-space-refraction",
@@ -267,10 +194,4 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, q| {
-        Some(Verdict {
-            score: if q.plan.planner.speed() { 3.0 } else { 2.0 },
-            reason: "solid dielectric: image-space double refraction, two interfaces from one extra camera pass (§4.4)".into(),
-        })
-    },
 });

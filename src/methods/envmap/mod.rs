@@ -8,9 +8,8 @@ pub mod slots;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
 use crate::frame::FLAG_PROXY_BOX;
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled};
 use crate::methods::EVERY_CLASS;
-use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
 use crate::quality::Quality;
 use crate::quality::{CubeKnobs, EnvmapKnobs, FrameKnobs};
@@ -89,7 +88,6 @@ pub const ENVMAP: Method = Method(&MethodInfo {
     gpu: Some(spec(SHADE)),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| Some(Verdict { score: 1.0, reason: "classic environment map: the cheapest lookup, but it ignores where the ray starts (§3.1)".into() }),
 });
 
 pub const PROXY_SPHERE: Method = Method(&MethodInfo {
@@ -103,7 +101,6 @@ pub const PROXY_SPHERE: Method = Method(&MethodInfo {
     gpu: Some(spec(proxy(0))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| Some(Verdict { score: 1.1, reason: "proxy sphere: localised by a sphere around the reference point (§3.2)".into() }),
 });
 
 pub const PROXY_BOX: Method = Method(&MethodInfo {
@@ -117,24 +114,4 @@ pub const PROXY_BOX: Method = Method(&MethodInfo {
     gpu: Some(spec(proxy(FLAG_PROXY_BOX))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: proxy_box_rule,
 });
-
-/// Where the environment seen from the object is the scene's box (a box room with nothing
-/// else in view), the proxy box is exact and costs one fetch per ray: as accurate as the
-/// distance-map search and cheaper (measured: tests/per_object.rs, BENCHMARKS.md).
-pub const EXACT_BOX: f32 = 0.97;
-
-fn proxy_box_rule(f: &ObjectFacts, _: &Quality) -> Option<Verdict> {
-    if f.box_fraction >= EXACT_BOX && f.class != crate::methods::ObjectClass::SolidDielectric {
-        return Some(Verdict {
-            score: 3.5,
-            reason: format!(
-                "{}: {:.0} % of what it sees is the scene's bounding box, so the proxy box is exact: one cube-map fetch per ray (§3.2)",
-                f.class.label(),
-                100.0 * f.box_fraction
-            ),
-        });
-    }
-    Some(Verdict { score: 1.2, reason: "proxy box: localised by the scene's box, one cube-map fetch per ray (§3.2)".into() })
-}

@@ -29,8 +29,7 @@ use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::layout::{binding, GpuCurvedParams, GpuCurvedVertex, CURVED_BINDINGS, CURVED_REFLECTOR_SHIFT};
 use crate::frame::stage::{order, FrameIo, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs, PUSH_BYTES};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape, Verdict};
-use crate::plan::facts::Curvature;
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape};
 use crate::plan::CameraPlan;
 use crate::quality::Quality;
 use crate::quality::{FrameKnobs, GeometryKnobs};
@@ -58,19 +57,6 @@ const fn one(_: &Quality) -> u32 {
     1
 }
 
-/// The planner's rule (survey §5: a search on the reflector "can cope with environment
-/// surfaces of large depth variations", Table 1: it needs "high tessellation"): a convex or
-/// concave mirror whose surroundings span at least this ratio of distances from its
-/// reference point ...
-pub const DEEP_ENVIRONMENT: f32 = 3.5;
-/// ... and whose environment, tessellated, shows no edge wider than this angle (radians)
-/// from it. Measured (tests/curved.rs, 64×48): the mirror sphere with two balls 0.25 m from
-/// it (depth ratio 3.76, edges 0.69/4 rad) takes 36.80 dB, distance maps 29.55 dB, the proxy
-/// box 26.08 dB (the balls are not the box); the same sphere in a hall 8× as long (ratio
-/// 10.2, edges 1.38/4 rad) takes 31.77 dB against distance maps' 48.00 dB (the long walls'
-/// reflections bend between vertices); in the empty room (ratio 2.80) 36.80 against 33.66.
-pub const FINE_EDGE: f32 = 0.2;
-
 pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
     name: "curved-reflector",
     abi: 15,
@@ -82,20 +68,6 @@ pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::ConvexOrConcave,
-    rule: |f, q| {
-        let shaped = matches!(f.curvature, Curvature::Convex | Curvature::Concave) && !f.planar;
-        let fine = f.edge_angle / q.geometry.tessellation.max(1) as f32;
-        (shaped && f.depth_ratio >= DEEP_ENVIRONMENT && fine <= FINE_EDGE && !q.plan.planner.speed()).then(|| Verdict {
-            // Above the proxy box's 3.5 for box rooms: near objects are not the box.
-            score: 3.6,
-            reason: format!(
-                "{} mirror whose surroundings vary {:.1}× in depth, tessellated to {:.2} rad edges: geometry transformation searches the reflector, not the environment (§5)",
-                f.curvature.label(),
-                f.depth_ratio,
-                fine
-            ),
-        })
-    },
 });
 
 /// Creates the stage of the plan's curved reflectors.
@@ -710,7 +682,7 @@ impl Stage for CurvedReflectors {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::plan::facts::curvature;
+    use crate::plan::facts::{curvature, Curvature};
     use crate::scene::shapes;
 
     #[test]

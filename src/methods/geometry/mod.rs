@@ -17,9 +17,7 @@ pub mod views;
 pub use curved::CURVED_REFLECTOR;
 
 use crate::frame::stage::order;
-use crate::methods::registry::{
-    CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Shape, Verdict,
-};
+use crate::methods::registry::{CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Shape};
 use crate::quality::Quality;
 use crate::quality::{FrameKnobs, GeometryKnobs};
 
@@ -92,12 +90,6 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
-    rule: |f, _| {
-        f.planar.then(|| Verdict {
-            score: 5.0,
-            reason: "planar reflector: exact by rendering the mirrored camera's view (§5, Table 1: exact, multiple reflections)".into(),
-        })
-    },
 });
 
 /// `geometry.refract`: each flat-faced dielectric (and thin pane) drawn from the camera (and
@@ -124,12 +116,4 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
-    rule: |f, _| {
-        // A solid's linearisation and its deep internal paths lose to refractor maps and ray
-        // tracing on the measured scenes (BENCHMARKS.md): only the pane, exact, is taken.
-        (f.class == ObjectClass::ThinDielectric && f.planar).then(|| Verdict {
-            score: 5.0,
-            reason: "planar thin pane: exact by its reflected and transmitted views (§5; two views, tests/geometry.rs: 154 dB)".into(),
-        })
-    },
 });

@@ -18,9 +18,8 @@ pub mod slots;
 use glam::Vec3;
 
 use crate::frame::stage::{order, FramePart, MapInfo, ViewFrame};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape};
 use crate::methods::EVERY_CLASS;
-use crate::plan::facts::ObjectFacts;
 use crate::plan::Plan;
 use crate::quality::{CubeKnobs, FrameKnobs, LayeredKnobs, SearchKnobs};
 use crate::quality::{Quality, MAX_LAYERS};
@@ -75,7 +74,6 @@ pub const LAYERED: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, shades_every_pixel: false }),
     fallback: None,
     shape: Shape::Any,
-    rule: layered_rule,
 });
 
 /// Below this visible fraction from its own reference point an object is not convex from
@@ -86,28 +84,6 @@ pub const CONVEX_FRACTION: f32 = 0.98;
 /// Above this area fraction of its surface facing its reference point an object is
 /// concave there (a bowl): its reflections see itself.
 pub const SELF_FACING: f32 = 0.02;
-
-fn layered_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    let hides = f.visible_fraction < CONVEX_FRACTION;
-    let faces = f.self_facing > SELF_FACING;
-    if !(hides || faces) || f.planar {
-        return None;
-    }
-    let mut why = Vec::new();
-    if hides {
-        why.push(format!(
-            "only {:.0} % of it is visible from its reference point (non-convex: it hides part of itself)",
-            100.0 * f.visible_fraction
-        ));
-    }
-    if faces {
-        why.push(format!("{:.0} % of its surface faces its reference point (concave: it sees itself)", 100.0 * f.self_facing));
-    }
-    Some(Verdict {
-        score: if q.plan.planner.speed() { 2.5 } else { 4.5 },
-        reason: format!("{}: {}; layered maps of the whole scene, traced recursively (§4.5)", f.class.label(), why.join(", ")),
-    })
-}
 
 /// The layered map's reference point: the `ref_point` knob, else the centre of the
 /// bounding box of the objects that take the method (`meshes`).

@@ -34,9 +34,9 @@ use glam::Vec3;
 use crate::error::{Error, Result};
 use crate::frame::layout::{GpuAccel, GpuTriangle};
 use crate::frame::stage::{order, Stage, StageInit};
-use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Verdict};
+use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled};
 use crate::methods::EVERY_CLASS;
-use crate::plan::facts::{ObjectFacts, MIN_COVERAGE};
+
 use crate::plan::CameraPlan;
 use crate::quality::Quality;
 use crate::quality::{FrameKnobs, RaytraceKnobs};
@@ -60,52 +60,6 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
         // `raytrace.spawn` and `raytrace.shade`, `raytrace.resolve`) run over the whole screen.
         profiled: Profiled { prefix: "raytrace.", shared: true },
     }
-}
-
-/// How many other specular objects in view (each covering at least `MIN_COVERAGE` of an
-/// object's directions) make ray tracing the planner's choice for it.
-pub const MUTUAL_VIEW_OBJECTS: usize = 2;
-
-/// The planner's rule for `bvh` (with `planner=accuracy`): exact ray tracing for an object
-/// that sees `MUTUAL_VIEW_OBJECTS` or more other specular objects (survey Table 1: the
-/// sampled-geometry methods then need inter-object map cycles whose cost grows with the
-/// square of the object count and whose depth is capped by the cycles, while the ray
-/// pipeline's cost does not grow with the object count and follows every path to the
-/// depth R), and for a solid dielectric whose surface is not all visible from its
-/// reference point (single-layer refractor maps miss what they cannot see). Measured
-/// (`specula raytrace-bench --parts mutual`, BENCHMARKS.md): k mirror spheres on a ring give
-/// the distance maps 37 and 34 dB at k = 1, 2 and 17–24 dB from k = 3 (two others in view)
-/// on, while bvh stays at 60 dB and its frame flat in k.
-fn bvh_rule(f: &ObjectFacts, q: &Quality) -> Option<Verdict> {
-    if q.plan.planner.speed() {
-        return None;
-    }
-    let others = f.sees_specular.iter().filter(|(_, c)| *c >= MIN_COVERAGE).count();
-    if others >= MUTUAL_VIEW_OBJECTS {
-        return Some(Verdict {
-            score: 4.5, // above distance-multi's 4.0 for objects in mutual view
-            reason: format!(
-                "sees {others} other specular objects: exact ray tracing through a BVH (inter-object paths to depth {})",
-                q.frame.depth
-            ),
-        });
-    }
-    if f.sees_planar_mirror && !f.planar {
-        return Some(Verdict {
-            score: 4.5,
-            reason: "sees a planar mirror or pane, which cube maps show one reflection deep (a pane: the environment only): exact ray tracing through a BVH (tests/geometry.rs: 46 vs 31 dB)".into(),
-        });
-    }
-    if f.class == ObjectClass::SolidDielectric && f.visible_fraction < 0.9 {
-        return Some(Verdict {
-            score: 4.5,
-            reason: format!(
-                "solid dielectric only {:.0} % visible from its reference point: exact ray tracing through a BVH",
-                100.0 * f.visible_fraction
-            ),
-        });
-    }
-    None
 }
 
 /// Every ray tracer's GPU side: no maps, its own stage, seen in other objects' maps as the
@@ -157,7 +111,6 @@ pub const BVH: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: bvh_rule,
 });
 
 pub const RAY_ENGINE: Method = Method(&MethodInfo {
@@ -171,7 +124,6 @@ pub const RAY_ENGINE: Method = Method(&MethodInfo {
     gpu: Some(ray_tracer("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| None,
 });
 
 pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
@@ -187,7 +139,6 @@ pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| None,
 });
 
 pub const KD_TREE: Method = Method(&MethodInfo {
@@ -204,7 +155,6 @@ pub const KD_TREE: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| None,
 });
 
 pub const GRID: Method = Method(&MethodInfo {
@@ -221,7 +171,6 @@ pub const GRID: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-    rule: |_, _| None,
 });
 
 /// The scene's triangles in world space in scene order (mesh by mesh, index by index):

@@ -3,7 +3,9 @@
 //! error floor (`--min-psnr`: every specular object's PSNR on its own pixels) at the least
 //! predicted time, or a time budget (`--max-ms`) at the least predicted error.
 //!
-//! **Models** come from a calibration run (`specula tradeoff --calibrate`): the study renders
+//! **Models** come from predictions (`plan::predict`: per object and method, error from the
+//! object's facts, cost from the device's unit costs) or from a calibration run of the very
+//! scene (`specula tradeoff --calibrate`): the study renders
 //! every method × knob variant; per row, each specular object's PSNR on its own pixels (the
 //! reference's object ids) and its share of the GPU time. A pass belongs to the objects whose
 //! plan lists it (`ObjectPlan::passes`); a pass a stage records under the prefix its
@@ -15,9 +17,7 @@
 //! camera pass declares them *shared* (`Profiled::shared`): paid once per method a frame
 //! uses. Each cost
 //! has a fixed part (maps, shadow maps, photons: independent of the output size) and a screen
-//! part, scaled by the pixel count when a frame's size differs from the calibration's. Without a calibration the planner uses the
-//! stored defaults measured on the bundled scenes (`assets/models/`), matched by object class
-//! (mirror, thin or solid dielectric); without those, the rules of the registry.
+//! part, scaled by the pixel count when a frame's size differs from the calibration's.
 //!
 //! **Choice.** Knob values are global to a frame (one `Quality`), so a choice is one
 //! calibrated knob variant and, per object, one method measured with it. Predicted frame ms =
@@ -45,6 +45,6 @@ mod search;
 pub use attribute::{attribute, measured_by_object, Cost};
 pub use choose::{choose, choose_with};
 pub use fit::{fit, Measured};
-pub use models::{stored_defaults, variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};
+pub use models::{variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};
 pub use prediction::{report, Budget, FrameMeasured, ObjectPrediction, Prediction};
 pub use search::MAX_COMBINATIONS;

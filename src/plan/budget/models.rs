@@ -77,26 +77,6 @@ pub struct Models {
     pub variants: Vec<VariantModel>,
 }
 
-/// The stored defaults, measured on the bundled scenes (`assets/models/*.json`, written by
-/// `specula tradeoff --calibrate`; see BENCHMARKS.md for the commands).
-pub fn stored_defaults() -> Result<Models> {
-    let files = [
-        ("assets/models/demo.json", include_str!("../../../assets/models/demo.json")),
-        ("assets/models/mirrors.json", include_str!("../../../assets/models/mirrors.json")),
-    ];
-    let mut all: Vec<Models> = Vec::new();
-    for (name, text) in files {
-        let mut m = Models::parse(text, name)?;
-        // Matched by class only: a user's object that shares a bundled object's name is
-        // not that object.
-        for o in m.variants.iter_mut().flat_map(|v| v.objects.iter_mut()) {
-            o.object = format!("{}:{}", m.scene, o.object);
-        }
-        all.push(m);
-    }
-    Ok(Models::merge(all))
-}
-
 impl Models {
     pub fn parse(text: &str, what: &str) -> Result<Models> {
         let m: Models = serde_json::from_str(text).map_err(|e| Error::invalid(what.to_string(), format!("not a models file: {e}")))?;
@@ -238,13 +218,5 @@ mod tests {
         assert_eq!((v.objects[1].cost.screen_ms, v.objects[1].pixels), (1.0, 3));
         assert_eq!(v.base, Cost { fixed_ms: 2.0, screen_ms: 1.0 });
         assert_eq!(Cost { fixed_ms: 1.0, screen_ms: 2.0 }.at(200.0, 100.0), 5.0);
-    }
-
-    #[test]
-    fn stored_defaults_parse_and_cover_the_bundled_classes() {
-        let d = stored_defaults().unwrap();
-        let classes: std::collections::BTreeSet<&str> =
-            d.variants.iter().flat_map(|v| v.objects.iter().map(|o| o.class.as_str())).collect();
-        assert!(classes.contains("mirror") && classes.contains("solid dielectric"), "{classes:?}");
     }
 }

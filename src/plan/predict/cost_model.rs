@@ -124,7 +124,11 @@ impl CostModel {
     pub fn predict(&self, method: &str, w: &Workload) -> Option<(f64, f64, f64)> {
         let c = self.methods.get(method)?;
         let x = cost_features(w);
-        Some((linear::dot(&c.fixed, &pick(&x, &FIXED)), linear::dot(&c.screen, &pick(&x, &SCREEN)), linear::dot(&c.shared, &pick(&x, &SHARED))))
+        Some((
+            linear::dot(&c.fixed, &pick(&x, &FIXED)),
+            linear::dot(&c.screen, &pick(&x, &SCREEN)),
+            linear::dot(&c.shared, &pick(&x, &SHARED)),
+        ))
     }
 
     /// The frame's base (what belongs to no object) at this workload's screen and lights.
@@ -141,7 +145,10 @@ impl CostModel {
         for (m, mc) in &c.methods {
             crate::plan::Method::parse(m).map_err(|e| Error::invalid(format!("{what} methods"), e.to_string()))?;
             if !ok(&mc.fixed, FIXED.len()) || !ok(&mc.screen, SCREEN.len()) || !ok(&mc.shared, SHARED.len()) || mc.cycles == 0 {
-                return Err(Error::invalid(format!("{what} methods.{m}"), "unit costs must be finite, non-negative and complete".to_string()));
+                return Err(Error::invalid(
+                    format!("{what} methods.{m}"),
+                    "unit costs must be finite, non-negative and complete".to_string(),
+                ));
             }
         }
         if !ok(&c.base, 4) {
@@ -159,7 +166,9 @@ impl CostModel {
 /// `$HOME/.cache/specula`; `None` when none is set (nothing is cached then).
 pub fn cache_dir() -> Option<PathBuf> {
     let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
-    var("SPECULA_CACHE_DIR").or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("specula"))).or_else(|| var("HOME").map(|h| h.join(".cache/specula")))
+    var("SPECULA_CACHE_DIR")
+        .or_else(|| var("XDG_CACHE_HOME").map(|d| d.join("specula")))
+        .or_else(|| var("HOME").map(|h| h.join(".cache/specula")))
 }
 
 /// The cached unit costs of `key` in `dir`: `Ok(None)` when none are cached; an error naming

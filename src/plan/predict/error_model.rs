@@ -31,6 +31,11 @@ fn weight(s: &Sample) -> f64 {
 impl ErrorModel {
     /// Fits every method's model from `samples` for which `keep` holds.
     pub fn fit(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> ErrorModel {
+        Self::fit_with(samples, keep, RIDGE)
+    }
+
+    /// [`ErrorModel::fit`] with another ridge penalty.
+    pub fn fit_with(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool, ridge: f64) -> ErrorModel {
         let mut by: BTreeMap<&str, Vec<&Sample>> = BTreeMap::new();
         for s in samples.iter().filter(|s| keep(s)) {
             by.entry(s.method.as_str()).or_default().push(s);
@@ -47,7 +52,7 @@ impl ErrorModel {
                     b[0] = y.iter().zip(&w).map(|(y, w)| y * w).sum::<f64>() / w.iter().sum::<f64>();
                     b
                 } else {
-                    linear::fit(&x, &y, &w, RIDGE, false)
+                    linear::fit(&x, &y, &w, ridge, false)
                 };
                 (m.to_string(), (beta, ss.len()))
             })
@@ -77,12 +82,17 @@ pub struct Held {
 /// Leave-one-scene-out: per scene, the models fitted on every other scene predict its
 /// samples.
 pub fn leave_one_scene_out(samples: &[Sample]) -> Vec<Held> {
+    leave_one_scene_out_with(samples, RIDGE)
+}
+
+/// [`leave_one_scene_out`] with another ridge penalty.
+pub fn leave_one_scene_out_with(samples: &[Sample], ridge: f64) -> Vec<Held> {
     let mut scenes: Vec<usize> = samples.iter().map(|s| s.scene).collect();
     scenes.sort();
     scenes.dedup();
     let mut out = Vec::new();
     for sc in scenes {
-        let model = ErrorModel::fit(samples, &|s| s.scene != sc);
+        let model = ErrorModel::fit_with(samples, &|s| s.scene != sc, ridge);
         for s in samples.iter().filter(|s| s.scene == sc) {
             if let Some(p) = model.predict(&s.method, &s.features) {
                 out.push(Held {

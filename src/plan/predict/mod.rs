@@ -116,7 +116,8 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             base = target.costs.base_ms(&work);
             let feats = error_features(f, scene, &q);
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
-                let (Some(psnr), Some((fixed, screen, shared))) = (errors.predict(m.name, &feats), target.costs.predict(m.name, &work)) else {
+                let (Some(psnr), Some((fixed, screen, shared))) = (errors.predict(m.name, &feats), target.costs.predict(m.name, &work))
+                else {
                     continue;
                 };
                 let cycles = target.costs.methods.get(m.name).map_or(1, |c| c.cycles);
@@ -142,6 +143,34 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
         size: [target.size.0, target.size.1],
         variants: out,
     })
+}
+
+/// The knob variants a budget chooses among (besides the methods): the cube maps' size,
+/// the knob most of the map-based methods' error and cost turn on.
+pub fn budget_variants() -> Vec<String> {
+    ["default", "cube_size=128", "cube_size=512"].iter().map(|s| s.to_string()).collect()
+}
+
+/// Per object of the first variant of `models`, its candidates that no other candidate beats
+/// in both predicted time (its own share plus its method's whole-screen kernels) and error,
+/// fastest first, and how many were dominated.
+pub fn pareto(models: &Models) -> Vec<(String, Vec<&ObjectModel>, usize)> {
+    let Some(v) = models.variants.first() else { return Vec::new() };
+    let ms = |o: &ObjectModel| o.cost.fixed_ms + o.cost.screen_ms + o.shared.fixed_ms + o.shared.screen_ms;
+    let mut names: Vec<&str> = v.objects.iter().map(|o| o.object.as_str()).collect();
+    names.dedup();
+    names
+        .into_iter()
+        .map(|n| {
+            let all: Vec<&ObjectModel> = v.objects.iter().filter(|o| o.object == n).collect();
+            let beats =
+                |a: &ObjectModel, b: &ObjectModel| ms(a) <= ms(b) && a.psnr_db >= b.psnr_db && (ms(a) < ms(b) || a.psnr_db > b.psnr_db);
+            let mut front: Vec<&ObjectModel> = all.iter().copied().filter(|c| !all.iter().any(|d| beats(d, c))).collect();
+            front.sort_by(|a, b| ms(a).total_cmp(&ms(b)));
+            let dominated = all.len() - front.len();
+            (n.to_string(), front, dominated)
+        })
+        .collect()
 }
 
 /// Where predictions come from, for reports.
@@ -183,7 +212,8 @@ impl AutoPlan {
             return format!("auto ({})", b.describe());
         };
         let others = self.models.variants.first().map(|v| v.objects.iter().filter(|c| c.object == name && c.method != method.name));
-        let runner = others.and_then(|it| it.max_by(|a, b| a.psnr_db.total_cmp(&b.psnr_db).then(b.cost.fixed_ms.total_cmp(&a.cost.fixed_ms))));
+        let runner =
+            others.and_then(|it| it.max_by(|a, b| a.psnr_db.total_cmp(&b.psnr_db).then(b.cost.fixed_ms.total_cmp(&a.cost.fixed_ms))));
         let runner = runner.map_or(String::new(), |r| {
             let ms = r.cost.fixed_ms + r.cost.screen_ms + r.shared.screen_ms;
             format!("; runner-up {} ({:.1} dB, {:.1} ms)", r.method, r.psnr_db, ms)
@@ -215,4 +245,59 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
     let tolerance = if quality.plan.planner.speed() { SPEED_TOLERANCE_DB } else { TOLERANCE_DB };
     let floor_db = best.specular_psnr_db - tolerance;
     Ok(run(choices, Budget::Near { max_ms, floor_db })?.map(|(choices, _, prediction)| AutoPlan { choices, prediction, models }))
+}
+
+/// Hysteresis: switching from `current` to `next` (per-object methods, every object named)
+/// must gain more than this PSNR (within the default budget) ...
+pub const SWITCH_DB: f64 = 1.0;
+/// ... or save this fraction of the frame at no more than the tolerance's loss, or bring a
+/// frame more than 10 % over the budget back within it.
+pub const SWITCH_SAVING: f64 = 0.2;
+
+/// Whether `auto` should leave `current` for `next` on the scene as it is now, and why
+/// (both predicted: the frame's ms and its specular PSNR, the budget being the exact
+/// tracer's predicted frame as in [`auto`]); `None`: keep `current` (the difference is within
+/// the hysteresis, so a choice does not flicker frame to frame).
+pub fn switch(
+    scene: &Scene,
+    facts: &SceneFacts,
+    current: &Choices,
+    next: &Choices,
+    quality: &Quality,
+    target: &Target,
+) -> Result<Option<String>> {
+    let models = predict_models(scene, facts, quality, target, &["default".to_string()])?;
+    let src = [(&models, source(target))];
+    let eval = |c: &Choices| budget::choose_with(scene, facts, c, quality, Budget::MaxMs(f64::INFINITY), target.size, &src);
+    let exact = Choices { method: current.method, objects: current.objects.iter().map(|(n, _)| (n.clone(), BVH)).collect() };
+    let (Some((_, _, a)), Some((_, _, b)), Some((_, _, e))) = (eval(current)?, eval(next)?, eval(&exact)?) else { return Ok(None) };
+    let max_ms = e.frame_ms;
+    let better = b.specular_psnr_db > a.specular_psnr_db + SWITCH_DB && b.frame_ms <= max_ms;
+    let cheaper = b.frame_ms < a.frame_ms * (1.0 - SWITCH_SAVING) && b.specular_psnr_db >= a.specular_psnr_db - TOLERANCE_DB;
+    let back = a.frame_ms > max_ms * 1.1 && b.frame_ms <= max_ms;
+    if !(better || cheaper || back) {
+        return Ok(None);
+    }
+    let changed: Vec<String> = b
+        .objects
+        .iter()
+        .zip(&a.objects)
+        .filter(|(n, o)| n.method != o.method)
+        .map(|(n, o)| format!("{} {} → {}", n.name, o.method.name, n.method.name))
+        .collect();
+    Ok(Some(format!(
+        "{} (predicted {:.1} dB, {:.2} ms against {:.1} dB, {:.2} ms: {})",
+        changed.join(", "),
+        b.specular_psnr_db,
+        b.frame_ms,
+        a.specular_psnr_db,
+        a.frame_ms,
+        if better {
+            "more accurate within the exact tracer's time"
+        } else if cheaper {
+            "faster at no visible loss"
+        } else {
+            "back within the exact tracer's time"
+        }
+    )))
 }

@@ -77,7 +77,10 @@ impl Corpus {
             let field = |f: &str| format!("{what} samples[{k}].{f}");
             Method::parse(&s.method).map_err(|e| Error::invalid(field("method"), e.to_string()))?;
             if s.features.len() != ERROR_FEATURES.len() || s.features.iter().any(|x| !x.is_finite()) {
-                return Err(Error::invalid(field("features"), format!("{} finite values expected, got {:?}", ERROR_FEATURES.len(), s.features)));
+                return Err(Error::invalid(
+                    field("features"),
+                    format!("{} finite values expected, got {:?}", ERROR_FEATURES.len(), s.features),
+                ));
             }
             for (name, v) in [("psnr_db", s.psnr_db), ("fixed_ms", s.fixed_ms), ("screen_ms", s.screen_ms), ("shared_ms", s.shared_ms)] {
                 if !v.is_finite() || v < 0.0 {
@@ -88,7 +91,10 @@ impl Corpus {
         }
         for (k, f) in c.frames.iter().enumerate() {
             if !f.base_ms.is_finite() || f.base_ms < 0.0 {
-                return Err(Error::invalid(format!("{what} frames[{k}].base_ms"), format!("{} is not a finite non-negative number", f.base_ms)));
+                return Err(Error::invalid(
+                    format!("{what} frames[{k}].base_ms"),
+                    format!("{} is not a finite non-negative number", f.base_ms),
+                ));
             }
             check_work(&f.work, &format!("{what} frames[{k}].work"))?;
         }
