@@ -499,7 +499,7 @@ SpeculaResult specula_context_set_knob(SpeculaContext *ctx, const char *key, con
 // Plans and creates everything a frame of the scene needs with the given method and size.
 // With a budget (`max_ms` or `min_psnr_db`, SPECULA_METHOD_AUTO only) the budgeted planner
 // chooses per object a method and the knobs (see SpeculaRenderDesc); it returns
-// SPECULA_WARNING_NO_MODELS when no models cover the scene (the rules chose). A desc of
+// SPECULA_WARNING_NO_MODELS when no models cover the scene (auto's default chose). A desc of
 // SPECULA_RENDER_DESC_SIZE_V1 bytes (before the budget fields) is read as no budget.
 // Reconfiguring destroys the previous renderer: needs an idle GPU in host-device mode.
 SpeculaResult specula_context_configure(SpeculaContext *ctx, const SpeculaRenderDesc *desc);

@@ -71,9 +71,10 @@ fn bad_animation_arguments_are_refused() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Poses where the plan's structure changes (with `auto`, the demo's mirror sphere comes into
-/// the glass sphere's view around t = 2.58 s and the objects start to compose through
-/// inter-object cycles) get a new renderer: the sequence goes on, and frames.csv says so.
+/// Poses where the plan's structure changes (the demo's mirror sphere on distance maps and its
+/// glass sphere on refractor maps: the mirror comes into the glass sphere's view around
+/// t = 2.58 s and the objects start to compose through inter-object cycles) get a new
+/// renderer: the sequence goes on, and frames.csv says so.
 #[test]
 fn animate_replans_where_the_pose_changes_the_plan() {
     let dir = temp("animate-replan");
@@ -91,6 +92,10 @@ fn animate_replans_where_the_pose_changes_the_plan() {
         "cube_size=16",
         "-q",
         "shadow_size=16",
+        "--object",
+        "mirror_sphere=distance",
+        "--object",
+        "glass_sphere=refractor-map",
         "--out",
         out_dir,
     ];

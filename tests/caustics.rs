@@ -755,17 +755,20 @@ fn total_internal_reflection_paths_reach_the_floor() {
 
 #[test]
 fn the_caustic_is_seen_in_a_planar_mirror() {
-    // A planar mirror behind the sphere (survey §5, planar-mirror by the planner): its
-    // mirrored view shades the floor with the caustic too (Figure 40).
+    // A planar mirror behind the sphere (survey §5, planar-mirror for it, auto for the
+    // glass): its mirrored view shades the floor with the caustic too (Figure 40).
     let ctx = common::gpu();
     let mut s = sphere_over_floor(1.5);
     let m = s.add_material(common::mirror(0.9)).unwrap();
     s.add_mesh(shapes::quad("mirror", Vec3::new(-1.5, 0.0, -1.2), Vec3::new(3.0, 0.0, 0.0), Vec3::new(0.0, 2.0, 0.0), 1, m)).unwrap();
     s.camera = Some(Camera::look_at(Vec3::new(0.0, 0.6, 3.0), Vec3::new(0.0, 0.4, -1.2), 50f32.to_radians()));
+    let choices =
+        specula::plan::Choices { method: specula::Choice::Auto, objects: vec![("mirror".into(), specula::methods::PLANAR_MIRROR)] };
     let render = |s: &Scene, c: &str| {
-        specula::render(&ctx, s, specula::Choice::Auto, &quality(&[&format!("caustics={c}")]), (64, 64), (0, 1)).unwrap()
+        let q = quality(&[&format!("caustics={c}")]);
+        specula::render_plan(&ctx, s, specula::plan::plan_with(s, &choices, &q).unwrap(), (64, 64), (0, 1)).unwrap()
     };
-    let p = plan(&s, specula::Choice::Auto, &quality(&["caustics=triangles"]));
+    let p = specula::plan::plan_with(&s, &choices, &quality(&["caustics=triangles"])).unwrap();
     assert_eq!(p.object(2).map(|o| o.method.name), Some("planar-mirror"), "{:?}", p.objects);
     let (off, on) = (render(&s, "off").image, render(&s, "triangles").image);
     let mut gone = s.clone();

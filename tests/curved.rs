@@ -332,12 +332,13 @@ fn cluttered_scene() -> Scene {
     s
 }
 
-/// The planner takes curved-reflector for a convex mirror in an environment of large depth
-/// variation that is tessellated finely as seen from it (two balls close to the sphere),
-/// where it measured better than distance maps and the proxy box; not for the same sphere
-/// in a long hall, deep but coarse, where it measured worse.
+/// Curved-reflector on a convex mirror in an environment of large depth variation that is
+/// tessellated finely as seen from it (two balls close to the sphere) measures better than
+/// distance maps and the proxy box; in a long hall, deep but coarse, worse. The measuring
+/// planner's choice is at least as accurate as all three in the first, and is not
+/// curved-reflector in the second.
 #[test]
-fn the_planner_takes_it_in_a_deep_finely_tessellated_environment() {
+fn curved_reflector_wins_in_a_deep_finely_tessellated_environment_and_auto_is_no_worse() {
     let ctx = common::gpu();
     let q = quality();
     let s = cluttered_scene();
@@ -347,14 +348,18 @@ fn the_planner_takes_it_in_a_deep_finely_tessellated_environment() {
     let plan = specula::plan(&s, specula::Choice::Auto, &q);
     let o = plan.objects.iter().find(|o| o.name == "sphere").unwrap();
     println!("auto: {} ({})", o.method, o.reason);
-    assert_eq!(o.method, specula::methods::CURVED_REFLECTOR, "{}", o.reason);
     let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
     let auto = psnr(&specula::render(&ctx, &s, specula::Choice::Auto, &q, SIZE, (0, 1)).unwrap().image, &reference);
+    let curved = psnr(&gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q).image, &reference);
     let distance = psnr(&gpu(&ctx, &s, specula::methods::DISTANCE, &q).image, &reference);
     let proxy = psnr(&gpu(&ctx, &s, specula::methods::PROXY_BOX, &q).image, &reference);
-    println!("cluttered: auto {auto:.2} dB, distance {distance:.2} dB, proxy-box {proxy:.2} dB");
-    // Rule 1: measured 36.80, 29.55 and 26.08 dB (margins 7.25 and 10.72 dB).
-    assert!(auto >= 35.80 && auto >= distance + 6.25 && auto >= proxy + 9.72, "auto {auto:.2} dB");
+    println!(
+        "cluttered: auto ({}) {auto:.2} dB, curved-reflector {curved:.2}, distance {distance:.2} dB, proxy-box {proxy:.2} dB",
+        o.method
+    );
+    // Measured 36.80, 29.55 and 26.08 dB (margins 7.25 and 10.72 dB).
+    assert!(curved >= 35.80 && curved >= distance + 6.25 && curved >= proxy + 9.72, "curved-reflector {curved:.2} dB");
+    assert!(auto >= curved.max(distance).max(proxy) - 0.5, "auto {auto:.2} dB");
 
     let hall = hall_scene();
     let plan = specula::plan(&hall, specula::Choice::Auto, &q);

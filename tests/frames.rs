@@ -362,10 +362,11 @@ fn frame_latency_restarts_its_cycles_after_a_change() {
     common::assert_clean(&ctx);
 }
 
-/// A move that changes the plan's structure (with `auto`, the demo's mirror sphere taken to
-/// where it sees the glass sphere: the objects now compose through inter-object cycles) is
-/// accepted through the C ABI; a standalone context reconfigures at its next render, and the
-/// image equals a fresh context's for the same state.
+/// A move that changes the plan's structure (the demo's mirror sphere on distance maps and
+/// its glass sphere on refractor maps, the mirror taken to where it sees the glass: the
+/// objects now compose through inter-object cycles) is accepted through the C ABI; a
+/// standalone context reconfigures at its next render, and the image equals a fresh
+/// context's for the same state.
 #[test]
 fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
     use specula::ffi::*;
@@ -383,11 +384,22 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         assert_eq!(r, SPECULA_SUCCESS, "{}", unsafe { std::ffi::CStr::from_ptr(specula_context_last_error(ctx)) }.to_string_lossy());
         px
     };
+    let methods: Vec<(String, specula::Method)> = scene
+        .specular_meshes()
+        .map(|(_, m)| {
+            let glass = matches!(scene.materials[m.material].kind, specula::scene::SurfaceKind::Dielectric { .. });
+            (m.name.clone(), if glass { specula::methods::REFRACTOR_MAP } else { specula::methods::DISTANCE })
+        })
+        .collect();
     let knobs = |ctx: *mut SpeculaContext| {
         for k in ["cube_size=16", "shadow_size=32", "depth=4"] {
             let (key, value) = k.split_once('=').unwrap();
             let (key, value) = (std::ffi::CString::new(key).unwrap(), std::ffi::CString::new(value).unwrap());
             assert_eq!(unsafe { specula_context_set_knob(ctx, key.as_ptr(), value.as_ptr()) }, SPECULA_SUCCESS);
+        }
+        for (name, m) in &methods {
+            let name = std::ffi::CString::new(name.as_str()).unwrap();
+            assert_eq!(unsafe { specula_context_set_object_method(ctx, name.as_ptr(), m.abi) }, SPECULA_SUCCESS);
         }
     };
     unsafe {
@@ -418,7 +430,8 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         knobs.frame.depth = 4;
         knobs
     };
-    let mut r = Renderer::new(&ctx, &scene, specula::plan(&scene, specula::Choice::Auto, &q), w, h).unwrap();
+    let choices = specula::plan::Choices { method: specula::Choice::Auto, objects: methods.clone() };
+    let mut r = Renderer::new(&ctx, &scene, specula::plan::plan_with(&scene, &choices, &q).unwrap(), w, h).unwrap();
     let mut s = scene.clone();
     s.set_object_transform(sphere as usize, Mat4::from_cols_array(&moved)).unwrap();
     let e = r.update(&s).unwrap_err();

@@ -307,22 +307,26 @@ fn the_map_models_only_the_layers_the_scene_needs() {
     common::assert_clean(&ctx);
 }
 
+/// What the rule-based planner knew, the measuring planner's error models learned from the
+/// corpus: an object that sees itself (a bowl facing its reference point, a torus) is
+/// predicted more accurate with layered maps than with a single distance map.
 #[test]
-fn the_planner_takes_layered_maps_for_objects_that_see_themselves() {
+fn error_models_prefer_layered_maps_for_objects_that_see_themselves() {
     let q = quality(&[]);
-    let p = specula::plan::plan(&bowl_scene(), specula::Choice::Auto, &q);
-    let bowl = p.objects.iter().find(|o| o.name == "bowl").unwrap();
-    assert_eq!(bowl.method, specula::methods::LAYERED, "{}", bowl.reason);
-    assert!(bowl.reason.contains("faces its reference point"), "{}", bowl.reason);
-    let p = specula::plan::plan(&torus_scene(), specula::Choice::Auto, &q);
-    assert_eq!(p.objects[0].method, specula::methods::LAYERED, "{}", p.objects[0].reason);
-    // A convex mirror sphere stays on a single-layer method.
-    let p = specula::plan::plan(&common::mirror_and_glass(32), specula::Choice::Auto, &q);
-    assert!(
-        p.objects.iter().all(|o| o.method != specula::methods::LAYERED),
-        "{:?}",
-        p.objects.iter().map(|o| &o.reason).collect::<Vec<_>>()
-    );
+    let target = specula::plan::predict::Target::nominal().unwrap();
+    for (name, scene) in [("bowl", bowl_scene()), ("torus", torus_scene())] {
+        let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
+        let models = specula::plan::predict::predict_models(&scene, &facts, &q, &target, &["default".into()]).unwrap();
+        let f = &facts.objects[0];
+        let object = &scene.meshes[f.mesh].name;
+        let db = |m: &str| models.variants[0].objects.iter().find(|o| &o.object == object && o.method == m).map(|o| o.psnr_db).unwrap();
+        let (layered, distance) = (db("layered"), db("distance"));
+        println!(
+            "{name}: self-facing {:.2}, visible {:.2}; predicted layered {layered:.1} dB, distance {distance:.1} dB",
+            f.self_facing, f.visible_fraction
+        );
+        assert!(layered > distance, "{name}: layered {layered:.1} dB, distance {distance:.1} dB");
+    }
 }
 
 #[test]

@@ -6,6 +6,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 const SCENE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
+/// refractor-map at cube_size 64 over 16 on the demo (see its use): measured 33.947 vs
+/// 33.383 dB, the bound at half the 0.564 dB gain (tests/README.md rule 1).
+const MARGIN: f64 = 0.282;
 
 fn specula() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_specula"));
@@ -141,12 +144,14 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
             assert_eq!(row(m, knobs), traced, "{m} {knobs}");
         }
     }
-    // The sweep reaches the renderer: auto's maps at cube_size 64 against 16 (measured 33.946
-    // vs 33.374 dB with caustics off, the 6.5 cd light: the margin asserted at half its
-    // 0.572 dB, rule 1; with caustics on it was 2.715 dB, mostly the light cubes').
-    let (small, large) = (row("auto", "cube_size=16 cube_precision=half").1, row("auto", "cube_size=64 cube_precision=half").1);
-    eprintln!("auto: cube_size 16 {small} dB, 64 {large} dB");
-    assert!(large >= small + 0.286, "auto: cube_size 64 {large} dB vs 16 {small} dB");
+    // The sweep reaches the renderer: refractor-map's maps (distance's for the mirror) at
+    // cube_size 64 against 16 (caustics off, the 6.5 cd light; the margin asserted at half the
+    // measured one, rule 1). (auto ray traces this scene on lavapipe: its rows are the
+    // tracers'.)
+    let (small, large) =
+        (row("refractor-map", "cube_size=16 cube_precision=half").1, row("refractor-map", "cube_size=64 cube_precision=half").1);
+    eprintln!("refractor-map: cube_size 16 {small} dB, 64 {large} dB");
+    assert!(large >= small + MARGIN, "refractor-map: cube_size 64 {large} dB vs 16 {small} dB");
     // The front is the undominated set in (frame ms, mean FLIP), checked from the printed
     // values (a relative 1e-3 for their rounding): no row on it is beaten in both, every row
     // off it is matched or beaten in both by some row.
