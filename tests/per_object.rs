@@ -5,7 +5,7 @@
 mod common;
 
 use glam::Vec3;
-use specula::methods::{DISTANCE, DISTANCE_MULTI, PROXY_BOX, REFRACTOR_MAP};
+use specula::methods::{DISTANCE, REFRACTOR_MAP};
 use specula::metrics;
 use specula::plan::{plan_with, Choices};
 use specula::reference::{render_reference, CameraRays};

@@ -133,6 +133,10 @@ pub struct GpuSpec {
     pub leaves_out: LeavesOut,
     /// Distance-map cycles per frame this method asks for (§4.3).
     pub cycles: fn(&Quality) -> u32,
+    /// Views of the whole scene it renders per object it serves, at most (planar mirrors'
+    /// and planar refraction's mirrored views, §5): every other object's camera work repeats
+    /// in each — what the planner's cost of a mix counts (`plan::budget`).
+    pub views: fn(&Quality) -> u32,
     /// Whether, asked for the whole scene (`--method`), it shades every pixel in its own
     /// stage, diffuse surfaces included (exact shadow rays), from no maps and with no
     /// fallback: no other family's pass reaches its image, so only the knobs it lists and

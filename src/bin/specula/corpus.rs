@@ -69,15 +69,13 @@ pub fn run_calibrate(out: Option<&Path>, validate: bool, device: &Option<String>
         }
     };
     println!("calibrated {} in {:.1} s; wrote {}", c.key.label(), c.calibration_s, path.display());
-    println!(
-        "{:<24} {:>10} {:>12} {:>12} {:>12} {:>12} {:>12}",
-        "method", "ms/object", "ms/Mtexel·kTri", "ms/Mtexel", "ms/10⁴ px", "ms/10⁴ scr", "ms/10⁴ scr·d"
-    );
+    use specula::plan::predict::features::{MAP_FEATURES, SCREEN_FEATURES, SHARED_FEATURES};
+    let names: Vec<&str> = MAP_FEATURES.iter().chain(&SCREEN_FEATURES).chain(&SHARED_FEATURES).copied().collect();
+    println!("unit costs (ms per unit of each feature: plan::predict::features)");
+    println!("{:<24} {}", "method", names.iter().map(|n| format!("{n:>17}")).collect::<String>());
     for (m, u) in &c.methods {
-        println!(
-            "{:<24} {:>10.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3} {:>12.3}",
-            m, u.fixed[0], u.fixed[1], u.fixed[2], u.screen[0], u.shared[0], u.shared[1]
-        );
+        let all: Vec<f64> = u.fixed.iter().chain(&u.screen).chain(&u.shared).copied().collect();
+        println!("{m:<24} {}", all.iter().map(|v| format!("{v:>17.3}")).collect::<String>());
     }
     Ok(())
 }

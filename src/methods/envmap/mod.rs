@@ -43,6 +43,7 @@ const fn spec(camera: CameraPass) -> GpuSpec {
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,
         cycles: one,
+        views: |_| 0,
         shades_every_pixel: false,
     }
 }

@@ -87,7 +87,7 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     summary: "planar reflectors by geometry transformation: the scene rendered again from the camera mirrored through the mirror's plane (oblique near plane at the mirror), laid onto the mirror's pixels with its Fresnel weight; mirrors in mirrors recurse up to depth, at most mirror_budget views a frame",
     serves: &[ObjectClass::Mirror],
     knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, GeometryKnobs::map_mirrors, FrameKnobs::fresnel],
-    gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
+    gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.frame.depth.min(q.geometry.mirror_budget).max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
 });
@@ -113,7 +113,7 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     summary: "flat-faced dielectrics (slabs, prisms, gems; convex) and thin panes by geometry transformation: per face seen, the scene rendered through it by the linearised refraction of the eye ray (GS04: an affine map per face, exact on the face's central ray; exact for thin panes) and reflected in it (exact), recursing through internal reflections to the exit faces up to depth, at most mirror_budget views a frame, with the pixel's own Fresnel split",
     serves: &[ObjectClass::SolidDielectric, ObjectClass::ThinDielectric],
     knobs: &[FrameKnobs::depth, GeometryKnobs::mirror_budget, FrameKnobs::fresnel],
-    gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, shades_every_pixel: false }),
+    gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.geometry.mirror_budget.max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
 });

@@ -71,7 +71,7 @@ pub const LAYERED: Method = Method(&MethodInfo {
     knobs: &[
         LayeredKnobs::layers, LayeredKnobs::layered_branches, FrameKnobs::depth, CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::search_tolerance,
     ],
-    gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, shades_every_pixel: false }),
+    gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
     shape: Shape::Any,
 });

@@ -71,6 +71,7 @@ const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> R
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Nothing,
         cycles: one,
+        views: |_| 0,
         shades_every_pixel: true,
     }
 }

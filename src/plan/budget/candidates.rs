@@ -48,6 +48,7 @@ pub(super) fn candidates(
     let ratio = if measured > 0.0 { px / measured } else { 1.0 };
     let mut out = Vec::new();
     for v in &models.variants {
+        let variant_q = super::variant_quality(&crate::quality::Quality::default(), &v.knobs).unwrap_or_default();
         let mut per_object = Vec::new();
         let mut wholes: Vec<(Method, Vec<Candidate>)> = Vec::new();
         let base = v.base.at(px, measured);
@@ -114,7 +115,12 @@ pub(super) fn candidates(
             }
             // Drop the dominated: another candidate of no higher cost in every part and
             // at least as accurate (strictly better somewhere).
-            let le = |d: &Candidate, c: &Candidate| d.fixed <= c.fixed && d.screen <= c.screen && d.shared <= c.shared && d.psnr >= c.psnr;
+            // A candidate that renders views of the scene (`GpuSpec::views`) costs what the
+            // other objects' methods cost in them: it dominates nothing by its own parts.
+            let renders_views = |d: &Candidate| d.method.gpu.is_some_and(|g| (g.views)(&variant_q) > 0);
+            let le = |d: &Candidate, c: &Candidate| {
+                !renders_views(d) && d.fixed <= c.fixed && d.screen <= c.screen && d.shared <= c.shared && d.psnr >= c.psnr
+            };
             let keep: Vec<Candidate> = list
                 .iter()
                 .enumerate()

@@ -55,8 +55,33 @@ impl Timing<'_> {
         }
     }
 
+    /// Views of the whole scene the picks render (`GpuSpec::views`), `i`'s own left out:
+    /// every other object's camera work and its method's kernels repeat in each. Not for a
+    /// whole-scene row (measured with its views) nor for a calibration row's candidates,
+    /// whose measured camera work includes them.
+    fn views(&self, picks: &[&Candidate], i: Option<usize>, whole: bool) -> f64 {
+        if whole {
+            return 0.0;
+        }
+        let gpu = |m: Method| m.gpu.expect("GPU method");
+        picks.iter().enumerate().filter(|(k, _)| Some(*k) != i).map(|(_, c)| (gpu(c.method).views)(&self.quality) as f64).sum()
+    }
+
     pub(super) fn frame_ms(&self, picks: &[&Candidate], whole: bool) -> f64 {
-        let own: f64 = picks.iter().map(|c| c.fixed * self.scale(picks, c, whole) + c.screen).sum();
+        (0..picks.len()).map(|i| self.own_ms(picks, i, whole)).sum::<f64>()
+            + self.base
+            + self.kernels(picks, whole).iter().map(|(_, s)| s).sum::<f64>()
+    }
+
+    /// Object `i`'s maps and camera work, its camera work repeated in the others' views.
+    fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
+        let c = picks[i];
+        c.fixed * self.scale(picks, c, whole) + c.screen * (1.0 + self.views(picks, Some(i), whole))
+    }
+
+    /// Per method its whole-screen kernels, once, repeated in the views of objects of other
+    /// methods.
+    fn kernels(&self, picks: &[&Candidate], whole: bool) -> Vec<(Method, f64)> {
         let mut methods: Vec<(Method, f64)> = Vec::new();
         for c in picks {
             match methods.iter_mut().find(|(m, _)| *m == c.method) {
@@ -64,7 +89,11 @@ impl Timing<'_> {
                 None => methods.push((c.method, c.shared)),
             }
         }
-        self.base + own + methods.iter().map(|(_, s)| s).sum::<f64>()
+        for (m, s) in &mut methods {
+            let others: Vec<&Candidate> = picks.iter().copied().filter(|c| c.method != *m).collect();
+            *s *= 1.0 + self.views(&others, None, whole);
+        }
+        methods
     }
 
     /// Object `i`'s part of the frame: its share, and its method's shared kernels split
@@ -72,7 +101,8 @@ impl Timing<'_> {
     pub(super) fn object_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
         let c = picks[i];
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
-        c.fixed * self.scale(picks, c, whole) + c.screen + c.shared / users
+        let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
+        self.own_ms(picks, i, whole) + shared / users
     }
 }
 

@@ -1,9 +1,10 @@
 //! Cost models: per method, an object's GPU milliseconds on one device as non-negative
-//! unit costs times its workload (`features::cost_features`), split as the frame spends
-//! them: map passes (a constant per object, cube-map rasterisation per texel × scene
-//! triangle, per texel), camera passes (per covered pixel) and whole-screen kernels (per
-//! screen pixel, and per pixel × hierarchy depth), and the frame's base (per frame, per
-//! screen pixel, per light, per light × scene triangle). The unit costs are fitted
+//! unit costs times its workload (`features`), split as the frame spends them: map passes
+//! (a constant per object, cube-map rasterisation per texel × scene triangle, per texel),
+//! camera work (per covered pixel; per pixel × hierarchy depth, more for dielectrics, whose
+//! rays bounce) and whole-screen kernels (per screen pixel, and × hierarchy depth), and the
+//! frame's base (per frame, per screen pixel, per light, per light × scene triangle). The
+//! unit costs are fitted
 //! (non-negative least squares) on a calibration run on the device itself
 //! (`tradeoff::calibrate`), keyed by the device and cached on disk.
 
@@ -12,18 +13,13 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use super::features::{cost_features, Workload};
+use super::features::{map_features, screen_features, shared_features, Workload, MAP_FEATURES, SCREEN_FEATURES, SHARED_FEATURES};
 use super::linear;
 use super::samples::Corpus;
 use crate::error::{Error, Result};
 
 /// The first line of every cost file's `format` field.
 pub const FORMAT: &str = "specula-costs 1";
-
-/// Which cost features (`features::COST_FEATURES` indices) each part reads.
-const FIXED: [usize; 3] = [0, 3, 4];
-const SCREEN: [usize; 1] = [1];
-const SHARED: [usize; 2] = [2, 5];
 
 /// A device as the cost cache knows it: PCI vendor and device ids, the driver's version
 /// and its name (`VkPhysicalDeviceProperties`), and the driver's own description
@@ -52,7 +48,9 @@ impl DeviceKey {
     }
 }
 
-/// Unit costs of one method.
+/// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
+/// `SCREEN_FEATURES` (per object, its camera work) and `SHARED_FEATURES` (per frame, the
+/// method's whole-screen kernels).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MethodCost {
     pub fixed: Vec<f64>,
@@ -75,10 +73,6 @@ pub struct CostModel {
     pub calibration_s: f64,
 }
 
-fn pick(x: &[f64], idx: &[usize]) -> Vec<f64> {
-    idx.iter().map(|&i| x[i]).collect()
-}
-
 fn base_features(w: &Workload) -> Vec<f64> {
     vec![1.0, w.screen / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
 }
@@ -93,19 +87,42 @@ impl CostModel {
         let methods = by
             .into_iter()
             .map(|(m, ss)| {
-                let x: Vec<Vec<f64>> = ss.iter().map(|s| cost_features(&s.work)).collect();
-                // Relative error matters (a 1 ms part beside a 100 ms one): weight by 1/y.
-                let part = |idx: &[usize], y: &dyn Fn(&super::samples::Sample) -> f64| {
-                    let xs: Vec<Vec<f64>> = x.iter().map(|r| pick(r, idx)).collect();
-                    let ys: Vec<f64> = ss.iter().map(|s| y(s)).collect();
-                    let mean = ys.iter().sum::<f64>() / ys.len().max(1) as f64;
-                    let w: Vec<f64> = ys.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
-                    linear::fit(&xs, &ys, &w, 1e-4, true)
+                // Relative error matters (a 1 ms part beside a 100 ms one): weight by 1/y².
+                let nnls = |x: Vec<Vec<f64>>, y: Vec<f64>| {
+                    let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
+                    let w: Vec<f64> = y.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
+                    linear::fit(&x, &y, &w, 1e-4, true)
                 };
+                // Maps: per object.
+                let fixed = nnls(ss.iter().map(|s| map_features(&s.work)).collect(), ss.iter().map(|s| s.fixed_ms).collect());
+                // Camera work and whole-screen kernels: per frame (a ray tracer's kernels serve
+                // every object at once; its time is the frame's, its features the sum of its
+                // objects' and the screen's).
+                let mut frames: Vec<(Vec<f64>, f64)> = Vec::new();
+                let mut keys: Vec<(usize, &str, u64)> = Vec::new();
+                for s in &ss {
+                    let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
+                    let per = screen_features(&s.work);
+                    match keys.iter().position(|k| *k == key) {
+                        Some(k) => {
+                            let (x, y) = &mut frames[k];
+                            per.iter().enumerate().for_each(|(j, v)| x[j] += v);
+                            *y += s.screen_ms;
+                        }
+                        None => {
+                            keys.push(key);
+                            let mut x = per;
+                            x.extend(shared_features(&s.work));
+                            frames.push((x, s.screen_ms + s.shared_ms));
+                        }
+                    }
+                }
+                let beta = nnls(frames.iter().map(|f| f.0.clone()).collect(), frames.iter().map(|f| f.1).collect());
+                let n = SCREEN_FEATURES.len();
                 let cost = MethodCost {
-                    fixed: part(&FIXED, &|s| s.fixed_ms),
-                    screen: part(&SCREEN, &|s| s.screen_ms),
-                    shared: part(&SHARED, &|s| s.shared_ms),
+                    fixed,
+                    screen: beta[..n].to_vec(),
+                    shared: beta[n..].to_vec(),
                     cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
                     samples: ss.len(),
                 };
@@ -123,11 +140,10 @@ impl CostModel {
     /// workload; `None` for a method the calibration did not measure.
     pub fn predict(&self, method: &str, w: &Workload) -> Option<(f64, f64, f64)> {
         let c = self.methods.get(method)?;
-        let x = cost_features(w);
         Some((
-            linear::dot(&c.fixed, &pick(&x, &FIXED)),
-            linear::dot(&c.screen, &pick(&x, &SCREEN)),
-            linear::dot(&c.shared, &pick(&x, &SHARED)),
+            linear::dot(&c.fixed, &map_features(w)),
+            linear::dot(&c.screen, &screen_features(w)),
+            linear::dot(&c.shared, &shared_features(w)),
         ))
     }
 
@@ -144,7 +160,11 @@ impl CostModel {
         let ok = |v: &[f64], n: usize| v.len() == n && v.iter().all(|x| x.is_finite() && *x >= 0.0);
         for (m, mc) in &c.methods {
             crate::plan::Method::parse(m).map_err(|e| Error::invalid(format!("{what} methods"), e.to_string()))?;
-            if !ok(&mc.fixed, FIXED.len()) || !ok(&mc.screen, SCREEN.len()) || !ok(&mc.shared, SHARED.len()) || mc.cycles == 0 {
+            if !ok(&mc.fixed, MAP_FEATURES.len())
+                || !ok(&mc.screen, SCREEN_FEATURES.len())
+                || !ok(&mc.shared, SHARED_FEATURES.len())
+                || mc.cycles == 0
+            {
                 return Err(Error::invalid(
                     format!("{what} methods.{m}"),
                     "unit costs must be finite, non-negative and complete".to_string(),

@@ -74,24 +74,46 @@ pub struct Workload {
     pub cube_texels: f64,
     /// Punctual lights (one shadow map each).
     pub lights: f64,
+    /// 1 for a solid dielectric, 0 else: its rays refract in and out and reflect inside
+    /// (a ray tracer's bounces per pixel).
+    #[serde(default)]
+    pub solid: f64,
+    /// 1 for a thin dielectric, 0 else: a reflected and a transmitted ray per hit.
+    #[serde(default)]
+    pub thin: f64,
 }
 
-/// Names of the cost features, in the order [`cost_features`] returns them.
-pub const COST_FEATURES: [&str; 6] = ["object", "pixels", "screen", "cube_raster", "cube_texels", "screen_log_triangles"];
+/// Names of the per-object map features, in the order [`map_features`] returns them.
+pub const MAP_FEATURES: [&str; 3] = ["object", "cube_raster", "cube_texels"];
 
-/// The cost features of a workload: a constant per object, its pixels (1e4), the frame's
-/// pixels (1e4: kernels over the whole screen), cube-map rasterisation (texels × scene
-/// triangles, 1e9), cube texels (1e6), and rays over the screen times the depth of a
-/// hierarchy over the scene's triangles.
-pub fn cost_features(w: &Workload) -> Vec<f64> {
-    vec![
-        1.0,
-        w.pixels / 1e4,
-        w.screen / 1e4,
-        w.cube_texels * w.scene_triangles / 1e9,
-        w.cube_texels / 1e6,
-        w.screen / 1e4 * w.scene_triangles.max(2.0).log2() / 16.0,
-    ]
+/// What an object's maps cost scales with: a constant per object (its passes), cube-map
+/// rasterisation (texels × scene triangles, 1e9) and cube texels (1e6).
+pub fn map_features(w: &Workload) -> Vec<f64> {
+    vec![1.0, w.cube_texels * w.scene_triangles / 1e9, w.cube_texels / 1e6]
+}
+
+/// Names of the per-object screen features, in the order [`screen_features`] returns them.
+pub const SCREEN_FEATURES: [&str; 4] = ["pixels", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
+
+/// What an object's camera work scales with: its pixels (1e4), and its pixels times the
+/// depth of a hierarchy over the scene's triangles (log₂ / 16: a traversal per ray), again
+/// for a solid dielectric's and a thin one's pixels (more rays per pixel).
+pub fn screen_features(w: &Workload) -> Vec<f64> {
+    let rays = w.pixels / 1e4 * depth(w);
+    vec![w.pixels / 1e4, rays, rays * w.solid, rays * w.thin]
+}
+
+/// Names of the whole-screen features, in the order [`shared_features`] returns them.
+pub const SHARED_FEATURES: [&str; 2] = ["screen", "screen_rays"];
+
+/// What a method's whole-screen kernels scale with: the frame's pixels (1e4), and times the
+/// hierarchy depth (every pixel's primary ray).
+pub fn shared_features(w: &Workload) -> Vec<f64> {
+    vec![w.screen / 1e4, w.screen / 1e4 * depth(w)]
+}
+
+fn depth(w: &Workload) -> f64 {
+    w.scene_triangles.max(2.0).log2() / 16.0
 }
 
 /// The workload of object `f` at `size` covering `pixels` of it.
@@ -104,5 +126,7 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         triangles: f.triangles as f64,
         cube_texels: 6.0 * (q.cube.cube_size as f64).powi(2),
         lights: scene.lights.len() as f64,
+        solid: (f.class == ObjectClass::SolidDielectric) as u8 as f64,
+        thin: (f.class == ObjectClass::ThinDielectric) as u8 as f64,
     }
 }
