@@ -269,8 +269,10 @@ fn a_mirror_sphere_beside_a_mirror_wall() {
     // shows the wall's reflection by the wall's mirrored view per cube face (map_mirrors);
     // without them the map shows the wall reflecting the environment only. Measured on the
     // sphere's own pixels (where the image differs from the room without the sphere).
-    let choices =
-        specula::plan::Choices { method: specula::Choice::Auto, objects: vec![("sphere".into(), specula::methods::DISTANCE_MULTI)] };
+    let choices = specula::plan::Choices {
+        method: specula::Choice::Auto,
+        objects: vec![("mirror0".into(), specula::methods::PLANAR_MIRROR), ("sphere".into(), specula::methods::DISTANCE_MULTI)],
+    };
     let without_sphere = {
         let mut w = s.clone();
         w.meshes.retain(|m| m.name != "sphere");
@@ -584,7 +586,11 @@ fn spheres_see_a_mirror_wall_in_their_maps() {
     };
     let choices = specula::plan::Choices {
         method: specula::Choice::Auto,
-        objects: vec![("sphere".into(), specula::methods::DISTANCE), ("glass".into(), specula::methods::REFRACTOR_MAP)],
+        objects: vec![
+            ("mirror0".into(), specula::methods::PLANAR_MIRROR),
+            ("sphere".into(), specula::methods::DISTANCE),
+            ("glass".into(), specula::methods::REFRACTOR_MAP),
+        ],
     };
     let mut rows = Vec::new();
     for map_mirrors in ["on", "off"] {

@@ -44,6 +44,7 @@ pub fn plan() -> Measure {
         sparse: vec![(RAY_ENGINE, 7), (RAY_HIERARCHY, 7)],
         warmup: 1,
         frames: 2,
+        errors: false,
         // Every map regenerated every frame: what a frame costs when objects move (the
         // planner's frame budget is for that frame).
         base: {
@@ -74,7 +75,8 @@ pub enum Source {
     Calibrated(Option<PathBuf>),
 }
 
-type Known = Mutex<Vec<(DeviceKey, Arc<CostModel>)>>;
+/// Per device and cache directory, what this process found.
+type Known = Mutex<Vec<((DeviceKey, Option<PathBuf>), Arc<CostModel>)>>;
 
 fn known() -> &'static Known {
     static K: OnceLock<Known> = OnceLock::new();
@@ -86,25 +88,37 @@ fn known() -> &'static Known {
 /// cached). A cache file that cannot be read is reported through `warn` and replaced.
 pub fn costs_for(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(String)) -> Result<(Arc<CostModel>, Source)> {
     let key = device_key(ctx);
-    if let Some((_, c)) = known().lock().ok().and_then(|k| k.iter().find(|(k2, _)| *k2 == key).cloned()) {
+    let dir = dir.or_else(cache_dir);
+    let id = (key.clone(), dir.clone());
+    if let Some((_, c)) = known().lock().ok().and_then(|k| k.iter().find(|(k2, _)| *k2 == id).cloned()) {
         return Ok((c, Source::Memory));
     }
-    let dir = dir.or_else(cache_dir);
     let remember = |c: CostModel| {
         let c = Arc::new(c);
         if let Ok(mut k) = known().lock() {
-            k.push((key.clone(), c.clone()));
+            k.push((id.clone(), c.clone()));
         }
         c
     };
+    let mut corrupt = false;
     if let Some(d) = &dir {
         match load_cached(d, &key) {
             Ok(Some(c)) => return Ok((remember(c), Source::Cache(d.join(key.file_name())))),
             Ok(None) => {}
-            Err(e) => warn(format!("{e}: re-calibrating")),
+            Err(e) => {
+                warn(format!("{e}: re-calibrating"));
+                corrupt = true;
+            }
         }
     }
     if let Some(c) = crate::plan::predict::stored_costs().filter(|c| c.key.label() == key.label()) {
+        // The stored calibration is this device's: it replaces a cache file that could not
+        // be read.
+        if let (true, Some(d)) = (corrupt, &dir) {
+            if let Err(e) = store(d, c) {
+                warn(format!("could not replace the cache file: {e}"));
+            }
+        }
         return Ok((remember(c.clone()), Source::Stored));
     }
     // A calibration renders whole-scene methods only, which never ask for costs; this

@@ -20,7 +20,7 @@ mod sweep;
 mod ticks;
 
 pub use calibrate::{calibrate, costs_for, device_key, Source};
-pub use corpus::{gpu_methods, measure, Measure};
+pub use corpus::{gpu_methods, measure, reference_quality, Measure};
 pub use csv::csv;
 pub use labels::{place_labels, PixelRect};
 pub(crate) use plot::write_bitmap_png;

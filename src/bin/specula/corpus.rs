@@ -24,6 +24,7 @@ pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, devi
         warmup: 1,
         frames: 1,
         base: specula::Quality::default(),
+        errors: true,
     };
     let t = std::time::Instant::now();
     let c = tradeoff::measure(&ctx, &cfg, &mut |s| eprintln!("[{:7.1} s] {s}", t.elapsed().as_secs_f64()))?;

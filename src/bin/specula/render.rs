@@ -48,13 +48,15 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
     }
     if let (Some(pr), Some(plan)) = (&prediction, &budget_plan) {
         // What the frame measured beside the prediction: each object's share of the passes,
-        // and its PSNR against the exact tracer (bvh, rendered now at the same size: what the
-        // error models predict).
+        // and its PSNR against the exact tracer (bvh supersampled 4×4, rendered now at the same
+        // size: what the error models predict).
         let passes: Vec<(String, f64)> = frame.passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
         let (costs, base) = specula::plan::budget::measured_by_object(plan, &passes);
         let frame_ms: f64 = passes.iter().filter(|(n, _)| n != "frame.readback").map(|(_, ms)| ms).sum();
         let size = (job.width, job.height);
-        let reference = specula::render(&ctx, &job.scene, specula::methods::BVH, &job.quality, size, (1, 1))?.image;
+        let reference =
+            specula::render(&ctx, &job.scene, specula::methods::BVH, &specula::tradeoff::reference_quality(&job.quality), size, (1, 1))?
+                .image;
         let ids = specula::reference::object_ids(&job.scene, size)?;
         let specular: Vec<bool> = job.scene.meshes.iter().map(|m| job.scene.materials[m.material].kind.is_specular()).collect();
         let names: Vec<String> = job.scene.meshes.iter().map(|m| m.name.clone()).collect();
@@ -69,7 +71,7 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
             })
             .collect();
         println!("\n{}", specula::plan::budget::report(pr, Some((&objects, (frame_ms, psnr("specular"))))));
-        println!("(actual: this frame's passes split as the models split them, base {base:.3} ms; PSNR against the exact tracer, bvh)");
+        println!("(actual: this frame's passes split as the models split them, base {base:.3} ms; PSNR against the exact tracer, bvh supersampled 4×4)");
     }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);

@@ -23,6 +23,19 @@ pub struct ErrorModel {
     pub methods: BTreeMap<String, (Vec<f64>, usize)>,
 }
 
+/// The model a method's error comes from: every scheme of ray tracing in the original
+/// geometry (`GpuSpec::shades_every_pixel`) renders the same image, so they share one
+/// (fitted on all their samples); every other method has its own.
+pub fn model_key(method: &str) -> &str {
+    match crate::plan::Method::parse(method) {
+        Ok(m) if m.gpu.is_some_and(|g| g.shades_every_pixel) => EXACT,
+        _ => method,
+    }
+}
+
+/// The shared model of the exact tracers.
+pub const EXACT: &str = "ray tracing (every scheme)";
+
 /// A sample's weight: objects of few pixels measure their PSNR noisily.
 fn weight(s: &Sample) -> f64 {
     (s.work.pixels / 400.0).clamp(0.05, 1.0)
@@ -38,7 +51,7 @@ impl ErrorModel {
     pub fn fit_with(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool, ridge: f64) -> ErrorModel {
         let mut by: BTreeMap<&str, Vec<&Sample>> = BTreeMap::new();
         for s in samples.iter().filter(|s| keep(s)) {
-            by.entry(s.method.as_str()).or_default().push(s);
+            by.entry(model_key(&s.method)).or_default().push(s);
         }
         let methods = by
             .into_iter()
@@ -63,7 +76,7 @@ impl ErrorModel {
     /// Predicted PSNR of `method` on an object with these features; `None` for a method
     /// the corpus never measured.
     pub fn predict(&self, method: &str, features: &[f64]) -> Option<f64> {
-        let (beta, _) = self.methods.get(method)?;
+        let (beta, _) = self.methods.get(model_key(method))?;
         Some(linear::dot(beta, features).clamp(PSNR_FLOOR, PSNR_CAP))
     }
 }
