@@ -106,6 +106,11 @@ pub unsafe fn c_abi(ctx: *mut SpeculaContext, data: &[u8]) -> Option<Finding> {
             }
             4 => {
                 let mut d: SpeculaRenderDesc = read(chunk);
+                // Pointers from random bytes would be the host's undefined behaviour, not the
+                // library's: the paths are NULL or strings the harness owns.
+                let path = CString::new(format!("/nonexistent/fuzz-{}", chunk.first().copied().unwrap_or(0))).unwrap_or_default();
+                d.models_path = if chunk.len() % 3 == 1 { path.as_ptr() } else { std::ptr::null() };
+                d.cache_dir = if chunk.len() % 3 == 2 { path.as_ptr() } else { std::ptr::null() };
                 if fix {
                     (d.r#type, d.size) = (SPECULA_STRUCT_RENDER_DESC, std::mem::size_of::<SpeculaRenderDesc>() as u32);
                     (d.width, d.height) = (d.width % 33, d.height % 33);

@@ -57,9 +57,6 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
             let d = header(desc, SPECULA_STRUCT_RENDER_DESC, "render desc")?;
             (d.max_ms, d.min_psnr_db, d.models_path, d.cache_dir)
         };
-        if !cache_dir.is_null() {
-            c.cache_dir = Some(std::path::PathBuf::from(cstr(cache_dir, "render desc.cache_dir")?));
-        }
         let choice = match method {
             ABI_AUTO => Choice::Auto,
             m => match Method::by_abi(m).filter(|m| m.is_gpu()) {
@@ -72,6 +69,12 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                     );
                 }
             },
+        };
+        // Kept by the context only if the call succeeds.
+        let cache = if cache_dir.is_null() {
+            c.cache_dir.clone()
+        } else {
+            Some(std::path::PathBuf::from(cstr(cache_dir, "render desc.cache_dir")?))
         };
         let unset = |v: f64| Some(v).filter(|v| *v != 0.0);
         let budget = Budget::from_limits(unset(max_ms), unset(min_psnr)).map_err(|e| match e {
@@ -93,7 +96,7 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                 let choices = Choices { method: Choice::Auto, objects: c.object_methods.clone() };
                 let r = if models_path.is_null() {
                     // Predicted from the object's facts and this device's unit costs.
-                    match target(c, (width, height)) {
+                    match target(c, cache.clone(), (width, height)) {
                         Some(t) => {
                             crate::plan::predict::choose(&c.scene, &choices, &c.quality, b, &t, &crate::plan::predict::budget_variants())?
                         }
@@ -109,8 +112,10 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
             }
         };
         let previous = std::mem::replace(&mut c.budget, chosen);
+        let previous_cache = std::mem::replace(&mut c.cache_dir, cache);
         if let Err(e) = configure(c, choice, width, height) {
             c.budget = previous;
+            c.cache_dir = previous_cache;
             return Err(e);
         }
         Ok(if no_models { SPECULA_WARNING_NO_MODELS } else { SPECULA_SUCCESS })
@@ -120,9 +125,9 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
 /// What `auto` predicts for: the device's unit costs (from the context's cache directory, a
 /// calibration said through the log) at this size; the stored calibration's when the device
 /// has none.
-fn target(c: &mut SpeculaContext, size: (u32, u32)) -> Option<crate::plan::predict::Target> {
+fn target(c: &mut SpeculaContext, dir: Option<std::path::PathBuf>, size: (u32, u32)) -> Option<crate::plan::predict::Target> {
     let mut warnings = Vec::new();
-    let found = crate::tradeoff::costs_for(&c.vk, c.cache_dir.clone(), &mut |w| warnings.push(w));
+    let found = crate::tradeoff::costs_for(&c.vk, dir, &mut |w| warnings.push(w));
     for w in warnings {
         c.log(SPECULA_LOG_WARNING, &w);
     }
@@ -149,7 +154,7 @@ fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) ->
         Some((choices, quality, _)) => (choices.clone(), quality.clone()),
         None => (Choices { method: choice, objects: c.object_methods.clone() }, c.quality.clone()),
     };
-    let target = target(c, (width, height));
+    let target = target(c, c.cache_dir.clone(), (width, height));
     let p = crate::plan::plan_for(&c.scene, &choices, &quality, target.as_ref())?;
     c.destroy_renderer();
     let r = Renderer::new(&c.vk, &c.scene, p, width, height)?;
