@@ -166,15 +166,9 @@ pub fn scene(i: usize) -> Result<Scene> {
     Ok(s)
 }
 
-/// A mirror material of reflectance `f0` at normal incidence.
+/// A mirror material of reflectance `f0` at normal incidence (`scenes::mirror_material`).
 fn mirror(s: &mut Scene, f0: f32) -> Result<usize> {
-    let r = f0.sqrt();
-    let nu = (1.0 + r) / (1.0 - r);
-    s.add_material(Material {
-        name: format!("mirror{f0}"),
-        kind: SurfaceKind::Mirror { nu: Vec3::splat(nu), kappa: Vec3::ZERO },
-        ..Default::default()
-    })
+    s.add_material(super::mirror_material(&format!("mirror{f0}"), f0))
 }
 
 fn glass(s: &mut Scene, nu: f32, thin: bool) -> Result<usize> {
