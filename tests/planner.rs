@@ -231,7 +231,7 @@ fn a_corrupt_cost_cache_is_named_and_replaced() {
     let _turn = turn();
     use specula::plan::predict::cost_model::{store, CostModel, DeviceKey, FORMAT};
     let ctx = common::gpu();
-    let key = specula::tradeoff::device_key(&ctx);
+    let key = specula::plan::predict::device::DeviceKey::of(&ctx);
     let dir = std::env::temp_dir().join(format!("specula-cost-cache-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();

@@ -8,7 +8,7 @@ use ash::vk;
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
 use crate::frame::stage::{FrameIo, Stage};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs};
-use crate::plan::CameraPlan;
+use crate::plan::types::CameraPlan;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{Access, Context, Recorder};
 use crate::Result;
@@ -25,13 +25,13 @@ impl CameraShade {
     /// interpolated at each sample, so the search starts from the sample's own point).
     pub fn new(ctx: &Context, layout: vk::PipelineLayout, plan: &CameraPlan, multisample: Multisample) -> Result<CameraShade> {
         let per_sample = multisample.per_sample && multisample.samples > 1;
-        let fragment = if per_sample { format!("{}#PER_SAMPLE", plan.pass.fragment) } else { plan.pass.fragment.to_string() };
+        let fragment = if per_sample { format!("{}#PER_SAMPLE", plan.fragment) } else { plan.fragment.to_string() };
         let pipeline = graphics_pipeline(
             ctx,
             layout,
             &GraphicsDesc {
                 name: plan.name,
-                vertex: plan.pass.vertex,
+                vertex: plan.vertex,
                 fragment: &fragment,
                 vertex_input: VertexInput::Mesh,
                 color_formats: &[TARGET_FORMAT],

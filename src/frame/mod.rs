@@ -10,6 +10,7 @@ pub mod ids;
 pub mod knobs;
 pub mod layout;
 pub mod maps;
+pub mod schedule;
 pub mod output;
 pub mod shadow;
 pub mod stage;

@@ -7,7 +7,7 @@ use ash::vk;
 use super::maps::{Sampler, Slot};
 use super::stage::{FrameIo, Maps, Stage, StageInit};
 use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::quality::CubeMode;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};

@@ -8,7 +8,7 @@ use glam::{Mat4, Vec3, Vec4};
 use crate::cube::face_view_proj;
 use crate::frame::stage::ViewLayout;
 use crate::gpu_scene::{light_kind_code, GpuLight, GpuView};
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::scene::{LightKind, Scene};
 
 impl ViewLayout {

@@ -15,7 +15,7 @@ use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Slot, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
 use crate::methods::registry::LeavesOut;
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::quality::{CubeMode, Precision};
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder};

@@ -24,7 +24,11 @@ pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
 pub use geometry::{CURVED_REFLECTOR, PLANAR_MIRROR, PLANAR_REFRACTION};
 pub use layered::LAYERED;
 pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
-pub use registry::{Choice, Method, MethodInfo, ObjectClass};
+pub use registry::{map_named, Choice, Method, MethodInfo, ObjectClass, EVERY_CLASS};
+
+use crate::error::{Error, Result};
+use crate::frame::stage::EffectInfo;
+use crate::plan::facts::ObjectFacts;
 
 /// Every registered method, family by family (`FAMILIES`), the GPU families first: the CLI's
 /// list, `specula knobs`, the C header's constants, the README tables, `tradeoff` and the
@@ -44,8 +48,77 @@ pub fn all_slots() -> Vec<&'static crate::frame::maps::Slot> {
     crate::frame::shadow::SLOTS.iter().chain(FAMILIES.iter().flat_map(|f| f.slots.iter())).collect()
 }
 
-/// Every object class, for methods that serve them all.
-pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
+/// The registry's side of a method id (`plan::types::Method`, which the plan's data holds):
+/// its description, found among the families' (the same `&'static str` is compared first,
+/// then the name).
+impl std::ops::Deref for Method {
+    type Target = MethodInfo;
+    fn deref(&self) -> &MethodInfo {
+        self.info()
+    }
+}
+
+/// The registry's lookups of a method id.
+impl Method {
+    /// Every registered method, GPU methods first (`methods::ALL`).
+    pub const ALL: &'static [Method] = ALL;
+
+    /// The description its family registered. A `Method` names a registered method by
+    /// construction (`FAMILIES`, `parse`, `by_abi`); one that does not is a bug, reported.
+    pub fn info(self) -> &'static MethodInfo {
+        let every = || FAMILIES.iter().flat_map(|f| f.methods.iter().copied());
+        every()
+            .find(|i| std::ptr::eq(i.name, self.0))
+            .or_else(|| every().find(|i| i.name == self.0))
+            .unwrap_or_else(|| panic!("method '{}' is not registered in methods::FAMILIES", self.0))
+    }
+
+    /// Whether the method renders on the GPU (through `Renderer`); the reference renders
+    /// on the CPU (`reference::render_reference`).
+    pub fn is_gpu(self) -> bool {
+        self.gpu.is_some()
+    }
+
+    pub fn can_serve(self, class: ObjectClass) -> bool {
+        self.serves.contains(&class)
+    }
+
+    /// Whether it can serve this object: its class and its shape.
+    pub fn fits(self, f: &ObjectFacts) -> bool {
+        self.can_serve(f.class) && self.shape.fits(f)
+    }
+
+    pub fn parse(s: &str) -> Result<Method> {
+        ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
+            let names: Vec<_> = ALL.iter().map(|m| m.name()).collect();
+            Error::invalid("method", format!("unknown method '{}' (known: auto, {})", crate::error::clip(s), names.join(", ")))
+        })
+    }
+
+    pub fn by_abi(n: u32) -> Option<Method> {
+        ALL.iter().copied().find(|m| m.abi == n)
+    }
+}
+
+impl Choice {
+    pub fn parse(s: &str) -> Result<Choice> {
+        if s == "auto" {
+            Ok(Choice::Auto)
+        } else {
+            Method::parse(s).map(Choice::Method)
+        }
+    }
+}
+
+/// The camera pass named `name` (a plan's `CameraPlan`): the first method's that names it.
+pub fn camera_named(name: &str) -> Option<registry::CameraPass> {
+    ALL.iter().filter_map(|m| m.gpu).map(|g| g.camera).find(|c| c.name == name)
+}
+
+/// The frame effect named `name` (a plan's `EffectPlan`), among the families' effects.
+pub fn effect_named(name: &str) -> Option<EffectInfo> {
+    FAMILIES.iter().flat_map(|f| f.effects.iter()).find(|e| e.name == name).copied()
+}
 
 #[cfg(test)]
 mod tests {
@@ -53,7 +126,7 @@ mod tests {
 
     #[test]
     fn registry_is_consistent() {
-        registry::check(ALL).unwrap();
+        registry::check(&ALL.iter().map(|m| m.info()).collect::<Vec<_>>()).unwrap();
     }
 
     /// Every slot binds a declared binding of its kind, no two the same, and every map
@@ -99,12 +172,12 @@ mod tests {
 
     #[test]
     fn registry_refuses_duplicates() {
-        static COPY: MethodInfo = MethodInfo { name: "distance", abi: 77, ..*DISTANCE.0 };
-        assert!(registry::check(&[DISTANCE, Method(&COPY)]).unwrap_err().contains("named 'distance'"));
-        static SAME_NUMBER: MethodInfo = MethodInfo { name: "other", ..*DISTANCE.0 };
-        assert!(registry::check(&[DISTANCE, Method(&SAME_NUMBER)]).unwrap_err().contains("C ABI number"));
-        static BAD_KNOB: MethodInfo = MethodInfo { name: "other", abi: 78, knobs: &["warp"], ..*DISTANCE.0 };
-        assert!(registry::check(&[Method(&BAD_KNOB)]).unwrap_err().contains("unknown knob"));
+        static COPY: MethodInfo = MethodInfo { name: "distance", abi: 77, ..*distance::DISTANCE_INFO };
+        assert!(registry::check(&[distance::DISTANCE_INFO, &COPY]).unwrap_err().contains("named 'distance'"));
+        static SAME_NUMBER: MethodInfo = MethodInfo { name: "other", ..*distance::DISTANCE_INFO };
+        assert!(registry::check(&[distance::DISTANCE_INFO, &SAME_NUMBER]).unwrap_err().contains("C ABI number"));
+        static BAD_KNOB: MethodInfo = MethodInfo { name: "other", abi: 78, knobs: &["warp"], ..*distance::DISTANCE_INFO };
+        assert!(registry::check(&[&BAD_KNOB]).unwrap_err().contains("unknown knob"));
     }
 
     #[test]
@@ -117,11 +190,12 @@ mod tests {
             }
         }
         // Maps (and no stage of its own): other passes reach its image.
-        static MAPPED: MethodInfo = MethodInfo { name: "other", abi: 78, gpu: whole(DISTANCE.0.gpu), ..*DISTANCE.0 };
-        assert!(registry::check(&[Method(&MAPPED)]).unwrap_err().contains("shades every pixel"));
+        static MAPPED: MethodInfo =
+            MethodInfo { name: "other", abi: 78, gpu: whole(distance::DISTANCE_INFO.gpu), ..*distance::DISTANCE_INFO };
+        assert!(registry::check(&[&MAPPED]).unwrap_err().contains("shades every pixel"));
         // A fallback: its objects are another method's.
-        static FALLS_BACK: MethodInfo = MethodInfo { name: "other", abi: 78, fallback: Some(DISTANCE), ..*BVH.0 };
-        assert!(registry::check(&[Method(&FALLS_BACK)]).unwrap_err().contains("shades every pixel"));
+        static FALLS_BACK: MethodInfo = MethodInfo { name: "other", abi: 78, fallback: Some(DISTANCE), ..*raytrace::BVH_INFO };
+        assert!(registry::check(&[&FALLS_BACK]).unwrap_err().contains("shades every pixel"));
         assert!(BVH.gpu.is_some_and(|g| g.shades_every_pixel) && !DISTANCE.gpu.is_some_and(|g| g.shades_every_pixel));
     }
 

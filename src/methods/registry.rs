@@ -5,80 +5,12 @@
 //! `specula knobs`, the C header's `SPECULA_METHOD_*`, the README tables, `tradeoff`, the
 //! demo — reads `methods::ALL`.
 
-use crate::error::{Error, Result};
-use crate::frame::stage::{CreateFramePart, MapInfo};
+use crate::frame::stage::{CreateFramePart, EffectInfo, MapInfo};
 use crate::plan::facts::ObjectFacts;
-use crate::plan::{Plan, PlanStages};
+pub use crate::plan::ids::{Choice, LeavesOut, MapShading, Method, ObjectClass, Profiled};
+use crate::plan::types::{CameraPlan, Plan, PlanStages};
 use crate::quality::Quality;
-use crate::scene::{Scene, SurfaceKind};
-
-/// What kind of specular object a method can serve (survey §1.1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ObjectClass {
-    /// Ideal mirror (conductor or dielectric reflectance, no transmission).
-    Mirror,
-    /// Thin-walled dielectric: reflection plus undeviated transmission.
-    ThinDielectric,
-    /// Solid dielectric: refraction in and out, possibly total internal reflection.
-    SolidDielectric,
-}
-
-impl ObjectClass {
-    pub fn of(kind: &SurfaceKind) -> Option<ObjectClass> {
-        match kind {
-            SurfaceKind::Diffuse => None,
-            SurfaceKind::Mirror { .. } => Some(ObjectClass::Mirror),
-            SurfaceKind::Dielectric { thin: true, .. } => Some(ObjectClass::ThinDielectric),
-            SurfaceKind::Dielectric { thin: false, .. } => Some(ObjectClass::SolidDielectric),
-        }
-    }
-
-    pub fn label(self) -> &'static str {
-        match self {
-            ObjectClass::Mirror => "mirror",
-            ObjectClass::ThinDielectric => "thin dielectric",
-            ObjectClass::SolidDielectric => "solid dielectric",
-        }
-    }
-}
-
-/// How a specular object appears in the other objects' distance maps (survey §4.3): what
-/// the map-generation shader does when it draws it (`map_shading` in `Object`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum MapShading {
-    /// Reflects and refracts the environment map only (one bounce).
-    Sky,
-    /// Traced in its own distance map of the previous cycle (inter-object cycles).
-    Traced,
-    /// Self refraction in its own refractor map, then its own distance map of the previous
-    /// cycle (§4.4 composed with §4.3).
-    Refractor,
-}
-
-impl MapShading {
-    /// The code the shaders read (`MAP_SHADING_*`, src/frame/layout.in.rs).
-    pub fn code(self) -> u32 {
-        use crate::frame::layout::{MAP_SHADING_REFRACTOR, MAP_SHADING_SKY, MAP_SHADING_TRACED};
-        match self {
-            MapShading::Sky => MAP_SHADING_SKY,
-            MapShading::Traced => MAP_SHADING_TRACED,
-            MapShading::Refractor => MAP_SHADING_REFRACTOR,
-        }
-    }
-}
-
-/// What an object's own cube maps leave out (survey §3.1: "the object itself left out";
-/// §4.5's layered maps keep the whole scene).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LeavesOut {
-    /// The object itself: its maps see the environment around it.
-    Itself,
-    /// Nothing: its maps see the whole scene, the object included.
-    Nothing,
-}
+use crate::scene::Scene;
 
 /// A method's camera pass: its objects drawn over `scene.direct`'s colour and depth with
 /// its shaders. Methods that name the same pass share it (and must name the same shaders).
@@ -100,25 +32,8 @@ pub struct CameraPass {
     pub profiled: Profiled,
 }
 
-/// The timed passes of a method's camera stage, for the budget (`plan::budget`), which
-/// charges each timed pass to the objects of the stages that record it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Profiled {
-    /// The passes the stage records besides its `name` (and its family's frame work, e.g.
-    /// planar mirrors' views) are named with this prefix; `""`: it records `name` only.
-    pub prefix: &'static str,
-    /// They run over the whole screen whatever the stage serves (a ray tracer's kernels):
-    /// paid once per method a frame uses, not split among its objects.
-    pub shared: bool,
-}
-
-impl Profiled {
-    /// One pass under the stage's own name, per object.
-    pub const OWN: Profiled = Profiled { prefix: "", shared: false };
-}
-
 /// Creates a method's own camera stage for the plan's objects.
-pub type CreateCamera = fn(&crate::frame::stage::StageInit, &crate::plan::CameraPlan) -> crate::Result<Box<dyn crate::frame::stage::Stage>>;
+pub type CreateCamera = fn(&crate::frame::stage::StageInit, &CameraPlan) -> crate::Result<Box<dyn crate::frame::stage::Stage>>;
 
 /// How a GPU method plans an object.
 #[derive(Clone, Copy)]
@@ -226,7 +141,10 @@ pub struct Family {
     /// The folder's name, as `MethodInfo::family` names it.
     pub name: &'static str,
     /// Its methods, in the order `methods::ALL` lists them.
-    pub methods: &'static [Method],
+    pub methods: &'static [&'static MethodInfo],
+    /// The frame effects its planning hooks add (`EffectPlan`s name them; the renderer
+    /// finds their constructors here).
+    pub effects: &'static [EffectInfo],
     /// Its slots in the frame's maps (`frame::maps::Slot`: binding, sampler, who reads it).
     pub slots: &'static [crate::frame::maps::Slot],
     /// Before the frame's stages are derived: moves the objects' reference points (the
@@ -259,6 +177,7 @@ impl Family {
     pub const NONE: Family = Family {
         name: "",
         methods: &[],
+        effects: &[],
         slots: &[],
         plan_objects: None,
         plan_frame: None,
@@ -283,12 +202,12 @@ pub const fn method_count(families: &[Family]) -> usize {
 
 /// Every method of `families`, family by family (`N`: their `method_count`).
 pub const fn all_methods<const N: usize>(families: &[Family]) -> [Method; N] {
-    let mut out = [families[0].methods[0]; N];
+    let mut out = [Method(""); N];
     let (mut i, mut n) = (0, 0);
     while i < families.len() {
         let mut j = 0;
         while j < families[i].methods.len() {
-            out[n] = families[i].methods[j];
+            out[n] = Method(families[i].methods[j].name);
             n += 1;
             j += 1;
         }
@@ -298,120 +217,24 @@ pub const fn all_methods<const N: usize>(families: &[Family]) -> [Method; N] {
     out
 }
 
-/// The map kind named `name` that some registered method needs (a family that needs
-/// another's map for its own purpose, as caustics need refractor maps).
+/// The map kind named `name` that some registered method needs: its constructor, for the
+/// renderer (a plan's `MapPlan` names it), and for a family that needs another's map for its
+/// own purpose (caustics need refractor maps) without importing that family.
 pub fn map_named(name: &str) -> Option<MapInfo> {
-    crate::methods::ALL.iter().filter_map(|m| m.gpu).flat_map(|g| g.maps.iter()).find(|i| i.name == name).copied()
+    Method::ALL.iter().filter_map(|m| m.gpu).flat_map(|g| g.maps.iter()).find(|i| i.name == name).copied()
 }
 
-/// A handle to a registered method: copyable, compared by name.
-#[derive(Clone, Copy)]
-pub struct Method(pub &'static MethodInfo);
-
-impl PartialEq for Method {
-    fn eq(&self, o: &Method) -> bool {
-        self.0.name == o.0.name
-    }
-}
-impl Eq for Method {}
-
-impl std::fmt::Debug for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.0.name)
-    }
-}
-
-impl std::fmt::Display for Method {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.0.name)
-    }
-}
-
-impl serde::Serialize for Method {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
-        s.serialize_str(self.0.name)
-    }
-}
-
-impl std::ops::Deref for Method {
-    type Target = MethodInfo;
-    fn deref(&self) -> &MethodInfo {
-        self.0
-    }
-}
-
-impl Method {
-    /// Every registered method, GPU methods first (`methods::ALL`).
-    pub const ALL: &'static [Method] = crate::methods::ALL;
-
-    pub fn name(self) -> &'static str {
-        self.0.name
-    }
-
-    /// Whether the method renders on the GPU (through `Renderer`); the reference renders
-    /// on the CPU (`reference::render_reference`).
-    pub fn is_gpu(self) -> bool {
-        self.0.gpu.is_some()
-    }
-
-    pub fn can_serve(self, class: ObjectClass) -> bool {
-        self.0.serves.contains(&class)
-    }
-
-    /// Whether it can serve this object: its class and its shape.
-    pub fn fits(self, f: &ObjectFacts) -> bool {
-        self.can_serve(f.class) && self.0.shape.fits(f)
-    }
-
-    pub fn parse(s: &str) -> Result<Method> {
-        Method::ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
-            let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();
-            Error::invalid("method", format!("unknown method '{}' (known: auto, {})", crate::error::clip(s), names.join(", ")))
-        })
-    }
-
-    pub fn by_abi(n: u32) -> Option<Method> {
-        Method::ALL.iter().copied().find(|m| m.abi == n)
-    }
-}
+/// Every object class, for methods that serve them all.
+pub const EVERY_CLASS: &[ObjectClass] = &[ObjectClass::Mirror, ObjectClass::ThinDielectric, ObjectClass::SolidDielectric];
 
 /// The C ABI number of `--method auto` (`SPECULA_METHOD_AUTO`).
 pub const ABI_AUTO: u32 = 100;
-
-/// A whole-scene choice: one method for every specular object, or the planner.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub enum Choice {
-    Auto,
-    Method(Method),
-}
-
-impl Choice {
-    pub fn parse(s: &str) -> Result<Choice> {
-        if s == "auto" {
-            Ok(Choice::Auto)
-        } else {
-            Method::parse(s).map(Choice::Method)
-        }
-    }
-    pub fn name(self) -> &'static str {
-        match self {
-            Choice::Auto => "auto",
-            Choice::Method(m) => m.name(),
-        }
-    }
-}
-
-impl From<Method> for Choice {
-    fn from(m: Method) -> Choice {
-        Choice::Method(m)
-    }
-}
 
 /// Checks the registry: names and numbers unique, every knob a method reads exists, every
 /// fallback serves what the method does not, methods sharing a camera pass share its
 /// shaders, a method that shades every pixel has its own stage and no maps or fallback.
 /// `methods::ALL` passes (a unit test); a table that breaks a rule is refused.
-pub fn check(all: &[Method]) -> std::result::Result<(), String> {
+pub fn check(all: &[&MethodInfo]) -> std::result::Result<(), String> {
     for (i, a) in all.iter().enumerate() {
         for b in &all[i + 1..] {
             if a.name == b.name {
@@ -440,7 +263,7 @@ pub fn check(all: &[Method]) -> std::result::Result<(), String> {
             }
         }
         if let Some(f) = a.fallback {
-            if !f.is_gpu() || a.is_gpu() != f.is_gpu() {
+            if !f.is_gpu() || a.gpu.is_some() != f.is_gpu() {
                 return Err(format!("'{}' falls back to '{}' of another kind", a.name, f.name));
             }
         }

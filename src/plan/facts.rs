@@ -9,8 +9,8 @@ use std::sync::{Arc, Mutex};
 
 use glam::{DVec3, Vec3};
 
-use crate::methods::registry::ObjectClass;
 use crate::optics::ray_triangle;
+use crate::plan::ids::ObjectClass;
 use crate::quality::Quality;
 use crate::reference::bvh::Bvh;
 use crate::scene::{Mesh, Scene};

@@ -6,14 +6,15 @@
 
 pub mod budget;
 pub mod facts;
+pub mod ids;
 pub mod knobs;
 pub mod predict;
-mod types;
+pub mod types;
 
 use glam::Vec3;
 
 use crate::error::{Error, Result};
-pub use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass};
+pub use crate::methods::registry::CameraPass;
 pub use types::*;
 
 use crate::methods::FAMILIES;
@@ -449,12 +450,19 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
         let spec = gpu(o.method);
         o.map_shading = if p.inter_object { spec.map_shading } else { MapShading::Sky };
         for info in spec.maps {
-            st.add_map(o, *info, (info.describe)(&q, (0, 0)));
+            st.add_map(o, info.kind(), (info.describe)(&q, (0, 0)));
         }
         let cam = spec.camera;
         match cameras.iter_mut().find(|c| c.name == cam.name) {
             Some(c) => c.objects.push((o.mesh, cam.flags)),
-            None => cameras.push(CameraPlan { pass: cam, name: cam.name, objects: vec![(o.mesh, cam.flags)] }),
+            None => cameras.push(CameraPlan {
+                name: cam.name,
+                vertex: cam.vertex,
+                fragment: cam.fragment,
+                order: cam.order,
+                profiled: cam.profiled,
+                objects: vec![(o.mesh, cam.flags)],
+            }),
         }
         o.passes.push(cam.name);
     }
@@ -466,13 +474,14 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     let PlanStages { mut maps, mut stages, .. } = st;
     // The cube-mapped objects and their views.
     for o in &p.objects {
-        let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.info.cube));
+        let cube = o.maps.iter().any(|m| maps.iter().any(|mp| mp.name == m.pass && mp.cube));
         if cube {
             p.envmaps.push(EnvmapPlan { mesh: o.mesh, layer: p.envmaps.len() as u32, reference_point: o.own_reference_point });
         }
     }
     for m in &mut maps {
-        m.bytes = (m.info.bytes)(p, m.objects.len() as u32, (0, 0));
+        let info = crate::methods::map_named(m.name).expect("a planned map is registered");
+        m.bytes = (info.bytes)(p, m.objects.len() as u32, (0, 0));
     }
     for o in &mut p.objects {
         for om in &mut o.maps {
@@ -489,7 +498,7 @@ fn stages(scene: &Scene, p: &mut Plan, composes: bool) {
     stages.extend(cameras.into_iter().map(StageSpec::Camera));
     // Stable sort: equal orders keep their registry order.
     stages.sort_by_key(|s| s.order());
-    p.passes = stages.iter().flat_map(|s| s.passes(p)).collect();
+    p.passes = stages.iter().flat_map(|s| s.passes()).collect();
     p.stages = stages;
 }
 

@@ -1,13 +1,15 @@
-//! The plan's data: per specular object its method (a registry handle) and maps, the
-//! frame's stages in recording order, and what the families planned for the whole frame
-//! (shadow maps, planar mirrors' view layers, the shared layered map's centre, the
-//! caustics' generators). Plain data, built by `plan::plan` and the families' planning
-//! hooks (`registry::Family`), read by the renderer and the families' stages.
+//! The plan's data: per specular object its method (by id) and maps, the frame's stages in
+//! recording order, and what the families planned for the whole frame (shadow maps, planar
+//! mirrors' view layers, the shared layered map's centre, the caustics' generators). Plain
+//! data that names no family and holds no constructor: built by `plan::plan` and the
+//! families' planning hooks (`registry::Family`), read by the frame's stages (which receive
+//! it as their frame description) and by the renderer, which looks each stage's constructor
+//! up in the registry by its name (`methods::map_named`, `camera_named`, `effect_named`).
 
 use glam::Vec3;
 
-use crate::frame::stage::{order, Deps, EffectInfo, MapInfo};
-use crate::methods::registry::{CameraPass, Choice, LeavesOut, MapShading, Method, ObjectClass};
+pub use super::ids::{Choice, LeavesOut, MapShading, Method, ObjectClass, Profiled};
+use crate::frame::schedule::{order, Deps, LayerField};
 use crate::quality::{CausticSpace, Caustics, Quality};
 
 /// One cube-mapped object's views: the six faces around its reference point.
@@ -27,7 +29,7 @@ pub struct ObjectMap {
     /// The object's layer in that pass's map array.
     pub layer: u32,
     #[serde(skip)]
-    pub layer_field: Option<crate::frame::stage::LayerField>,
+    pub layer_field: Option<LayerField>,
     pub what: String,
     pub bytes: u64,
 }
@@ -63,9 +65,13 @@ pub struct ObjectPlan {
 /// A map pass over all the objects that need that map.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct MapPlan {
-    #[serde(skip)]
-    pub info: MapInfo,
+    /// The map kind's pass (`frame::stage::MapInfo::name`).
     pub name: &'static str,
+    /// Its `MapInfo::order` and whether it is a cube around each object.
+    #[serde(skip)]
+    pub order: u32,
+    #[serde(skip)]
+    pub cube: bool,
     /// Meshes, in layer order.
     pub objects: Vec<usize>,
     pub bytes: u64,
@@ -74,9 +80,17 @@ pub struct MapPlan {
 /// A camera pass over the objects of the methods that share it.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CameraPlan {
-    #[serde(skip)]
-    pub pass: CameraPass,
+    /// The camera pass's name (`registry::CameraPass::name`), its shaders and position.
     pub name: &'static str,
+    #[serde(skip)]
+    pub vertex: &'static str,
+    #[serde(skip)]
+    pub fragment: &'static str,
+    #[serde(skip)]
+    pub order: u32,
+    /// The passes its stage records, for the budget.
+    #[serde(skip)]
+    pub profiled: Profiled,
     /// (mesh, push flags of its method).
     pub objects: Vec<(usize, u32)>,
 }
@@ -106,18 +120,17 @@ pub enum StageSpec {
 /// A frame effect over the objects it was planned for.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct EffectPlan {
-    #[serde(skip)]
-    pub info: EffectInfo,
+    /// The effect's name (`frame::stage::EffectInfo::name`).
     pub name: &'static str,
+    #[serde(skip)]
+    pub order: u32,
+    #[serde(skip)]
+    pub deps: Deps,
+    /// The profiled passes it records, in order.
+    #[serde(skip)]
+    pub passes: Vec<&'static str>,
     /// Meshes it serves (caustics: the generators).
     pub objects: Vec<usize>,
-}
-
-impl EffectPlan {
-    /// The stage of effect `info` over `objects`.
-    pub fn stage(info: EffectInfo, objects: Vec<usize>) -> StageSpec {
-        StageSpec::Effect(EffectPlan { info, name: info.name, objects })
-    }
 }
 
 impl StageSpec {
@@ -136,9 +149,9 @@ impl StageSpec {
             StageSpec::Upload => order::UPLOAD,
             StageSpec::Shadows => order::SHADOWS,
             StageSpec::Direct => order::DIRECT,
-            StageSpec::Map(m) => m.info.order,
-            StageSpec::Effect(e) => e.info.order,
-            StageSpec::Camera(c) => c.pass.order,
+            StageSpec::Map(m) => m.order,
+            StageSpec::Effect(e) => e.order,
+            StageSpec::Camera(c) => c.order,
         }
     }
 
@@ -147,10 +160,10 @@ impl StageSpec {
         match self {
             StageSpec::Upload | StageSpec::Direct | StageSpec::Camera(_) => Deps::EveryFrame,
             StageSpec::Shadows => Deps::Shadows,
-            StageSpec::Map(m) if m.info.order == order::CAMERA_MAPS => Deps::CameraMap,
-            StageSpec::Map(m) if m.info.order == order::GEOMETRY_MAPS => Deps::Geometry,
+            StageSpec::Map(m) if m.order == order::CAMERA_MAPS => Deps::CameraMap,
+            StageSpec::Map(m) if m.order == order::GEOMETRY_MAPS => Deps::Geometry,
             StageSpec::Map(_) => Deps::World,
-            StageSpec::Effect(e) => e.info.deps,
+            StageSpec::Effect(e) => e.deps,
         }
     }
 
@@ -165,9 +178,9 @@ impl StageSpec {
     }
 
     /// The profiled passes it records.
-    pub fn passes(&self, p: &Plan) -> Vec<&'static str> {
+    pub fn passes(&self) -> Vec<&'static str> {
         match self {
-            StageSpec::Effect(e) => (e.info.passes)(p),
+            StageSpec::Effect(e) => e.passes.clone(),
             s => vec![s.name()],
         }
     }
@@ -178,15 +191,15 @@ pub struct Plan {
     /// What was asked for the whole scene (`--method`).
     pub choice: Choice,
     /// What was asked per object (by name), over `choice`.
-    pub overrides: Vec<(String, crate::methods::registry::Method)>,
+    pub overrides: Vec<(String, Method)>,
     /// What `auto` predicted for (the frame's size, the device's unit costs); `None`: the
     /// nominal target.
     #[serde(skip)]
-    pub target: Option<super::predict::Target>,
+    pub target: Option<super::predict::cost_model::Target>,
     /// What `auto` predicted per object and for the frame (`None` when no object was left
     /// to it).
     #[serde(skip)]
-    pub prediction: Option<super::budget::Prediction>,
+    pub prediction: Option<super::budget::prediction::Prediction>,
     pub quality: Quality,
     /// Lights that get a cube distance map (point and spot), in cube order.
     pub shadow_cubes: Vec<usize>,
@@ -283,6 +296,31 @@ pub struct CausticsPlan {
     pub bytes: u64,
 }
 
+/// What the plan needs of a map kind (`frame::stage::MapInfo`, which carries its
+/// constructor): its pass, position, shape and the object field that indexes it.
+#[derive(Clone, Copy, Debug)]
+pub struct MapKind {
+    pub name: &'static str,
+    pub order: u32,
+    pub cube: bool,
+    pub layer_field: Option<LayerField>,
+}
+
+/// What the plan needs of a frame effect (`frame::stage::EffectInfo`): its stage over
+/// `objects`, its passes for this plan.
+pub struct EffectKind {
+    pub name: &'static str,
+    pub order: u32,
+    pub deps: Deps,
+}
+
+impl EffectPlan {
+    /// The stage of effect `kind` over `objects`, recording `passes`.
+    pub fn stage(kind: EffectKind, objects: Vec<usize>, passes: Vec<&'static str>) -> StageSpec {
+        StageSpec::Effect(EffectPlan { name: kind.name, order: kind.order, deps: kind.deps, passes, objects })
+    }
+}
+
 /// What the planner has derived when `Family::plan_stages` runs: the map passes (one per
 /// map kind, layers in mesh order) and the frame's stages so far.
 pub struct PlanStages {
@@ -295,14 +333,14 @@ pub struct PlanStages {
 
 impl PlanStages {
     /// Gives `object` map `info` (its layer the next of that map's array), unless it has it.
-    pub fn add_map(&mut self, object: &mut ObjectPlan, info: MapInfo, what: String) {
+    pub fn add_map(&mut self, object: &mut ObjectPlan, info: MapKind, what: String) {
         if object.maps.iter().any(|m| m.pass == info.name) {
             return;
         }
         let k = match self.maps.iter().position(|m| m.name == info.name) {
             Some(k) => k,
             None => {
-                self.maps.push(MapPlan { info, name: info.name, objects: Vec::new(), bytes: 0 });
+                self.maps.push(MapPlan { name: info.name, order: info.order, cube: info.cube, objects: Vec::new(), bytes: 0 });
                 self.maps.len() - 1
             }
         };

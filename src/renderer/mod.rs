@@ -26,7 +26,7 @@ use crate::frame::stage::{Deps, FrameIo, FramePart, MapSets, Maps, Stage, StageI
 use crate::frame::views;
 use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
 use crate::gpu_scene::{GpuLight, GpuScene};
-use crate::methods::FAMILIES;
+use crate::methods::{camera_named, effect_named, map_named, FAMILIES};
 use crate::plan::{Plan, StageSpec};
 use crate::quality::FresnelMode;
 use crate::scene::{Camera, Scene};
@@ -209,9 +209,9 @@ impl Renderer {
                 StageSpec::Upload => continue,
                 StageSpec::Shadows => ShadowMaps::create(&init, &mut self.maps)?,
                 StageSpec::Direct => Box::new(SceneDirect::new(ctx, init.layout, multisample)?),
-                StageSpec::Map(m) => (m.info.create)(&init, &m.objects, &mut self.maps)?,
-                StageSpec::Effect(e) => (e.info.create)(&init, &mut self.maps)?,
-                StageSpec::Camera(c) => match c.pass.create {
+                StageSpec::Map(m) => (map_named(m.name).ok_or_else(|| unregistered(m.name))?.create)(&init, &m.objects, &mut self.maps)?,
+                StageSpec::Effect(e) => (effect_named(e.name).ok_or_else(|| unregistered(e.name))?.create)(&init, &mut self.maps)?,
+                StageSpec::Camera(c) => match camera_named(c.name).ok_or_else(|| unregistered(c.name))?.create {
                     Some(create) => create(&init, c)?,
                     None => Box::new(CameraShade::new(ctx, init.layout, c, multisample)?),
                 },
@@ -368,4 +368,10 @@ impl crate::vk::Owner for Renderer {
     fn destroy(&mut self, ctx: &Context) {
         Renderer::destroy(self, ctx)
     }
+}
+
+/// A plan's stage that no registered family declares (a plan built by hand, or by another
+/// build of the library).
+fn unregistered(name: &str) -> Error {
+    Error::invalid("plan", format!("stage '{}' is not declared by any registered family", crate::error::clip(name)))
 }

@@ -20,18 +20,6 @@ pub const SCENES: [usize; 6] = [0, 3, 6, 7, 14, 22];
 /// Its two frame sizes (screen-proportional costs are told from fixed ones by the pair).
 pub const SIZES: [(u32, u32); 2] = [(64, 64), (128, 128)];
 
-/// The key of `ctx`'s device.
-pub fn device_key(ctx: &Context) -> DeviceKey {
-    let p = &ctx.properties;
-    DeviceKey {
-        vendor: p.vendor_id,
-        device: p.device_id,
-        driver: p.driver_version,
-        name: ctx.device_name.clone(),
-        driver_info: ctx.driver_info.clone(),
-    }
-}
-
 /// What a calibration renders.
 pub fn plan() -> Measure {
     Measure {
@@ -59,7 +47,7 @@ pub fn plan() -> Measure {
 pub fn calibrate(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<CostModel> {
     let t = std::time::Instant::now();
     let corpus = measure(ctx, &plan(), progress)?;
-    Ok(CostModel::fit(&corpus, device_key(ctx), t.elapsed().as_secs_f64()))
+    Ok(CostModel::fit(&corpus, DeviceKey::of(ctx), t.elapsed().as_secs_f64()))
 }
 
 /// Where `ctx`'s costs came from.
@@ -87,7 +75,7 @@ fn known() -> &'static Known {
 /// the stored corpus when it was measured on this device, or a calibration run now (and
 /// cached). A cache file that cannot be read is reported through `warn` and replaced.
 pub fn costs_for(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(String)) -> Result<(Arc<CostModel>, Source)> {
-    let key = device_key(ctx);
+    let key = DeviceKey::of(ctx);
     let dir = dir.or_else(cache_dir);
     let id = (key.clone(), dir.clone());
     if let Some((_, c)) = known().lock().ok().and_then(|k| k.iter().find(|(k2, _)| *k2 == id).cloned()) {

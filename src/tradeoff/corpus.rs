@@ -52,7 +52,7 @@ pub fn gpu_methods() -> Vec<Method> {
 
 /// Renders and measures `cfg`; `progress` hears each step's name.
 pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> Result<Corpus> {
-    let mut out = Corpus::new(super::calibrate::device_key(ctx));
+    let mut out = Corpus::new(crate::plan::predict::device::DeviceKey::of(ctx));
     for &i in &cfg.scenes {
         let scene = corpus::scene(i)?;
         let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();

@@ -119,11 +119,23 @@ pub struct Job {
     pub quality: Quality,
     pub width: u32,
     pub height: u32,
-    /// The device's unit costs for `auto` (found once, by `budget::target`).
+    /// The device's unit costs for `auto` (found once, by `Job::target`).
     pub target: std::sync::OnceLock<Option<specula::plan::predict::Target>>,
 }
 
 impl Job {
+    /// What `auto` predicts for: the job's size on the first device that opens (its unit costs),
+    /// else on the stored calibration's device.
+    pub fn target(&self) -> Option<specula::plan::predict::Target> {
+        let t = self.target.get_or_init(|| {
+            let ctx = specula::vk::Context::new(&specula::vk::DeviceOptions::default()).ok();
+            ctx.as_ref().and_then(|c| specula::target_for(c, (1, 1)))
+        });
+        t.clone().map(|t| specula::plan::predict::Target { size: (self.width, self.height), ..t }).or_else(|| {
+            specula::plan::predict::Target::nominal().map(|n| specula::plan::predict::Target { size: (self.width, self.height), ..n })
+        })
+    }
+
     /// The CPU method, when the whole scene asks for one (the reference).
     pub fn cpu_method(&self) -> Option<Method> {
         match self.choices.method {
@@ -133,7 +145,7 @@ impl Job {
     }
 
     pub fn plan(&self, quality: &Quality) -> specula::Result<Plan> {
-        let target = crate::budget::target(self);
+        let target = self.target();
         specula::plan::plan_for(&self.scene, &self.choices, quality, target.as_ref())
     }
 

@@ -57,7 +57,7 @@ pub fn apply(job: &mut Job, scene_path: &Path, a: &BudgetArgs) -> specula::Resul
             )?
         }
         // Predicted from the objects' facts and the device's unit costs.
-        None => match target(job) {
+        None => match job.target() {
             Some(t) => {
                 specula::plan::predict::choose(&job.scene, &job.choices, &job.quality, b, &t, &specula::plan::predict::budget_variants())?
             }
@@ -78,16 +78,4 @@ pub fn apply(job: &mut Job, scene_path: &Path, a: &BudgetArgs) -> specula::Resul
             Ok(None)
         }
     }
-}
-
-/// What `auto` predicts for: the job's size on the first device that opens (its unit costs),
-/// else on the stored calibration's device.
-pub fn target(job: &Job) -> Option<specula::plan::predict::Target> {
-    let t = job.target.get_or_init(|| {
-        let ctx = specula::vk::Context::new(&specula::vk::DeviceOptions::default()).ok();
-        ctx.as_ref().and_then(|c| specula::target_for(c, (1, 1)))
-    });
-    t.clone().map(|t| specula::plan::predict::Target { size: (job.width, job.height), ..t }).or_else(|| {
-        specula::plan::predict::Target::nominal().map(|n| specula::plan::predict::Target { size: (job.width, job.height), ..n })
-    })
 }

@@ -30,7 +30,7 @@ pub fn run(args: &RenderArgs, json: bool, candidates: bool, budget: &BudgetArgs)
 /// chose from.
 fn print_candidates(job: &crate::args::Job) -> specula::Result<()> {
     use specula::plan::predict;
-    let Some(t) = crate::budget::target(job) else {
+    let Some(t) = job.target() else {
         return Err(specula::Error::invalid("--candidates", "no unit costs: run specula calibrate"));
     };
     let facts = specula::plan::facts::SceneFacts::new(&job.scene, &job.quality, true);

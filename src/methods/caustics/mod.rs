@@ -31,7 +31,7 @@ use crate::Result;
 
 use crate::gpu_scene::{GpuLight, GpuView};
 use crate::methods::registry::Family;
-use crate::plan::{CausticCube, CausticsPlan, EffectPlan, Generator, LightViews, ObjectPlan, Plan, PlanStages};
+use crate::plan::types::{CausticCube, CausticsPlan, Generator, LightViews, ObjectPlan, Plan, PlanStages};
 use crate::quality::{CausticSpace, Caustics, Quality};
 use crate::scene::{LightKind, Scene};
 
@@ -62,6 +62,7 @@ pub const FAMILY: Family = Family {
     name: "caustics",
     slots: slots::SLOTS,
     methods: &[],
+    effects: &[STAGE, PROJECT],
     plan_frame: Some(|scene, p| p.caustics = plan(scene, &p.objects, &p.quality)),
     plan_stages: Some(plan_stages),
     views: Some(|p| {
@@ -92,14 +93,14 @@ fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
             matches!(scene.materials[scene.meshes[g.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. });
         let o = p.objects.iter_mut().find(|o| o.mesh == g.mesh).expect("generator is a planned object");
         if solid {
-            st.add_map(o, refractor, (refractor.describe)(&q, (0, 0)) + " for its caustics");
+            st.add_map(o, refractor.kind(), (refractor.describe)(&q, (0, 0)) + " for its caustics");
         }
     }
     let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
-    st.stages.push(EffectPlan::stage(STAGE, generators.clone()));
+    st.stages.push(STAGE.stage(p, generators.clone()));
     // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
     if !st.shades_scene {
-        st.stages.push(EffectPlan::stage(PROJECT, generators));
+        st.stages.push(PROJECT.stage(p, generators));
     }
     for o in &mut p.objects {
         if c.generators.iter().any(|g| g.mesh == o.mesh) {

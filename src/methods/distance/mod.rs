@@ -13,7 +13,7 @@ use crate::methods::cube_maps::{distance_images, CubeMaps, MapKind};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled};
 use crate::methods::EVERY_CLASS;
 
-use crate::plan::{CameraPlan, Plan};
+use crate::plan::types::{CameraPlan, Plan};
 use crate::quality::Quality;
 use crate::quality::{CubeKnobs, DistanceKnobs, FrameKnobs, SearchKnobs};
 use crate::Result;
@@ -106,11 +106,11 @@ const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "distance",
     slots: slots::SLOTS,
-    methods: &[DISTANCE, DISTANCE_MULTI, REFRACTOR_MAP, IMAGE_SPACE_REFRACTION],
+    methods: &[DISTANCE_INFO, DISTANCE_MULTI_INFO, REFRACTOR_MAP_INFO, IMAGE_SPACE_REFRACTION_INFO],
     ..crate::methods::registry::Family::NONE
 };
 
-pub const DISTANCE: Method = Method(&MethodInfo {
+pub const DISTANCE_INFO: &MethodInfo = &MethodInfo {
     name: "distance",
     abi: 3,
     section: "§4.1, §4.2",
@@ -122,9 +122,10 @@ pub const DISTANCE: Method = Method(&MethodInfo {
         leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const DISTANCE: Method = Method(DISTANCE_INFO.name);
 
-pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
+pub const DISTANCE_MULTI_INFO: &MethodInfo = &MethodInfo {
     name: "distance-multi",
     abi: 4,
     section: "§4.3",
@@ -145,9 +146,10 @@ pub const DISTANCE_MULTI: Method = Method(&MethodInfo {
     }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const DISTANCE_MULTI: Method = Method(DISTANCE_MULTI_INFO.name);
 
-pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
+pub const REFRACTOR_MAP_INFO: &MethodInfo = &MethodInfo {
     name: "refractor-map",
     abi: 5,
     section: "§4.4",
@@ -168,9 +170,10 @@ pub const REFRACTOR_MAP: Method = Method(&MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const REFRACTOR_MAP: Method = Method(REFRACTOR_MAP_INFO.name);
 
-pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
+pub const IMAGE_SPACE_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     name: "image-space-refraction",
     abi: 6,
     section: "§4.4",
@@ -197,4 +200,5 @@ pub const IMAGE_SPACE_REFRACTION: Method = Method(&MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const IMAGE_SPACE_REFRACTION: Method = Method(IMAGE_SPACE_REFRACTION_INFO.name);

@@ -10,7 +10,7 @@ use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, Ma
 use crate::frame::FLAG_PROXY_BOX;
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled};
 use crate::methods::EVERY_CLASS;
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::quality::Quality;
 use crate::quality::{CubeKnobs, EnvmapKnobs, FrameKnobs};
 
@@ -74,11 +74,11 @@ const fn proxy(flags: u32) -> CameraPass {
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "envmap",
     slots: slots::SLOTS,
-    methods: &[ENVMAP, PROXY_SPHERE, PROXY_BOX],
+    methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO],
     ..crate::methods::registry::Family::NONE
 };
 
-pub const ENVMAP: Method = Method(&MethodInfo {
+pub const ENVMAP_INFO: &MethodInfo = &MethodInfo {
     name: "envmap",
     abi: 0,
     section: "§3, §3.1",
@@ -89,9 +89,10 @@ pub const ENVMAP: Method = Method(&MethodInfo {
     gpu: Some(spec(SHADE)),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const ENVMAP: Method = Method(ENVMAP_INFO.name);
 
-pub const PROXY_SPHERE: Method = Method(&MethodInfo {
+pub const PROXY_SPHERE_INFO: &MethodInfo = &MethodInfo {
     name: "proxy-sphere",
     abi: 1,
     section: "§3.2",
@@ -102,9 +103,10 @@ pub const PROXY_SPHERE: Method = Method(&MethodInfo {
     gpu: Some(spec(proxy(0))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const PROXY_SPHERE: Method = Method(PROXY_SPHERE_INFO.name);
 
-pub const PROXY_BOX: Method = Method(&MethodInfo {
+pub const PROXY_BOX_INFO: &MethodInfo = &MethodInfo {
     name: "proxy-box",
     abi: 2,
     section: "§3.2",
@@ -115,4 +117,5 @@ pub const PROXY_BOX: Method = Method(&MethodInfo {
     gpu: Some(spec(proxy(FLAG_PROXY_BOX))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const PROXY_BOX: Method = Method(PROXY_BOX_INFO.name);

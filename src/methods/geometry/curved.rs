@@ -30,7 +30,7 @@ use crate::frame::layout::{binding, GpuCurvedParams, GpuCurvedVertex, CURVED_BIN
 use crate::frame::stage::{order, FrameIo, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs, PUSH_BYTES};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Shape};
-use crate::plan::CameraPlan;
+use crate::plan::types::CameraPlan;
 use crate::quality::Quality;
 use crate::quality::{FrameKnobs, GeometryKnobs};
 use crate::scene::{Mesh, Scene};
@@ -57,7 +57,7 @@ const fn one(_: &Quality) -> u32 {
     1
 }
 
-pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
+pub const CURVED_REFLECTOR_INFO: &MethodInfo = &MethodInfo {
     name: "curved-reflector",
     abi: 15,
     section: "§5",
@@ -68,7 +68,8 @@ pub const CURVED_REFLECTOR: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::ConvexOrConcave,
-});
+};
+pub const CURVED_REFLECTOR: Method = Method(CURVED_REFLECTOR_INFO.name);
 
 /// Creates the stage of the plan's curved reflectors.
 fn create(init: &StageInit, plan: &CameraPlan) -> Result<Box<dyn Stage>> {

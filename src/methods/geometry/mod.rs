@@ -14,7 +14,7 @@ pub mod mirror;
 pub mod slots;
 pub mod views;
 
-pub use curved::CURVED_REFLECTOR;
+pub use curved::{CURVED_REFLECTOR, CURVED_REFLECTOR_INFO};
 
 use crate::frame::stage::order;
 use crate::methods::registry::{CameraPass, Family, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, ObjectClass, Profiled, Shape};
@@ -25,7 +25,7 @@ use crate::quality::{FrameKnobs, GeometryKnobs};
 pub const FAMILY: Family = Family {
     name: "geometry",
     slots: slots::SLOTS,
-    methods: &[PLANAR_MIRROR, PLANAR_REFRACTION, CURVED_REFLECTOR],
+    methods: &[PLANAR_MIRROR_INFO, PLANAR_REFRACTION_INFO, CURVED_REFLECTOR_INFO],
     plan_views: Some(plan_views),
     views: Some(view_blocks),
     frame_part: Some(views::create_frame_part),
@@ -34,7 +34,7 @@ pub const FAMILY: Family = Family {
 
 /// The planar mirrors' views (the frame's extra camera views, one per layer), and their
 /// mirrored cube views inside other objects' cube maps.
-fn view_blocks(p: &crate::plan::Plan) -> Vec<(&'static str, u32)> {
+fn view_blocks(p: &crate::plan::types::Plan) -> Vec<(&'static str, u32)> {
     let mut v = vec![(crate::frame::stage::EXTRA_VIEWS, p.mirror_layers)];
     if !p.map_mirrors.is_empty() {
         v.push((crate::methods::cube_maps::MAP_MIRROR_VIEWS, (6 * p.map_mirrors.len() * p.envmaps.len()) as u32));
@@ -44,7 +44,7 @@ fn view_blocks(p: &crate::plan::Plan) -> Vec<(&'static str, u32)> {
 
 /// Planar mirrors' views (§5): as many layers as the recursion can use, within the budget.
 /// Flat-faced refractors' faces bring two views each (reflection and refraction).
-fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::Plan) {
+fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::types::Plan) {
     let q = &p.quality;
     let planar = [PLANAR_MIRROR, PLANAR_REFRACTION];
     p.mirrors = p.objects.iter().filter(|o| planar.contains(&o.method)).map(|o| o.mesh).collect();
@@ -79,7 +79,7 @@ pub const MIRROR_PASS: CameraPass = CameraPass {
     profiled: PROFILED,
 };
 
-pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
+pub const PLANAR_MIRROR_INFO: &MethodInfo = &MethodInfo {
     name: "planar-mirror",
     abi: 12,
     section: "§5",
@@ -90,7 +90,8 @@ pub const PLANAR_MIRROR: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.frame.depth.min(q.geometry.mirror_budget).max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
-});
+};
+pub const PLANAR_MIRROR: Method = Method(PLANAR_MIRROR_INFO.name);
 
 /// `geometry.refract`: each flat-faced dielectric (and thin pane) drawn from the camera (and
 /// from every view that sees it) with its faces' reflected and refracted views at their
@@ -105,7 +106,7 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
     profiled: PROFILED,
 };
 
-pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
+pub const PLANAR_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     name: "planar-refraction",
     abi: 14,
     section: "§5",
@@ -116,4 +117,5 @@ pub const PLANAR_REFRACTION: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.geometry.mirror_budget.max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
-});
+};
+pub const PLANAR_REFRACTION: Method = Method(PLANAR_REFRACTION_INFO.name);

@@ -14,7 +14,7 @@ use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SH
 use crate::frame::stage::{FramePart, Maps, StageInit, ViewFrame, ViewLayout, ViewPass, EXTRA_VIEWS};
 use crate::frame::FrameInputs;
 use crate::gpu_scene::GpuView;
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::scene::Scene;
 use crate::vk::pipeline::{graphics_pipeline, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{Access, Context, Image, ImageDesc, ImageKind, Recorder};

@@ -20,7 +20,7 @@ use glam::Vec3;
 use crate::frame::stage::{order, FramePart, MapInfo, ViewFrame};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape};
 use crate::methods::EVERY_CLASS;
-use crate::plan::Plan;
+use crate::plan::types::Plan;
 use crate::quality::{CubeKnobs, FrameKnobs, LayeredKnobs, SearchKnobs};
 use crate::quality::{Quality, MAX_LAYERS};
 
@@ -61,7 +61,7 @@ pub const SEARCH: CameraPass = CameraPass {
     profiled: Profiled::OWN,
 };
 
-pub const LAYERED: Method = Method(&MethodInfo {
+pub const LAYERED_INFO: &MethodInfo = &MethodInfo {
     name: "layered",
     abi: 13,
     section: "§4.5",
@@ -74,7 +74,8 @@ pub const LAYERED: Method = Method(&MethodInfo {
     gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
     shape: Shape::Any,
-});
+};
+pub const LAYERED: Method = Method(LAYERED_INFO.name);
 
 /// Below this visible fraction from its own reference point an object is not convex from
 /// there: it sees itself (a concave mirror) or hides part of itself (a non-convex
@@ -106,7 +107,7 @@ pub fn centre(scene: &crate::scene::Scene, q: &Quality, meshes: &[usize]) -> Vec
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "layered",
     slots: slots::SLOTS,
-    methods: &[LAYERED],
+    methods: &[LAYERED_INFO],
     plan_objects: Some(share_centre),
     views: Some(|p| if p.layered_centre.is_some() { vec![(VIEWS, 6)] } else { Vec::new() }),
     frame_part: Some(|init, _| Ok(init.plan.layered_centre.map(|_| Box::new(LayeredViews) as Box<dyn FramePart>))),

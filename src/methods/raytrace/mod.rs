@@ -37,7 +37,7 @@ use crate::frame::stage::{order, Stage, StageInit};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled};
 use crate::methods::EVERY_CLASS;
 
-use crate::plan::CameraPlan;
+use crate::plan::types::CameraPlan;
 use crate::quality::Quality;
 use crate::quality::{FrameKnobs, RaytraceKnobs};
 use crate::scene::Scene;
@@ -94,11 +94,11 @@ const RAY_KNOBS_GRID: &[&str] =
 /// pipeline; no hooks.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "raytrace",
-    methods: &[BVH, KD_TREE, GRID, RAY_ENGINE, RAY_HIERARCHY],
+    methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO],
     ..crate::methods::registry::Family::NONE
 };
 
-pub const BVH: Method = Method(&MethodInfo {
+pub const BVH_INFO: &MethodInfo = &MethodInfo {
     name: "bvh",
     abi: 7,
     section: "§2.3.5",
@@ -112,9 +112,10 @@ pub const BVH: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const BVH: Method = Method(BVH_INFO.name);
 
-pub const RAY_ENGINE: Method = Method(&MethodInfo {
+pub const RAY_ENGINE_INFO: &MethodInfo = &MethodInfo {
     name: "ray-engine",
     abi: 10,
     section: "§2.2",
@@ -125,9 +126,10 @@ pub const RAY_ENGINE: Method = Method(&MethodInfo {
     gpu: Some(ray_tracer("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const RAY_ENGINE: Method = Method(RAY_ENGINE_INFO.name);
 
-pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
+pub const RAY_HIERARCHY_INFO: &MethodInfo = &MethodInfo {
     name: "ray-hierarchy",
     abi: 11,
     section: "§2.2.1",
@@ -140,9 +142,10 @@ pub const RAY_HIERARCHY: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const RAY_HIERARCHY: Method = Method(RAY_HIERARCHY_INFO.name);
 
-pub const KD_TREE: Method = Method(&MethodInfo {
+pub const KD_TREE_INFO: &MethodInfo = &MethodInfo {
     name: "kd-tree",
     abi: 9,
     section: "§2.3.3",
@@ -156,9 +159,10 @@ pub const KD_TREE: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const KD_TREE: Method = Method(KD_TREE_INFO.name);
 
-pub const GRID: Method = Method(&MethodInfo {
+pub const GRID_INFO: &MethodInfo = &MethodInfo {
     name: "grid",
     abi: 8,
     section: "§2.3.1",
@@ -172,7 +176,8 @@ pub const GRID: Method = Method(&MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
-});
+};
+pub const GRID: Method = Method(GRID_INFO.name);
 
 /// The scene's triangles in world space in scene order (mesh by mesh, index by index):
 /// the ids that every scheme's hits refer to.

@@ -29,7 +29,7 @@ use crate::frame::layout::{
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
 use crate::methods::Choice;
-use crate::plan::CameraPlan;
+use crate::plan::types::CameraPlan;
 use crate::vk::pipeline::{
     compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, GraphicsDesc, Multisample, VertexInput,
 };

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::plan::{Plan, StageSpec};
+use crate::plan::types::{Plan, StageSpec};
 
 /// GPU milliseconds, split by what they scale with.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -30,12 +30,13 @@ impl Cost {
 /// (`Profiled::prefix`: a ray tracer's kernels, planar mirrors' views). None: the frame's
 /// own work outside the plan's stages (resolve, object ids, output).
 fn recorded_by<'p>(p: &'p Plan, name: &str) -> Vec<&'p StageSpec> {
-    let own = |s: &StageSpec| s.passes(p).contains(&name);
+    let own = |s: &StageSpec| s.passes().contains(&name);
     let exact: Vec<&StageSpec> = p.stages.iter().filter(|s| own(s)).collect();
     if !exact.is_empty() {
         return exact;
     }
-    let declares = |s: &&StageSpec| matches!(s, StageSpec::Camera(c) if !c.pass.profiled.prefix.is_empty() && name.starts_with(c.pass.profiled.prefix));
+    let declares =
+        |s: &&StageSpec| matches!(s, StageSpec::Camera(c) if !c.profiled.prefix.is_empty() && name.starts_with(c.profiled.prefix));
     p.stages.iter().filter(declares).collect()
 }
 
@@ -45,7 +46,7 @@ fn fixed(s: &StageSpec) -> bool {
         StageSpec::Map(_) | StageSpec::Upload | StageSpec::Shadows => true,
         // An effect that is not drawn per view (caustics' maps and photons, not their
         // projection onto the camera's surfaces).
-        StageSpec::Effect(e) => !e.info.deps.per_view(),
+        StageSpec::Effect(e) => !e.deps.per_view(),
         StageSpec::Direct | StageSpec::Camera(_) => false,
     }
 }
@@ -70,7 +71,7 @@ pub fn attribute(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, Cost, Cost)
             let draws = |s: &StageSpec, mesh: usize| matches!(s, StageSpec::Camera(c) if c.objects.iter().any(|(m, _)| *m == mesh));
             owners = (0..p.objects.len()).filter(|&i| stages.iter().any(|s| draws(s, p.objects[i].mesh))).collect();
         }
-        let shared = stages.iter().any(|s| matches!(s, StageSpec::Camera(c) if c.pass.profiled.shared));
+        let shared = stages.iter().any(|s| matches!(s, StageSpec::Camera(c) if c.profiled.shared));
         if owners.is_empty() {
             base.add(part, 1.0);
         } else if shared {

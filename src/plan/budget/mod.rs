@@ -39,7 +39,7 @@ mod candidates;
 mod choose;
 mod fit;
 mod models;
-mod prediction;
+pub mod prediction;
 mod search;
 
 pub use attribute::{attribute, measured_by_object, Cost};

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::Cost;
 use crate::error::{Error, Result};
-use crate::plan::Method;
+use crate::plan::ids::Method;
 use crate::quality::Quality;
 
 /// The first line of every models file's `format` field.

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use crate::error::{Error, Result};
-use crate::plan::Method;
+use crate::plan::ids::Method;
 
 /// A frame budget.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

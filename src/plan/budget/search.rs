@@ -4,7 +4,7 @@ use super::candidates::Candidate;
 use super::models::{mse_of, psnr_of};
 use super::Budget;
 use crate::plan::facts::SceneFacts;
-use crate::plan::{MapShading, Method};
+use crate::plan::ids::{MapShading, Method};
 use crate::quality::Quality;
 
 /// Past this many (variant × per-object candidate) combinations the search is greedy.

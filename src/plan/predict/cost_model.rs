@@ -13,6 +13,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use super::device::DeviceKey;
 use super::features::{map_features, screen_features, shared_features, Workload, MAP_FEATURES, SCREEN_FEATURES, SHARED_FEATURES};
 use super::linear;
 use super::samples::Corpus;
@@ -20,33 +21,6 @@ use crate::error::{Error, Result};
 
 /// The first line of every cost file's `format` field.
 pub const FORMAT: &str = "specula-costs 1";
-
-/// A device as the cost cache knows it: PCI vendor and device ids, the driver's version
-/// and its name (`VkPhysicalDeviceProperties`), and the driver's own description
-/// (`VkPhysicalDeviceDriverProperties`: lavapipe reports driver version 1 whatever Mesa
-/// release it is, and names the release there).
-#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
-pub struct DeviceKey {
-    pub vendor: u32,
-    pub device: u32,
-    pub driver: u32,
-    pub name: String,
-    pub driver_info: String,
-}
-
-impl DeviceKey {
-    /// How files and reports name it.
-    pub fn label(&self) -> String {
-        format!("{} ({}) [{:04x}:{:04x} driver {:#x}]", self.name, self.driver_info, self.vendor, self.device, self.driver)
-    }
-
-    /// Its cache file's name.
-    pub fn file_name(&self) -> String {
-        // FNV-1a of the driver's description.
-        let h = self.driver_info.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3));
-        format!("costs-{:04x}-{:04x}-{:08x}-{:016x}.json", self.vendor, self.device, self.driver, h)
-    }
-}
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
 /// `SCREEN_FEATURES` (per object, its camera work) and `SHARED_FEATURES` (per frame, the
@@ -254,4 +228,11 @@ mod tests {
         assert!(load_cached(&dir, &key(1)).is_err());
         let _ = std::fs::remove_dir_all(&dir);
     }
+}
+
+/// What a plan is predicted for: the frame's size and the device's unit costs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Target {
+    pub size: (u32, u32),
+    pub costs: std::sync::Arc<CostModel>,
 }

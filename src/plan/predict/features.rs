@@ -6,8 +6,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::methods::registry::ObjectClass;
 use crate::plan::facts::{Curvature, ObjectFacts};
+use crate::plan::ids::ObjectClass;
 use crate::quality::Quality;
 use crate::scene::{Scene, SurfaceKind};
 

@@ -18,6 +18,8 @@
 //!   within [`TOLERANCE_DB`] of the most accurate one.
 
 pub mod cost_model;
+pub mod device;
+pub use cost_model::Target;
 pub mod error_model;
 pub mod features;
 mod linear;
@@ -67,13 +69,6 @@ pub fn error_model() -> &'static ErrorModel {
 pub fn stored_costs() -> Option<&'static CostModel> {
     static C: OnceLock<Option<CostModel>> = OnceLock::new();
     C.get_or_init(|| CostModel::parse(include_str!("../../../assets/models/costs.json"), COSTS_FILE).ok()).as_ref()
-}
-
-/// What a plan is predicted for: the frame's size and the device's unit costs.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Target {
-    pub size: (u32, u32),
-    pub costs: Arc<CostModel>,
 }
 
 impl Target {

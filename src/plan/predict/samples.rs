@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 use super::features::{Workload, ERROR_FEATURES};
 use crate::error::{Error, Result};
-use crate::plan::Method;
+use crate::plan::ids::Method;
 
 /// The first line of every corpus file's `format` field.
 pub const FORMAT: &str = "specula-corpus 1";
@@ -57,13 +57,13 @@ pub struct FrameSample {
 pub struct Corpus {
     pub format: String,
     /// Where it was measured.
-    pub device: super::cost_model::DeviceKey,
+    pub device: super::device::DeviceKey,
     pub samples: Vec<Sample>,
     pub frames: Vec<FrameSample>,
 }
 
 impl Corpus {
-    pub fn new(device: super::cost_model::DeviceKey) -> Corpus {
+    pub fn new(device: super::device::DeviceKey) -> Corpus {
         Corpus { format: FORMAT.into(), device, samples: Vec::new(), frames: Vec::new() }
     }
 
