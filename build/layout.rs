@@ -86,12 +86,28 @@ pub struct FlagBits {
     pub doc: Vec<&'static str>,
 }
 
+/// Words of the push block's `words` array that one owner (the frame or a family) declares:
+/// set once a frame for every pass (by the frame, and by each family's `push_words` hook),
+/// read by the owner's shaders and by shaders of families that share the owner's facility (the
+/// distance-map search of `common/search.glsl`). The frame-wide block itself holds only what
+/// every pass reads (view, object, flags, lights).
+pub struct PushWords {
+    /// `frame` or the family's folder name (filled in by [`declared`]).
+    pub owner: &'static str,
+    /// [start, end): the members take these words in order.
+    pub words: (u32, u32),
+    /// (name, `uint` or `float`, doc)
+    pub members: Vec<(&'static str, Ty, Vec<&'static str>)>,
+    pub doc: Vec<&'static str>,
+}
+
 #[derive(Default)]
 pub struct Layout {
     pub structs: Vec<StructDecl>,
     pub consts: Vec<ConstDecl>,
     pub sets: Vec<SetDecl>,
     pub flags: Vec<FlagBits>,
+    pub words: Vec<PushWords>,
 }
 
 /// One struct laid out both ways (they agree, or `check_structs` failed).
@@ -364,6 +380,16 @@ pub fn glsl(l: &Layout) -> Result<String, String> {
         writeln!(out, "layout(push_constant) uniform {} {{", s.glsl).unwrap();
         s.fields.iter().for_each(|f| field(&mut out, f));
         writeln!(out, "}} {};", s.instance).unwrap();
+        for r in &l.words {
+            out.push('\n');
+            comment(&mut out, "", &r.doc);
+            for (k, (name, ty, doc)) in r.members.iter().enumerate() {
+                comment(&mut out, "", doc);
+                let w = format!("{}.words[{}]", s.instance, r.words.0 as usize + k);
+                let (t, v) = if *ty == Ty::Float { ("float", format!("uintBitsToFloat({w})")) } else { ("uint", w) };
+                writeln!(out, "{t} push_{}() {{ return {v}; }}", name.to_lowercase()).unwrap();
+            }
+        }
     }
     out.push_str("\n#endif\n");
     Ok(out)
@@ -488,6 +514,70 @@ macro_rules! flag_bits {
     };
 }
 
+/// The push words: `pub fn push_words() -> Vec<PushWords>` (the owner is filled in by
+/// [`declared`]). `start..end { NAME: uint, NAME: float, … }`, one word each, in order.
+#[macro_export]
+macro_rules! push_words {
+    ($(
+        $(#[doc = $doc:literal])*
+        $start:literal .. $end:literal { $( $(#[doc = $mdoc:literal])* $name:ident : $ty:tt ),* $(,)? }
+    )*) => {
+        pub fn push_words() -> Vec<$crate::layout::PushWords> {
+            vec![$($crate::layout::PushWords {
+                owner: "",
+                words: ($start, $end),
+                members: vec![$( (stringify!($name), $crate::layout_ty!($ty), vec![$($mdoc),*]) ),*],
+                doc: vec![$($doc),*],
+            }),*]
+        }
+    };
+}
+
+/// Refuses push-word declarations that can collide: a range outside the push block's `words`
+/// array, two ranges that overlap (whoever owns them: every word is set on every pass), a
+/// range whose members do not fill it exactly, a member that is neither `uint` nor `float`,
+/// and a name declared twice (as a word or a const).
+pub fn check_words(l: &Layout) -> Result<(), String> {
+    let mut errors = Vec::new();
+    let count = l.structs.iter().filter(|s| s.kind == "push_constant").flat_map(|s| s.fields.iter()).find_map(|f| match &f.ty {
+        Ty::Array(t, n) if f.name == "words" && **t == Ty::Uint => Some(*n as u32),
+        _ => None,
+    });
+    if !l.words.is_empty() && count.is_none() {
+        errors.push("layout: push words are declared but the push block has no `words: [uint; N]`".into());
+    }
+    let count = count.unwrap_or(0);
+    for (i, r) in l.words.iter().enumerate() {
+        let (start, end) = r.words;
+        let what = format!("layout: {} push words {start}..{end}", r.owner);
+        if start >= end || end > count {
+            errors.push(format!("{what}: not a range of the push block's {count} words"));
+        }
+        if r.members.len() as u32 != end.saturating_sub(start) {
+            errors.push(format!("{what}: {} members for {} words", r.members.len(), end.saturating_sub(start)));
+        }
+        for o in &l.words[..i] {
+            if start < o.words.1 && o.words.0 < end {
+                errors.push(format!("{what} overlap {}'s words {}..{}", o.owner, o.words.0, o.words.1));
+            }
+        }
+        for (name, ty, _) in &r.members {
+            if *ty != Ty::Uint && *ty != Ty::Float {
+                errors.push(format!("{what}: `{name}` is a {}, not a uint or float", ty.glsl_name(&l.structs)));
+            }
+            let twice = l.words.iter().flat_map(|o| o.members.iter()).filter(|m| m.0 == *name).count() > 1;
+            if twice || l.consts.iter().any(|c| c.name == *name) {
+                errors.push(format!("{what}: `{name}` is declared twice"));
+            }
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors.join("\n"))
+    }
+}
+
 /// Refuses push-flag declarations that can collide: a range past bit 32 or of an unknown
 /// scope; an `every_pass` range that overlaps any other owner's range (`own_passes` ranges of
 /// different owners may overlap: no pass is two families'); a member that is not a uint const
@@ -580,6 +670,15 @@ pub fn rust(l: &Layout) -> String {
         doc(&mut out, "", &c.doc);
         writeln!(out, "pub const {}: {} = {};", c.name, c.ty.rust_name(), c.value).unwrap();
     }
+    for r in &l.words {
+        out.push('\n');
+        doc(&mut out, "", &r.doc);
+        for (k, (name, ty, d)) in r.members.iter().enumerate() {
+            doc(&mut out, "", d);
+            let w = r.words.0 as usize + k;
+            writeln!(out, "pub const {name}: crate::frame::words::Word<{}> = crate::frame::words::Word::at({w});", ty.rust_name()).unwrap();
+        }
+    }
     for set in &l.sets {
         out.push('\n');
         doc(&mut out, "", &set.doc);
@@ -609,6 +708,9 @@ pub mod empty {
     pub fn flag_bits() -> Vec<super::FlagBits> {
         Vec::new()
     }
+    pub fn push_words() -> Vec<super::PushWords> {
+        Vec::new()
+    }
 }
 
 /// The declaration files, each as a module named after its owner: the frame's, then each
@@ -632,6 +734,7 @@ macro_rules! declarations {
                     consts: $owner::consts(),
                     sets: $owner::sets(),
                     flags: $owner::flag_bits(),
+                    words: $owner::push_words(),
                 })),*]
             }
 
@@ -676,6 +779,7 @@ pub fn merged() -> Result<Layout, String> {
         l.structs.extend(file.structs);
         l.consts.extend(file.consts);
         l.flags.extend(file.flags.into_iter().map(|f| FlagBits { owner, ..f }));
+        l.words.extend(file.words.into_iter().map(|w| PushWords { owner, ..w }));
         for mut set in file.sets {
             match l.sets.iter_mut().find(|s| s.set == set.set || s.name == set.name) {
                 Some(s) if s.set == set.set && s.name == set.name => {
@@ -701,6 +805,9 @@ pub fn merged() -> Result<Layout, String> {
         }
     }
     if let Err(e) = check_flags(&l, &owners) {
+        errors.push(e);
+    }
+    if let Err(e) = check_words(&l) {
         errors.push(e);
     }
     if errors.is_empty() {

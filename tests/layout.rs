@@ -100,9 +100,7 @@ fn every_shared_struct_sits_where_std430_puts_it() {
     assert_eq!(size_of::<GpuLight>(), by_name("GpuLight").size);
     assert_eq!(offset_of!(GpuLight, shadow_view_proj), offset("GpuLight", "shadow_view_proj"));
     assert_eq!(size_of::<Push>(), by_name("Push").size);
-    assert_eq!(offset_of!(Push, search), offset("Push", "search"));
-    assert_eq!(offset_of!(Push, tolerance), offset("Push", "tolerance"));
-    assert_eq!(size_of::<SearchKnobs>(), by_name("SearchKnobs").size);
+    assert_eq!(offset_of!(Push, words), offset("Push", "words"));
     assert_eq!(specula::frame::PUSH_BYTES as usize, by_name("Push").size);
 }
 
@@ -120,7 +118,9 @@ fn bindings_come_from_the_declaration() {
     let text = layout::glsl(&layout::declared()).unwrap();
     assert!(text.contains("layout(std430, set = 1, binding = 3) readonly buffer Thickness { float thickness[]; };"), "{text}");
     assert!(text.contains("layout(push_constant) uniform Push {"), "{text}");
-    assert!(text.contains("    SearchKnobs search;\n"), "{text}");
+    assert!(text.contains("    uint words[8];\n"), "{text}");
+    assert!(text.contains("float push_search_tolerance() { return uintBitsToFloat(push.words[6]); }"), "{text}");
+    assert!(text.contains("uint push_recursion_depth() { return push.words[0]; }"), "{text}");
     assert!(text.contains("    uint pad[2];\n"), "{text}");
     assert!(text.contains("const uint FLAG_FIRST_CYCLE = 16u;"), "{text}");
 }
@@ -228,6 +228,44 @@ fn colliding_push_flags_are_refused() {
     assert!(err.contains("`FLAG_LOOSE` is in no declared flag range"), "{err}");
 }
 
+mod push_block {
+    gpu_structs! {
+        struct Push => push_constant Push push {
+            view: uint,
+            words: [uint; 4],
+        }
+    }
+    gpu_consts! {
+        TAKEN: uint = 1;
+    }
+    push_words! {
+        0..2 { A: uint, B: float }
+        1..3 { C: uint, TAKEN: uint }
+        3..5 { D: vec4 }
+    }
+}
+
+#[test]
+fn colliding_push_words_are_refused() {
+    let l = layout::Layout {
+        structs: push_block::structs(),
+        consts: push_block::consts(),
+        words: push_block::push_words().into_iter().map(|w| layout::PushWords { owner: "layered", ..w }).collect(),
+        ..Default::default()
+    };
+    let err = layout::check_words(&l).unwrap_err();
+    println!("{err}");
+    assert!(err.contains("layered push words 1..3 overlap layered's words 0..2"), "{err}");
+    assert!(err.contains("`TAKEN` is declared twice"), "{err}");
+    assert!(err.contains("push words 3..5: not a range of the push block's 4 words"), "{err}");
+    assert!(err.contains("push words 3..5: 1 members for 2 words"), "{err}");
+    assert!(err.contains("`D` is a vec4, not a uint or float"), "{err}");
+    // The crate's own words pass, and fill the block.
+    let own = layout::declared();
+    layout::check_words(&own).unwrap();
+    assert!(!own.words.is_empty());
+}
+
 fn sources(dir: &Path, out: &mut Vec<std::path::PathBuf>) {
     for e in std::fs::read_dir(dir).unwrap().flatten() {
         let p = e.path();
@@ -262,7 +300,7 @@ fn no_shader_declares_the_shared_layout_by_hand() {
         for (i, line) in text.lines().enumerate() {
             let code = line.split("//").next().unwrap();
             let squeezed: String = code.split_whitespace().collect::<Vec<_>>().join(" ");
-            for s in ["View", "Material", "Object", "Light", "SearchKnobs"] {
+            for s in ["View", "Material", "Object", "Light"] {
                 if squeezed.contains(&format!("struct {s} ")) || squeezed.ends_with(&format!("struct {s}")) {
                     found.push(format!("glsl/{name}:{}: declares struct {s}", i + 1));
                 }

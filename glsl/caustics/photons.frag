@@ -71,7 +71,7 @@ void main() {
         dir = s.t;
         float ior = m.nu.x;
         bool out_of_it = false;
-        for (uint bounce = 0u; bounce <= push.internal_bounces; ++bounce) {
+        for (uint bounce = 0u; bounce <= push_internal_bounces(); ++bounce) {
             vec3 hit, n2;
             if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the photon is out
                 out_of_it = true;

@@ -19,8 +19,8 @@ float search_lookup(vec3 dir) {
 
 // The knobs decide: linear steps 0 means parallax correction alone.
 SearchResult search_ray(vec3 x, vec3 dir) {
-    if (push.search.linear_steps == 0u) return parallax_search(x, dir, int(max(push.search.parallax_iterations, 1u)));
-    return linear_search(x, dir, int(push.search.linear_steps), int(push.search.binary_steps), int(push.search.secant_steps), push.tolerance);
+    if (push_search_linear_steps() == 0u) return parallax_search(x, dir, int(max(push_search_parallax_iterations(), 1u)));
+    return linear_search(x, dir, int(push_search_linear_steps()), int(push_search_binary_steps()), int(push_search_secant_steps()), push_search_tolerance());
 }
 
 // Radiance arriving at world point p from direction dir, traced in the distance map of

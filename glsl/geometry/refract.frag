@@ -35,7 +35,7 @@ void main() {
         uint count = push.flags >> MIRROR_COUNT_SHIFT;
         for (uint i = 0u; i < count; ++i) {
             uint layer = first + i;
-            View c = views[push.mirror_base + layer];
+            View c = views[push_extra_view_base() + layer];
             float facing = dot(c.clip.xyz, towards);
             float offset = abs(dot(c.clip.xyz, in_position) + c.clip.w);
             // Its plane: the normals agree and the pixel lies `hair` from the clip plane

@@ -14,6 +14,6 @@ layout(location = 0) out vec4 out_color;
 void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
-    vec3 c = layered_radiance(o.map_centre.xyz, m, in_position, normalize(in_normal), views[in_view].eye.xyz, max(push.depth, 1u) - 1u);
+    vec3 c = layered_radiance(o.map_centre.xyz, m, in_position, normalize(in_normal), views[in_view].eye.xyz, max(push_recursion_depth(), 1u) - 1u);
     out_color = vec4(c, 1.0);
 }

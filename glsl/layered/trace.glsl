@@ -48,10 +48,10 @@ LayeredHit layered_hit(vec3 x, vec3 R, vec3 n) {
     h.layer = 0;
     h.dir = R;
     h.d = 1e30;
-    int steps = max(int(push.search.linear_steps), 1);
+    int steps = max(int(push_search_linear_steps()), 1);
     for (int k = 0; k < layers; ++k) {
         layered_layer = k;
-        SearchResult s = layer_search(x, R, steps, int(push.search.binary_steps), int(push.search.secant_steps), push.tolerance,
+        SearchResult s = layer_search(x, R, steps, int(push_search_binary_steps()), int(push_search_secant_steps()), push_search_tolerance(),
                                       LAYERED_GAP, k == origin ? side : 0);
         if (!s.escaped && s.d < h.d) {
             h.escaped = false;

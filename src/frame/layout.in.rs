@@ -81,15 +81,6 @@ gpu_structs! {
         shadow_view_proj: mat4,
     }
 
-    /// The distance-map search knobs (§4.1) as the shaders read them.
-    struct SearchKnobs => struct SearchKnobs {
-        /// 0: parallax correction only
-        linear_steps: uint,
-        secant_steps: uint,
-        binary_steps: uint,
-        parallax_iterations: uint,
-    }
-
     /// Push constants of every scene-drawing shader.
     struct Push => push_constant Push push {
         /// first view of this draw (multiview adds gl_ViewIndex)
@@ -98,16 +89,20 @@ gpu_structs! {
         /// FLAG_* and the drawing pass's own bits (`flag_bits!`)
         flags: uint,
         light_count: uint,
-        search: SearchKnobs,
-        /// early exit when | |l|/|l'| − 1 | ≤ tolerance
-        tolerance: float,
-        /// self refraction: total internal reflections followed (§4.4)
-        internal_bounces: uint,
+        /// Parameters the frame and the families declare word by word (`push_words!`), set
+        /// once a frame for every pass; shaders read them through `push_<name>()`.
+        words: [uint; 8],
+    }
+}
+
+push_words! {
+    /// The frame's words.
+    0..2 {
         /// specular recursion depth R (`depth`): layered maps (§4.5) trace this many bounces
-        depth: uint,
+        RECURSION_DEPTH: uint,
         /// the view table's first extra camera view (the `frame::stage::EXTRA_VIEWS` block,
-        /// planar mirrors'): layer L of `mirror_views` is view `mirror_base + L`
-        mirror_base: uint,
+        /// planar mirrors'): layer L of `mirror_views` is view `push_extra_view_base() + L`
+        EXTRA_VIEW_BASE: uint,
     }
 }
 

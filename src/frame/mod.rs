@@ -10,13 +10,14 @@ pub mod ids;
 pub mod knobs;
 pub mod layout;
 pub mod maps;
-pub mod schedule;
 pub mod output;
+pub mod schedule;
 pub mod shadow;
 pub mod stage;
 pub mod views;
+pub mod words;
 
-pub use layout::{Push, SearchKnobs, FLAG_FIRST_CYCLE, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_INTER_OBJECT, FLAG_PROXY_BOX};
+pub use layout::{Push, FLAG_FIRST_CYCLE, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT, FLAG_INTER_OBJECT, FLAG_PROXY_BOX};
 
 use ash::vk;
 
@@ -24,18 +25,8 @@ use crate::gpu_scene::{Draw, GpuScene};
 use crate::quality::CubeMode;
 use crate::vk::{begin_rendering, Access, Context, Image, Recorder, Target};
 
-impl SearchKnobs {
-    pub fn of(q: &crate::quality::Quality) -> SearchKnobs {
-        SearchKnobs {
-            linear_steps: q.search.linear_steps,
-            secant_steps: q.search.secant_steps,
-            binary_steps: q.search.binary_steps,
-            parallax_iterations: q.search.parallax_iterations,
-        }
-    }
-}
-
 pub const PUSH_BYTES: u32 = std::mem::size_of::<Push>() as u32;
+const _: () = assert!(PUSH_BYTES as usize == 16 + 4 * words::COUNT, "words::COUNT is the push block's `words` length");
 
 /// What every pass needs to draw the scene: geometry, the frame's descriptor set and
 /// pipeline layout, and the frame-wide push-constant fields.
@@ -45,12 +36,8 @@ pub struct FrameInputs<'a> {
     pub layout: vk::PipelineLayout,
     pub flags: u32,
     pub light_count: u32,
-    pub search: SearchKnobs,
-    pub tolerance: f32,
-    pub internal_bounces: u32,
-    pub depth: u32,
-    /// The first extra camera view (`stage::EXTRA_VIEWS`, planar mirrors' views).
-    pub mirror_base: u32,
+    /// `Push.words` of this frame (`words`).
+    pub words: words::PushWords,
 }
 
 impl FrameInputs<'_> {
@@ -78,17 +65,7 @@ impl FrameInputs<'_> {
     /// `push_flags` into another pipeline layout with the same push range (a method's own
     /// stage with sets of its own).
     pub fn push_in(&self, ctx: &Context, cmd: vk::CommandBuffer, layout: vk::PipelineLayout, view: u32, object: u32, flags: u32) {
-        let p = Push {
-            view,
-            object,
-            flags,
-            light_count: self.light_count,
-            search: self.search,
-            tolerance: self.tolerance,
-            internal_bounces: self.internal_bounces,
-            depth: self.depth,
-            mirror_base: self.mirror_base,
-        };
+        let p = Push { view, object, flags, light_count: self.light_count, words: self.words.0 };
         unsafe {
             ctx.device.cmd_push_constants(
                 cmd,

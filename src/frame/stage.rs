@@ -65,7 +65,7 @@ pub struct ViewBlock {
 }
 
 /// The block of extra camera views that frame parts render the camera's stages into
-/// (`FramePart::record_views`; `Push.mirror_base` is its first view).
+/// (`FramePart::record_views`; `EXTRA_VIEW_BASE` of the push words is its first view).
 pub const EXTRA_VIEWS: &str = "frame.extra_views";
 
 impl ViewLayout {

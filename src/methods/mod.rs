@@ -158,6 +158,22 @@ mod tests {
         assert!(slots.iter().any(|s| s.key() == (0, SHADOW_CUBES)));
     }
 
+    /// A family is its folder plus its registration: every folder under `src/methods/` is a
+    /// registered family, and one with knobs has them composed into `Quality` (a forgotten
+    /// line fails here; build.rs refuses a forgotten `layout.in.rs` line the same way).
+    #[test]
+    fn every_family_folder_is_registered() {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let quality = std::fs::read_to_string(root.join("src/quality/mod.rs")).unwrap();
+        for e in std::fs::read_dir(root.join("src/methods")).unwrap().flatten().filter(|e| e.path().is_dir()) {
+            let name = e.file_name().into_string().unwrap();
+            assert!(FAMILIES.iter().any(|f| f.name == name), "src/methods/{name}/ is not in methods::FAMILIES");
+            if e.path().join("knobs.rs").is_file() {
+                assert!(quality.contains(&format!("crate::methods::{name}::knobs::")), "{name}'s knobs are not composed into Quality");
+            }
+        }
+    }
+
     #[test]
     fn every_method_is_listed_by_its_own_family() {
         for f in FAMILIES {

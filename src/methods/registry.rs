@@ -162,6 +162,8 @@ pub struct Family {
     pub views: Option<ViewBlocks>,
     /// After objects moved, with the plan's structure kept: its plan follows them.
     pub refresh: Option<fn(&mut Plan)>,
+    /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame.
+    pub push_words: Option<fn(&Quality, &mut crate::frame::words::PushWords)>,
     /// Its part of `specula plan`'s table, if it planned anything.
     pub describe: Option<fn(&Plan, &Scene) -> Option<String>>,
     /// State it keeps across frames: views of its own in the view table, extra camera views
@@ -185,6 +187,7 @@ impl Family {
         plan_views: None,
         views: None,
         refresh: None,
+        push_words: None,
         describe: None,
         frame_part: None,
     };

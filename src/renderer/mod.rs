@@ -24,7 +24,7 @@ use crate::frame::direct::SceneDirect;
 use crate::frame::shadow::ShadowMaps;
 use crate::frame::stage::{Deps, FrameIo, FramePart, MapSets, Maps, Stage, StageInit, ViewFrame, ViewLayout, ViewPass, EXTRA_VIEWS};
 use crate::frame::views;
-use crate::frame::{FrameInputs, SearchKnobs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
+use crate::frame::{FrameInputs, FLAG_FRESNEL_EXACT, FLAG_HAS_ENVIRONMENT};
 use crate::gpu_scene::{GpuLight, GpuScene};
 use crate::methods::{camera_named, effect_named, map_named, FAMILIES};
 use crate::plan::{Plan, StageSpec};
@@ -225,6 +225,16 @@ impl Renderer {
         Ok(())
     }
 
+    /// This frame's `Push.words`: the frame's own, then each family's.
+    fn push_words(&self, q: &crate::quality::Quality) -> crate::frame::words::PushWords {
+        use crate::frame::layout::{EXTRA_VIEW_BASE, RECURSION_DEPTH};
+        let mut w = crate::frame::words::PushWords::default();
+        w.set(RECURSION_DEPTH, q.frame.depth);
+        w.set(EXTRA_VIEW_BASE, self.views.first(EXTRA_VIEWS).unwrap_or(self.views.count));
+        FAMILIES.iter().filter_map(|f| f.push_words).for_each(|fill| fill(q, &mut w));
+        w
+    }
+
     /// Every map image, by slot: what tests and tools inspect after a frame.
     pub fn maps(&self) -> &Maps {
         &self.maps
@@ -270,20 +280,16 @@ impl Renderer {
     pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
         self.apply_updates(ctx)?;
         self.write_views()?;
+        let words = self.push_words(&self.plan.quality);
         let mut rec = Recorder::new(ctx, cmd, &mut self.profiler);
         self.scene.record_upload(&mut rec);
-        let q = &self.plan.quality;
         let f = FrameInputs {
             scene: &self.scene,
             set: self.bindings.set,
             layout: self.bindings.layout,
             flags: self.flags,
             light_count: self.light_table.len() as u32,
-            search: SearchKnobs::of(q),
-            tolerance: q.search.search_tolerance,
-            internal_bounces: q.distance.internal_bounces,
-            depth: q.frame.depth,
-            mirror_base: self.views.first(EXTRA_VIEWS).unwrap_or(self.views.count),
+            words,
         };
         let t = &mut self.targets;
         let full = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.target.width, height: t.target.height } };

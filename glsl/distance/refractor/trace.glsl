@@ -36,7 +36,7 @@ vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     vec3 pos = p;
     vec3 dir = s.t;
     float ior = m.nu.x;
-    for (uint bounce = 0u; bounce <= push.internal_bounces && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
+    for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
         if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
             c += weight * traced_radiance(o, pos, dir);

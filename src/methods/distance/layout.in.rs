@@ -25,3 +25,19 @@ descriptor_sets! {
         THICKNESS = 3: STORAGE_BUFFER => "readonly buffer Thickness { float thickness[]; }";
     }
 }
+
+push_words! {
+    /// The distance-map search (§4.1) that every search of a cube map runs (common/search.glsl:
+    /// distance's, layered's, the caustics' photons), and self refraction's bounces (§4.4).
+    2..8 {
+        /// linear steps on the projected segment (0: parallax correction only)
+        SEARCH_LINEAR_STEPS: uint,
+        SEARCH_SECANT_STEPS: uint,
+        SEARCH_BINARY_STEPS: uint,
+        SEARCH_PARALLAX_ITERATIONS: uint,
+        /// early exit when | |l|/|l'| − 1 | ≤ tolerance
+        SEARCH_TOLERANCE: float,
+        /// self refraction: total internal reflections followed (§4.4)
+        INTERNAL_BOUNCES: uint,
+    }
+}

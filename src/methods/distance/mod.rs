@@ -107,8 +107,21 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     name: "distance",
     slots: slots::SLOTS,
     methods: &[DISTANCE_INFO, DISTANCE_MULTI_INFO, REFRACTOR_MAP_INFO, IMAGE_SPACE_REFRACTION_INFO],
+    push_words: Some(push_words),
     ..crate::methods::registry::Family::NONE
 };
+
+/// The search's words (every cube-map search reads them) and self refraction's bounces.
+fn push_words(q: &crate::quality::Quality, w: &mut crate::frame::words::PushWords) {
+    use crate::frame::layout::*;
+    let s = &q.search;
+    w.set(SEARCH_LINEAR_STEPS, s.linear_steps);
+    w.set(SEARCH_SECANT_STEPS, s.secant_steps);
+    w.set(SEARCH_BINARY_STEPS, s.binary_steps);
+    w.set(SEARCH_PARALLAX_ITERATIONS, s.parallax_iterations);
+    w.set(SEARCH_TOLERANCE, s.search_tolerance);
+    w.set(INTERNAL_BOUNCES, q.distance.internal_bounces);
+}
 
 pub const DISTANCE_INFO: &MethodInfo = &MethodInfo {
     name: "distance",
