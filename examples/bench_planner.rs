@@ -62,7 +62,7 @@ fn main() -> specula::Result<()> {
                         continue;
                     };
                     let measured_db = regions.iter().find(|r| r.name == o.name).map_or(60.0, |r| r.psnr.min(60.0));
-                    let measured_ms = per.iter().find(|(k, _)| *k == o.mesh).map_or(0.0, |(_, v)| *v);
+                    let measured_ms = per.iter().find(|(k, ..)| *k == o.mesh).map_or(0.0, |&(_, a, b)| a + b);
                     let predicted_ms = m.cost.fixed_ms + m.cost.screen_ms + m.shared.screen_ms;
                     db_err.push((m.psnr_db - measured_db).abs());
                     if measured_ms > 0.0 && predicted_ms > 0.0 {

@@ -136,8 +136,18 @@ fn the_cli_calibrates_predicts_and_reports_what_the_frame_measured() {
         let line =
             stdout.lines().find(|l| l.starts_with(object) && l.contains("object '")).unwrap_or_else(|| panic!("{object}:\n{stdout}"));
         // method, predicted ms, actual ms, predicted PSNR, actual PSNR: all numbers present.
-        let numbers = line.split_whitespace().filter(|w| w.parse::<f64>().is_ok()).count();
-        assert!(numbers >= 4, "{line}");
+        let numbers: Vec<f64> = line.split_whitespace().filter_map(|w| w.parse::<f64>().ok()).collect();
+        assert!(numbers.len() >= 4, "{line}");
+        // Per pass kind, predicted/actual: maps and frame effects, camera work; the actual
+        // parts are the object's actual ms, the predicted parts its predicted ms.
+        let pairs: Vec<(f64, f64)> = line
+            .split_whitespace()
+            .filter_map(|w| w.split_once('/'))
+            .filter_map(|(a, b)| Some((a.parse::<f64>().ok()?, b.parse::<f64>().ok()?)))
+            .collect();
+        assert_eq!(pairs.len(), 2, "{line}");
+        assert!((pairs[0].0 + pairs[1].0 - numbers[0]).abs() < 2e-3, "predicted parts of {line}");
+        assert!((pairs[0].1 + pairs[1].1 - numbers[1]).abs() < 2e-3, "actual parts of {line}");
     }
     assert!(png.exists());
 

@@ -62,16 +62,16 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
         let names: Vec<String> = job.scene.meshes.iter().map(|m| m.name.clone()).collect();
         let regions = specula::metrics::errors_by_object(&frame.image, &reference, &ids, &specular, &names)?;
         let psnr = |name: &str| regions.iter().find(|e| e.name == name).map(|e| e.psnr);
-        let objects: Vec<(f64, Option<f64>)> = pr
+        let objects: Vec<specula::plan::budget::ObjectMeasured> = pr
             .objects
             .iter()
             .map(|o| {
-                let ms = costs.iter().find(|(m, _)| *m == o.mesh).map_or(0.0, |(_, ms)| *ms);
-                (ms, psnr(&o.name))
+                let (maps_ms, camera_ms) = costs.iter().find(|(m, ..)| *m == o.mesh).map_or((0.0, 0.0), |&(_, a, b)| (a, b));
+                specula::plan::budget::ObjectMeasured { maps_ms, camera_ms, psnr_db: psnr(&o.name) }
             })
             .collect();
         println!("\n{}", specula::plan::budget::report(pr, Some((&objects, (frame_ms, psnr("specular"))))));
-        println!("(actual: this frame's passes split as the models split them, base {base:.3} ms; PSNR against the exact tracer, bvh supersampled 4×4)");
+        println!("(actual: this frame's passes split as the models split them — maps and frame effects, camera passes and kernels — base {base:.3} ms; PSNR against the exact tracer, bvh supersampled 4×4)");
     }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);

@@ -84,16 +84,16 @@ pub fn attribute(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, Cost, Cost)
     (objects, base)
 }
 
-/// What a frame spent per object, as the prediction counts it (its share, plus its
-/// method's shared kernels split among the objects that use it), and on the base.
-pub fn measured_by_object(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, f64)>, f64) {
+/// What a frame spent per object, as the prediction counts it: (mesh, its maps and frame
+/// effects, its camera work with its share of its method's shared kernels), and the base.
+pub fn measured_by_object(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, f64, f64)>, f64) {
     let (costs, base) = attribute(p, passes);
     let per = costs
         .iter()
         .zip(&p.objects)
         .map(|((mesh, own, shared), o)| {
             let users = p.objects.iter().filter(|q| q.method == o.method).count().max(1) as f64;
-            (*mesh, own.fixed_ms + own.screen_ms + (shared.fixed_ms + shared.screen_ms) / users)
+            (*mesh, own.fixed_ms, own.screen_ms + (shared.fixed_ms + shared.screen_ms) / users)
         })
         .collect();
     (per, base.fixed_ms + base.screen_ms)

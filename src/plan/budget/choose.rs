@@ -71,6 +71,7 @@ pub fn choose_with(
                 name: scene.meshes[f.mesh].name.clone(),
                 method: c.method,
                 ms: timing.object_ms(&refs, i, whole.is_some()),
+                maps_ms: timing.object_parts(&refs, i, whole.is_some()).0,
                 psnr_db: c.psnr,
                 pixels: c.pixels,
                 model: c.model.clone(),

@@ -46,5 +46,5 @@ pub use attribute::{attribute, measured_by_object, Cost};
 pub use choose::{choose, choose_with};
 pub use fit::{fit, Measured};
 pub use models::{variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};
-pub use prediction::{report, Budget, FrameMeasured, ObjectPrediction, Prediction};
+pub use prediction::{report, Budget, FrameMeasured, ObjectMeasured, ObjectPrediction, Prediction};
 pub use search::MAX_COMBINATIONS;

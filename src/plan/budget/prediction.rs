@@ -50,6 +50,10 @@ pub struct ObjectPrediction {
     pub name: String,
     pub method: Method,
     pub ms: f64,
+    /// Of `ms`, its maps and frame effects (passes that do not scale with the output); the
+    /// rest is its camera work (its camera passes, in every view that shows it, and its share
+    /// of its method's whole-screen kernels).
+    pub maps_ms: f64,
     pub psnr_db: f64,
     /// Its pixels in the models' frame (weights the specular PSNR).
     pub pixels: usize,
@@ -77,9 +81,18 @@ pub struct Prediction {
     pub whole_scene: Option<String>,
 }
 
-/// What a frame measured: per object (ms, PSNR) in the prediction's order, then the
-/// frame's (ms, specular PSNR).
-pub type FrameMeasured<'a> = (&'a [(f64, Option<f64>)], (f64, Option<f64>));
+/// What a frame measured for one object: its passes split as the predictions split them
+/// (`attribute::measured_by_object`), and its PSNR.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ObjectMeasured {
+    pub maps_ms: f64,
+    pub camera_ms: f64,
+    pub psnr_db: Option<f64>,
+}
+
+/// What a frame measured: per object in the prediction's order, then the frame's (ms,
+/// specular PSNR).
+pub type FrameMeasured<'a> = (&'a [ObjectMeasured], (f64, Option<f64>));
 
 /// The prediction as a table, with what a frame measured beside it where given.
 pub fn report(p: &Prediction, actual: Option<FrameMeasured>) -> String {
@@ -96,21 +109,24 @@ pub fn report(p: &Prediction, actual: Option<FrameMeasured>) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<24} {:<18} {:>12} {:>10} {:>14} {:>12}  model",
-        "object", "method", "predicted ms", "actual ms", "predicted PSNR", "actual PSNR"
+        "{:<24} {:<18} {:>12} {:>10} {:>14} {:>12}  {:>17}  {:>17}  model",
+        "object", "method", "predicted ms", "actual ms", "predicted PSNR", "actual PSNR", "maps ms pred/act", "camera ms pred/act"
     );
     let fmt = |v: Option<f64>, prec: usize| v.map_or("-".to_string(), |v| format!("{v:.prec$}"));
     for (i, o) in p.objects.iter().enumerate() {
         let a = actual.and_then(|(objs, _)| objs.get(i).copied());
+        let pair = |pred: f64, act: Option<f64>| format!("{pred:.3}/{}", fmt(act, 3));
         let _ = writeln!(
             s,
-            "{:<24} {:<18} {:>12.3} {:>10} {:>14.2} {:>12}  {}",
+            "{:<24} {:<18} {:>12.3} {:>10} {:>14.2} {:>12}  {:>17}  {:>17}  {}",
             crate::error::clip(&o.name),
-            o.method.name,
+            o.method.name(),
             o.ms,
-            fmt(a.map(|a| a.0), 3),
+            fmt(a.map(|a| a.maps_ms + a.camera_ms), 3),
             o.psnr_db,
-            fmt(a.and_then(|a| a.1), 2),
+            fmt(a.and_then(|a| a.psnr_db), 2),
+            pair(o.maps_ms, a.map(|a| a.maps_ms)),
+            pair(o.ms - o.maps_ms, a.map(|a| a.camera_ms)),
             o.model
         );
     }

@@ -99,10 +99,19 @@ impl Timing<'_> {
     /// Object `i`'s part of the frame: its share, and its method's shared kernels split
     /// among the objects that use it.
     pub(super) fn object_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
+        let (maps, camera) = self.object_parts(picks, i, whole);
+        maps + camera
+    }
+
+    /// Object `i`'s part of the frame by pass kind: (its maps and frame effects, which do not
+    /// scale with the output; its camera work, repeated in the others' views, with its
+    /// share of its method's whole-screen kernels).
+    pub(super) fn object_parts(&self, picks: &[&Candidate], i: usize, whole: bool) -> (f64, f64) {
         let c = picks[i];
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
         let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
-        self.own_ms(picks, i, whole) + shared / users
+        let maps = c.fixed * self.scale(picks, c, whole);
+        (maps, self.own_ms(picks, i, whole) - maps + shared / users)
     }
 }
 
