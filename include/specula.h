@@ -348,6 +348,11 @@ typedef struct {
 // the registry's rules chose (specula_get_predictions reports none).
 #define SPECULA_WARNING_NO_MODELS 3
 
+// specula_context_configure with a budget: no choice is predicted to meet it; the nearest
+// was configured (specula_get_predictions says what it is predicted to reach), and the log
+// callback says why.
+#define SPECULA_WARNING_BUDGET_UNREACHABLE 4
+
 #define SPECULA_ERROR_INVALID_ARGUMENT -1
 
 #define SPECULA_ERROR_NULL_POINTER -2

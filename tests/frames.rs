@@ -366,7 +366,10 @@ fn frame_latency_restarts_its_cycles_after_a_change() {
 /// its glass sphere on refractor maps, the mirror taken to where it sees the glass: the
 /// objects now compose through inter-object cycles) is accepted through the C ABI; a
 /// standalone context reconfigures at its next render, and the image equals a fresh
-/// context's for the same state.
+/// context's for the same state. Before the move, refused calls (a method the sphere's shape
+/// or class cannot take, a bad knob, bad budgets, a NaN transform) change nothing: the next
+/// frame is the same bit for bit, and so is the frame after the replan. An unreachable
+/// budget configures the nearest choice with a warning code and a log message.
 #[test]
 fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
     use specula::ffi::*;
@@ -376,8 +379,12 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
     // The sphere's place on its glTF path at t = 2.58 s.
     let moved = Mat4::from_translation(Vec3::new(-0.6944, 0.5, -0.4889)).to_cols_array();
     let (w, h) = (32u32, 24u32);
-    let mut desc = common::render_desc(specula::methods::DISTANCE, w, h);
-    desc.method = specula::methods::registry::ABI_AUTO;
+    let auto_desc = || {
+        let mut d = common::render_desc(specula::methods::DISTANCE, w, h);
+        d.method = specula::methods::registry::ABI_AUTO;
+        d
+    };
+    let desc = auto_desc();
     let render = |ctx: *mut SpeculaContext| {
         let mut px = vec![0f32; (w * h * 4) as usize];
         let r = unsafe { specula_context_render(ctx, SPECULA_PIXEL_RGBA32F, px.as_mut_ptr().cast(), px.len() * 4) };
@@ -407,7 +414,30 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         assert_eq!(specula_context_load_gltf(a, demo.as_ptr().cast()), SPECULA_SUCCESS);
         knobs(a);
         assert_eq!(specula_context_configure(a, &desc), SPECULA_SUCCESS);
-        render(a);
+        let before = render(a);
+        let message = |ctx| std::ffi::CStr::from_ptr(specula_context_last_error(ctx)).to_string_lossy().into_owned();
+        let sphere_name = std::ffi::CString::new(scene.meshes[sphere as usize].name.as_str()).unwrap();
+        let refused = |r: SpeculaResult, want: &str| {
+            assert_eq!(r, SPECULA_ERROR_INVALID_ARGUMENT, "{want}");
+            let m = message(a);
+            assert!(m.contains(want), "{m}");
+            assert!(render(a) == before, "the refused call ({want}) changed the frame");
+        };
+        // Judged at the call: a planar method on a curved mirror, a dielectric method on a mirror.
+        refused(specula_context_set_object_method(a, sphere_name.as_ptr(), specula::methods::PLANAR_MIRROR.abi), "planar reflectors only");
+        refused(
+            specula_context_set_object_method(a, sphere_name.as_ptr(), specula::methods::PLANAR_REFRACTION.abi),
+            "cannot serve a mirror",
+        );
+        refused(specula_context_set_object_method(a, sphere_name.as_ptr(), 9999), "not a GPU method");
+        refused(specula_context_set_knob(a, c"cube_size".as_ptr(), c"7".as_ptr()), "cube_size");
+        refused(specula_context_set_object_transform(a, sphere, [f32::NAN; 16].as_ptr()), "NaN");
+        let mut bad = auto_desc();
+        for (max_ms, min_psnr, want) in [(0.0, -5.0, "min_psnr"), (f64::NAN, 0.0, "max_ms"), (1e9, 0.0, "max_ms"), (5.0, 30.0, "not both")]
+        {
+            (bad.max_ms, bad.min_psnr_db) = (max_ms, min_psnr);
+            refused(specula_context_configure(a, &bad), want);
+        }
         assert_eq!(specula_context_set_object_transform(a, sphere, moved.as_ptr()), SPECULA_SUCCESS, "the move is accepted");
         let incremental = render(a);
 
@@ -418,6 +448,20 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         assert_eq!(specula_context_configure(b, &desc), SPECULA_SUCCESS);
         let fresh = render(b);
         assert!(incremental == fresh, "after the replan the image equals a fresh context's");
+
+        // A floor no choice is predicted to reach: the nearest, a warning code and a log line.
+        unsafe extern "C" fn log(user: *mut std::ffi::c_void, level: SpeculaLogLevel, msg: *const std::ffi::c_char) {
+            if level == SPECULA_LOG_WARNING {
+                (*(user as *mut Vec<String>)).push(std::ffi::CStr::from_ptr(msg).to_string_lossy().into_owned());
+            }
+        }
+        let mut warnings: Vec<String> = Vec::new();
+        assert_eq!(specula_context_set_log_callback(b, Some(log), (&mut warnings as *mut Vec<String>).cast()), SPECULA_SUCCESS);
+        let mut unreachable = auto_desc();
+        unreachable.min_psnr_db = 150.0;
+        assert_eq!(specula_context_configure(b, &unreachable), SPECULA_WARNING_BUDGET_UNREACHABLE);
+        assert!(warnings.iter().any(|w| w.contains("no choice is predicted to meet it")), "{warnings:?}");
+        render(b);
         specula_context_destroy(a);
         specula_context_destroy(b);
     }

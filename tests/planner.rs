@@ -220,6 +220,20 @@ fn auto_keeps_its_choice_within_the_hysteresis_and_says_why_it_switches() {
             other => panic!("expected a plan change, got {other:?}"),
         }
     }
+    // plan_hysteresis=off: a choice that differs from a fresh plan's by any margin is left at
+    // the next move (here the first object moved to the method auto ranks second: within the
+    // hysteresis, so kept when it is on).
+    let mut off = q.clone();
+    off.set("plan_hysteresis", "off").unwrap();
+    let fresh = plan_for(&scene, &Choices::all(Choice::Auto), &off, Some(&t)).unwrap();
+    assert_eq!(methods(&fresh), methods(&p), "the knob changes moves, not the first choice");
+    let other = if p.objects[0].method == specula::methods::BVH { specula::methods::KD_TREE } else { specula::methods::BVH };
+    let mut near = fresh.clone();
+    near.objects[0].method = other;
+    match near.refresh_geometry(&moved) {
+        Err(specula::Error::PlanChanged(w)) => assert!(w.contains("plan_hysteresis=off") && w.contains(&p.objects[0].name), "{w}"),
+        other => panic!("expected a plan change with plan_hysteresis=off, got {other:?}"),
+    }
 }
 
 /// The cost cache on a real context: a cache file of this device that is corrupt or

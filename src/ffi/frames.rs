@@ -111,12 +111,24 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
                 r
             }
         };
+        let unreachable = chosen.as_ref().filter(|(_, _, p)| !p.met).map(|(_, _, p)| {
+            format!(
+                "budget {}: no choice is predicted to meet it; configured the nearest (predicted {:.3} ms, {:.2} dB on the specular pixels)",
+                p.budget.describe(),
+                p.frame_ms,
+                p.specular_psnr_db
+            )
+        });
         let previous = std::mem::replace(&mut c.budget, chosen);
         let previous_cache = std::mem::replace(&mut c.cache_dir, cache);
         if let Err(e) = configure(c, choice, width, height) {
             c.budget = previous;
             c.cache_dir = previous_cache;
             return Err(e);
+        }
+        if let Some(why) = unreachable {
+            c.log(SPECULA_LOG_WARNING, &why);
+            return Ok(SPECULA_WARNING_BUDGET_UNREACHABLE);
         }
         Ok(if no_models { SPECULA_WARNING_NO_MODELS } else { SPECULA_SUCCESS })
     })

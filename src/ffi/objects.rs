@@ -1,7 +1,10 @@
 //! Per-object methods: each specular object (addressed by its name — the glTF node or mesh
 //! name, `meshN` for meshes added through the C ABI — or by its index in the scene) can be
 //! given its own method, overriding the render description's. Checked when set: the object
-//! must exist and be specular, the method must exist, render on the GPU and serve it.
+//! must exist and be specular, the method must exist, render on the GPU and serve it — its
+//! class and its shape (planar methods a planar mesh, …): whatever the library can judge at
+//! the call is refused there, and a refused call leaves the context as it was (the object's
+//! earlier method included).
 
 use std::ffi::c_char;
 
@@ -100,8 +103,8 @@ fn set(c: &mut SpeculaContext, index: usize, method: SpeculaMethod) -> FfiResult
             format!("object '{name}' is not specular (material '{}' is diffuse): only specular objects take a method", material.name),
         );
     };
-    c.object_methods.retain(|(n, _)| *n != name);
     if method == ABI_AUTO {
+        c.object_methods.retain(|(n, _)| *n != name);
         return Ok(SPECULA_SUCCESS);
     }
     let Some(m) = Method::by_abi(method).filter(|m| m.is_gpu()) else {
@@ -118,6 +121,21 @@ fn set(c: &mut SpeculaContext, index: usize, method: SpeculaMethod) -> FfiResult
             format!("object '{name}': method '{}' cannot serve a {} (it serves: {})", m.name, class.label(), serves.join(", ")),
         );
     }
+    // Its shape: judged from the mesh as the planner judges it (rigid and affine moves keep it).
+    let facts = crate::plan::facts::SceneFacts::new(&c.scene, &c.quality, false);
+    if let Some(f) = facts.objects.iter().find(|f| f.mesh == index).filter(|f| !m.fits(f)) {
+        return fail(
+            SPECULA_ERROR_INVALID_ARGUMENT,
+            format!(
+                "object '{name}': method '{}' cannot serve {} {}: {}",
+                m.name,
+                m.shape.misfit(),
+                f.class.label(),
+                m.shape.requirement()
+            ),
+        );
+    }
+    c.object_methods.retain(|(n, _)| *n != name);
     c.object_methods.push((name, m));
     Ok(SPECULA_SUCCESS)
 }

@@ -15,6 +15,10 @@ pub const SPECULA_WARNING_NOT_READY: SpeculaResult = 2;
 /// specula_context_configure with a budget: no models cover the scene's specular objects;
 /// the registry's rules chose (specula_get_predictions reports none).
 pub const SPECULA_WARNING_NO_MODELS: SpeculaResult = 3;
+/// specula_context_configure with a budget: no choice is predicted to meet it; the nearest
+/// was configured (specula_get_predictions says what it is predicted to reach), and the log
+/// callback says why.
+pub const SPECULA_WARNING_BUDGET_UNREACHABLE: SpeculaResult = 4;
 pub const SPECULA_ERROR_INVALID_ARGUMENT: SpeculaResult = -1;
 pub const SPECULA_ERROR_NULL_POINTER: SpeculaResult = -2;
 /// A struct's `type` tag or `size` does not match what the call expects.

@@ -8,6 +8,10 @@ knobs! {
         /// what --method auto optimises: within the exact tracer's predicted frame time, the fastest choice predicted within
         /// 0.5 dB (accuracy) or 3 dB (speed) of the most accurate one
         planner: Planner = "accuracy", one_of()["accuracy" => Planner::Accuracy, "speed" => Planner::Speed];
+        /// when objects or the camera move, auto keeps its per-object choices unless the new ones are predicted better by
+        /// more than 1 dB or 20 % faster (on); off: every move re-chooses as a fresh plan would, so a frame equals a
+        /// fresh context's, at the price of choices that may flicker between frames
+        plan_hysteresis: bool = "on", one_of()["on" => true, "off" => false];
     }
 }
 

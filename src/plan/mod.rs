@@ -66,6 +66,16 @@ impl Plan {
         let kept = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
         let mut fresh = plan_inner(scene, &asked, &self.quality, true, self.target.as_ref())?;
         if methods(&fresh) != methods(self) {
+            if self.choice == Choice::Auto && !self.quality.plan.plan_hysteresis {
+                let changed: Vec<String> = fresh
+                    .objects
+                    .iter()
+                    .zip(&self.objects)
+                    .filter(|(n, o)| n.method != o.method)
+                    .map(|(n, o)| format!("{} {} → {}", n.name, o.method, n.method))
+                    .collect();
+                return Err(Error::PlanChanged(format!("auto: {} (plan_hysteresis=off: re-chosen as a fresh plan)", changed.join(", "))));
+            }
             if self.choice == Choice::Auto {
                 let nominal = predict::Target::nominal();
                 if let Some(t) = self.target.as_ref().or(nominal.as_ref()) {

@@ -5,6 +5,12 @@ use serde::Serialize;
 use crate::error::{Error, Result};
 use crate::plan::ids::Method;
 
+/// The longest frame a budget may ask for (a minute).
+pub const MAX_FRAME_MS: f64 = 60_000.0;
+/// The highest PSNR floor a budget may ask for (the error models are fitted up to
+/// `samples::PSNR_CAP`, 60 dB: a floor above that is refused as unreachable, not as invalid).
+pub const MAX_PSNR_DB: f64 = 200.0;
+
 /// A frame budget.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum Budget {
@@ -19,12 +25,17 @@ pub enum Budget {
 }
 
 impl Budget {
-    /// From the CLI's two options (the C ABI passes 0 as absent); at most one may be set.
+    /// From the CLI's two options (the C ABI passes 0 as absent); at most one may be set,
+    /// `max_ms` in (0, [`MAX_FRAME_MS`]] and `min_psnr` in (0, [`MAX_PSNR_DB`]].
     pub fn from_limits(max_ms: Option<f64>, min_psnr: Option<f64>) -> Result<Option<Budget>> {
         match (max_ms, min_psnr) {
             (Some(_), Some(_)) => Err(Error::invalid("budget", "a time budget (max-ms) or a PSNR floor (min-psnr), not both")),
-            (Some(ms), None) if !(ms.is_finite() && ms > 0.0) => Err(Error::invalid("max-ms", format!("{ms} is not a positive time"))),
-            (None, Some(db)) if !db.is_finite() => Err(Error::invalid("min-psnr", format!("{db} is not a finite PSNR"))),
+            (Some(ms), None) if !(ms.is_finite() && ms > 0.0 && ms <= MAX_FRAME_MS) => {
+                Err(Error::invalid("max-ms", format!("{ms} is not a frame time in (0, {MAX_FRAME_MS}] ms")))
+            }
+            (None, Some(db)) if !(db.is_finite() && db > 0.0 && db <= MAX_PSNR_DB) => {
+                Err(Error::invalid("min-psnr", format!("{db} is not a PSNR in (0, {MAX_PSNR_DB}] dB")))
+            }
             (Some(ms), None) => Ok(Some(Budget::MaxMs(ms))),
             (None, Some(db)) => Ok(Some(Budget::MinPsnr(db))),
             (None, None) => Ok(None),
