@@ -105,9 +105,12 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
     for pass in ["envmap.generate ms", "scene.direct ms", "envmap.shade ms"] {
         assert!(header.contains(&pass), "no {pass} column: {}", lines[0]);
     }
-    // `auto` and every GPU method of the registry, each under its name.
+    // `auto` and every GPU method of the registry, each under its name, but the O(N)-per-ray
+    // schemes (minutes a frame on lavapipe: only when named with --method).
+    let linear = |m: &specula::Method| specula::methods::raytrace::bench::complexity(*m).starts_with("O(N)");
     let gpu_methods: Vec<&str> =
-        std::iter::once("auto").chain(specula::Method::ALL.iter().filter(|m| m.is_gpu()).map(|m| m.name())).collect();
+        std::iter::once("auto").chain(specula::Method::ALL.iter().filter(|m| m.is_gpu() && !linear(m)).map(|m| m.name())).collect();
+    assert!(!csv.contains("\nray-engine,") && !csv.contains("\nray-hierarchy,"), "{csv}");
     assert_eq!(lines.len() - 1, gpu_methods.len() * 4, "one row per method and combination:\n{csv}");
     for m in &gpu_methods {
         assert_eq!(lines[1..].iter().filter(|l| l.split(',').next() == Some(m)).count(), 4, "{m}");
@@ -134,7 +137,7 @@ fn tradeoff_writes_csv_and_plot_for_every_gpu_method_and_sweep() {
     let traced = row("bvh", "cube_size=16 cube_precision=half");
     eprintln!("ray tracers: RMSE {}, {} dB, mean FLIP {}", traced.0, traced.1, traced.2);
     assert!(traced.1 >= 72.68, "bvh {} dB against the reference", traced.1);
-    for m in ["bvh", "kd-tree", "grid", "ray-engine", "ray-hierarchy"] {
+    for m in ["bvh", "kd-tree", "grid"] {
         for knobs in [
             "cube_size=16 cube_precision=half",
             "cube_size=16 cube_precision=single",

@@ -84,8 +84,12 @@ pub struct Report {
 /// `cfg.out`.
 pub fn run(cfg: &Config, progress: &mut dyn FnMut(Progress)) -> Result<Report> {
     let series = series(&cfg.quality, &cfg.sweeps, cfg.each)?;
+    // By default every GPU method but the O(N)-per-ray schemes (the ray engine and the ray
+    // hierarchy test every triangle for every ray: minutes a frame on a CPU device), which
+    // run when named (`--method`).
+    let linear = |m: &Method| crate::methods::raytrace::bench::complexity(*m).starts_with("O(N)");
     let methods: Vec<Choice> = if cfg.methods.is_empty() {
-        std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu()).map(Choice::Method)).collect()
+        std::iter::once(Choice::Auto).chain(Method::ALL.iter().copied().filter(|m| m.is_gpu() && !linear(m)).map(Choice::Method)).collect()
     } else {
         if let Some(m) = cfg.methods.iter().find(|m| matches!(m, Choice::Method(m) if !m.is_gpu())) {
             return Err(Error::invalid("--method", format!("'{}' is the reference itself", m.name())));

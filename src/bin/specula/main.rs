@@ -103,7 +103,8 @@ enum Command {
         /// method, named METHOD (KNOB), instead of every combination.
         #[arg(long)]
         each: bool,
-        /// Only these methods (repeatable); default every GPU method.
+        /// Only these methods (repeatable); default every GPU method but the O(N)-per-ray
+        /// ray engine and ray hierarchy (minutes a frame on a CPU device: name them to run them).
         #[arg(long = "method")]
         methods: Vec<String>,
         /// Output directory.

@@ -55,7 +55,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], each: bool, only: &[String], out
         Progress::Start { steps } => {
             let b = indicatif::ProgressBar::new(steps);
             b.set_style(
-                indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} [{elapsed_precise}] {msg}")
+                indicatif::ProgressStyle::with_template("{bar:30} {pos}/{len} [{elapsed_precise}, about {eta} left] {msg}")
                     .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
             );
             bar = Some(b);
