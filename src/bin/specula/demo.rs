@@ -310,32 +310,6 @@ fn showcase(outdir: &Path, (w, h): (u32, u32), validate: bool, device: &Option<S
     Ok(report)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Every study `specula demo` runs names a built-in scene, GPU methods, base knobs and
-    /// sweeps that parse (the demo is not run by the suite: this is what would break it).
-    #[test]
-    fn every_study_parses() {
-        for s in STUDIES {
-            assert!(specula::scenes::builtin(s.scene).is_some_and(|r| r.is_ok()), "{}", s.scene);
-            for m in s.methods {
-                assert!(matches!(Choice::parse(m), Ok(Choice::Method(m)) if m.is_gpu()), "{}: {m}", s.scene);
-            }
-            let mut q = Quality::default();
-            for p in s.base {
-                q.set_pair(p).unwrap_or_else(|e| panic!("{}: {p}: {e}", s.scene));
-            }
-            for w in s.sweeps {
-                specula::tradeoff::Sweep::parse(w).unwrap_or_else(|e| panic!("{}: {w}: {e}", s.scene));
-            }
-        }
-        let names: Vec<&str> = STUDIES.iter().map(|s| s.scene).collect();
-        assert_eq!(names, ["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball"]);
-    }
-}
-
 /// `image` averaged over k×k blocks (what a render at 1/k of the size a side is compared with).
 fn box_filter(image: &specula::image::ImageData, k: u32) -> specula::image::ImageData {
     let (w, h, c) = (image.width / k, image.height / k, image.channels as usize);
@@ -363,4 +337,30 @@ fn enlarge(image: &specula::image::ImageData, k: u32) -> specula::image::ImageDa
         }
     }
     specula::image::ImageData { width: w, height: h, layers: 1, channels: image.channels, data }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every study `specula demo` runs names a built-in scene, GPU methods, base knobs and
+    /// sweeps that parse (the demo is not run by the suite: this is what would break it).
+    #[test]
+    fn every_study_parses() {
+        for s in STUDIES {
+            assert!(specula::scenes::builtin(s.scene).is_some_and(|r| r.is_ok()), "{}", s.scene);
+            for m in s.methods {
+                assert!(matches!(Choice::parse(m), Ok(Choice::Method(m)) if m.is_gpu()), "{}: {m}", s.scene);
+            }
+            let mut q = Quality::default();
+            for p in s.base {
+                q.set_pair(p).unwrap_or_else(|e| panic!("{}: {p}: {e}", s.scene));
+            }
+            for w in s.sweeps {
+                specula::tradeoff::Sweep::parse(w).unwrap_or_else(|e| panic!("{}: {w}: {e}", s.scene));
+            }
+        }
+        let names: Vec<&str> = STUDIES.iter().map(|s| s.scene).collect();
+        assert_eq!(names, ["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball"]);
+    }
 }
