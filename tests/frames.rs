@@ -432,6 +432,54 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
         refused(specula_context_set_object_method(a, sphere_name.as_ptr(), 9999), "not a GPU method");
         refused(specula_context_set_knob(a, c"cube_size".as_ptr(), c"7".as_ptr()), "cube_size");
         refused(specula_context_set_object_transform(a, sphere, [f32::NAN; 16].as_ptr()), "NaN");
+        refused(specula_context_set_object_visible(a, 999, 0), "999");
+        let material = |surface, ior: f32| SpeculaMaterialDesc {
+            r#type: SPECULA_STRUCT_MATERIAL_DESC,
+            size: std::mem::size_of::<SpeculaMaterialDesc>() as u32,
+            surface,
+            base_color: [0.5; 3],
+            emission: [0.0; 3],
+            nu: [0.2; 3],
+            kappa: [3.0; 3],
+            ior,
+            thin: 0,
+        };
+        let glass_material = scene
+            .meshes
+            .iter()
+            .find(|m| matches!(scene.materials[m.material].kind, specula::scene::SurfaceKind::Dielectric { .. }))
+            .unwrap()
+            .material as u32;
+        refused(specula_context_set_material(a, glass_material, &material(SPECULA_SURFACE_DIELECTRIC, -1.0)), "ior");
+        refused(specula_context_set_material(a, glass_material, &material(SPECULA_SURFACE_DIFFUSE, 1.0)), "kind");
+        refused(specula_context_set_material(a, 999, &material(SPECULA_SURFACE_DIFFUSE, 1.0)), "999");
+        let mut bad_light = SpeculaLightDesc {
+            r#type: SPECULA_STRUCT_LIGHT_DESC,
+            size: std::mem::size_of::<SpeculaLightDesc>() as u32,
+            kind: SPECULA_LIGHT_POINT,
+            position: [0.0, f32::NAN, 0.0],
+            direction: [0.0, -1.0, 0.0],
+            intensity: [5.0; 3],
+            inner_cone: 0.0,
+            outer_cone: 0.0,
+            range: 0.0,
+        };
+        refused(specula_context_set_light(a, 0, &bad_light), "position");
+        bad_light.position = [0.0, 1.0, 0.0];
+        refused(specula_context_set_light(a, 99, &bad_light), "99");
+        let bad_camera = SpeculaCameraDesc {
+            r#type: SPECULA_STRUCT_CAMERA_DESC,
+            size: std::mem::size_of::<SpeculaCameraDesc>() as u32,
+            position: [0.0, 1.0, 2.0],
+            target: [0.0, 1.0, 2.0],
+            yfov: 1.0,
+            znear: 0.01,
+        };
+        refused(specula_context_set_camera(a, &bad_camera), "camera");
+        // A scene that cannot be loaded replaces nothing.
+        assert_eq!(specula_context_load_gltf(a, c"no/such/scene.gltf".as_ptr()), SPECULA_ERROR_IO);
+        assert!(message(a).contains("no/such/scene.gltf"), "{}", message(a));
+        assert!(render(a) == before, "the refused load changed the frame");
         let mut bad = auto_desc();
         for (max_ms, min_psnr, want) in [(0.0, -5.0, "min_psnr"), (f64::NAN, 0.0, "max_ms"), (1e9, 0.0, "max_ms"), (5.0, 30.0, "not both")]
         {
