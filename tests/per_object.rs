@@ -144,6 +144,23 @@ fn mixed_methods_compose() {
     eprintln!("mirror pixels: mixed {pm:.2} dB, all-distance {pd:.2} dB");
     // Measured 29.81 vs 25.74 dB: the floor and the 4.07 dB margin each 1 dB under.
     assert!(pm >= 28.81 && pm >= pd + 3.07, "mixed {pm} vs all-distance {pd}");
+
+    // Families that keep no cube map of their own compose too: the glass ray traced (or in
+    // layered maps) gets a distance and a refractor map of its own for the mirror's map, so
+    // the mirror shows it refracting the room, not a black silhouette.
+    for glass_method in [specula::methods::BVH, specula::methods::LAYERED] {
+        let mix = Choices { method: Choice::Auto, objects: vec![("mirror".into(), DISTANCE), ("glass".into(), glass_method)] };
+        let p = plan_with(&scene, &mix, &q).unwrap();
+        let g = p.objects.iter().find(|o| o.name == "glass").unwrap();
+        assert!(g.map_shading == specula::plan::MapShading::Refractor && p.inter_object && p.cycles >= 2, "{glass_method}: {g:?}");
+        let mixed = render(&ctx, &scene, &mix, &q, (w, h));
+        let pg = masked_psnr(&mixed, &reference, &mirror);
+        let lit = mirror.iter().enumerate().filter(|(i, &m)| m && (0..3).map(|c| all_d.data[4 * i + c]).sum::<f32>() < 0.02);
+        let lit: Vec<f32> = lit.map(|(i, _)| (0..3).map(|c| mixed.data[4 * i + c]).sum::<f32>()).collect();
+        let bright = lit.iter().filter(|&&l| l > 0.1).count() as f64 / lit.len().max(1) as f64;
+        eprintln!("mirror pixels with the glass on {glass_method}: {pg:.2} dB; lit where all-distance is black: {:.0} %", 100.0 * bright);
+        assert!(bright > 0.95 && pg >= pd + 3.07, "{glass_method}: mirror {pg} dB vs all-distance {pd} dB, {bright} lit");
+    }
     common::assert_clean(&ctx);
 }
 

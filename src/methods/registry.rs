@@ -162,6 +162,11 @@ pub struct Family {
     pub views: Option<ViewBlocks>,
     /// After objects moved, with the plan's structure kept: its plan follows them.
     pub refresh: Option<fn(&mut Plan)>,
+    /// Which objects (by position in `methods`, each object's method in a mixed plan) get
+    /// maps of their own so that they show in this family's maps (§4.3 across families):
+    /// what the budget adds to their cost (their cheapest candidate that shades itself in
+    /// maps) and the inter-object cycles that needs.
+    pub composes: Option<Composes>,
     /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame.
     pub push_words: Option<fn(&Quality, &mut crate::frame::words::PushWords)>,
     /// Its part of `specula plan`'s table, if it planned anything.
@@ -170,6 +175,9 @@ pub struct Family {
     /// (planar mirrors), push flags of the camera's objects, stats (`stage::FramePart`).
     pub frame_part: Option<CreateFramePart>,
 }
+
+/// Which objects of a mixed plan (their methods, in order) a family composes into its maps.
+pub type Composes = fn(&[Method]) -> Vec<bool>;
 
 /// A family's blocks of views for a plan: (name, count), in table order.
 pub type ViewBlocks = fn(&Plan) -> Vec<(&'static str, u32)>;
@@ -188,6 +196,7 @@ impl Family {
         views: None,
         refresh: None,
         push_words: None,
+        composes: None,
         describe: None,
         frame_part: None,
     };

@@ -102,14 +102,70 @@ fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
 
-/// Ray tracing in the sampled geometry (§4.1–§4.4): maps and camera passes only, no hooks.
+/// Ray tracing in the sampled geometry (§4.1–§4.4): its maps, camera passes, the search's
+/// push words, and how other families' objects show in its distance maps.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "distance",
     slots: slots::SLOTS,
     methods: &[DISTANCE_INFO, DISTANCE_MULTI_INFO, REFRACTOR_MAP_INFO, IMAGE_SPACE_REFRACTION_INFO],
     push_words: Some(push_words),
+    plan_stages: Some(compose),
+    composes: Some(composed),
     ..crate::methods::registry::Family::NONE
 };
+
+/// Composition across families (§4.3 across methods): an object whose method keeps no cube
+/// map of its own (the ray tracers, layered maps, curved reflectors, planar refraction) would
+/// show in the other objects' distance maps as a reflection of the sky only (black in a closed
+/// room). Where some object has a distance map, each such object gets one of its own, around
+/// its own reference point, used only for how it looks in the others' maps — traced in it
+/// (a solid dielectric: refracted through its own refractor map first), as distance-multi's
+/// objects are — with the inter-object cycles that needs. Planar mirrors are drawn into the
+/// maps by their mirrored views instead (geometry family); objects with radiance cubes of
+/// their own (environment mapping) keep reflecting the sky there. A whole-scene method keeps
+/// its own behaviour, fallbacks included (what `tradeoff` and the planner's corpus measure
+/// of it): only per-object choices compose.
+/// The objects of `methods` that composition gives maps of their own: a method with no cube
+/// map of its own that shades it in maps, not drawn by planar views, where another object's
+/// method keeps distance maps.
+fn composed(methods: &[Method]) -> Vec<bool> {
+    let gpu = |m: &Method| m.gpu.expect("GPU method");
+    let distance = |m: &Method| gpu(m).maps.iter().any(|i| i.name == DISTANCE_CUBES.name);
+    let needs = |m: &Method| {
+        let g = gpu(m);
+        let own_cube = g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap));
+        !own_cube && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
+    };
+    (0..methods.len()).map(|i| needs(&methods[i]) && methods.iter().enumerate().any(|(j, m)| j != i && distance(m))).collect()
+}
+
+fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::PlanStages) {
+    let whole_scene = matches!(p.choice, crate::plan::ids::Choice::Method(_)) && p.overrides.is_empty();
+    if whole_scene {
+        return;
+    }
+    let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
+    let chosen = composed(&methods);
+    let q = p.quality.clone();
+    let mut composed = false;
+    for (o, _) in p.objects.iter_mut().zip(chosen).filter(|(_, c)| *c) {
+        let solid = o.class == ObjectClass::SolidDielectric;
+        if solid {
+            st.add_map(o, REFRACTOR_CUBES.kind(), describe_cube(&q) + " (normal, distance) for the other objects' maps");
+        }
+        st.add_map(o, DISTANCE_CUBES.kind(), describe_cube(&q) + " for the other objects' maps");
+        o.map_shading = if solid { MapShading::Refractor } else { MapShading::Traced };
+        o.leaves_out = LeavesOut::Itself;
+        o.reason += " · in the other objects' distance maps: traced in a distance map of its own (§4.3)";
+        composed = true;
+    }
+    if composed {
+        p.inter_object = true;
+        if !p.frame_latency {
+            p.cycles = p.cycles.max(2);
+        }
+    }
+}
 
 /// The search's words (every cube-map search reads them) and self refraction's bounces.
 fn push_words(q: &crate::quality::Quality, w: &mut crate::frame::words::PushWords) {

@@ -4,7 +4,7 @@
 use super::models::{mse_of, psnr_of};
 use super::{Models, ObjectModel};
 use crate::plan::facts::SceneFacts;
-use crate::plan::{names_object, Choices, Method};
+use crate::plan::{names_object, Choices, MapShading, Method};
 use crate::scene::Scene;
 
 /// One candidate of one object in one variant (costs at the frame's size).
@@ -21,6 +21,10 @@ pub(super) struct Candidate {
     pub(super) psnr: f64,
     pub(super) pixels: usize,
     pub(super) model: String,
+    /// The maps the object gets where a mixed choice composes it into another family's maps
+    /// (`registry::Family::composes`): the map cost of its cheapest candidate whose method
+    /// shades it in maps (0 where the models have none).
+    pub(super) compose_fixed: f64,
 }
 
 /// One knob variant's candidates.
@@ -74,6 +78,7 @@ pub(super) fn candidates(
                     psnr: psnr_of(mean(&|o| mse_of(o.psnr_db))),
                     pixels: (mean(&|o| o.pixels as f64) * ratio).round() as usize,
                     model: model.clone(),
+                    compose_fixed: 0.0,
                 }
             };
             let usable = |m: Method| m.is_gpu() && m.fits(f);
@@ -108,6 +113,18 @@ pub(super) fn candidates(
                 let es: Vec<&ObjectModel> = entries.iter().copied().filter(|o| o.method == mname).collect();
                 list.push(make(m, &es));
             }
+            // What composing the object into others' maps costs: its cheapest map-shaded candidate.
+            let compose_fixed = entries
+                .iter()
+                .filter_map(|o| {
+                    Method::parse(&o.method)
+                        .ok()
+                        .filter(|m| m.gpu.is_some_and(|g| g.map_shading != MapShading::Sky))
+                        .map(|_| o.cost.fixed_ms)
+                })
+                .fold(f64::INFINITY, f64::min);
+            let compose_fixed = if compose_fixed.is_finite() { compose_fixed } else { 0.0 };
+            list.iter_mut().for_each(|c| c.compose_fixed = compose_fixed);
             if list.is_empty() {
                 // This variant cannot serve the object (or not with its forced method).
                 per_object.clear();

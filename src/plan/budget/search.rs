@@ -34,7 +34,8 @@ impl Timing<'_> {
         let composes = picks
             .iter()
             .zip(&self.facts.objects)
-            .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
+            .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)))
+            || Self::composed(picks).contains(&true);
         let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
         if latency {
             1
@@ -73,10 +74,26 @@ impl Timing<'_> {
             + self.kernels(picks, whole).iter().map(|(_, s)| s).sum::<f64>()
     }
 
+    /// The picks that a mixed choice composes into another family's maps (maps of their own,
+    /// `registry::Family::composes`); none when one method serves every object (planned as
+    /// that whole-scene method, which keeps its own behaviour).
+    fn composed(picks: &[&Candidate]) -> Vec<bool> {
+        let mut out = vec![false; picks.len()];
+        if Self::uniform(picks) {
+            return out;
+        }
+        let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
+        for f in crate::methods::FAMILIES.iter().filter_map(|f| f.composes) {
+            out.iter_mut().zip(f(&methods)).for_each(|(o, c)| *o |= c);
+        }
+        out
+    }
+
     /// Object `i`'s maps and camera work, its camera work repeated in the others' views.
     fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
         let c = picks[i];
-        c.fixed * self.scale(picks, c, whole) + c.screen * (1.0 + self.views(picks, Some(i), whole))
+        let compose = if !whole && Self::composed(picks)[i] { c.compose_fixed } else { 0.0 };
+        (c.fixed + compose) * self.scale(picks, c, whole) + c.screen * (1.0 + self.views(picks, Some(i), whole))
     }
 
     /// Per method its whole-screen kernels, once, repeated in the views of objects of other
@@ -236,6 +253,7 @@ mod tests {
             psnr,
             pixels: 100,
             model: String::new(),
+            compose_fixed: 0.0,
         }
     }
 
