@@ -1,6 +1,6 @@
-//! Tables generated from the registry and the knob table: the README's method and knob
-//! tables and `specula knobs` print these, so no list of methods or knobs is written by
-//! hand anywhere (tests/readme.rs checks the README against them).
+//! Tables generated from the registry and the knob table: the README's method table,
+//! docs/knobs.md's knob table and `specula knobs` print these, so no list of methods or knobs
+//! is written by hand anywhere (tests/readme.rs checks both files against them).
 
 use crate::methods::{Method, ObjectClass};
 use crate::quality::KNOBS;
@@ -28,7 +28,7 @@ pub fn abi_name(m: Method) -> String {
     m.name.to_uppercase().replace('-', "_")
 }
 
-/// The README's knob table (Markdown): name, values, default, doc, and the methods that read it.
+/// docs/knobs.md's knob table (Markdown): name, values, default, doc, and the methods that read it.
 pub fn knob_table() -> String {
     let mut s = String::from("| knob | values | default | what it does | read by |\n|---|---|---|---|---|\n");
     for k in KNOBS {
