@@ -136,7 +136,10 @@ fn composed(methods: &[Method]) -> Vec<bool> {
         let own_cube = g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap));
         !own_cube && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
-    (0..methods.len()).map(|i| needs(&methods[i]) && methods.iter().enumerate().any(|(j, m)| j != i && distance(m))).collect()
+    let mapped: Vec<bool> = methods.iter().map(distance).collect();
+    let count = mapped.iter().filter(|&&d| d).count();
+    // Another object than itself keeps distance maps.
+    methods.iter().zip(&mapped).map(|(m, &d)| needs(m) && count > usize::from(d)).collect()
 }
 
 fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::PlanStages) {

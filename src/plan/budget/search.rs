@@ -69,7 +69,8 @@ impl Timing<'_> {
     }
 
     pub(super) fn frame_ms(&self, picks: &[&Candidate], whole: bool) -> f64 {
-        (0..picks.len()).map(|i| self.own_ms(picks, i, whole)).sum::<f64>()
+        let composed = Self::composed(picks);
+        (0..picks.len()).map(|i| self.own_ms(picks, i, whole, &composed)).sum::<f64>()
             + self.base
             + self.kernels(picks, whole).iter().map(|(_, s)| s).sum::<f64>()
     }
@@ -90,9 +91,9 @@ impl Timing<'_> {
     }
 
     /// Object `i`'s maps and camera work, its camera work repeated in the others' views.
-    fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
+    fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool, composed: &[bool]) -> f64 {
         let c = picks[i];
-        let compose = if !whole && Self::composed(picks)[i] { c.compose_fixed } else { 0.0 };
+        let compose = if !whole && composed[i] { c.compose_fixed } else { 0.0 };
         (c.fixed + compose) * self.scale(picks, c, whole) + c.screen * (1.0 + self.views(picks, Some(i), whole))
     }
 
@@ -128,7 +129,7 @@ impl Timing<'_> {
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
         let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
         let maps = c.fixed * self.scale(picks, c, whole);
-        (maps, self.own_ms(picks, i, whole) - maps + shared / users)
+        (maps, self.own_ms(picks, i, whole, &Self::composed(picks)) - maps + shared / users)
     }
 }
 
