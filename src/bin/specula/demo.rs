@@ -343,6 +343,22 @@ fn enlarge(image: &specula::image::ImageData, k: u32) -> specula::image::ImageDa
 mod tests {
     use super::*;
 
+    /// The O(N) tracers' small frames: a k×k box averages, enlarging repeats pixels, and
+    /// enlarging then filtering gives the image back.
+    #[test]
+    fn box_filter_and_enlarge() {
+        let data: Vec<f32> = (0..4 * 4 * 4).map(|i| i as f32).collect();
+        let img = specula::image::ImageData { width: 4, height: 4, layers: 1, channels: 4, data };
+        let small = box_filter(&img, 2);
+        assert_eq!((small.width, small.height), (2, 2));
+        // Pixels (0,0), (1,0), (0,1), (1,1): channel 0 values 0, 4, 16, 20.
+        assert_eq!(small.texel(0, 0, 0)[0], 10.0);
+        let big = enlarge(&small, 2);
+        assert_eq!((big.width, big.height), (4, 4));
+        assert_eq!(big.texel(0, 1, 1), small.texel(0, 0, 0));
+        assert_eq!(box_filter(&big, 2).data, small.data);
+    }
+
     /// Every study `specula demo` runs names a built-in scene, GPU methods, base knobs and
     /// sweeps that parse (the demo is not run by the suite: this is what would break it).
     #[test]

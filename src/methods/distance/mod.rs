@@ -114,17 +114,6 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     ..crate::methods::registry::Family::NONE
 };
 
-/// Composition across families (§4.3 across methods): an object whose method keeps no cube
-/// map of its own (the ray tracers, layered maps, curved reflectors, planar refraction) would
-/// show in the other objects' distance maps as a reflection of the sky only (black in a closed
-/// room). Where some object has a distance map, each such object gets one of its own, around
-/// its own reference point, used only for how it looks in the others' maps — traced in it
-/// (a solid dielectric: refracted through its own refractor map first), as distance-multi's
-/// objects are — with the inter-object cycles that needs. Planar mirrors are drawn into the
-/// maps by their mirrored views instead (geometry family); objects with radiance cubes of
-/// their own (environment mapping) keep reflecting the sky there. A whole-scene method keeps
-/// its own behaviour, fallbacks included (what `tradeoff` and the planner's corpus measure
-/// of it): only per-object choices compose.
 /// The objects of `methods` that composition gives maps of their own: a method with no cube
 /// map of its own that shades it in maps, not drawn by planar views, where another object's
 /// method keeps distance maps.
@@ -142,6 +131,17 @@ fn composed(methods: &[Method]) -> Vec<bool> {
     methods.iter().zip(&mapped).map(|(m, &d)| needs(m) && count > usize::from(d)).collect()
 }
 
+/// Composition across families (§4.3 across methods): an object whose method keeps no cube
+/// map of its own (the ray tracers, layered maps, curved reflectors, planar refraction) would
+/// show in the other objects' distance maps as a reflection of the sky only (black in a closed
+/// room). Where some object has a distance map, each such object gets one of its own, around
+/// its own reference point, used only for how it looks in the others' maps — traced in it
+/// (a solid dielectric: refracted through its own refractor map first), as distance-multi's
+/// objects are — with the inter-object cycles that needs. Planar mirrors are drawn into the
+/// maps by their mirrored views instead (geometry family); objects with radiance cubes of
+/// their own (environment mapping) keep reflecting the sky there. A whole-scene method keeps
+/// its own behaviour, fallbacks included (what `tradeoff` and the planner's corpus measure
+/// of it): only per-object choices compose.
 fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::PlanStages) {
     let whole_scene = matches!(p.choice, crate::plan::ids::Choice::Method(_)) && p.overrides.is_empty();
     if whole_scene {

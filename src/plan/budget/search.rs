@@ -114,13 +114,6 @@ impl Timing<'_> {
         methods
     }
 
-    /// Object `i`'s part of the frame: its share, and its method's shared kernels split
-    /// among the objects that use it.
-    pub(super) fn object_ms(&self, picks: &[&Candidate], i: usize, whole: bool) -> f64 {
-        let (maps, camera) = self.object_parts(picks, i, whole);
-        maps + camera
-    }
-
     /// Object `i`'s part of the frame by pass kind: (its maps and frame effects, which do not
     /// scale with the output; its camera work, repeated in the others' views, with its
     /// share of its method's whole-screen kernels).
