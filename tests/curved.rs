@@ -393,7 +393,7 @@ fn tradeoff_sweeps_the_geometry_image_and_the_tessellation() {
         size: SIZE,
         warmup: 1,
         frames: 1,
-        device: specula::vk::DeviceOptions { validation: true, device_filter: None },
+        device: specula::vk::DeviceOptions { validation: true, device_filter: None, ..Default::default() },
         out: out.clone(),
         metric: specula::tradeoff::Metric::Psnr,
         calibrate: None,

@@ -354,6 +354,14 @@ pub unsafe extern "C" fn specula_get_requirements(out: *mut SpeculaRequirements)
         struct Ptrs([*const c_char; 1]);
         unsafe impl Sync for Ptrs {}
         static PTRS: Ptrs = Ptrs([c"VK_EXT_robustness2".as_ptr()]);
+        // Static C strings of RAY_QUERY_DEVICE_EXTENSIONS (a test checks they agree).
+        struct Optional([*const c_char; 3]);
+        unsafe impl Sync for Optional {}
+        static OPTIONAL: Optional = Optional([
+            c"VK_KHR_acceleration_structure".as_ptr(),
+            c"VK_KHR_ray_query".as_ptr(),
+            c"VK_KHR_deferred_host_operations".as_ptr(),
+        ]);
         let o = &mut *out;
         o.api_version = vk::API_VERSION_1_3;
         o.device_extensions = PTRS.0.as_ptr();
@@ -365,6 +373,11 @@ pub unsafe extern "C" fn specula_get_requirements(out: *mut SpeculaRequirements)
         o.synchronization2 = 1;
         o.maintenance4 = 1;
         o.null_descriptor = 1;
+        o.optional_device_extensions = OPTIONAL.0.as_ptr();
+        o.optional_device_extension_count = OPTIONAL.0.len() as u32;
+        o.acceleration_structure = 1;
+        o.ray_query = 1;
+        o.buffer_device_address = 1;
         Ok(SPECULA_SUCCESS)
     });
     r.unwrap_or_else(|f| {
@@ -380,7 +393,7 @@ pub unsafe extern "C" fn specula_context_create(desc: *const SpeculaContextDesc,
     create(out, || {
         let d = header(desc, SPECULA_STRUCT_CONTEXT_DESC, "desc")?;
         let filter = if d.device_name.is_null() { None } else { Some(cstr(d.device_name, "desc.device_name")?.to_string()) };
-        Ok(Context::new(&DeviceOptions { validation: d.enable_validation != 0, device_filter: filter })?)
+        Ok(Context::new(&DeviceOptions { validation: d.enable_validation != 0, device_filter: filter, ..Default::default() })?)
     })
 }
 
@@ -406,6 +419,7 @@ pub unsafe extern "C" fn specula_context_create_host(desc: *const SpeculaHostDes
             device: vk::Device::from_raw(d.device as u64),
             queue_family: d.queue_family,
             debug_utils: d.debug_utils_enabled != 0,
+            ray_query: d.ray_query_enabled != 0,
         };
         Ok(Context::from_host(&host)?)
     })

@@ -129,6 +129,11 @@ pub struct SpeculaHostDesc {
     /// Non-zero if the host enabled VK_EXT_debug_utils on the instance: the library then
     /// names its objects and labels every pass (RenderDoc shows the survey's vocabulary).
     pub debug_utils_enabled: u32,
+    /// Non-zero if the host enabled the optional ray-query extensions and features that
+    /// SpeculaRequirements lists (`optional_device_extensions`, `acceleration_structure`,
+    /// `ray_query`, `buffer_device_address`): the `ray-query` method then traces through
+    /// them; else its objects get `bvh`, and the plan's reason says why.
+    pub ray_query_enabled: u32,
 }
 
 /// What a host must enable before it creates its device (host-device mode).
@@ -155,6 +160,19 @@ pub struct SpeculaRequirements {
     pub synchronization2: u32,
     pub maintenance4: u32,
     pub null_descriptor: u32,
+    /// Optional device extensions (static strings): with them and the three features below
+    /// enabled (and SpeculaHostDesc::ray_query_enabled set), `ray-query` traces rays
+    /// through Vulkan's acceleration structures: VK_KHR_acceleration_structure,
+    /// VK_KHR_ray_query, VK_KHR_deferred_host_operations.
+    pub optional_device_extensions: *const *const c_char,
+    pub optional_device_extension_count: u32,
+    /// Optional features, each 1 (with the optional extensions):
+    /// VkPhysicalDeviceAccelerationStructureFeaturesKHR::accelerationStructure,
+    /// VkPhysicalDeviceRayQueryFeaturesKHR::rayQuery,
+    /// VkPhysicalDeviceVulkan12Features::bufferDeviceAddress.
+    pub acceleration_structure: u32,
+    pub ray_query: u32,
+    pub buffer_device_address: u32,
 }
 
 #[repr(C)]

@@ -82,6 +82,29 @@ pub struct MethodInfo {
     pub fallback: Option<Method>,
     /// What shape of object it can serve beyond its class (planar-mirror: planar only).
     pub shape: Shape,
+    /// What it needs of the device beyond the library's requirements, and what serves
+    /// its objects on a device without it.
+    pub needs: DeviceNeeds,
+}
+
+/// What a method needs of the device beyond `REQUIRED_DEVICE_EXTENSIONS`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceNeeds {
+    Nothing,
+    /// Vulkan's ray queries and acceleration structures (`Context::ray_query`); `otherwise`
+    /// serves its objects where they are missing.
+    RayQuery { otherwise: Method },
+}
+
+impl DeviceNeeds {
+    /// `None` when `ctx` has what the method needs; else the method that serves instead and
+    /// why.
+    pub fn missing_on(&self, ctx: &crate::vk::Context) -> Option<(Method, String)> {
+        match (*self, &ctx.ray_query) {
+            (DeviceNeeds::RayQuery { otherwise }, Err(why)) => Some((otherwise, why.clone())),
+            _ => None,
+        }
+    }
 }
 
 /// The object shapes a method serves.

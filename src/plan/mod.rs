@@ -121,6 +121,43 @@ impl Plan {
         Ok(())
     }
 
+    /// The plan for a device that may lack what some methods need (`missing(m)`: the method
+    /// that serves instead of `m`, and why; `DeviceNeeds::missing_on`): every object whose
+    /// method the device cannot run gets that fallback, planned as if it had been asked for,
+    /// and its reason says so. The plan itself when nothing is missing.
+    pub fn for_device(self, scene: &Scene, missing: impl Fn(Method) -> Option<(Method, String)>) -> Result<Plan> {
+        let lacking: Vec<(usize, Method, Method, String)> =
+            self.objects.iter().filter_map(|o| missing(o.method).map(|(f, why)| (o.mesh, o.method, f, why))).collect();
+        let whole = match self.choice {
+            Choice::Method(m) => missing(m),
+            _ => None,
+        };
+        if lacking.is_empty() && whole.is_none() {
+            return Ok(self);
+        }
+        let sub = |m: Method| missing(m).map_or(m, |(f, _)| f);
+        let method = match self.choice {
+            Choice::Method(m) => Choice::Method(sub(m)),
+            c => c,
+        };
+        let mut objects: Vec<(String, Method)> = self.overrides.iter().map(|(n, m)| (n.clone(), sub(*m))).collect();
+        // Objects `auto` gave the method (on another device's costs) keep their fallback.
+        for (mesh, _, f, _) in &lacking {
+            let name = &scene.meshes[*mesh].name;
+            if !objects.iter().any(|(n, _)| names_object(scene, *mesh, n)) {
+                objects.push((name.clone(), *f));
+            }
+        }
+        let mut fresh = plan_inner(scene, &Choices { method, objects }, &self.quality, true, self.target.as_ref())?;
+        for o in &mut fresh.objects {
+            if let Some((_, m, f, why)) = lacking.iter().find(|(mesh, ..)| *mesh == o.mesh) {
+                let before = self.objects.iter().find(|x| x.mesh == o.mesh).map_or(String::new(), |x| x.reason.clone());
+                o.reason = format!("{before}; '{}' cannot run on this device ({why}): its fallback {}", m.name, f.name);
+            }
+        }
+        Ok(fresh)
+    }
+
     /// Device memory the plan's maps will hold (bytes), excluding the frame's own images.
     pub fn map_bytes(&self) -> u64 {
         let caustics = self.caustics.as_ref().map_or(0, |c| c.bytes);

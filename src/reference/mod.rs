@@ -55,6 +55,7 @@ pub const REFERENCE_INFO: &crate::methods::registry::MethodInfo = &crate::method
     gpu: None,
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const REFERENCE: crate::methods::registry::Method = crate::methods::registry::Method(REFERENCE_INFO.name);
 

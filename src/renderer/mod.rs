@@ -134,6 +134,9 @@ impl Renderer {
         }
         let camera = scene.camera_or_default();
         camera.validate()?;
+        // Methods the device cannot run (ray queries without the extensions) give way to
+        // their fallbacks, named in the objects' reasons.
+        let plan = plan.for_device(scene, |m| m.needs.missing_on(ctx))?;
         let (ssaa, multisample) = Targets::check(ctx, &plan, width, height)?;
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.

@@ -38,6 +38,18 @@ impl Rest {
     }
 }
 
+impl Mesh {
+    /// The object-space positions (before the world transform): the stored positions while
+    /// the object has not moved from an identity transform, else those it was moved from.
+    pub fn object_positions(&self) -> Vec<Vec3> {
+        match &self.rest {
+            Some(r) => r.positions.clone(),
+            None if self.world == Mat4::IDENTITY => self.positions.clone(),
+            None => Rest::of(self).positions,
+        }
+    }
+}
+
 /// Whether a material keeps its class (diffuse, mirror, solid or thin dielectric), which
 /// decides the methods that may serve its objects.
 fn same_kind(a: &SurfaceKind, b: &SurfaceKind) -> bool {

@@ -31,6 +31,10 @@ pub struct DeviceOptions {
     /// to the `SPECULA_DEVICE` environment variable; without either, the first discrete or
     /// integrated GPU is taken, then anything else (lavapipe).
     pub device_filter: Option<String>,
+    /// Leave Vulkan's ray-tracing extensions off even where the device has them (as does
+    /// `SPECULA_RAY_QUERY=off`): `ray-query` then falls back to `bvh`, as on a device
+    /// without them.
+    pub hide_ray_query: bool,
 }
 
 /// What a host engine hands over in host-device mode.
@@ -43,6 +47,9 @@ pub struct HostHandles {
     pub queue_family: u32,
     /// The host enabled VK_EXT_debug_utils on its instance: object names and pass labels.
     pub debug_utils: bool,
+    /// The host enabled [`RAY_QUERY_DEVICE_EXTENSIONS`] and the features
+    /// [`ray_query_supported`] checks: `ray-query` traces through them.
+    pub ray_query: bool,
 }
 
 /// Messages the validation layer reported; tests fail on any error.
@@ -144,11 +151,57 @@ pub struct Context {
     /// The device was created with `sampleRateShading` (MSAA's per-sample passes need it).
     /// Only the library's own devices: a host device's enabled features are not known.
     pub sample_rate_shading: bool,
+    /// Vulkan's ray-tracing API (acceleration structures and ray queries), where the device
+    /// has it and it was enabled; else why not (the `ray-query` method's fallback reason).
+    pub ray_query: std::result::Result<RayQueryDevice, String>,
+}
+
+/// What the `ray-query` method needs of a device that traces through Vulkan's ray-tracing
+/// API: the extension's functions and its alignment rules.
+pub struct RayQueryDevice {
+    pub accel: ash::khr::acceleration_structure::Device,
+    /// `minAccelerationStructureScratchOffsetAlignment`.
+    pub scratch_alignment: u64,
 }
 
 /// Device extensions the library needs beyond Vulkan 1.3: null descriptors stand in for
 /// maps a scene does not need, instead of dummy allocations.
 pub const REQUIRED_DEVICE_EXTENSIONS: &[&CStr] = &[ash::ext::robustness2::NAME];
+
+/// Optional device extensions: with them (and the features [`ray_query_supported`] checks)
+/// the `ray-query` method traces rays through acceleration structures built by the driver.
+pub const RAY_QUERY_DEVICE_EXTENSIONS: &[&CStr] =
+    &[ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME];
+
+/// Whether the device has what `ray-query` needs: [`RAY_QUERY_DEVICE_EXTENSIONS`] and the
+/// features accelerationStructure, rayQuery and bufferDeviceAddress; else which is missing.
+pub fn ray_query_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> std::result::Result<(), String> {
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    for name in RAY_QUERY_DEVICE_EXTENSIONS {
+        if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == *name)) {
+            return Err(format!("the device lacks the extension {}", name.to_string_lossy()));
+        }
+    }
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut accel).push_next(&mut rq);
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    let checks = [
+        (accel.acceleration_structure, "accelerationStructure"),
+        (rq.ray_query, "rayQuery"),
+        (f12.buffer_device_address, "bufferDeviceAddress"),
+    ];
+    match checks.iter().find(|(v, _)| *v == vk::FALSE) {
+        Some((_, name)) => Err(format!("the device lacks the feature {name}")),
+        None => Ok(()),
+    }
+}
+
+/// Whether ray queries are hidden by `SPECULA_RAY_QUERY=off` (or `0`, `no`).
+pub fn ray_query_hidden_by_env() -> bool {
+    std::env::var("SPECULA_RAY_QUERY").is_ok_and(|v| matches!(v.trim().to_ascii_lowercase().as_str(), "off" | "0" | "no" | "false"))
+}
 
 /// Device features every pass relies on; a host device must enable them (see
 /// `required_device_extensions` and `Context::from_host`).
@@ -296,19 +349,47 @@ impl Context {
         let mut f11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
         let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
-        let ext_names: Vec<*const i8> = REQUIRED_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
-        let dci = vk::DeviceCreateInfo::default()
+        let mut ext_names: Vec<*const i8> = REQUIRED_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+        // Vulkan's ray-tracing API where the device has it, unless hidden.
+        let ray_query = if opts.hide_ray_query || ray_query_hidden_by_env() {
+            Err("ray queries are hidden (SPECULA_RAY_QUERY=off or DeviceOptions::hide_ray_query)".to_string())
+        } else {
+            ray_query_supported(instance_ref, physical)
+        };
+        let on = ray_query.is_ok();
+        if on {
+            ext_names.extend(RAY_QUERY_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()));
+        }
+        let mut f12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(on);
+        let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(on);
+        let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(on);
+        let mut dci = vk::DeviceCreateInfo::default()
             .queue_create_infos(&qci)
             .enabled_extension_names(&ext_names)
             .enabled_features(&features)
             .push_next(&mut f11)
+            .push_next(&mut f12)
             .push_next(&mut f13)
             .push_next(&mut robust);
+        if on {
+            dci = dci.push_next(&mut accel).push_next(&mut rq);
+        }
         let device = unsafe { instance_ref.create_device(physical, &dci, None) }.call("vkCreateDevice")?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let (instance, debug_instance, messenger) = ctx_guard.release();
-        let mut ctx =
-            Context::assemble(entry, instance, physical, device, queue_family, Some(queue), debug_instance, messenger, validation, true)?;
+        let mut ctx = Context::assemble(
+            entry,
+            instance,
+            physical,
+            device,
+            queue_family,
+            Some(queue),
+            debug_instance,
+            messenger,
+            validation,
+            true,
+            ray_query,
+        )?;
         ctx.owned = true;
         ctx.sample_rate_shading = sample_rate_shading;
         Ok(ctx)
@@ -337,6 +418,14 @@ impl Context {
             _ => return Err(Error::invalid("queue_family", "is not a graphics queue family with timestamps on this physical device")),
         }
         let debug_instance = host.debug_utils.then(|| ash::ext::debug_utils::Instance::new(&entry, &instance));
+        // The host says whether it enabled the ray-tracing extensions; the device must have them.
+        let ray_query = if !host.ray_query {
+            Err("the host device did not enable the ray-query extensions and features (see specula_get_requirements)".to_string())
+        } else if ray_query_hidden_by_env() {
+            Err("ray queries are hidden (SPECULA_RAY_QUERY=off)".to_string())
+        } else {
+            ray_query_supported(&instance, host.physical_device)
+        };
         Context::assemble(
             entry,
             instance,
@@ -348,6 +437,7 @@ impl Context {
             vk::DebugUtilsMessengerEXT::null(),
             Arc::new(ValidationLog::default()),
             false,
+            ray_query,
         )
     }
 
@@ -368,6 +458,7 @@ impl Context {
         messenger: vk::DebugUtilsMessengerEXT,
         validation: Arc<ValidationLog>,
         owned: bool,
+        ray_query: std::result::Result<(), String>,
     ) -> Result<Context> {
         let properties = unsafe { instance.get_physical_device_properties(physical) };
         let device_name = properties.device_name_as_c_str().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
@@ -385,10 +476,20 @@ impl Context {
             device: device.clone(),
             physical_device: physical,
             debug_settings: Default::default(),
-            buffer_device_address: false,
+            // Acceleration structures and their inputs are found by device address.
+            buffer_device_address: ray_query.is_ok(),
             allocation_sizes: Default::default(),
         })
         .map_err(|e| Error::Unsupported(format!("gpu-allocator: {e}")))?;
+        let ray_query = ray_query.map(|()| {
+            let mut accel_props = vk::PhysicalDeviceAccelerationStructurePropertiesKHR::default();
+            let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut accel_props);
+            unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
+            RayQueryDevice {
+                accel: ash::khr::acceleration_structure::Device::new(&instance, &device),
+                scratch_alignment: (accel_props.min_acceleration_structure_scratch_offset_alignment as u64).max(1),
+            }
+        });
         Ok(Context {
             entry,
             instance,
@@ -407,6 +508,7 @@ impl Context {
             allocator: Mutex::new(Some(allocator)),
             owned,
             sample_rate_shading: false,
+            ray_query,
         })
     }
 

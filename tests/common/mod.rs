@@ -10,7 +10,7 @@ use specula::vk::{Context, DeviceOptions};
 /// the layer reports them at vkDestroyDevice, after `assert_clean` ran).
 pub fn gpu() -> Gpu {
     Gpu(Some(
-        Context::new(&DeviceOptions { validation: true, device_filter: None })
+        Context::new(&DeviceOptions { validation: true, device_filter: None, ..Default::default() })
             .expect("Vulkan context with validation (is vulkan-validationlayers installed?)"),
     ))
 }

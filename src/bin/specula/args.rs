@@ -249,7 +249,7 @@ pub fn prepare(a: &RenderArgs) -> specula::Result<Job> {
 }
 
 pub fn context(validate: bool, device: &Option<String>) -> specula::Result<Context> {
-    Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })
+    Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })
 }
 
 pub fn write_image(path: &Path, img: &ImageData) -> specula::Result<()> {

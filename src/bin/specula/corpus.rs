@@ -14,7 +14,7 @@ use crate::args::parse_size;
 /// the error models' leave-one-scene-out accuracy.
 pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, device: &Option<String>) -> specula::Result<()> {
     let size = parse_size(size)?;
-    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })?;
+    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
     let cfg = Measure {
         scenes: if scenes.is_empty() { (0..corpus::SIZE).collect() } else { scenes.to_vec() },
         sizes: vec![size],
@@ -54,7 +54,7 @@ pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, devi
 
 /// Calibrates this device's unit costs and writes them to `out`, or to the cache.
 pub fn run_calibrate(out: Option<&Path>, validate: bool, device: &Option<String>) -> specula::Result<()> {
-    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone() })?;
+    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
     let t = std::time::Instant::now();
     let c = tradeoff::calibrate(&ctx, &mut |s| eprintln!("[{:6.1} s] {s}", t.elapsed().as_secs_f64()))?;
     let path = match out {

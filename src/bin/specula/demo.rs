@@ -285,7 +285,7 @@ fn showcase(outdir: &Path, (w, h): (u32, u32), validate: bool, device: &Option<S
             size,
             warmup: STUDY_FRAMES.0,
             frames: STUDY_FRAMES.1,
-            device: specula::vk::DeviceOptions { validation: validate, device_filter: device.clone() },
+            device: specula::vk::DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() },
             out: out.clone(),
             metric: Metric::Psnr,
             calibrate: None,

@@ -44,7 +44,7 @@ pub fn run(a: &TradeoffArgs, sweeps: &[String], each: bool, only: &[String], out
         size: (w, h),
         warmup: a.warmup,
         frames: a.frames,
-        device: DeviceOptions { validation: a.validate, device_filter: a.device.clone() },
+        device: DeviceOptions { validation: a.validate, device_filter: a.device.clone(), ..Default::default() },
         out: out.to_path_buf(),
         metric,
         calibrate: calibrate.map(Path::to_path_buf),

@@ -194,6 +194,7 @@ pub const DISTANCE_INFO: &MethodInfo = &MethodInfo {
         leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const DISTANCE: Method = Method(DISTANCE_INFO.name);
 
@@ -218,6 +219,7 @@ pub const DISTANCE_MULTI_INFO: &MethodInfo = &MethodInfo {
     }),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const DISTANCE_MULTI: Method = Method(DISTANCE_MULTI_INFO.name);
 
@@ -242,6 +244,7 @@ pub const REFRACTOR_MAP_INFO: &MethodInfo = &MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const REFRACTOR_MAP: Method = Method(REFRACTOR_MAP_INFO.name);
 
@@ -272,5 +275,6 @@ pub const IMAGE_SPACE_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     }),
     fallback: Some(DISTANCE),
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const IMAGE_SPACE_REFRACTION: Method = Method(IMAGE_SPACE_REFRACTION_INFO.name);

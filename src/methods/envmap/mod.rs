@@ -89,6 +89,7 @@ pub const ENVMAP_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(spec(SHADE)),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const ENVMAP: Method = Method(ENVMAP_INFO.name);
 
@@ -103,6 +104,7 @@ pub const PROXY_SPHERE_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(spec(proxy(0))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PROXY_SPHERE: Method = Method(PROXY_SPHERE_INFO.name);
 
@@ -117,5 +119,6 @@ pub const PROXY_BOX_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(spec(proxy(FLAG_PROXY_BOX))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PROXY_BOX: Method = Method(PROXY_BOX_INFO.name);

@@ -68,6 +68,7 @@ pub const CURVED_REFLECTOR_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::ConvexOrConcave,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const CURVED_REFLECTOR: Method = Method(CURVED_REFLECTOR_INFO.name);
 

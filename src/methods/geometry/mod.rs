@@ -90,6 +90,7 @@ pub const PLANAR_MIRROR_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: MIRROR_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.frame.depth.min(q.geometry.mirror_budget).max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Planar,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PLANAR_MIRROR: Method = Method(PLANAR_MIRROR_INFO.name);
 
@@ -117,5 +118,6 @@ pub const PLANAR_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(GpuSpec { maps: &[], camera: REFRACT_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |q| q.geometry.mirror_budget.max(1), shades_every_pixel: false }),
     fallback: Some(crate::methods::DISTANCE),
     shape: Shape::Faceted,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PLANAR_REFRACTION: Method = Method(PLANAR_REFRACTION_INFO.name);

@@ -74,6 +74,7 @@ pub const LAYERED_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(GpuSpec { maps: &[LAYERED_CUBES], camera: SEARCH, map_shading: MapShading::Sky, leaves_out: LeavesOut::Nothing, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
     shape: Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const LAYERED: Method = Method(LAYERED_INFO.name);
 

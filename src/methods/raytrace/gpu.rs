@@ -5,6 +5,8 @@
 
 use ash::vk;
 
+use super::ray_query::accel::{AccelStructures, MeshInput};
+use super::ray_query::RAY_QUERY_BINDINGS;
 use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result};
 use crate::frame::layout::{binding, GpuAccel, GpuRayHit, GpuRayQuery, RAY_BINDINGS};
@@ -91,12 +93,16 @@ impl Structure {
 pub struct Intersector {
     pub structure: Structure,
     count: Buffer,
-    /// Empty layouts for sets 0 and 1, then set 2.
-    set_layouts: [vk::DescriptorSetLayout; 3],
+    /// Empty layouts for sets 0 and 1, then set 2; for ray queries an empty set 3 and set 4.
+    set_layouts: [vk::DescriptorSetLayout; 5],
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     set: vk::DescriptorSet,
+    /// The ray-query scheme's structures (over the list as one mesh) and its set 4.
+    pub accel: Option<AccelStructures>,
+    rq_pool: vk::DescriptorPool,
+    rq_set: vk::DescriptorSet,
 }
 
 impl Intersector {
@@ -106,13 +112,16 @@ impl Intersector {
         let mut me = Intersector {
             structure,
             count: Buffer::placeholder(),
-            set_layouts: [vk::DescriptorSetLayout::null(); 3],
+            set_layouts: [vk::DescriptorSetLayout::null(); 5],
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
+            accel: None,
+            rq_pool: vk::DescriptorPool::null(),
+            rq_set: vk::DescriptorSet::null(),
         };
-        match me.init(ctx) {
+        match me.init(ctx, list) {
             Ok(()) => Ok(me),
             Err(e) => {
                 me.destroy(ctx);
@@ -121,13 +130,28 @@ impl Intersector {
         }
     }
 
-    fn init(&mut self, ctx: &Context) -> Result<()> {
+    fn init(&mut self, ctx: &Context, list: &TriangleList) -> Result<()> {
         self.count = Buffer::with_data(ctx, "raytrace.count", &[0u32], STORAGE)?;
         let stage = vk::ShaderStageFlags::COMPUTE;
         self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.set0", &[], stage)?;
         self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.set1", &[], stage)?;
         self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stage)?;
-        self.layout = pipeline_layout(ctx, "raytrace.intersect", &self.set_layouts, 0, stage)?;
+        let sets = if self.structure.scheme == Scheme::RayQuery {
+            let mut accel = AccelStructures::new(ctx, &[MeshInput::from_soup(&list.triangles)])?;
+            let built = accel.build_tlas_now(ctx);
+            self.accel = Some(accel);
+            built?;
+            self.set_layouts[3] = descriptor_set_layout(ctx, "raytrace.set3", &[], stage)?;
+            self.set_layouts[4] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, stage)?;
+            let (pool, set) = allocate_set(ctx, "raytrace.ray-query", self.set_layouts[4], RAY_QUERY_BINDINGS)?;
+            self.rq_pool = pool;
+            self.rq_set = set;
+            super::stage::write_tlas(ctx, set, self.accel.as_ref().map_or(vk::AccelerationStructureKHR::null(), |a| a.tlas()));
+            5
+        } else {
+            3
+        };
+        self.layout = pipeline_layout(ctx, "raytrace.intersect", &self.set_layouts[..sets], 0, stage)?;
         self.pipeline = compute_pipeline(ctx, self.layout, self.structure.shader)?;
         let (pool, set) = allocate_set(ctx, "raytrace.rays", self.set_layouts[2], RAY_BINDINGS)?;
         self.pool = pool;
@@ -157,6 +181,9 @@ impl Intersector {
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 2, &[self.set], &[]);
+            if self.rq_set != vk::DescriptorSet::null() {
+                ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 4, &[self.rq_set], &[]);
+            }
             ctx.device.cmd_dispatch(cmd, count.div_ceil(64), 1, 1);
         }
         rec.end(open);
@@ -204,6 +231,7 @@ impl Intersector {
             ctx.device.destroy_pipeline(self.pipeline, None);
             ctx.device.destroy_pipeline_layout(self.layout, None);
             ctx.device.destroy_descriptor_pool(self.pool, None);
+            ctx.device.destroy_descriptor_pool(self.rq_pool, None);
             for l in self.set_layouts {
                 ctx.device.destroy_descriptor_set_layout(l, None);
             }
@@ -211,7 +239,12 @@ impl Intersector {
         self.pipeline = vk::Pipeline::null();
         self.layout = vk::PipelineLayout::null();
         self.pool = vk::DescriptorPool::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 3];
+        self.rq_pool = vk::DescriptorPool::null();
+        self.rq_set = vk::DescriptorSet::null();
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 5];
+        if let Some(mut a) = self.accel.take() {
+            a.destroy(ctx);
+        }
         self.count.destroy(ctx);
         self.structure.destroy(ctx);
     }

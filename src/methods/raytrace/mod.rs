@@ -18,6 +18,9 @@
 //!   back with a short stack that falls back to kd-restart (HSHH07), or by pure kd-restart
 //!   (FS05).
 //!
+//! - [`Scheme::RayQuery`]: Vulkan's ray queries through acceleration structures that the
+//!   driver builds on the GPU (`ray_query`).
+//!
 //! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
 //! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
 
@@ -27,6 +30,7 @@ pub mod gpu;
 pub mod grid;
 pub mod kdtree;
 pub mod knobs;
+pub mod ray_query;
 pub mod stage;
 
 use glam::Vec3;
@@ -64,7 +68,7 @@ const fn camera(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Resul
 
 /// Every ray tracer's GPU side: no maps, its own stage, seen in other objects' maps as the
 /// environment only.
-const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Result<Box<dyn Stage>>) -> GpuSpec {
+pub(crate) const fn ray_tracer(name: &'static str, create: fn(&StageInit, &CameraPlan) -> Result<Box<dyn Stage>>) -> GpuSpec {
     GpuSpec {
         maps: &[],
         camera: camera(name, create),
@@ -85,7 +89,7 @@ const RAY_KNOBS_KD: &[&str] = &[
     RaytraceKnobs::kd_leaf_size,
     RaytraceKnobs::kd_traversal,
 ];
-const RAY_KNOBS_ENGINE: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget];
+pub(crate) const RAY_KNOBS_ENGINE: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget];
 const RAY_KNOBS_HIERARCHY: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::tile_size];
 const RAY_KNOBS_GRID: &[&str] =
     &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::grid_density, RaytraceKnobs::grid_skip];
@@ -94,7 +98,7 @@ const RAY_KNOBS_GRID: &[&str] =
 /// pipeline; no hooks.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "raytrace",
-    methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO],
+    methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO, ray_query::RAY_QUERY_INFO],
     ..crate::methods::registry::Family::NONE
 };
 
@@ -112,6 +116,7 @@ pub const BVH_INFO: &MethodInfo = &MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const BVH: Method = Method(BVH_INFO.name);
 
@@ -126,6 +131,7 @@ pub const RAY_ENGINE_INFO: &MethodInfo = &MethodInfo {
     gpu: Some(ray_tracer("raytrace.ray-engine", |init, plan| stage::create(init, plan, Scheme::RayEngine))),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const RAY_ENGINE: Method = Method(RAY_ENGINE_INFO.name);
 
@@ -142,6 +148,7 @@ pub const RAY_HIERARCHY_INFO: &MethodInfo = &MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const RAY_HIERARCHY: Method = Method(RAY_HIERARCHY_INFO.name);
 
@@ -159,6 +166,7 @@ pub const KD_TREE_INFO: &MethodInfo = &MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const KD_TREE: Method = Method(KD_TREE_INFO.name);
 
@@ -176,6 +184,7 @@ pub const GRID_INFO: &MethodInfo = &MethodInfo {
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const GRID: Method = Method(GRID_INFO.name);
 
@@ -253,6 +262,10 @@ pub enum Scheme {
     /// texture, each tile drawn for a triangle only if its rays' cone meets the triangle's
     /// bounding sphere.
     RayHierarchy { tile: u32 },
+    /// Vulkan's ray queries through acceleration structures the driver builds
+    /// (`ray_query::accel`): the triangle list is kept for shading, the kernel traverses
+    /// the TLAS.
+    RayQuery,
 }
 
 impl Scheme {
@@ -265,6 +278,7 @@ impl Scheme {
             Scheme::Bvh { .. } => "raytrace.intersect.bvh",
             Scheme::Grid { .. } => "raytrace.intersect.grid",
             Scheme::KdTree { .. } => "raytrace.intersect.kdtree",
+            Scheme::RayQuery => "raytrace.intersect.ray-query",
         }
     }
 
@@ -278,6 +292,14 @@ impl Scheme {
                 aux: Vec::new(),
                 accel: GpuAccel { triangle_count: list.len() as u32, ..bytemuck::Zeroable::zeroed() },
                 shader: "raytrace/intersect_brute.comp",
+            }),
+            // The structures are the driver's, built on the GPU by the stage.
+            Scheme::RayQuery => Ok(Packed {
+                nodes: Vec::new(),
+                refs: Vec::new(),
+                aux: Vec::new(),
+                accel: GpuAccel { triangle_count: list.len() as u32, ..bytemuck::Zeroable::zeroed() },
+                shader: "raytrace/intersect_ray_query.comp",
             }),
             Scheme::Bvh { stackless } => bvh::pack(list, stackless),
             Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),

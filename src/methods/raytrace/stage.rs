@@ -21,6 +21,8 @@
 use ash::vk;
 
 use super::gpu::Structure;
+use super::ray_query::accel::{AccelStructures, MeshInput};
+use super::ray_query::RAY_QUERY_BINDINGS;
 use super::{Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
@@ -108,6 +110,9 @@ pub struct RayTrace {
     samples: u32,
     triangle_count: u32,
     structure: Option<Structure>,
+    /// The ray-query scheme's acceleration structures, and its set 4 (the TLAS).
+    accel: Option<AccelStructures>,
+    rq_set: vk::DescriptorSet,
     shading: Buffer,
     handled: Buffer,
     queues: Vec<Queue>,
@@ -134,7 +139,8 @@ pub struct RayTrace {
     ray_texture: (u32, u32),
     tiles: u32,
     stride: u64,
-    set_layouts: [vk::DescriptorSetLayout; 2],
+    /// Sets 2 and 3, then set 4 of the ray-query scheme (null for the others).
+    set_layouts: [vk::DescriptorSetLayout; 3],
     layout: vk::PipelineLayout,
     p: Pipelines,
     pool: vk::DescriptorPool,
@@ -161,6 +167,8 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         samples: init.multisample.samples,
         triangle_count: 0,
         structure: None,
+        accel: None,
+        rq_set: vk::DescriptorSet::null(),
         shading: Buffer::placeholder(),
         handled: Buffer::placeholder(),
         queues: Vec::new(),
@@ -181,7 +189,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         ray_texture: (0, 0),
         tiles: 0,
         stride: 64,
-        set_layouts: [vk::DescriptorSetLayout::null(); 2],
+        set_layouts: [vk::DescriptorSetLayout::null(); 3],
         layout: vk::PipelineLayout::null(),
         p: Pipelines::default(),
         pool: vk::DescriptorPool::null(),
@@ -233,6 +241,9 @@ impl RayTrace {
         let packed = self.scheme.build(&list)?;
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
         self.structure = Some(Structure::new(ctx, self.scheme, &list, &packed)?);
+        if self.scheme == Scheme::RayQuery {
+            self.accel = Some(AccelStructures::new(ctx, &MeshInput::from_scene(scene))?);
+        }
         self.shading = Buffer::with_data(ctx, "raytrace.shading", &triangle_shading(scene), STORAGE)?;
         // Its objects' pixels; every pixel when the whole scene is ray traced (the plan then
         // makes no shadow maps: diffuse surfaces seen directly get exact shadow rays too).
@@ -332,7 +343,11 @@ impl RayTrace {
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
         self.set_layouts[0] = descriptor_set_layout(ctx, "raytrace.rays", RAY_BINDINGS, stages)?;
         self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.trace", TRACE_BINDINGS, stages)?;
-        let layouts = [init.set_layouts[0], init.set_layouts[1], self.set_layouts[0], self.set_layouts[1]];
+        let mut layouts = vec![init.set_layouts[0], init.set_layouts[1], self.set_layouts[0], self.set_layouts[1]];
+        if self.accel.is_some() {
+            self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, vk::ShaderStageFlags::COMPUTE)?;
+            layouts.push(self.set_layouts[2]);
+        }
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
         self.create_pipelines(ctx)?;
         self.create_sets(ctx)
@@ -417,11 +432,15 @@ impl RayTrace {
                 ty: vk::DescriptorType::STORAGE_IMAGE,
                 descriptor_count: count(TRACE_BINDINGS, vk::DescriptorType::STORAGE_IMAGE, trace_sets),
             },
+            vk::DescriptorPoolSize { ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, descriptor_count: 1 },
         ];
-        let info = vk::DescriptorPoolCreateInfo::default().max_sets((ray_sets + trace_sets) as u32).pool_sizes(&sizes);
+        let rq_sets = self.accel.is_some() as usize;
+        let sizes = &sizes[..2 + rq_sets];
+        let info = vk::DescriptorPoolCreateInfo::default().max_sets((ray_sets + trace_sets + rq_sets) as u32).pool_sizes(sizes);
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
         let mut layouts = vec![self.set_layouts[0]; ray_sets];
         layouts.extend(std::iter::repeat_n(self.set_layouts[1], trace_sets));
+        layouts.extend(std::iter::repeat_n(self.set_layouts[2], rq_sets));
         let sets = unsafe {
             ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts))
         }
@@ -429,7 +448,11 @@ impl RayTrace {
         self.ray_sets = sets[..bounces].to_vec();
         self.shadow_sets = sets[bounces..ray_sets].to_vec();
         self.primary_set = sets[ray_sets];
-        self.trace_sets = sets[ray_sets + 1..].to_vec();
+        self.trace_sets = sets[ray_sets + 1..ray_sets + trace_sets].to_vec();
+        if let Some(accel) = &self.accel {
+            self.rq_set = sets[ray_sets + trace_sets];
+            write_tlas(ctx, self.rq_set, accel.tlas());
+        }
 
         let sb = vk::DescriptorType::STORAGE_BUFFER;
         let structure = self.structure.as_ref().expect("created before the sets");
@@ -517,6 +540,9 @@ impl RayTrace {
             ctx.device.cmd_bind_pipeline(cmd, point, pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[f.set], &[]);
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 2, &sets, &[]);
+            if self.rq_set != vk::DescriptorSet::null() && point == vk::PipelineBindPoint::COMPUTE {
+                ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 4, &[self.rq_set], &[]);
+            }
         }
     }
 
@@ -609,6 +635,19 @@ impl RayTrace {
     }
 }
 
+/// Points binding 0 of a ray-query set 4 at `tlas`.
+pub(super) fn write_tlas(ctx: &Context, set: vk::DescriptorSet, tlas: vk::AccelerationStructureKHR) {
+    let structures = [tlas];
+    let mut info = vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(&structures);
+    let mut w = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(0)
+        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+        .push_next(&mut info);
+    w.descriptor_count = 1;
+    unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+}
+
 /// Secondary and shadow rays start this far from the surface they leave (besides skipping
 /// its triangle): 10⁻⁶ of the scene's diagonal, far above f32 rounding of positions of
 /// the scene's size at any scale (1 mm or 1 km scenes alike).
@@ -648,6 +687,11 @@ impl Stage for RayTrace {
         for &set in self.ray_sets.iter().chain(&self.shadow_sets) {
             structure.write(ctx, set);
         }
+        // Ray queries: new instances (a TLAS rebuild in the next frame), BLAS only for
+        // deformed meshes.
+        if let Some(accel) = self.accel.as_mut() {
+            accel.update(ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
+        }
         self.shading.write(bytemuck::cast_slice(&triangle_shading(init.scene)))?;
         let mut params = self.params.read()?.to_vec();
         let t_min = list_offset(&list);
@@ -665,6 +709,9 @@ impl Stage for RayTrace {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let view = io.views.camera;
         let compute = vk::PipelineBindPoint::COMPUTE;
+        if let Some(accel) = self.accel.as_mut() {
+            accel.record(ctx, rec);
+        }
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
 
         // 1. Primary hits by rasterisation, then the first queue. The shading kernels shade
@@ -789,6 +836,13 @@ impl Stage for RayTrace {
         }
         out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
         out.push(("raytrace.build_ms".to_string(), self.build_ms));
+        if let Some(a) = &self.accel {
+            out.push(("raytrace.blas_builds".to_string(), a.stats.blas_builds as f64));
+            out.push(("raytrace.tlas_builds".to_string(), a.stats.tlas_builds as f64));
+            out.push(("raytrace.blas_build_ms".to_string(), a.stats.blas_build_ms));
+            out.push(("raytrace.accel_bytes".to_string(), a.stats.bytes as f64));
+            out.push(("raytrace.compacted_bytes_saved".to_string(), a.stats.compacted_away as f64));
+        }
         if let Ok(c) = self.cull_stats.read() {
             let w = |i: usize| c.get(4 * i..4 * i + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as f64;
             for k in 0..bounces as usize {
@@ -832,9 +886,13 @@ impl Stage for RayTrace {
         }
         self.layout = vk::PipelineLayout::null();
         self.pool = vk::DescriptorPool::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 2];
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 3];
+        self.rq_set = vk::DescriptorSet::null();
         if let Some(s) = self.structure.as_mut() {
             s.destroy(ctx);
+        }
+        if let Some(mut a) = self.accel.take() {
+            a.destroy(ctx);
         }
         self.structure = None;
         for q in self.queues.iter_mut().chain(self.shadow.iter_mut()) {
