@@ -65,6 +65,8 @@
 #define SPECULA_METHOD_RAY_ENGINE 10
 /* ray-hierarchy (§2.2.1) */
 #define SPECULA_METHOD_RAY_HIERARCHY 11
+/* ray-query (§2.3.5) */
+#define SPECULA_METHOD_RAY_QUERY 16
 /* planar-mirror (§5) */
 #define SPECULA_METHOD_PLANAR_MIRROR 12
 /* planar-refraction (§5) */
@@ -115,6 +117,19 @@ typedef struct {
   uint32_t synchronization2;
   uint32_t maintenance4;
   uint32_t null_descriptor;
+  // Optional device extensions (static strings): with them and the three features below
+  // enabled (and SpeculaHostDesc::ray_query_enabled set), `ray-query` traces rays
+  // through Vulkan's acceleration structures: VK_KHR_acceleration_structure,
+  // VK_KHR_ray_query, VK_KHR_deferred_host_operations.
+  const char *const *optional_device_extensions;
+  uint32_t optional_device_extension_count;
+  // Optional features, each 1 (with the optional extensions):
+  // VkPhysicalDeviceAccelerationStructureFeaturesKHR::accelerationStructure,
+  // VkPhysicalDeviceRayQueryFeaturesKHR::rayQuery,
+  // VkPhysicalDeviceVulkan12Features::bufferDeviceAddress.
+  uint32_t acceleration_structure;
+  uint32_t ray_query;
+  uint32_t buffer_device_address;
 } SpeculaRequirements;
 
 // Standalone mode: the library creates its own headless instance and device.
@@ -158,6 +173,11 @@ typedef struct {
   // Non-zero if the host enabled VK_EXT_debug_utils on the instance: the library then
   // names its objects and labels every pass (RenderDoc shows the survey's vocabulary).
   uint32_t debug_utils_enabled;
+  // Non-zero if the host enabled the optional ray-query extensions and features that
+  // SpeculaRequirements lists (`optional_device_extensions`, `acceleration_structure`,
+  // `ray_query`, `buffer_device_address`): the `ray-query` method then traces through
+  // them; else its objects get `bvh`, and the plan's reason says why.
+  uint32_t ray_query_enabled;
 } SpeculaHostDesc;
 
 typedef uint32_t SpeculaLogLevel;
@@ -352,6 +372,12 @@ typedef struct {
 // was configured (specula_get_predictions says what it is predicted to reach), and the log
 // callback says why.
 #define SPECULA_WARNING_BUDGET_UNREACHABLE 4
+
+// specula_context_configure: some objects' methods cannot run on this device (`ray-query`
+// on a device without VK_KHR_ray_query, or a host device that did not enable it:
+// SpeculaHostDesc::ray_query_enabled); each got its method's fallback, and the log
+// callback names the object, the method and why.
+#define SPECULA_WARNING_DEVICE_FALLBACK 5
 
 #define SPECULA_ERROR_INVALID_ARGUMENT -1
 

@@ -31,6 +31,7 @@ fn bad_host_target_formats_are_refused() {
         device: own.device.handle().as_raw() as *mut c_void,
         queue_family: own.queue_family,
         debug_utils_enabled: 0,
+        ray_query_enabled: 0,
     };
     let mut ctx = std::ptr::null_mut();
     unsafe {

@@ -121,16 +121,28 @@ pub unsafe extern "C" fn specula_context_configure(ctx: *mut SpeculaContext, des
         });
         let previous = std::mem::replace(&mut c.budget, chosen);
         let previous_cache = std::mem::replace(&mut c.cache_dir, cache);
-        if let Err(e) = configure(c, choice, width, height) {
-            c.budget = previous;
-            c.cache_dir = previous_cache;
-            return Err(e);
+        let fallbacks = match configure(c, choice, width, height) {
+            Ok(f) => f,
+            Err(e) => {
+                c.budget = previous;
+                c.cache_dir = previous_cache;
+                return Err(e);
+            }
+        };
+        for f in &fallbacks {
+            c.log(SPECULA_LOG_WARNING, f);
         }
         if let Some(why) = unreachable {
             c.log(SPECULA_LOG_WARNING, &why);
             return Ok(SPECULA_WARNING_BUDGET_UNREACHABLE);
         }
-        Ok(if no_models { SPECULA_WARNING_NO_MODELS } else { SPECULA_SUCCESS })
+        Ok(if no_models {
+            SPECULA_WARNING_NO_MODELS
+        } else if !fallbacks.is_empty() {
+            SPECULA_WARNING_DEVICE_FALLBACK
+        } else {
+            SPECULA_SUCCESS
+        })
     })
 }
 
@@ -161,20 +173,30 @@ fn target(c: &mut SpeculaContext, dir: Option<std::path::PathBuf>, size: (u32, u
 /// Plans the scene as it is now for `choice` (with the per-object methods, or the budgeted
 /// planner's choices and knobs) and replaces the renderer by one of `width`×`height`. A
 /// planning error keeps the previous renderer; a creation error leaves none.
-fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) -> FfiResult<()> {
+/// Returns what the device made the plan give up: per object whose method it cannot run, a
+/// message naming the object, the method, why, and its fallback.
+fn configure(c: &mut SpeculaContext, choice: Choice, width: u32, height: u32) -> FfiResult<Vec<String>> {
     let (choices, quality) = match &c.budget {
         Some((choices, quality, _)) => (choices.clone(), quality.clone()),
         None => (Choices { method: choice, objects: c.object_methods.clone() }, c.quality.clone()),
     };
     let target = target(c, c.cache_dir.clone(), (width, height));
     let p = crate::plan::plan_for(&c.scene, &choices, &quality, target.as_ref())?;
+    let asked: Vec<(usize, Method)> = p.objects.iter().map(|o| (o.mesh, o.method)).collect();
     c.destroy_renderer();
     let r = Renderer::new(&c.vk, &c.scene, p, width, height)?;
+    let fallbacks = r
+        .plan
+        .objects
+        .iter()
+        .filter(|o| asked.iter().any(|(m, method)| *m == o.mesh && *method != o.method))
+        .map(|o| format!("object '{}': {}", o.name, o.reason))
+        .collect();
     c.choice = choice;
     c.renderer = Some(r);
     c.renderer_version = c.scene_version;
     c.replan = false;
-    Ok(())
+    Ok(fallbacks)
 }
 
 /// Copies what the budgeted planner predicted at the last specula_context_configure with a

@@ -19,6 +19,11 @@ pub const SPECULA_WARNING_NO_MODELS: SpeculaResult = 3;
 /// was configured (specula_get_predictions says what it is predicted to reach), and the log
 /// callback says why.
 pub const SPECULA_WARNING_BUDGET_UNREACHABLE: SpeculaResult = 4;
+/// specula_context_configure: some objects' methods cannot run on this device (`ray-query`
+/// on a device without VK_KHR_ray_query, or a host device that did not enable it:
+/// SpeculaHostDesc::ray_query_enabled); each got its method's fallback, and the log
+/// callback names the object, the method and why.
+pub const SPECULA_WARNING_DEVICE_FALLBACK: SpeculaResult = 5;
 pub const SPECULA_ERROR_INVALID_ARGUMENT: SpeculaResult = -1;
 pub const SPECULA_ERROR_NULL_POINTER: SpeculaResult = -2;
 /// A struct's `type` tag or `size` does not match what the call expects.
