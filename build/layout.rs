@@ -302,6 +302,7 @@ pub fn check_sets(sets: &[SetDecl]) -> Result<(), String> {
                 "UNIFORM_BUFFER" => b.decl.starts_with("uniform ") && !b.decl.contains("sampler"),
                 "COMBINED_IMAGE_SAMPLER" => b.decl.starts_with("uniform sampler"),
                 "STORAGE_IMAGE" => b.decl.contains("image"),
+                "ACCELERATION_STRUCTURE_KHR" => b.decl.starts_with("uniform accelerationStructureEXT"),
                 _ => false,
             };
             if !fits {
@@ -371,7 +372,16 @@ pub fn glsl(l: &Layout) -> Result<String, String> {
         for b in &set.bindings {
             comment(&mut out, "", &b.doc);
             let std430 = if b.ty == "STORAGE_BUFFER" || b.ty == "UNIFORM_BUFFER" { "std430, " } else { "" };
+            // Acceleration structures need GL_EXT_ray_query, which only the shaders that
+            // trace through them enable (defining SPECULA_RAY_QUERY before the include).
+            let ray_query = b.ty == "ACCELERATION_STRUCTURE_KHR";
+            if ray_query {
+                out.push_str("#ifdef SPECULA_RAY_QUERY\n");
+            }
             writeln!(out, "layout({std430}set = {}, binding = {}) {};", set.set, b.binding, b.decl).unwrap();
+            if ray_query {
+                out.push_str("#endif\n");
+            }
         }
     }
     for s in l.structs.iter().filter(|s| s.kind == "push_constant") {

@@ -39,6 +39,7 @@ const MEASURED: &[(&str, f64, f64, f64)] = &[
     ("bvh", -2.416e-3, 5.425e-3, 0.3432),
     ("kd-tree", -2.416e-3, 5.425e-3, 0.3432),
     ("grid", -2.416e-3, 5.425e-3, 0.3432),
+    ("ray-query", -2.416e-3, 5.425e-3, 0.3432),
     ("planar-mirror", -4.831e-3, -9.063e-4, 0.6914),
     // Falls back to distance for the demo's spheres (curved glass and mirror).
     ("planar-refraction", -4.831e-3, -9.063e-4, 0.6914),

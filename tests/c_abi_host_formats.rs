@@ -8,31 +8,13 @@ mod common;
 
 use std::ffi::{c_void, CStr, CString};
 
-use ash::vk::{self, Handle};
+use ash::vk;
 use specula::ffi::*;
 
 #[test]
 fn bad_host_target_formats_are_refused() {
     let own = common::gpu();
-    let gipa: unsafe extern "system" fn(vk::Instance, *const std::ffi::c_char) -> vk::PFN_vkVoidFunction =
-        own.entry.static_fn().get_instance_proc_addr;
-    let desc = SpeculaHostDesc {
-        r#type: SPECULA_STRUCT_HOST_DESC,
-        size: std::mem::size_of::<SpeculaHostDesc>() as u32,
-        // The same function; the ABI spells the handle as a pointer.
-        get_instance_proc_addr: unsafe {
-            std::mem::transmute::<
-                Option<unsafe extern "system" fn(vk::Instance, *const std::ffi::c_char) -> vk::PFN_vkVoidFunction>,
-                SpeculaGetInstanceProcAddr,
-            >(Some(gipa))
-        },
-        instance: own.instance.handle().as_raw() as *mut c_void,
-        physical_device: own.physical.as_raw() as *mut c_void,
-        device: own.device.handle().as_raw() as *mut c_void,
-        queue_family: own.queue_family,
-        debug_utils_enabled: 0,
-        ray_query_enabled: 0,
-    };
+    let desc = common::host_desc(&own, 0);
     let mut ctx = std::ptr::null_mut();
     unsafe {
         assert_eq!(specula_context_create_host(&desc, &mut ctx), SPECULA_SUCCESS, "{:?}", CStr::from_ptr(specula_creation_error()));

@@ -1,5 +1,5 @@
-//! Ray tracing in the original geometry on the GPU (survey §2): the `bvh`, `kd-tree` and
-//! `grid` methods against the exact CPU reference at the same depth, pixel-centre sampling
+//! Ray tracing in the original geometry on the GPU (survey §2): the `bvh`, `kd-tree`,
+//! `grid` and `ray-query` methods against the exact CPU reference at the same depth, pixel-centre sampling
 //! on both sides (lavapipe, validation on). They are exact methods: the tolerance is the
 //! f32 arithmetic of the GPU against the reference's f64, stated per test with what was
 //! measured when it was set.
@@ -9,14 +9,16 @@ mod common;
 use std::path::Path;
 
 use glam::{Mat4, Vec3};
-use specula::methods::{BVH, GRID, KD_TREE};
+use specula::methods::{BVH, GRID, KD_TREE, RAY_QUERY};
 use specula::metrics;
 use specula::reference::render_reference;
 use specula::scene::{shapes, Camera, Material, Scene, SurfaceKind};
 use specula::vk::ImageData;
 use specula::{Method, Quality};
 
-const EXACT: [Method; 3] = [BVH, KD_TREE, GRID];
+/// The exact schemes; `ray-query` traces through Vulkan's ray queries (lavapipe from Mesa
+/// 25 has them; tests/ray_query.rs checks that the device does).
+const EXACT: [Method; 4] = [BVH, KD_TREE, GRID, RAY_QUERY];
 
 fn demo() -> Scene {
     specula::scene::load(Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap()
@@ -106,6 +108,10 @@ fn refraction_extremes_and_total_internal_reflection() {
         eprintln!("ν = {ior}: {e}; against the empty room {p:.2} dB");
         // Measured 141.81 / 122.30 / 114.61 dB.
         assert!(e.psnr >= 60.0, "ν = {ior}: {e}");
+        // The same paths through Vulkan's ray queries.
+        let rq = metrics::compare(&gpu(&ctx, &s, RAY_QUERY, &q, size), &reference).unwrap();
+        eprintln!("ν = {ior}, ray-query: {rq}");
+        assert!(rq.psnr >= 60.0, "ν = {ior}, ray-query: {rq}");
         if ior < 1.001 {
             // Measured 56.46 dB.
             assert!(p >= 55.5, "ν = 1.0001 should be invisible: {p:.2} dB against the empty room");
@@ -140,6 +146,11 @@ fn recursion_depth_on_facing_mirrors() {
         eprintln!("R = {r}: {p:.2} dB");
         // Measured 132.17 dB (R = 1) down to 131.14 dB (R = 8).
         assert!(p >= 60.0, "R = {r}: {p:.2} dB against the reference");
+        if r == 8 {
+            let rq = psnr(&gpu(&ctx, &s, RAY_QUERY, &q, (40, 40)), &reference);
+            eprintln!("R = 8, ray-query: {rq:.2} dB");
+            assert!(rq >= 60.0, "R = 8, ray-query: {rq:.2} dB against the reference");
+        }
         // Each bounce adds an image (measured: the mean radiance grows up to R = 7, where
         // the last paths leave the mirrors' edges; R = 8 is R = 7's image). Measured PSNR of
         // R against R − 1 for R = 2 … 7: 18.59, 25.44, 28.72, 31.74, 37.33, 35.14 dB; the

@@ -143,6 +143,50 @@ fn schemes() -> Vec<Scheme> {
     ]
 }
 
+/// Whether hit `h` lies on its triangle's boundary (barycentric within 1e-4 of an edge):
+/// where the other schemes' triangles, widened by 2⁻²⁰ against cracks, and the driver's
+/// watertight test may decide differently on a soup's unshared edges.
+fn on_boundary(h: &GpuRayHit) -> bool {
+    h.triangle != RAY_NO_TRIANGLE && (h.u < 1e-4 || h.v < 1e-4 || h.u + h.v > 1.0 - 1e-4)
+}
+
+/// Vulkan's ray queries against brute force: the same nearest hit (or the same t) on every
+/// ray, except rays aimed at a corner or an edge (i mod 4 = 1, 2) whose brute-force hit lies
+/// on the triangle's boundary; the same any-hit answers.
+fn check_ray_query(ctx: &specula::vk::Context, n: usize, list: &TriangleList, queries: &[GpuRayQuery], reference: &[GpuRayHit]) {
+    assert!(ctx.ray_query.is_ok(), "lavapipe from Mesa 25 (scripts/setup.sh) has ray queries: {:?}", ctx.ray_query.as_ref().err());
+    let mut x = Intersector::new(ctx, Scheme::RayQuery, list, &Scheme::RayQuery.build(list).unwrap()).unwrap();
+    let (hits, ms) = x.intersect(ctx, queries).unwrap();
+    x.destroy(ctx);
+    let (mut agree, mut excused, mut total) = (0, 0, 0);
+    for (i, ((q, h), r)) in queries.iter().zip(&hits).zip(reference).enumerate() {
+        if q.flags & RAY_ANY_HIT != 0 {
+            let edge = matches!(i % 4, 1 | 2) && (on_boundary(h) || on_boundary(r));
+            assert!(
+                (h.triangle != RAY_NO_TRIANGLE) == (r.triangle != RAY_NO_TRIANGLE) || edge,
+                "N = {n}, ray query, any-hit ray {i} {q:?}: {h:?}, brute force {r:?}"
+            );
+            if h.triangle != RAY_NO_TRIANGLE {
+                assert!(h.t >= q.origin[3] && h.t <= q.direction[3] && h.triangle != q.skip, "N = {n}, any-hit ray {i}: {h:?}");
+            }
+            continue;
+        }
+        total += 1;
+        let same =
+            h.triangle == r.triangle || (h.triangle != RAY_NO_TRIANGLE && r.triangle != RAY_NO_TRIANGLE && same_t(h.t, r.t as f64, 1e-5));
+        if same {
+            agree += 1;
+        } else {
+            assert!(
+                matches!(i % 4, 1 | 2) && (on_boundary(r) || on_boundary(h)),
+                "N = {n}, ray query, ray {i} {q:?}: got {h:?}, brute force {r:?}"
+            );
+            excused += 1;
+        }
+    }
+    eprintln!("N = {n}, RayQuery: agrees with brute force on {agree} of {total} nearest-hit rays, {excused} boundary hits decided otherwise, {ms:.2} ms");
+}
+
 fn check_soup(ctx: &specula::vk::Context, n: usize, m: usize, seed: u64) {
     let mut rng = Rng(seed);
     let tris = soup(n, &mut rng);
@@ -188,6 +232,7 @@ fn check_soup(ctx: &specula::vk::Context, n: usize, m: usize, seed: u64) {
             }
         }
     }
+    check_ray_query(ctx, n, &list, &queries, &reference);
     common::assert_clean(ctx);
 }
 
@@ -210,7 +255,7 @@ fn empty_list_and_rays_that_miss_everything() {
     let ctx = common::gpu();
     let list = TriangleList::from_soup(vec![]).unwrap();
     let q = [query(Vec3::ZERO, Vec3::X, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)];
-    for scheme in std::iter::once(Scheme::Brute).chain(schemes()) {
+    for scheme in [Scheme::Brute, Scheme::RayQuery].into_iter().chain(schemes()) {
         let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
         let (hits, _) = x.intersect(&ctx, &q).unwrap();
         x.destroy(&ctx);
@@ -243,6 +288,7 @@ fn triangles_beyond_the_loop_budget_are_tested() {
             Scheme::Bvh { stackless: true },
             Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: false },
             Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, restart: true },
+            Scheme::RayQuery,
         ] {
             let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
             let (hits, _) = x.intersect(&ctx, &[query(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)]).unwrap();

@@ -5,12 +5,9 @@
 // acceleration structures (one bottom level per mesh, one instance per object) answers the
 // same query as every other scheme. The triangle id is the instance's custom index (its
 // mesh's first triangle in the list) plus the primitive index.
+// Set 5 (`tlas`, src/methods/raytrace/layout.in.rs) is declared where this is defined.
+#define SPECULA_RAY_QUERY
 #include "raytrace/rays.glsl"
-
-// Set 4, the ray-query scheme's own (`RAY_QUERY_BINDINGS` in ray_query/mod.rs): outside
-// the generated layout, because only devices with VK_KHR_acceleration_structure may
-// declare it.
-layout(set = 4, binding = 0) uniform accelerationStructureEXT tlas;
 
 // The largest finite f32: ray queries take no infinite t_max.
 const float RQ_T_MAX = 3.4028234663852886e38;

@@ -93,7 +93,9 @@ pub enum DeviceNeeds {
     Nothing,
     /// Vulkan's ray queries and acceleration structures (`Context::ray_query`); `otherwise`
     /// serves its objects where they are missing.
-    RayQuery { otherwise: Method },
+    RayQuery {
+        otherwise: Method,
+    },
 }
 
 impl DeviceNeeds {

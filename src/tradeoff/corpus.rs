@@ -77,7 +77,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                 };
                 let facts = crate::plan::facts::SceneFacts::new(&scene, &q, true);
                 for &m in &cfg.methods {
-                    if !set.iter().all(|k| m.knobs.contains(k)) {
+                    // A method this device cannot run (ray-query without ray queries) would
+                    // measure its fallback under its name: left out, so the planner never
+                    // sees costs for it here.
+                    if !set.iter().all(|k| m.knobs.contains(k)) || m.needs.missing_on(ctx).is_some() {
                         continue;
                     }
                     if cfg.sparse.iter().any(|(s, n)| *s == m && i % (*n).max(1) != 0) {

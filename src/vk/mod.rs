@@ -9,8 +9,8 @@ mod recorder;
 mod resource;
 
 pub use context::{
-    process_validation_errors, required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry, ValidationLog,
-    REQUIRED_DEVICE_EXTENSIONS, RAY_QUERY_DEVICE_EXTENSIONS, RayQueryDevice, ray_query_supported,
+    process_validation_errors, ray_query_supported, required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry,
+    RayQueryDevice, ValidationLog, RAY_QUERY_DEVICE_EXTENSIONS, REQUIRED_DEVICE_EXTENSIONS,
 };
 pub use readback::{decode, read_image, record_copy_to_buffer};
 // ImageData moved to crate::image; the old path keeps working.

@@ -154,6 +154,28 @@ pub fn c_context() -> *mut specula::ffi::SpeculaContext {
     ctx
 }
 
+/// A host-device description of `own`'s instance and device (the C ABI's host mode over a
+/// device the library's Rust API created); `ray_query_enabled` as the host says.
+pub fn host_desc(own: &Context, ray_query_enabled: u32) -> specula::ffi::SpeculaHostDesc {
+    use ash::vk::{self, Handle};
+    use specula::ffi::*;
+    use std::ffi::{c_char, c_void};
+    type Gipa = unsafe extern "system" fn(vk::Instance, *const c_char) -> vk::PFN_vkVoidFunction;
+    let gipa: Gipa = own.entry.static_fn().get_instance_proc_addr;
+    SpeculaHostDesc {
+        r#type: SPECULA_STRUCT_HOST_DESC,
+        size: std::mem::size_of::<SpeculaHostDesc>() as u32,
+        // The same function; the ABI spells the handle as a pointer.
+        get_instance_proc_addr: unsafe { std::mem::transmute::<Option<Gipa>, SpeculaGetInstanceProcAddr>(Some(gipa)) },
+        instance: own.instance.handle().as_raw() as *mut c_void,
+        physical_device: own.physical.as_raw() as *mut c_void,
+        device: own.device.handle().as_raw() as *mut c_void,
+        queue_family: own.queue_family,
+        debug_utils_enabled: 0,
+        ray_query_enabled,
+    }
+}
+
 /// A render description for `method` at `width`×`height`.
 pub fn render_desc(method: specula::Method, width: u32, height: u32) -> specula::ffi::SpeculaRenderDesc {
     use specula::ffi::*;

@@ -6,10 +6,9 @@
 use ash::vk;
 
 use super::ray_query::accel::{AccelStructures, MeshInput};
-use super::ray_query::RAY_QUERY_BINDINGS;
 use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result};
-use crate::frame::layout::{binding, GpuAccel, GpuRayHit, GpuRayQuery, RAY_BINDINGS};
+use crate::frame::layout::{binding, GpuAccel, GpuRayHit, GpuRayQuery, RAY_BINDINGS, RAY_QUERY_BINDINGS};
 use crate::vk::pipeline::{allocate_set, compute_pipeline, descriptor_set_layout, pipeline_layout, write_buffer};
 use crate::vk::{Buffer, Context, MemoryLocation, Profiler, Recorder};
 
@@ -93,13 +92,13 @@ impl Structure {
 pub struct Intersector {
     pub structure: Structure,
     count: Buffer,
-    /// Empty layouts for sets 0 and 1, then set 2; for ray queries an empty set 3 and set 4.
-    set_layouts: [vk::DescriptorSetLayout; 5],
+    /// Empty layouts for sets 0 and 1, then set 2; for ray queries empty sets 3 and 4 and set 5.
+    set_layouts: [vk::DescriptorSetLayout; 6],
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
     pool: vk::DescriptorPool,
     set: vk::DescriptorSet,
-    /// The ray-query scheme's structures (over the list as one mesh) and its set 4.
+    /// The ray-query scheme's structures (over the list as one mesh) and its set 5.
     pub accel: Option<AccelStructures>,
     rq_pool: vk::DescriptorPool,
     rq_set: vk::DescriptorSet,
@@ -112,7 +111,7 @@ impl Intersector {
         let mut me = Intersector {
             structure,
             count: Buffer::placeholder(),
-            set_layouts: [vk::DescriptorSetLayout::null(); 5],
+            set_layouts: [vk::DescriptorSetLayout::null(); 6],
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
             pool: vk::DescriptorPool::null(),
@@ -142,12 +141,13 @@ impl Intersector {
             self.accel = Some(accel);
             built?;
             self.set_layouts[3] = descriptor_set_layout(ctx, "raytrace.set3", &[], stage)?;
-            self.set_layouts[4] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, stage)?;
-            let (pool, set) = allocate_set(ctx, "raytrace.ray-query", self.set_layouts[4], RAY_QUERY_BINDINGS)?;
+            self.set_layouts[4] = descriptor_set_layout(ctx, "raytrace.set4", &[], stage)?;
+            self.set_layouts[5] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, stage)?;
+            let (pool, set) = allocate_set(ctx, "raytrace.ray-query", self.set_layouts[5], RAY_QUERY_BINDINGS)?;
             self.rq_pool = pool;
             self.rq_set = set;
             super::stage::write_tlas(ctx, set, self.accel.as_ref().map_or(vk::AccelerationStructureKHR::null(), |a| a.tlas()));
-            5
+            6
         } else {
             3
         };
@@ -182,7 +182,7 @@ impl Intersector {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.pipeline);
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 2, &[self.set], &[]);
             if self.rq_set != vk::DescriptorSet::null() {
-                ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 4, &[self.rq_set], &[]);
+                ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 5, &[self.rq_set], &[]);
             }
             ctx.device.cmd_dispatch(cmd, count.div_ceil(64), 1, 1);
         }
@@ -241,7 +241,7 @@ impl Intersector {
         self.pool = vk::DescriptorPool::null();
         self.rq_pool = vk::DescriptorPool::null();
         self.rq_set = vk::DescriptorSet::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 5];
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 6];
         if let Some(mut a) = self.accel.take() {
             a.destroy(ctx);
         }

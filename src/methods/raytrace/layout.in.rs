@@ -164,4 +164,12 @@ descriptor_sets! {
         /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
         CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
     }
+
+    /// The `ray-query` scheme's own set 5 (src/methods/raytrace/ray_query/): the TLAS over
+    /// one instance per object. Declared in GLSL only where SPECULA_RAY_QUERY is defined (the
+    /// shaders that enable GL_EXT_ray_query); only devices with VK_KHR_acceleration_structure
+    /// create it.
+    RAY_QUERY_BINDINGS = set 5 {
+        TLAS = 0: ACCELERATION_STRUCTURE_KHR => "uniform accelerationStructureEXT tlas";
+    }
 }

@@ -22,11 +22,10 @@ use ash::vk;
 
 use super::gpu::Structure;
 use super::ray_query::accel::{AccelStructures, MeshInput};
-use super::ray_query::RAY_QUERY_BINDINGS;
 use super::{Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
-    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, TRACE_BINDINGS,
+    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, RAY_QUERY_BINDINGS, TRACE_BINDINGS,
 };
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
@@ -110,9 +109,11 @@ pub struct RayTrace {
     samples: u32,
     triangle_count: u32,
     structure: Option<Structure>,
-    /// The ray-query scheme's acceleration structures, and its set 4 (the TLAS).
+    /// The ray-query scheme's acceleration structures, and its set 5 (the TLAS).
     accel: Option<AccelStructures>,
     rq_set: vk::DescriptorSet,
+    /// `map_updates=always`: the TLAS is rebuilt every frame, as when objects move.
+    tlas_every_frame: bool,
     shading: Buffer,
     handled: Buffer,
     queues: Vec<Queue>,
@@ -139,8 +140,9 @@ pub struct RayTrace {
     ray_texture: (u32, u32),
     tiles: u32,
     stride: u64,
-    /// Sets 2 and 3, then set 4 of the ray-query scheme (null for the others).
-    set_layouts: [vk::DescriptorSetLayout; 3],
+    /// Sets 2 and 3, then for the ray-query scheme an empty set 4 and set 5 (null for the
+    /// others).
+    set_layouts: [vk::DescriptorSetLayout; 4],
     layout: vk::PipelineLayout,
     p: Pipelines,
     pool: vk::DescriptorPool,
@@ -169,6 +171,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         structure: None,
         accel: None,
         rq_set: vk::DescriptorSet::null(),
+        tlas_every_frame: q.frame.map_updates_always,
         shading: Buffer::placeholder(),
         handled: Buffer::placeholder(),
         queues: Vec::new(),
@@ -189,7 +192,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         ray_texture: (0, 0),
         tiles: 0,
         stride: 64,
-        set_layouts: [vk::DescriptorSetLayout::null(); 3],
+        set_layouts: [vk::DescriptorSetLayout::null(); 4],
         layout: vk::PipelineLayout::null(),
         p: Pipelines::default(),
         pool: vk::DescriptorPool::null(),
@@ -345,8 +348,9 @@ impl RayTrace {
         self.set_layouts[1] = descriptor_set_layout(ctx, "raytrace.trace", TRACE_BINDINGS, stages)?;
         let mut layouts = vec![init.set_layouts[0], init.set_layouts[1], self.set_layouts[0], self.set_layouts[1]];
         if self.accel.is_some() {
-            self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, vk::ShaderStageFlags::COMPUTE)?;
-            layouts.push(self.set_layouts[2]);
+            self.set_layouts[2] = descriptor_set_layout(ctx, "raytrace.set4", &[], vk::ShaderStageFlags::COMPUTE)?;
+            self.set_layouts[3] = descriptor_set_layout(ctx, "raytrace.ray-query", RAY_QUERY_BINDINGS, vk::ShaderStageFlags::COMPUTE)?;
+            layouts.extend([self.set_layouts[2], self.set_layouts[3]]);
         }
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
         self.create_pipelines(ctx)?;
@@ -440,7 +444,7 @@ impl RayTrace {
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
         let mut layouts = vec![self.set_layouts[0]; ray_sets];
         layouts.extend(std::iter::repeat_n(self.set_layouts[1], trace_sets));
-        layouts.extend(std::iter::repeat_n(self.set_layouts[2], rq_sets));
+        layouts.extend(std::iter::repeat_n(self.set_layouts[3], rq_sets));
         let sets = unsafe {
             ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(self.pool).set_layouts(&layouts))
         }
@@ -541,7 +545,7 @@ impl RayTrace {
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 0, &[f.set], &[]);
             ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 2, &sets, &[]);
             if self.rq_set != vk::DescriptorSet::null() && point == vk::PipelineBindPoint::COMPUTE {
-                ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 4, &[self.rq_set], &[]);
+                ctx.device.cmd_bind_descriptor_sets(cmd, point, self.layout, 5, &[self.rq_set], &[]);
             }
         }
     }
@@ -635,13 +639,13 @@ impl RayTrace {
     }
 }
 
-/// Points binding 0 of a ray-query set 4 at `tlas`.
+/// Points a ray-query set 5's TLAS binding at `tlas`.
 pub(super) fn write_tlas(ctx: &Context, set: vk::DescriptorSet, tlas: vk::AccelerationStructureKHR) {
     let structures = [tlas];
     let mut info = vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(&structures);
     let mut w = vk::WriteDescriptorSet::default()
         .dst_set(set)
-        .dst_binding(0)
+        .dst_binding(crate::frame::layout::binding::TLAS)
         .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
         .push_next(&mut info);
     w.descriptor_count = 1;
@@ -710,6 +714,9 @@ impl Stage for RayTrace {
         let view = io.views.camera;
         let compute = vk::PipelineBindPoint::COMPUTE;
         if let Some(accel) = self.accel.as_mut() {
+            if self.tlas_every_frame {
+                accel.touch();
+            }
             accel.record(ctx, rec);
         }
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
@@ -886,7 +893,7 @@ impl Stage for RayTrace {
         }
         self.layout = vk::PipelineLayout::null();
         self.pool = vk::DescriptorPool::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 3];
+        self.set_layouts = [vk::DescriptorSetLayout::null(); 4];
         self.rq_set = vk::DescriptorSet::null();
         if let Some(s) = self.structure.as_mut() {
             s.destroy(ctx);

@@ -78,6 +78,34 @@ impl MeshInput {
         }
     }
 
+    /// The BLAS build's vertices and indices: the mesh's, with every zero-area triangle
+    /// (|e1 × e2| ≤ 10⁻⁶ |e1| |e2|, which the other schemes' triangle test rejects for every
+    /// ray) collapsed onto one extra vertex outside the mesh's bounds, so that every triangle
+    /// keeps its primitive index and no ray that the renderer makes meets those. Measured on
+    /// lavapipe (Mesa 25.0.7): a ray exactly along a zero-area triangle's segment is reported
+    /// as a hit, and a NaN vertex (the spec's inactive triangle) makes its builder lose
+    /// other triangles' hits.
+    fn build_input(&self) -> (Vec<[f32; 3]>, Vec<u32>) {
+        let mut positions: Vec<[f32; 3]> = self.positions.iter().map(|p| p.to_array()).collect();
+        let away = positions.len() as u32;
+        let mut indices = self.indices.clone();
+        let mut collapsed = false;
+        for t in indices.chunks_exact_mut(3) {
+            let [a, b, c] = [0, 1, 2].map(|k| self.positions.get(t[k] as usize).copied().unwrap_or(Vec3::ZERO));
+            let (e1, e2) = (b - a, c - a);
+            if e1.cross(e2).length() <= 1e-6 * e1.length() * e2.length() {
+                t.copy_from_slice(&[away; 3]);
+                collapsed = true;
+            }
+        }
+        if collapsed {
+            let (lo, hi) = self.positions.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+            let extent = (hi - lo).max_element().max(1.0);
+            positions.push((hi + Vec3::splat(extent)).to_array());
+        }
+        (positions, indices)
+    }
+
     fn triangles(&self) -> u32 {
         (self.indices.len() / 3) as u32
     }
@@ -134,8 +162,9 @@ fn device_address(ctx: &Context, b: &Buffer) -> u64 {
     unsafe { ctx.device.get_buffer_device_address(&vk::BufferDeviceAddressInfo::default().buffer(b.raw)) }
 }
 
-const INPUT: vk::BufferUsageFlags =
-    vk::BufferUsageFlags::from_raw(vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR.as_raw() | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS.as_raw());
+const INPUT: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(
+    vk::BufferUsageFlags::ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_KHR.as_raw() | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS.as_raw(),
+);
 const SCRATCH: vk::BufferUsageFlags =
     vk::BufferUsageFlags::from_raw(vk::BufferUsageFlags::STORAGE_BUFFER.as_raw() | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS.as_raw());
 
@@ -242,7 +271,8 @@ impl AccelStructures {
         let count = meshes.len() as u32;
         let (size, scratch) = self.tlas_sizes(ctx, rq, count);
         self.tlas = Some(Structure::new(ctx, rq, "raytrace.ray-query.tlas", vk::AccelerationStructureTypeKHR::TOP_LEVEL, size)?);
-        self.tlas_scratch = Buffer::new(ctx, "raytrace.ray-query.tlas_scratch", scratch + rq.scratch_alignment, SCRATCH, MemoryLocation::GpuOnly)?;
+        self.tlas_scratch =
+            Buffer::new(ctx, "raytrace.ray-query.tlas_scratch", scratch + rq.scratch_alignment, SCRATCH, MemoryLocation::GpuOnly)?;
         self.tlas_scratch_address = aligned(device_address(ctx, &self.tlas_scratch), rq.scratch_alignment);
         if ctx.queue.is_some() {
             self.build_now(ctx, rq, &all)?;
@@ -270,7 +300,8 @@ impl AccelStructures {
     }
 
     const BLAS_FLAGS: vk::BuildAccelerationStructureFlagsKHR = vk::BuildAccelerationStructureFlagsKHR::from_raw(
-        vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw() | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION.as_raw(),
+        vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw()
+            | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION.as_raw(),
     );
 
     /// Uploads the inputs of meshes `which`, sizes their BLAS and allocates it and its scratch.
@@ -284,9 +315,10 @@ impl AccelStructures {
             if b.triangles == 0 {
                 continue;
             }
-            let positions: Vec<[f32; 3]> = m.positions.iter().map(|p| p.to_array()).collect();
+            let (positions, indices) = m.build_input();
+            b.vertices = positions.len() as u32;
             b.positions = Some(Buffer::with_data(ctx, "raytrace.ray-query.vertices", &positions, INPUT)?);
-            b.indices = Some(Buffer::with_data(ctx, "raytrace.ray-query.indices", &m.indices, INPUT)?);
+            b.indices = Some(Buffer::with_data(ctx, "raytrace.ray-query.indices", &indices, INPUT)?);
             let geometry = [self.geometry(ctx, k)];
             let info = vk::AccelerationStructureBuildGeometryInfoKHR::default()
                 .ty(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL)
@@ -454,8 +486,10 @@ impl AccelStructures {
                 let open = rec.pass("raytrace.blas").begin();
                 self.record_blas(ctx, rq, cmd, &built);
                 rec.end(open);
-                let raws: Vec<vk::AccelerationStructureKHR> =
-                    built.iter().map(|&k| self.blas[k].structure.as_ref().map_or(vk::AccelerationStructureKHR::null(), |s| s.raw)).collect();
+                let raws: Vec<vk::AccelerationStructureKHR> = built
+                    .iter()
+                    .map(|&k| self.blas[k].structure.as_ref().map_or(vk::AccelerationStructureKHR::null(), |s| s.raw))
+                    .collect();
                 unsafe {
                     ctx.device.cmd_reset_query_pool(cmd, queries, 0, built.len() as u32);
                     rq.accel.cmd_write_acceleration_structures_properties(
@@ -473,8 +507,10 @@ impl AccelStructures {
             self.stats.blas_build_ms = ms?.iter().map(|p| p.gpu_ms).sum();
             self.stats.blas_builds += built.len() as u64;
             let mut sizes = vec![0u64; built.len()];
-            unsafe { ctx.device.get_query_pool_results(queries, 0, &mut sizes, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-                .call("vkGetQueryPoolResults")?;
+            unsafe {
+                ctx.device.get_query_pool_results(queries, 0, &mut sizes, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT)
+            }
+            .call("vkGetQueryPoolResults")?;
             self.compact(ctx, rq, &built, &sizes)
         })();
         unsafe { ctx.device.destroy_query_pool(queries, None) };
@@ -508,7 +544,8 @@ impl AccelStructures {
         let copied = ctx.one_shot(|cmd| {
             for (k, s) in &fresh {
                 let src = self.blas[*k].structure.as_ref().map_or(vk::AccelerationStructureKHR::null(), |s| s.raw);
-                let info = vk::CopyAccelerationStructureInfoKHR::default().src(src).dst(s.raw).mode(vk::CopyAccelerationStructureModeKHR::COMPACT);
+                let info =
+                    vk::CopyAccelerationStructureInfoKHR::default().src(src).dst(s.raw).mode(vk::CopyAccelerationStructureModeKHR::COMPACT);
                 unsafe { rq.accel.cmd_copy_acceleration_structure(cmd, &info) };
             }
             Ok(())
@@ -548,12 +585,17 @@ impl AccelStructures {
     pub fn update(&mut self, ctx: &Context, meshes: &[MeshInput], moved: &[usize]) -> Result<()> {
         let rq = rq(ctx)?;
         if meshes.len() != self.inputs.len() {
-            return Err(Error::invalid("ray-query", format!("{} meshes, the structures were built for {}", meshes.len(), self.inputs.len())));
+            return Err(Error::invalid(
+                "ray-query",
+                format!("{} meshes, the structures were built for {}", meshes.len(), self.inputs.len()),
+            ));
         }
         let deformed: Vec<usize> = moved
             .iter()
             .copied()
-            .filter(|&k| k < meshes.len() && (meshes[k].shape_hash() != self.blas[k].shape || meshes[k].triangles() != self.blas[k].triangles))
+            .filter(|&k| {
+                k < meshes.len() && (meshes[k].shape_hash() != self.blas[k].shape || meshes[k].triangles() != self.blas[k].triangles)
+            })
             .collect();
         for &k in moved.iter().filter(|&&k| k < meshes.len()) {
             self.inputs[k] = (meshes[k].first_triangle, meshes[k].world, meshes[k].visible);
@@ -595,6 +637,12 @@ impl AccelStructures {
             recorded = true;
         }
         recorded
+    }
+
+    /// Rebuilds the TLAS in the next `record` although nothing moved (`map_updates=always`:
+    /// what a frame costs when objects move).
+    pub fn touch(&mut self) {
+        self.tlas_dirty = true;
     }
 
     /// Builds the TLAS now (standalone contexts: tests and tools that intersect without a frame).

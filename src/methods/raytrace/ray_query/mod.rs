@@ -7,18 +7,13 @@
 //!
 //! Its kernel (`glsl/raytrace/intersect_ray_query.comp`) reads the same query buffer and
 //! writes the same hit buffer as every other scheme; its one binding of its own, the TLAS,
-//! is set 4 ([`RAY_QUERY_BINDINGS`]).
+//! is set 5 (`RAY_QUERY_BINDINGS` in src/methods/raytrace/layout.in.rs).
 
 pub mod accel;
-
-use ash::vk;
 
 use super::{stage, Scheme};
 use crate::methods::registry::{DeviceNeeds, Method, MethodInfo};
 use crate::methods::EVERY_CLASS;
-
-/// Set 4 of the ray-query kernel: the TLAS.
-pub const RAY_QUERY_BINDINGS: &[crate::vk::pipeline::Binding] = &[(0, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, 1)];
 
 pub const RAY_QUERY_INFO: &MethodInfo = &MethodInfo {
     name: "ray-query",

@@ -1,0 +1,183 @@
+//! `ray-query` (issue 32): ray tracing through Vulkan's acceleration structures and ray
+//! queries, on lavapipe from Mesa 25 (scripts/setup.sh installs it from bookworm-backports;
+//! it exposes VK_KHR_acceleration_structure and VK_KHR_ray_query). Its exactness against
+//! the reference sits beside the other schemes' in tests/raytrace.rs, its nearest hits in
+//! tests/raytrace_conformance.rs, incremental = fresh in tests/frames.rs; here: what moves
+//! and deformation rebuild, memory, and the fallback where the extensions are missing.
+
+mod common;
+
+use std::ffi::{c_char, c_void, CStr, CString};
+use std::sync::Mutex;
+
+use glam::{Mat4, Vec3};
+use specula::methods::{BVH, RAY_QUERY};
+use specula::plan::{plan_with, Choices};
+use specula::scene::Scene;
+use specula::vk::{Context, DeviceOptions};
+use specula::{Quality, Renderer};
+
+const SIZE: (u32, u32) = (32, 24);
+
+fn quality() -> Quality {
+    let mut q = Quality::default();
+    q.frame.depth = 4;
+    q.frame.shadow_size = 64;
+    q.cube.cube_size = 32;
+    q
+}
+
+fn renderer(ctx: &Context, scene: &Scene, m: specula::Method) -> Renderer {
+    Renderer::new(ctx, scene, plan_with(scene, &Choices::all(m), &quality()).unwrap(), SIZE.0, SIZE.1).unwrap()
+}
+
+fn stat(f: &specula::Frame, name: &str) -> f64 {
+    f.stats.iter().find(|(k, _)| k == name).map(|(_, v)| *v).unwrap_or_else(|| panic!("no stat {name}: {:?}", f.stats))
+}
+
+fn bits(f: &specula::Frame) -> Vec<u32> {
+    f.image.data.iter().map(|v| v.to_bits()).collect()
+}
+
+/// lavapipe from Mesa 25 has the extensions: the tests below are about them.
+fn assert_ray_queries(ctx: &Context) {
+    assert!(
+        ctx.ray_query.is_ok(),
+        "this device has no ray queries ({:?}): scripts/setup.sh installs lavapipe from Mesa 25, which has them",
+        ctx.ray_query.as_ref().err()
+    );
+}
+
+/// Ten moves of the mirror sphere: every BLAS is built once (the first frame's), the TLAS
+/// once per frame after a move and not when nothing moved; each frame equals a fresh
+/// renderer's bit for bit. Then one mesh deforms (its vertices change in object space):
+/// its BLAS alone is rebuilt. The structures' bytes are in the memory registry under
+/// `raytrace.ray-query.*`, and equal the stage's `raytrace.accel_bytes`.
+#[test]
+fn moves_update_instances_and_deformation_rebuilds_one_blas() {
+    let ctx = common::gpu();
+    assert_ray_queries(&ctx);
+    let mut scene = common::mirror_and_glass(16);
+    let meshes = scene.meshes.iter().filter(|m| !m.indices.is_empty()).count() as f64;
+    let mirror = scene.meshes.iter().position(|m| m.name == "mirror").unwrap();
+    let mut r = renderer(&ctx, &scene, RAY_QUERY);
+    let first = r.render(&ctx).unwrap();
+    assert_eq!((stat(&first, "raytrace.blas_builds"), stat(&first, "raytrace.tlas_builds")), (meshes, 1.0));
+    let names: Vec<&str> = first.passes.iter().map(|p| p.name.as_str()).collect();
+    assert!(names.contains(&"raytrace.tlas") && names.contains(&"raytrace.intersect.ray-query"), "{names:?}");
+    let registry: u64 = ctx
+        .memory
+        .snapshot()
+        .iter()
+        .filter(|(n, _)| n == "raytrace.ray-query.blas" || n == "raytrace.ray-query.tlas")
+        .map(|(_, b)| b)
+        .sum();
+    assert!(registry > 0 && registry as f64 == stat(&first, "raytrace.accel_bytes"), "registry {registry} B");
+    // Nothing moved: no build is recorded.
+    let still = r.render(&ctx).unwrap();
+    assert_eq!(stat(&still, "raytrace.tlas_builds"), 1.0);
+    assert!(!still.passes.iter().any(|p| p.name == "raytrace.tlas"));
+    for k in 1..=10 {
+        let t = k as f32 * 0.05;
+        scene.set_object_transform(mirror, Mat4::from_translation(Vec3::new(0.2 * t.sin(), 0.05 * t, 0.1 * t))).unwrap();
+        assert_eq!(r.update(&scene).unwrap().moved, vec![mirror]);
+        let f = r.render(&ctx).unwrap();
+        assert_eq!(
+            (stat(&f, "raytrace.blas_builds"), stat(&f, "raytrace.tlas_builds")),
+            (meshes, 1.0 + k as f64),
+            "move {k}: instances only"
+        );
+        if k == 1 || k == 10 {
+            let mut fresh = renderer(&ctx, &scene, RAY_QUERY);
+            let want = bits(&fresh.render(&ctx).unwrap());
+            fresh.destroy(&ctx);
+            assert!(bits(&f) == want, "move {k}: incremental differs from a fresh render");
+        }
+    }
+    // Deformation: the glass sphere's vertices squashed in place (no transform).
+    let glass = scene.meshes.iter().position(|m| m.name == "glass").unwrap();
+    let centre = common::GLASS;
+    for p in &mut scene.meshes[glass].positions {
+        p.y = centre.y + (p.y - centre.y) * 0.7;
+    }
+    assert_eq!(r.update(&scene).unwrap().moved, vec![glass]);
+    let f = r.render(&ctx).unwrap();
+    assert_eq!((stat(&f, "raytrace.blas_builds"), stat(&f, "raytrace.tlas_builds")), (meshes + 1.0, 12.0), "one BLAS rebuilt");
+    let mut fresh = renderer(&ctx, &scene, RAY_QUERY);
+    let want = bits(&fresh.render(&ctx).unwrap());
+    fresh.destroy(&ctx);
+    assert!(bits(&f) == want, "after the deformation: incremental differs from a fresh render");
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+/// With the extensions hidden (`DeviceOptions::hide_ray_query`, as `SPECULA_RAY_QUERY=off`
+/// does), `ray-query` gives every object `bvh`: the reason says so, the image is bvh's bit
+/// for bit, and no acceleration structure is made.
+#[test]
+fn hidden_extensions_fall_back_to_bvh_with_a_reason() {
+    let ctx = Context::new(&DeviceOptions { validation: true, hide_ray_query: true, ..Default::default() }).unwrap();
+    assert!(ctx.ray_query.as_ref().is_err_and(|why| why.contains("hidden")), "{:?}", ctx.ray_query.as_ref().err());
+    let scene = common::mirror_and_glass(12);
+    let mut r = renderer(&ctx, &scene, RAY_QUERY);
+    for o in &r.plan.objects {
+        assert_eq!(o.method, BVH, "{}", o.name);
+        assert!(o.reason.contains("'ray-query' cannot run on this device") && o.reason.contains("fallback bvh"), "{}", o.reason);
+    }
+    let f = r.render(&ctx).unwrap();
+    assert!(f.stats.iter().all(|(k, _)| !k.contains("tlas")), "{:?}", f.stats);
+    assert!(!ctx.memory.snapshot().iter().any(|(n, _)| n.starts_with("raytrace.ray-query")));
+    r.destroy(&ctx);
+    let mut b = renderer(&ctx, &scene, BVH);
+    assert!(bits(&b.render(&ctx).unwrap()) == bits(&f), "the fallback renders bvh's image");
+    b.destroy(&ctx);
+    common::assert_clean(&ctx);
+}
+
+static LOG: Mutex<Vec<String>> = Mutex::new(Vec::new());
+
+unsafe extern "C" fn log(_user: *mut c_void, _level: u32, message: *const c_char) {
+    LOG.lock().unwrap().push(CStr::from_ptr(message).to_string_lossy().into_owned());
+}
+
+/// From C: specula_get_requirements lists the optional ray-query extensions and features;
+/// a host device that does not say it enabled them (SpeculaHostDesc::ray_query_enabled 0)
+/// gets `bvh` for `ray-query`, configure returns SPECULA_WARNING_DEVICE_FALLBACK, and the
+/// log callback names the object, the method and why.
+#[test]
+fn host_device_without_ray_queries_gets_the_fallback_and_a_message() {
+    use specula::ffi::*;
+    let own = common::gpu();
+    unsafe {
+        let mut req: SpeculaRequirements = std::mem::zeroed();
+        req.r#type = SPECULA_STRUCT_REQUIREMENTS;
+        req.size = std::mem::size_of::<SpeculaRequirements>() as u32;
+        assert_eq!(specula_get_requirements(&mut req), SPECULA_SUCCESS);
+        let optional: Vec<String> = (0..req.optional_device_extension_count as usize)
+            .map(|i| CStr::from_ptr(*req.optional_device_extensions.add(i)).to_string_lossy().into_owned())
+            .collect();
+        let want: Vec<String> = specula::vk::RAY_QUERY_DEVICE_EXTENSIONS.iter().map(|e| e.to_string_lossy().into_owned()).collect();
+        assert_eq!(optional, want);
+        assert_eq!((req.acceleration_structure, req.ray_query, req.buffer_device_address), (1, 1, 1));
+    }
+    let desc = common::host_desc(&own, 0);
+    let mut ctx = std::ptr::null_mut();
+    unsafe {
+        assert_eq!(specula_context_create_host(&desc, &mut ctx), SPECULA_SUCCESS, "{:?}", CStr::from_ptr(specula_creation_error()));
+        assert_eq!(specula_context_set_log_callback(ctx, Some(log), std::ptr::null_mut()), SPECULA_SUCCESS);
+        let scene = CString::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf")).unwrap();
+        assert_eq!(specula_context_load_gltf(ctx, scene.as_ptr()), SPECULA_SUCCESS);
+        let render = common::render_desc(RAY_QUERY, 16, 16);
+        assert_eq!(specula_context_configure(ctx, &render), SPECULA_WARNING_DEVICE_FALLBACK);
+        let log = LOG.lock().unwrap().clone();
+        assert!(
+            log.iter()
+                .any(|m| m.contains("object '") && m.contains("'ray-query' cannot run on this device") && m.contains("did not enable")),
+            "{log:?}"
+        );
+        // The same configuration with BVH asked for: no warning.
+        assert_eq!(specula_context_configure(ctx, &common::render_desc(BVH, 16, 16)), SPECULA_SUCCESS);
+        assert_eq!(specula_context_destroy(ctx), SPECULA_SUCCESS);
+    }
+    common::assert_clean(&own);
+}
