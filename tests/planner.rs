@@ -105,6 +105,9 @@ fn auto_and_budgets_on_unseen_scenes() {
     let _turn = turn();
     let ctx = common::gpu();
     let target = specula::target_for(&ctx, SIZE).expect("unit costs for this device");
+    // Where the device has ray queries its calibration measured `ray-query` (a candidate of
+    // auto and of every budget); where it has none, nothing did.
+    assert_eq!(target.costs.methods.contains_key("ray-query"), ctx.ray_query.is_ok(), "{:?}", target.costs.methods.keys());
     let q = {
         let mut q = Quality::default();
         q.frame.map_updates_always = true;

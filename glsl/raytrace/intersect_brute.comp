@@ -6,7 +6,7 @@
 RayHit intersect_brute(RayQuery q) {
     RayHit best = no_hit(q);
     bool any_hit = (q.flags & RAY_ANY_HIT) != 0u;
-    // lavapipe gives each invocation one budget of 65535 loop iterations, shared by all its
+    // lavapipe before Mesa 25 gives each invocation one budget of 65535 loop iterations, shared by all its
     // loops (gallivm's loop limiter; measured: with one loop the 65536th triangle is never
     // tested, with two nested loops the budget ends sooner), so the loop tests 8 triangles
     // per iteration: up to 524280 triangles there.

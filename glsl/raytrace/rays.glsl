@@ -6,9 +6,10 @@
 #include "common/scene.glsl"
 #include "common/ray_triangle.glsl"
 
-// lavapipe gives each invocation one budget of 65535 loop iterations shared by all its
+// lavapipe before Mesa 25 gives each invocation one budget of 65535 loop iterations shared by all its
 // loops (gallivm's loop limiter: the loop that exhausts it stops). Traversals stay far
-// below it (a ray visits hundreds of nodes or cells); brute force unrolls its loop.
+// below it (a ray visits hundreds of nodes or cells); brute force unrolls its loop. Mesa
+// 25.0.7 has no such budget (measured: hash chains of 200000 and 2 × 200000 steps complete).
 
 // Sample s of n per pixel, in the pixel's [0, 1)² (framebuffer axes): the Vulkan spec's
 // standard sample locations for n = 2, 4, 8 (the positions an MSAA camera target samples

@@ -13,7 +13,7 @@ knobs! {
         /// cube-map storage (radiance and distance): RGBA16F or RGBA32F
         cube_precision: Precision = "half", one_of()["half" => Precision::Half, "single" => Precision::Single];
         /// cube faces in six passes or one multiview pass (equal speed on lavapipe, six needs less depth memory: BENCHMARKS.md;
-        /// lavapipe's multiview puts large clipped triangles on wrong faces: use six there); the caustics' cubes always take six
+        /// lavapipe before Mesa 25 puts large clipped triangles on wrong faces with multiview: use six there; Mesa 25.0.7 renders both bit for bit alike); the caustics' cubes always take six
         /// passes
         cube_mode: CubeMode = "six", one_of()["six" => CubeMode::SixPasses, "multiview" => CubeMode::Multiview];
         /// reference point of every specular object's maps; auto = its bounding-box centre, moved when that lies inside or next to

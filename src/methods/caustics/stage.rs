@@ -89,7 +89,8 @@ impl CausticsStage {
             plan,
             photons: q.caustics.photons,
             filter: q.caustics.caustic_filter,
-            // Six passes whatever `cube_mode` says: with multiview, lavapipe (Mesa 22.3)
+            // Six passes whatever `cube_mode` says: with multiview, lavapipe (Mesa 22.3; Mesa
+            // 25.0.7 renders both alike, measured on the demo's cube-mapped methods)
             // scatters the receivers' triangles over the wrong faces of the cube (measured:
             // tests/caustics.rs, multiview_and_six_passes_make_the_same_caustic).
             mode: CubeMode::SixPasses,
