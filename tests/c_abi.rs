@@ -150,11 +150,12 @@ fn examples_render_the_same_image_through_every_link_mode() {
     // The methods with the most moving parts, through the host's command buffers too:
     // inter-object cycles (ping-pong maps, 4 cycles), self refraction, and the ray pipeline
     // of each acceleration scheme (GPU counters, indirect dispatch, integer accumulation),
-    // the ray engine and the ray hierarchy (raster passes over the ray texture) included.
+    // the ray engine and the ray hierarchy (raster passes over the ray texture) included, and
+    // ray queries (the host example enables their extensions where the device has them).
     let (standalone, host) = (dir.join("standalone_shared"), dir.join("host_shared"));
     // The O(N)-per-ray ray engine and ray hierarchy at depth 3 (the default 16 costs a
     // minute of CI for no further code path).
-    for method in ["4", "5", "6", "7", "8", "9", "10", "11"] {
+    for method in ["4", "5", "6", "7", "8", "9", "10", "11", "16"] {
         let (a, b) = (dir.join(format!("m{method}_standalone.f32")), dir.join(format!("m{method}_host.f32")));
         let depth = Path::new(if matches!(method, "10" | "11") { "depth=3" } else { "depth=16" });
         let ppm = dir.join(format!("m{method}.ppm"));

@@ -123,9 +123,44 @@ int main(int argc, char **argv) {
     f11.multiview = req.multiview;
     VkPhysicalDeviceFeatures2 f2 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f11};
     f2.features.imageCubeArray = req.image_cube_array;
+    /* The optional ray-query extensions and features, where the device has them all: the
+       `ray-query` method then traces through the driver's acceleration structures (without
+       them its objects get `bvh`, and configure says so). */
+    const char *extensions[16];
+    uint32_t extension_count = 0;
+    for (uint32_t i = 0; i < req.device_extension_count && extension_count < 16; ++i) extensions[extension_count++] = req.device_extensions[i];
+    uint32_t available_count = 0;
+    VK(vkEnumerateDeviceExtensionProperties(pd, NULL, &available_count, NULL));
+    VkExtensionProperties *available = calloc(available_count ? available_count : 1, sizeof *available);
+    VK(vkEnumerateDeviceExtensionProperties(pd, NULL, &available_count, available));
+    uint32_t found = 0;
+    for (uint32_t i = 0; i < req.optional_device_extension_count; ++i)
+        for (uint32_t j = 0; j < available_count; ++j)
+            if (strcmp(req.optional_device_extensions[i], available[j].extensionName) == 0) { ++found; break; }
+    free(available);
+    VkPhysicalDeviceRayQueryFeaturesKHR rq = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rq};
+    VkPhysicalDeviceVulkan12Features f12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &accel};
+    VkPhysicalDeviceFeatures2 probe = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &f12};
+    vkGetPhysicalDeviceFeatures2(pd, &probe);
+    int ray_query = found == req.optional_device_extension_count && f12.bufferDeviceAddress && accel.accelerationStructure && rq.rayQuery &&
+                    getenv("SPECULA_HOST_NO_RAY_QUERY") == NULL;
+    memset(&f12, 0, sizeof f12);
+    f12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+    if (ray_query) {
+        for (uint32_t i = 0; i < req.optional_device_extension_count && extension_count < 16; ++i)
+            extensions[extension_count++] = req.optional_device_extensions[i];
+        f12.bufferDeviceAddress = req.buffer_device_address;
+        accel = (VkPhysicalDeviceAccelerationStructureFeaturesKHR){VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rq};
+        accel.accelerationStructure = req.acceleration_structure;
+        rq = (VkPhysicalDeviceRayQueryFeaturesKHR){VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+        rq.rayQuery = req.ray_query;
+        f12.pNext = &accel;
+        robust.pNext = &f12;
+    }
     float prio = 1.0f;
     VkDeviceQueueCreateInfo qci = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO, NULL, 0, qf, 1, &prio};
-    VkDeviceCreateInfo dci = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f2, 0, 1, &qci, 0, NULL, req.device_extension_count, req.device_extensions, NULL};
+    VkDeviceCreateInfo dci = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &f2, 0, 1, &qci, 0, NULL, extension_count, extensions, NULL};
     VkDevice device;
     VK(vkCreateDevice(pd, &dci, NULL, &device));
     VkQueue queue;
@@ -154,7 +189,8 @@ int main(int argc, char **argv) {
     VK(vkBindBufferMemory(device, buffer, buffer_mem, 0));
 
     /* 6. specula on the engine's device. */
-    SpeculaHostDesc hd = {SPECULA_STRUCT_HOST_DESC, sizeof hd, (SpeculaGetInstanceProcAddr)vkGetInstanceProcAddr, instance, pd, device, qf, 1};
+    SpeculaHostDesc hd = {SPECULA_STRUCT_HOST_DESC, sizeof hd, (SpeculaGetInstanceProcAddr)vkGetInstanceProcAddr, instance, pd, device, qf, 1,
+                          (uint32_t)ray_query};
     SpeculaContext *ctx = NULL;
     specula_check(NULL, specula_context_create_host(&hd, &ctx), "create_host");
     specula_check(ctx, specula_context_load_gltf(ctx, argv[1]), "load_gltf");

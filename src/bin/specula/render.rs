@@ -19,7 +19,13 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
         return Ok(());
     }
     let ctx = context(args.validate, &args.device)?;
-    let plan = job.plan(&job.quality)?;
+    let asked = job.plan(&job.quality)?;
+    // What this device cannot run (ray-query without ray queries) gives way to its fallback,
+    // said here as the renderer would.
+    let plan = asked.clone().for_device(&job.scene, |m| m.needs.missing_on(&ctx))?;
+    for (o, _) in plan.objects.iter().zip(&asked.objects).filter(|(o, a)| o.method != a.method) {
+        eprintln!("specula: object '{}' gets {}: {}", o.name, o.method.name(), o.reason.rsplit("; ").next().unwrap_or(&o.reason));
+    }
     // Auto's own prediction where no budget made one.
     let prediction = prediction.or_else(|| plan.prediction.clone());
     let budget_plan = prediction.as_ref().map(|_| plan.clone());
