@@ -369,19 +369,20 @@ pub fn glsl(l: &Layout) -> Result<String, String> {
     for set in &l.sets {
         out.push('\n');
         comment(&mut out, "", &set.doc);
+        // A set that holds an acceleration structure needs GL_EXT_ray_query, which only the
+        // shaders that trace through it enable (defining SPECULA_RAY_QUERY before the include):
+        // the whole set is declared there alone.
+        let ray_query = set.bindings.iter().any(|b| b.ty == "ACCELERATION_STRUCTURE_KHR");
+        if ray_query {
+            out.push_str("#ifdef SPECULA_RAY_QUERY\n");
+        }
         for b in &set.bindings {
             comment(&mut out, "", &b.doc);
             let std430 = if b.ty == "STORAGE_BUFFER" || b.ty == "UNIFORM_BUFFER" { "std430, " } else { "" };
-            // Acceleration structures need GL_EXT_ray_query, which only the shaders that
-            // trace through them enable (defining SPECULA_RAY_QUERY before the include).
-            let ray_query = b.ty == "ACCELERATION_STRUCTURE_KHR";
-            if ray_query {
-                out.push_str("#ifdef SPECULA_RAY_QUERY\n");
-            }
             writeln!(out, "layout({std430}set = {}, binding = {}) {};", set.set, b.binding, b.decl).unwrap();
-            if ray_query {
-                out.push_str("#endif\n");
-            }
+        }
+        if ray_query {
+            out.push_str("#endif\n");
         }
     }
     for s in l.structs.iter().filter(|s| s.kind == "push_constant") {

@@ -131,6 +131,34 @@ fn hidden_extensions_fall_back_to_bvh_with_a_reason() {
     let mut b = renderer(&ctx, &scene, BVH);
     assert!(bits(&b.render(&ctx).unwrap()) == bits(&f), "the fallback renders bvh's image");
     b.destroy(&ctx);
+    // Exact caustic photons need ray queries: refused by name (a point light and a floor make
+    // the mirror and the glass caustic generators).
+    let mut lit = scene.clone();
+    let floor = lit.add_material(specula::scene::Material { name: "floor".into(), ..Default::default() }).unwrap();
+    lit.add_mesh(specula::scene::shapes::quad(
+        "floor",
+        Vec3::new(-2.0, 0.2, -2.0),
+        Vec3::new(0.0, 0.0, 4.0),
+        Vec3::new(4.0, 0.0, 0.0),
+        2,
+        floor,
+    ))
+    .unwrap();
+    lit.add_light(specula::scene::Light {
+        name: "lamp".into(),
+        kind: specula::scene::LightKind::Point,
+        position: Vec3::new(0.0, 3.0, 0.0),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(10.0),
+        range: None,
+    })
+    .unwrap();
+    let mut q = quality();
+    q.set_pair("caustic_paths=exact").unwrap();
+    let plan = plan_with(&lit, &Choices::all(BVH), &q).unwrap();
+    assert!(plan.caustics.is_some(), "caustics planned");
+    let e = Renderer::new(&ctx, &lit, plan, SIZE.0, SIZE.1).err().expect("refused").to_string();
+    assert!(e.contains("caustic_paths=exact") && e.contains("hidden"), "{e}");
     common::assert_clean(&ctx);
 }
 

@@ -1,5 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: EXACT_PATHS
+#ifdef EXACT_PATHS
+#extension GL_EXT_ray_query : require
+#define SPECULA_RAY_QUERY
+#endif
 // caustics.photons: the photon hit location image (survey §6.1.2, SKALP05/UPSK08). The
 // generator is rasterised from the light; each texel is one photon that follows its path
 // through the generator in the sampled geometry (§4): reflected by a mirror (or by a
@@ -10,7 +15,30 @@
 // in cube-map space, UPSK08; the light in light space, SP07) with the
 // photon's power: the light's intensity × the texel's solid angle (its area for a
 // directional light) × the Fresnel transmittances along the path.
+//
+// EXACT_PATHS (caustic_paths=exact, survey §6.1.1): the photon is traced in the original
+// geometry through ray queries (set 5) instead: the light's visibility by a shadow ray; at
+// a solid dielectric generator its layer's branch — 0: refracted in and out (T·T), 1:
+// reflected (R), k ≥ 2: refracted in, k − 1 internal reflections, refracted out (T·Rᵏ⁻¹·T),
+// each interface weighted by its Fresnel factor (total internal reflection by 1, and a
+// branch that would transmit there carries nothing); then every specular surface it meets
+// (mirrors reflect, dielectrics transmit, or reflect totally) up to EXACT_BOUNCES, to the
+// first diffuse hit.
 #include "distance/refractor/trace.glsl"
+#ifdef EXACT_PATHS
+#include "raytrace/ray_query.glsl"
+
+// Specular surfaces a photon passes after its generator before it is given up.
+const uint EXACT_BOUNCES = 8u;
+
+// The shading normal and material at hit h of a ray along d (set 5's triangle shading).
+void exact_surface(RayHit h, vec3 d, out vec3 n, out Material m) {
+    TriangleShading sh = rq_shading[h.triangle];
+    n = sh.n0.xyz * (1.0 - h.u - h.v) + sh.n1.xyz * h.u + sh.n2.xyz * h.v;
+    n = dot(n, n) > 0.0 ? normalize(n) : -normalize(d);
+    m = materials[floatBitsToUint(sh.n0.w)];
+}
+#endif
 
 layout(location = 0) in vec3 in_position;
 layout(location = 1) in vec3 in_normal;
@@ -43,10 +71,18 @@ void main() {
     }
     vec3 n = normalize(in_normal);
     if (dot(n, i) > 0.0) n = -n;  // the side the photon arrives on
+    uint branch = (push.flags >> CAUSTIC_BRANCH_SHIFT) & 0xfu;
+#ifdef EXACT_PATHS
+    float offset = caustic.ray_offset;
+    // Occluders between the light and the generator: a shadow ray.
+    bool directional = uint(l.direction_kind.w) == LIGHT_DIRECTIONAL;
+    if (rq_trace(p, -i, offset, directional ? RQ_T_MAX : dist * (1.0 - 1e-6), RAY_NO_TRIANGLE, true).triangle != RAY_NO_TRIANGLE) return;
+#else
     // Occluders between the light and the generator: the shadow map, offset towards the
     // light (not along the normal: at the silhouette, grazing, the generator would shadow
     // its own photons).
     power *= light_visibility(l, p, -i);
+#endif
     if (all(lessThanEqual(power, vec3(0.0)))) return;
 
     SpecularSplit s = specular_split(m, p, n, p - i);
@@ -54,7 +90,66 @@ void main() {
     vec3 pos = p;
     vec3 dir;
     vec3 w;
-    if (m.kind == KIND_MIRROR || (push.flags & CAUSTIC_REFLECTED) != 0u) {
+#ifdef EXACT_PATHS
+    uint skip = RAY_NO_TRIANGLE;
+    if (m.kind == KIND_MIRROR || branch == 1u) {
+        dir = s.r;
+        w = s.fr;
+    } else if (m.thin != 0u) {
+        dir = s.t;
+        w = s.ft;
+    } else {
+        // Refracted in; branch k ≥ 2 reflects k − 1 times inside, then every branch leaves.
+        if (all(lessThanEqual(s.ft, vec3(0.0)))) return;
+        dir = s.t;
+        w = s.ft;
+        uint reflections = branch == 0u ? 0u : branch - 1u;
+        for (uint k = 0u; k <= reflections; ++k) {
+            RayHit h = rq_trace(pos, dir, offset, RQ_T_MAX, skip, false);
+            if (h.triangle == RAY_NO_TRIANGLE) return;  // an open object: no exit surface
+            vec3 n2;
+            Material m2;
+            exact_surface(h, dir, n2, m2);
+            pos += dir * h.t;
+            skip = h.triangle;
+            SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
+            if (k < reflections) {
+                dir = s2.r;
+                w *= s2.fr;
+            } else {
+                if (all(lessThanEqual(s2.ft, vec3(0.0)))) return;  // totally reflected: another branch's
+                dir = s2.t;
+                w *= s2.ft;
+            }
+        }
+    }
+    // On to the first diffuse surface, through every specular one on the way.
+    for (uint bounce = 0u; bounce <= EXACT_BOUNCES; ++bounce) {
+        if (all(lessThan(w, vec3(1e-6)))) return;
+        RayHit h = rq_trace(pos, dir, offset, RQ_T_MAX, skip, false);
+        if (h.triangle == RAY_NO_TRIANGLE) return;  // escaped
+        vec3 n2;
+        Material m2;
+        exact_surface(h, dir, n2, m2);
+        pos += dir * h.t;
+        skip = h.triangle;
+        if (m2.kind == KIND_DIFFUSE) {
+            out_hit = vec4(pos - centre, 1.0);
+            out_power = vec4(w * power, 0.0);
+            return;
+        }
+        SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
+        if (m2.kind != KIND_MIRROR && any(greaterThan(s2.ft, vec3(0.0)))) {
+            dir = s2.t;
+            w *= s2.ft;
+        } else {
+            dir = s2.r;
+            w *= s2.fr;
+        }
+    }
+    return;
+#else
+    if (m.kind == KIND_MIRROR || branch == 1u) {
         // A mirror reflects, and so does a dielectric in its reflected-branch layer.
         dir = s.r;
         w = s.fr;
@@ -97,4 +192,5 @@ void main() {
     if (h.escaped) return;
     out_hit = vec4(x + dir * h.d, 1.0);
     out_power = vec4(w * power, 0.0);
+#endif
 }

@@ -8,7 +8,7 @@
 pub mod knob;
 
 pub use crate::frame::knobs::{Aa, DebugFault, FrameKnobs, FresnelMode};
-pub use crate::methods::caustics::knobs::{CausticSpace, Caustics, CausticsKnobs};
+pub use crate::methods::caustics::knobs::{CausticPaths, CausticSpace, Caustics, CausticsKnobs};
 pub use crate::methods::cube_knobs::{CubeKnobs, CubeMode, Precision};
 pub use crate::methods::distance::knobs::{DistanceKnobs, SearchKnobs};
 pub use crate::methods::envmap::knobs::EnvmapKnobs;

@@ -137,6 +137,13 @@ impl Renderer {
         // Methods the device cannot run (ray queries without the extensions) give way to
         // their fallbacks, named in the objects' reasons.
         let plan = plan.for_device(scene, |m| m.needs.missing_on(ctx))?;
+        if plan.caustics.is_some() && plan.quality.caustics.caustic_paths == crate::quality::CausticPaths::Exact {
+            if let Err(why) = &ctx.ray_query {
+                return Err(Error::Unsupported(format!(
+                    "knob caustic_paths=exact traces photons through ray queries, and {why}: use caustic_paths=both"
+                )));
+            }
+        }
         let (ssaa, multisample) = Targets::check(ctx, &plan, width, height)?;
         // Partial construction: every field that owns something starts empty, and
         // `destroy` frees whatever exists.

@@ -60,6 +60,26 @@ pub fn allocate_set(
     Ok((pool, set))
 }
 
+/// Destroys a pipeline layout, a descriptor pool (with its sets) and set layouts, and nulls
+/// the handles (null ones are no-ops), as every owner of its own layout does.
+pub fn destroy_layouts(
+    ctx: &Context,
+    layout: &mut vk::PipelineLayout,
+    pool: &mut vk::DescriptorPool,
+    set_layouts: &mut [vk::DescriptorSetLayout],
+) {
+    unsafe {
+        ctx.device.destroy_pipeline_layout(*layout, None);
+        ctx.device.destroy_descriptor_pool(*pool, None);
+        for l in set_layouts.iter() {
+            ctx.device.destroy_descriptor_set_layout(*l, None);
+        }
+    }
+    *layout = vk::PipelineLayout::null();
+    *pool = vk::DescriptorPool::null();
+    set_layouts.fill(vk::DescriptorSetLayout::null());
+}
+
 /// Writes a buffer descriptor; a null `buffer` writes a null descriptor.
 pub fn write_buffer(ctx: &Context, set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, buffer: vk::Buffer) {
     let info = [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];

@@ -30,10 +30,28 @@ knobs! {
         /// SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md)
         caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light];
         /// caustics: a dielectric generator's photons follow both Fresnel branches, each its own photon image (the reflected one is
-        /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way
-        caustic_reflections as caustic_paths: bool = "both", one_of()["both" => true, "refracted" => false];
+        /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way. `exact`: photons traced
+        /// in the original geometry through Vulkan ray queries (§6.1.1): every specular bounce to the first diffuse hit, a
+        /// solid dielectric's paths T·T, R and T·Rᵏ·T (k = 1 … internal_bounces, at most 14) each its own photon image, the
+        /// light's visibility by a shadow ray; needs a device with ray queries
+        caustic_paths: CausticPaths = "both", one_of()["both" => CausticPaths::Both, "refracted" => CausticPaths::Refracted, "exact" => CausticPaths::Exact];
     }
 }
+
+/// Which paths caustic photons follow, and through what geometry.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CausticPaths {
+    /// Both Fresnel branches at the generator's surface, in the sampled geometry (§6.1.2).
+    Both,
+    /// The refracted branch only.
+    Refracted,
+    /// Every specular bounce in the original geometry, through ray queries (§6.1.1).
+    Exact,
+}
+
+/// The most internal reflections an `exact` photon layer takes (its branch index has 4 bits).
+pub const EXACT_MAX_INTERNAL: u32 = 14;
 
 /// Where caustic photon hits are stored and projected from (survey §6.1.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]

@@ -33,6 +33,10 @@ gpu_structs! {
         triangle_count: uint,
         /// caustic triangles: triangles per photon layer, 2 (photon_size − 1)²
         layer_triangles: uint,
+        /// caustic_paths=exact: rays leave a surface this far along (10⁻⁶ of the scene's
+        /// diagonal, as the ray tracers' secondary rays)
+        ray_offset: float,
+        pad: [uint; 3],
     }
 }
 
@@ -48,9 +52,10 @@ gpu_consts! {
     /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_CUBE_SHIFT: uint = 8;
-    /// `Push.flags` of the photon pass: this layer's photons take the reflected branch at a
-    /// dielectric generator's surface (else the refracted one).
-    CAUSTIC_REFLECTED: uint = 65536;
+    /// `Push.flags` of the photon pass: this layer's branch `(flags >> CAUSTIC_BRANCH_SHIFT) &
+    /// 0xf` at a dielectric generator: 0 refracted in (and out), 1 reflected at its surface,
+    /// k ≥ 2 (caustic_paths=exact) refracted in, k − 1 internal reflections, refracted out.
+    CAUSTIC_BRANCH_SHIFT: uint = 16;
     CAUSTIC_LIGHT_SHIFT: uint = 20;
     /// Caustic triangles whose corners' distances from the reference point differ by more
     /// than this fraction land on different surfaces (§6.3.2) and are dropped.
@@ -61,7 +66,7 @@ flag_bits! {
     /// `scene.direct` is the frame's pass: the caustics' flag there is frame-wide.
     every_pass 7..8 { FLAG_CAUSTICS_APART }
     /// The photon pass's cube, branch and light.
-    own_passes 8..32 { CAUSTIC_CUBE_SHIFT: 8, CAUSTIC_REFLECTED, CAUSTIC_LIGHT_SHIFT: 12 }
+    own_passes 8..32 { CAUSTIC_CUBE_SHIFT: 8, CAUSTIC_BRANCH_SHIFT: 4, CAUSTIC_LIGHT_SHIFT: 12 }
 }
 
 descriptor_sets! {

@@ -32,7 +32,7 @@ use crate::Result;
 use crate::gpu_scene::{GpuLight, GpuView};
 use crate::methods::registry::Family;
 use crate::plan::types::{CausticCube, CausticsPlan, Generator, LightViews, ObjectPlan, Plan, PlanStages};
-use crate::quality::{CausticSpace, Caustics, Quality};
+use crate::quality::{CausticPaths, CausticSpace, Caustics, Quality};
 use crate::scene::{LightKind, Scene};
 
 impl CausticsPlan {
@@ -227,7 +227,15 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
     for o in objects {
         let (centre, radius) = bounding_sphere(scene, o.mesh);
         let dielectric = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
-        let branches = if dielectric && q.caustics.caustic_reflections { 2 } else { 1 };
+        let thin = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: true, .. });
+        let branches = match q.caustics.caustic_paths {
+            _ if !dielectric => 1,
+            CausticPaths::Refracted => 1,
+            CausticPaths::Both => 2,
+            CausticPaths::Exact if thin => 2,
+            // T·T, R, then T·Rᵏ·T for k = 1 … internal_bounces.
+            CausticPaths::Exact => 2 + q.distance.internal_bounces.min(knobs::EXACT_MAX_INTERNAL),
+        };
         let mut lights = Vec::new();
         let g = generators.len();
         let first_cube = cubes.len();

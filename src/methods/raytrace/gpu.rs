@@ -146,7 +146,9 @@ impl Intersector {
             let (pool, set) = allocate_set(ctx, "raytrace.ray-query", self.set_layouts[5], RAY_QUERY_BINDINGS)?;
             self.rq_pool = pool;
             self.rq_set = set;
-            super::stage::write_tlas(ctx, set, self.accel.as_ref().map_or(vk::AccelerationStructureKHR::null(), |a| a.tlas()));
+            super::ray_query::accel::write_tlas(ctx, set, self.accel.as_ref().map_or(vk::AccelerationStructureKHR::null(), |a| a.tlas()));
+            // The kernel reads no shading.
+            write_buffer(ctx, set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
             6
         } else {
             3
@@ -229,19 +231,12 @@ impl Intersector {
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
             ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device.destroy_descriptor_pool(self.pool, None);
             ctx.device.destroy_descriptor_pool(self.rq_pool, None);
-            for l in self.set_layouts {
-                ctx.device.destroy_descriptor_set_layout(l, None);
-            }
         }
         self.pipeline = vk::Pipeline::null();
-        self.layout = vk::PipelineLayout::null();
-        self.pool = vk::DescriptorPool::null();
         self.rq_pool = vk::DescriptorPool::null();
         self.rq_set = vk::DescriptorSet::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 6];
+        crate::vk::pipeline::destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
         if let Some(mut a) = self.accel.take() {
             a.destroy(ctx);
         }

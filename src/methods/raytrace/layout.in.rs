@@ -171,5 +171,8 @@ descriptor_sets! {
     /// create it.
     RAY_QUERY_BINDINGS = set 5 {
         TLAS = 0: ACCELERATION_STRUCTURE_KHR => "uniform accelerationStructureEXT tlas";
+        /// The triangles' shading attributes, as set 3's `SHADING` (caustic_paths=exact: the
+        /// normal and material at each photon hit)
+        RQ_SHADING = 1: STORAGE_BUFFER => "readonly buffer RqShading { TriangleShading rq_shading[]; }";
     }
 }

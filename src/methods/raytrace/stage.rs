@@ -212,7 +212,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
 }
 
 /// The shading attributes of every triangle of the list, in its order.
-fn triangle_shading(scene: &crate::scene::Scene) -> Vec<GpuTriangleShading> {
+pub(crate) fn triangle_shading(scene: &crate::scene::Scene) -> Vec<GpuTriangleShading> {
     let mut out = Vec::with_capacity(scene.triangle_count());
     for (m, mesh) in scene.meshes.iter().enumerate() {
         for t in mesh.indices.chunks_exact(3) {
@@ -426,7 +426,7 @@ impl RayTrace {
         let count = |bindings: &[crate::vk::pipeline::Binding], ty: vk::DescriptorType, sets: usize| {
             bindings.iter().filter(|b| b.1 == ty).count() as u32 * sets as u32
         };
-        let sizes = [
+        let mut sizes = [
             vk::DescriptorPoolSize {
                 ty: vk::DescriptorType::STORAGE_BUFFER,
                 descriptor_count: count(RAY_BINDINGS, vk::DescriptorType::STORAGE_BUFFER, ray_sets)
@@ -439,6 +439,7 @@ impl RayTrace {
             vk::DescriptorPoolSize { ty: vk::DescriptorType::ACCELERATION_STRUCTURE_KHR, descriptor_count: 1 },
         ];
         let rq_sets = self.accel.is_some() as usize;
+        sizes[0].descriptor_count += count(RAY_QUERY_BINDINGS, vk::DescriptorType::STORAGE_BUFFER, rq_sets);
         let sizes = &sizes[..2 + rq_sets];
         let info = vk::DescriptorPoolCreateInfo::default().max_sets((ray_sets + trace_sets + rq_sets) as u32).pool_sizes(sizes);
         self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
@@ -455,7 +456,8 @@ impl RayTrace {
         self.trace_sets = sets[ray_sets + 1..ray_sets + trace_sets].to_vec();
         if let Some(accel) = &self.accel {
             self.rq_set = sets[ray_sets + trace_sets];
-            write_tlas(ctx, self.rq_set, accel.tlas());
+            super::ray_query::accel::write_tlas(ctx, self.rq_set, accel.tlas());
+            write_buffer(ctx, self.rq_set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, self.shading.raw);
         }
 
         let sb = vk::DescriptorType::STORAGE_BUFFER;
@@ -637,19 +639,6 @@ impl RayTrace {
         self.push(ctx, cmd, f, view);
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, offset) };
     }
-}
-
-/// Points a ray-query set 5's TLAS binding at `tlas`.
-pub(super) fn write_tlas(ctx: &Context, set: vk::DescriptorSet, tlas: vk::AccelerationStructureKHR) {
-    let structures = [tlas];
-    let mut info = vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(&structures);
-    let mut w = vk::WriteDescriptorSet::default()
-        .dst_set(set)
-        .dst_binding(crate::frame::layout::binding::TLAS)
-        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
-        .push_next(&mut info);
-    w.descriptor_count = 1;
-    unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
 }
 
 /// Secondary and shadow rays start this far from the surface they leave (besides skipping
@@ -884,16 +873,7 @@ impl Stage for RayTrace {
             ],
         );
         self.p = Pipelines::default();
-        unsafe {
-            ctx.device.destroy_pipeline_layout(self.layout, None);
-            ctx.device.destroy_descriptor_pool(self.pool, None);
-            for l in self.set_layouts {
-                ctx.device.destroy_descriptor_set_layout(l, None);
-            }
-        }
-        self.layout = vk::PipelineLayout::null();
-        self.pool = vk::DescriptorPool::null();
-        self.set_layouts = [vk::DescriptorSetLayout::null(); 4];
+        crate::vk::pipeline::destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
         self.rq_set = vk::DescriptorSet::null();
         if let Some(s) = self.structure.as_mut() {
             s.destroy(ctx);

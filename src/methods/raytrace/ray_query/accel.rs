@@ -682,6 +682,19 @@ impl AccelStructures {
     }
 }
 
+/// Points a ray-query set 5's TLAS binding at `tlas`.
+pub fn write_tlas(ctx: &Context, set: vk::DescriptorSet, tlas: vk::AccelerationStructureKHR) {
+    let structures = [tlas];
+    let mut info = vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(&structures);
+    let mut w = vk::WriteDescriptorSet::default()
+        .dst_set(set)
+        .dst_binding(crate::frame::layout::binding::TLAS)
+        .descriptor_type(vk::DescriptorType::ACCELERATION_STRUCTURE_KHR)
+        .push_next(&mut info);
+    w.descriptor_count = 1;
+    unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
+}
+
 /// BLAS builds before the TLAS build (and any later build) reads them.
 fn build_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     let b = [vk::MemoryBarrier2::default()
