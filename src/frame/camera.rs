@@ -18,14 +18,49 @@ pub struct CameraShade {
     pipeline: vk::Pipeline,
     /// (mesh, push flags), the draws of this pass.
     objects: Vec<(usize, u32)>,
+    extra: Option<Box<dyn PassExtra>>,
+}
+
+/// What a family may add to its camera pass beyond the frame's sets: a pipeline layout with
+/// more sets, work recorded before the pass (and those sets bound for it), updates when
+/// objects move, and statistics (the distance family's hybrid search traces rays).
+pub trait PassExtra {
+    /// The pipeline layout: the frame's sets 0 and 1 and push constants, then its own sets.
+    fn layout(&self) -> vk::PipelineLayout;
+    /// Recorded before the pass.
+    fn before(&mut self, ctx: &Context, rec: &mut Recorder);
+    /// Binds its sets for the pass's pipeline.
+    fn bind(&self, ctx: &Context, cmd: vk::CommandBuffer);
+    fn update(&mut self, init: &crate::frame::stage::StageInit, changes: &crate::scene::update::Changes) -> Result<()>;
+    fn stats(&self) -> Vec<(String, f64)>;
+    fn destroy(&mut self, ctx: &Context);
 }
 
 impl CameraShade {
     /// With per-sample MSAA the fragment shader's PER_SAMPLE variant runs (its inputs
     /// interpolated at each sample, so the search starts from the sample's own point).
     pub fn new(ctx: &Context, layout: vk::PipelineLayout, plan: &CameraPlan, multisample: Multisample) -> Result<CameraShade> {
+        Self::with_extra(ctx, layout, plan, multisample, None, None)
+    }
+
+    /// `new` with the fragment shader's `variant` (`<variant>_PER_SAMPLE` where it runs per
+    /// sample) and `extra`'s layout and work.
+    pub fn with_extra(
+        ctx: &Context,
+        layout: vk::PipelineLayout,
+        plan: &CameraPlan,
+        multisample: Multisample,
+        variant: Option<&str>,
+        extra: Option<Box<dyn PassExtra>>,
+    ) -> Result<CameraShade> {
         let per_sample = multisample.per_sample && multisample.samples > 1;
-        let fragment = if per_sample { format!("{}#PER_SAMPLE", plan.fragment) } else { plan.fragment.to_string() };
+        let fragment = match (variant, per_sample) {
+            (Some(v), true) => format!("{}#{v}_PER_SAMPLE", plan.fragment),
+            (Some(v), false) => format!("{}#{v}", plan.fragment),
+            (None, true) => format!("{}#PER_SAMPLE", plan.fragment),
+            (None, false) => plan.fragment.to_string(),
+        };
+        let layout = extra.as_ref().map_or(layout, |e| e.layout());
         let pipeline = graphics_pipeline(
             ctx,
             layout,
@@ -44,8 +79,17 @@ impl CameraShade {
                 blend: crate::vk::pipeline::Blend::Replace,
                 depth_op: crate::vk::pipeline::DepthOp::Nearer,
             },
-        )?;
-        Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone() })
+        );
+        let pipeline = match pipeline {
+            Ok(p) => p,
+            Err(e) => {
+                if let Some(mut x) = extra {
+                    x.destroy(ctx);
+                }
+                return Err(e);
+            }
+        };
+        Ok(CameraShade { name: plan.name, pipeline, objects: plan.objects.clone(), extra })
     }
 }
 
@@ -57,6 +101,9 @@ impl Stage for CameraShade {
     /// Draws this pass's objects from the camera, sampling every map the frame holds
     /// (those the last cycle wrote).
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        if let Some(x) = self.extra.as_mut() {
+            x.before(rec.ctx, rec);
+        }
         let reads = io.maps.camera_reads();
         let mut pass = rec.pass(self.name).writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
         for img in reads {
@@ -69,6 +116,9 @@ impl Stage for CameraShade {
         if let Some(&set) = io.sets.camera.get(io.maps.latest) {
             f.bind_maps(ctx, cmd, set);
         }
+        if let Some(x) = &self.extra {
+            x.bind(ctx, cmd);
+        }
         for d in f.scene.draws.iter() {
             let Some(&(_, flags)) = self.objects.iter().find(|(m, _)| *m == d.mesh as usize) else { continue };
             let view_flags = io.object_flags.iter().find(|(m, _)| *m == d.mesh as usize).map_or(0, |(_, fl)| *fl);
@@ -79,8 +129,28 @@ impl Stage for CameraShade {
         rec.end(open);
     }
 
+    fn update(
+        &mut self,
+        init: &crate::frame::stage::StageInit,
+        changes: &crate::scene::update::Changes,
+        _maps: &mut crate::frame::stage::Maps,
+    ) -> Result<()> {
+        match self.extra.as_mut() {
+            Some(x) => x.update(init, changes),
+            None => Ok(()),
+        }
+    }
+
+    fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
+        self.extra.as_ref().map_or_else(Vec::new, |x| x.stats())
+    }
+
     fn destroy(&mut self, ctx: &Context) {
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
+        if let Some(x) = self.extra.as_mut() {
+            x.destroy(ctx);
+        }
+        self.extra = None;
     }
 }

@@ -9,17 +9,14 @@ use ash::vk;
 use super::slots::{CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_HITS, PHOTON_POWER};
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
-use crate::frame::layout::{binding, RAY_QUERY_BINDINGS};
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION};
 use crate::frame::shadow::FAR;
 use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
-use crate::frame::PUSH_BYTES;
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
-use crate::methods::raytrace::ray_query::accel::{AccelStructures, MeshInput};
+use crate::methods::raytrace::ray_query::scene::SceneRays;
 use crate::quality::{CausticPaths, Caustics, CubeMode, Quality};
-use crate::vk::pipeline::{allocate_set, descriptor_set_layout, destroy_layouts, pipeline_layout, write_buffer};
 use crate::vk::pipeline::{graphics_pipeline, Blend, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
@@ -42,65 +39,8 @@ pub struct CausticsStage {
     /// Caustic triangles: the set-up kernel (caustics/setup.comp).
     setup: vk::Pipeline,
     layout: vk::PipelineLayout,
-    /// caustic_paths=exact: the photons' ray queries (§6.1.1).
-    exact: Option<ExactPhotons>,
-    /// `map_updates=always`: the exact photons' TLAS is rebuilt every frame, as when objects
-    /// move.
-    tlas_every_frame: bool,
-}
-
-/// What exact photons trace through: the scene's acceleration structures and triangle
-/// shading (set 5), and the photon pipeline's layout that adds that set to the frame's.
-struct ExactPhotons {
-    accel: AccelStructures,
-    shading: Buffer,
-    /// Empty sets 2–4, then set 5.
-    set_layouts: [vk::DescriptorSetLayout; 4],
-    layout: vk::PipelineLayout,
-    pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
-}
-
-impl ExactPhotons {
-    fn new(init: &StageInit) -> Result<ExactPhotons> {
-        let ctx = init.ctx;
-        let me = ExactPhotons {
-            accel: AccelStructures::new(ctx, &MeshInput::from_scene(init.scene))?,
-            shading: Buffer::placeholder(),
-            set_layouts: [vk::DescriptorSetLayout::null(); 4],
-            layout: vk::PipelineLayout::null(),
-            pool: vk::DescriptorPool::null(),
-            set: vk::DescriptorSet::null(),
-        };
-        build(ctx, me, |me| {
-            me.shading = Buffer::with_data(
-                ctx,
-                "caustics.exact.shading",
-                &crate::methods::raytrace::stage::triangle_shading(init.scene),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-            )?;
-            let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT | vk::ShaderStageFlags::COMPUTE;
-            for k in 0..3 {
-                me.set_layouts[k] = descriptor_set_layout(ctx, "caustics.exact.empty", &[], stages)?;
-            }
-            me.set_layouts[3] = descriptor_set_layout(ctx, "caustics.exact", RAY_QUERY_BINDINGS, stages)?;
-            let layouts =
-                [init.set_layouts[0], init.set_layouts[1], me.set_layouts[0], me.set_layouts[1], me.set_layouts[2], me.set_layouts[3]];
-            me.layout = pipeline_layout(ctx, "caustics.exact", &layouts, PUSH_BYTES, stages)?;
-            let (pool, set) = allocate_set(ctx, "caustics.exact", me.set_layouts[3], RAY_QUERY_BINDINGS)?;
-            me.pool = pool;
-            me.set = set;
-            crate::methods::raytrace::ray_query::accel::write_tlas(ctx, set, me.accel.tlas());
-            write_buffer(ctx, set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, me.shading.raw);
-            Ok(())
-        })
-    }
-
-    fn destroy(&mut self, ctx: &Context) {
-        destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
-        self.accel.destroy(ctx);
-        self.shading.destroy(ctx);
-    }
+    /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
+    exact: Option<SceneRays>,
 }
 
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
@@ -175,7 +115,6 @@ impl CausticsStage {
             setup: vk::Pipeline::null(),
             layout: init.layout,
             exact: None,
-            tlas_every_frame: init.plan.quality.frame.map_updates_always,
         };
         Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
     }
@@ -237,7 +176,7 @@ impl CausticsStage {
         )?;
         self.photon = if q.caustics.caustic_paths == CausticPaths::Exact {
             // Photons traced through ray queries (§6.1.1): the variant with set 5.
-            let exact = ExactPhotons::new(init)?;
+            let exact = SceneRays::new(init, "caustics.exact")?;
             let layout = exact.layout;
             self.exact = Some(exact);
             graphics_pipeline(
@@ -352,11 +291,7 @@ impl Stage for CausticsStage {
     /// Reference points follow their objects; the table is rewritten before the frame.
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
         if let Some(e) = self.exact.as_mut() {
-            // Moved objects: new instances (and a TLAS in the next frame); their shading too.
-            if !changes.moved.is_empty() {
-                e.accel.update(init.ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
-                e.shading.write(bytemuck::cast_slice(&crate::methods::raytrace::stage::triangle_shading(init.scene)))?;
-            }
+            e.update(init, &changes.moved)?;
         }
         if let Some(p) = init.plan.caustics.as_ref() {
             for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
@@ -384,7 +319,7 @@ impl Stage for CausticsStage {
 
     fn destroy(&mut self, ctx: &Context) {
         if let Some(mut e) = self.exact.take() {
-            e.destroy(ctx);
+            Owner::destroy(&mut e, ctx);
         }
         self.cube_depth.destroy(ctx);
         self.photon_depth.destroy(ctx);
@@ -421,10 +356,7 @@ impl CausticsStage {
 
         // Exact photons: the structures they trace through, built where this frame needs them.
         if let Some(e) = self.exact.as_mut() {
-            if self.tlas_every_frame {
-                e.accel.touch();
-            }
-            e.accel.record(ctx, rec);
+            e.record(ctx, rec);
         }
         // The photon hit location images.
         let mut pass = rec.pass("caustics.photons").writes(hits, Access::ColorAttachment).writes(power, Access::ColorAttachment);
@@ -456,7 +388,7 @@ impl CausticsStage {
                     f.bind(ctx, cmd, self.photon);
                     f.bind_maps(ctx, cmd, io.sets.geometry);
                     if let Some(e) = &self.exact {
-                        unsafe { ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, e.layout, 5, &[e.set], &[]) };
+                        e.bind(ctx, cmd);
                     }
                     // Bits 8-31 are the caustics' own (layout.in.rs), apart from every frame-wide flag.
                     let flags = f.flags
@@ -516,12 +448,6 @@ impl CausticsStage {
             }
             rec.end(open);
         }
-    }
-}
-
-impl Owner for ExactPhotons {
-    fn destroy(&mut self, ctx: &Context) {
-        ExactPhotons::destroy(self, ctx)
     }
 }
 

@@ -3,6 +3,7 @@
 //! rays; inter-object cycles (§4.3); self refraction through refractor maps (§4.4) and
 //! Wyman's image-space double refraction (§4.4).
 
+pub mod hybrid;
 pub mod image_space;
 pub mod knobs;
 pub mod refractor;
@@ -64,7 +65,7 @@ pub const BACKFACES: MapInfo = MapInfo {
     describe: |_, _| "camera-sized RGBA32F back-face normals and depths + per-vertex thickness".into(),
 };
 
-const SEARCH_KNOBS: &[&str] = &[
+const SEARCH_KNOB_LIST: [&str; 10] = [
     CubeKnobs::cube_size,
     CubeKnobs::cube_precision,
     CubeKnobs::cube_mode,
@@ -76,6 +77,19 @@ const SEARCH_KNOBS: &[&str] = &[
     SearchKnobs::parallax_iterations,
     SearchKnobs::search_tolerance,
 ];
+const SEARCH_KNOBS: &[&str] = &SEARCH_KNOB_LIST;
+
+/// `distance`'s knobs: the search's, and the hybrid search's ray queries.
+const DISTANCE_KNOBS: &[&str] = &{
+    let mut all = [""; 11];
+    let mut k = 0;
+    while k < 10 {
+        all[k] = SEARCH_KNOB_LIST[k];
+        k += 1;
+    }
+    all[10] = DistanceKnobs::hybrid;
+    all
+};
 
 const fn one(_: &Quality) -> u32 {
     1
@@ -96,6 +110,18 @@ fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
     let mut c = c.clone();
     if init.plan.quality.frame.debug_fault == crate::quality::DebugFault::FlipReflection {
         c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
+    }
+    if init.plan.quality.distance.hybrid {
+        // The hybrid search: unresolved rays traced through ray queries (hybrid.rs).
+        let extra = hybrid::HybridRays::new(init, &c)?;
+        return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
+            init.ctx,
+            init.layout,
+            &c,
+            init.multisample,
+            Some("HYBRID"),
+            Some(Box::new(extra)),
+        )?));
     }
     Ok(Box::new(crate::frame::camera::CameraShade::new(init.ctx, init.layout, &c, init.multisample)?))
 }
@@ -189,7 +215,7 @@ pub const DISTANCE_INFO: &MethodInfo = &MethodInfo {
     family: "distance",
     summary: "distance maps (radiance + Euclidean distance from the reference point); reflected and refracted rays traced in them by linear search on the projected segment, secant and binary refinement, or parallax correction (eq. 4, 5)",
     serves: EVERY_CLASS,
-    knobs: SEARCH_KNOBS,
+    knobs: DISTANCE_KNOBS,
     gpu: Some(GpuSpec { maps: &[DISTANCE_CUBES], camera: SEARCH, map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
     fallback: None,
@@ -206,7 +232,7 @@ pub const DISTANCE_MULTI_INFO: &MethodInfo = &MethodInfo {
     summary: "inter-object reflections and refractions: each object's distance map regenerated in `cycles` cycles, specular objects in maps searching their own previous-cycle maps; `frame_latency=on` does one cycle per frame instead",
     serves: EVERY_CLASS,
     knobs: &[
-        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::cycles, DistanceKnobs::frame_latency,
+        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::cycles, DistanceKnobs::frame_latency, DistanceKnobs::hybrid,
     ],
     gpu: Some(GpuSpec {
         maps: &[DISTANCE_CUBES],

@@ -149,6 +149,7 @@ impl Intersector {
             super::ray_query::accel::write_tlas(ctx, set, self.accel.as_ref().map_or(vk::AccelerationStructureKHR::null(), |a| a.tlas()));
             // The kernel reads no shading.
             write_buffer(ctx, set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
+            write_buffer(ctx, set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
             6
         } else {
             3

@@ -174,5 +174,8 @@ descriptor_sets! {
         /// The triangles' shading attributes, as set 3's `SHADING` (caustic_paths=exact: the
         /// normal and material at each photon hit)
         RQ_SHADING = 1: STORAGE_BUFFER => "readonly buffer RqShading { TriangleShading rq_shading[]; }";
+        /// Per object two counters a raster pass that traces keeps (distance_fallback=rays:
+        /// the rays its search answered, the rays it traced)
+        RQ_COUNTS = 2: STORAGE_BUFFER => "buffer RqCounts { uint rq_counts[]; }";
     }
 }

@@ -458,6 +458,7 @@ impl RayTrace {
             self.rq_set = sets[ray_sets + trace_sets];
             super::ray_query::accel::write_tlas(ctx, self.rq_set, accel.tlas());
             write_buffer(ctx, self.rq_set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, self.shading.raw);
+            write_buffer(ctx, self.rq_set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
         }
 
         let sb = vk::DescriptorType::STORAGE_BUFFER;

@@ -10,6 +10,7 @@
 //! is set 5 (`RAY_QUERY_BINDINGS` in src/methods/raytrace/layout.in.rs).
 
 pub mod accel;
+pub mod scene;
 
 use super::{stage, Scheme};
 use crate::methods::registry::{DeviceNeeds, Method, MethodInfo};
