@@ -2,8 +2,9 @@
 //! queries, on lavapipe from Mesa 25 (scripts/setup.sh installs it from bookworm-backports;
 //! it exposes VK_KHR_acceleration_structure and VK_KHR_ray_query). Its exactness against
 //! the reference sits beside the other schemes' in tests/raytrace.rs, its nearest hits in
-//! tests/raytrace_conformance.rs, incremental = fresh in tests/frames.rs; here: what moves
-//! and deformation rebuild, memory, and the fallback where the extensions are missing.
+//! tests/raytrace_conformance.rs, incremental = fresh in tests/frames.rs, the exact caustic
+//! photons in tests/caustics.rs; here: what moves and deformation rebuild, memory, the
+//! fallback where the extensions are missing, and the hybrid distance-map search.
 
 mod common;
 
