@@ -36,6 +36,26 @@ fn stat(f: &specula::Frame, name: &str) -> f64 {
     f.stats.iter().find(|(k, _)| k == name).map(|(_, v)| *v).unwrap_or_else(|| panic!("no stat {name}: {:?}", f.stats))
 }
 
+/// `scene` with a diffuse floor under its spheres and a point light above: both spheres
+/// become caustic generators.
+fn lit(scene: &Scene) -> Scene {
+    let mut lit = scene.clone();
+    let floor = lit.add_material(specula::scene::Material { name: "floor".into(), ..Default::default() }).unwrap();
+    let quad =
+        specula::scene::shapes::quad("floor", Vec3::new(-2.0, 0.3, -2.0), Vec3::new(0.0, 0.0, 4.0), Vec3::new(4.0, 0.0, 0.0), 2, floor);
+    lit.add_mesh(quad).unwrap();
+    lit.add_light(specula::scene::Light {
+        name: "lamp".into(),
+        kind: specula::scene::LightKind::Point,
+        position: Vec3::new(0.0, 3.0, 0.3),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(10.0),
+        range: None,
+    })
+    .unwrap();
+    lit
+}
+
 fn bits(f: &specula::Frame) -> Vec<u32> {
     f.image.data.iter().map(|v| v.to_bits()).collect()
 }
@@ -134,26 +154,7 @@ fn hidden_extensions_fall_back_to_bvh_with_a_reason() {
     b.destroy(&ctx);
     // Exact caustic photons need ray queries: refused by name (a point light and a floor make
     // the mirror and the glass caustic generators).
-    let mut lit = scene.clone();
-    let floor = lit.add_material(specula::scene::Material { name: "floor".into(), ..Default::default() }).unwrap();
-    lit.add_mesh(specula::scene::shapes::quad(
-        "floor",
-        Vec3::new(-2.0, 0.2, -2.0),
-        Vec3::new(0.0, 0.0, 4.0),
-        Vec3::new(4.0, 0.0, 0.0),
-        2,
-        floor,
-    ))
-    .unwrap();
-    lit.add_light(specula::scene::Light {
-        name: "lamp".into(),
-        kind: specula::scene::LightKind::Point,
-        position: Vec3::new(0.0, 3.0, 0.0),
-        direction: Vec3::NEG_Y,
-        intensity: Vec3::splat(10.0),
-        range: None,
-    })
-    .unwrap();
+    let lit = lit(&scene);
     let mut q = quality();
     q.set_pair("caustic_paths=exact").unwrap();
     let plan = plan_with(&lit, &Choices::all(BVH), &q).unwrap();
@@ -260,5 +261,41 @@ fn hybrid_search_traces_only_what_the_map_cannot_answer() {
     assert_eq!(rays, 1181.0, "one ray per ball pixel: hidden fragments are not shaded");
     assert!(h >= 29.22 && h < e, "hybrid {h:.2} dB (distance {d:.2}, ray-query {e:.2})");
     assert!((0.01..=0.094).contains(&traced), "traced fraction {traced}");
+    common::assert_clean(&ctx);
+}
+
+/// The exact caustic photons and the hybrid search keep their structures in step with moving
+/// objects: after each of three moves of the mirror sphere the frame equals a fresh
+/// renderer's bit for bit, and no BLAS is built again.
+#[test]
+fn exact_photons_and_the_hybrid_search_follow_moves() {
+    let ctx = common::gpu();
+    assert_ray_queries(&ctx);
+    let scene = lit(&common::mirror_and_glass(16));
+    let mirror = scene.meshes.iter().position(|m| m.name == "mirror").unwrap();
+    for (method, knob, builds) in
+        [(BVH, "caustic_paths=exact", "caustics.exact.blas_builds"), (specula::methods::DISTANCE, "hybrid=rays", "")]
+    {
+        let mut q = quality();
+        q.set_pair(knob).unwrap();
+        q.set_pair("photons=32").unwrap();
+        let make = |s: &Scene| Renderer::new(&ctx, s, plan_with(s, &Choices::all(method), &q).unwrap(), SIZE.0, SIZE.1).unwrap();
+        let mut s = scene.clone();
+        let mut r = make(&s);
+        let first = r.render(&ctx).unwrap();
+        for k in 1..=3 {
+            s.set_object_transform(mirror, Mat4::from_translation(Vec3::new(0.1 * k as f32, 0.02 * k as f32, 0.0))).unwrap();
+            r.update(&s).unwrap();
+            let f = r.render(&ctx).unwrap();
+            let mut fresh = make(&s);
+            let want = bits(&fresh.render(&ctx).unwrap());
+            fresh.destroy(&ctx);
+            assert!(bits(&f) == want, "{knob}: move {k}: incremental differs from a fresh render");
+            if !builds.is_empty() {
+                assert_eq!(stat(&f, builds), stat(&first, builds), "{knob}: move {k} built a BLAS");
+            }
+        }
+        r.destroy(&ctx);
+    }
     common::assert_clean(&ctx);
 }
