@@ -27,19 +27,28 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     return true;
 }
 
+// What the camera's self refraction traces with: the map searches, unless a variant (the
+// hybrid search, distance/hybrid.glsl) defines its own before including this file.
+#ifndef REFRACTOR_ENV
+#define REFRACTOR_ENV traced_radiance
+#endif
+#ifndef REFRACTOR_EXIT
+#define REFRACTOR_EXIT refractor_exit
+#endif
+
 // Radiance leaving point p of solid refractor o (material m, interpolated normal n)
 // towards eye.
 vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
-    vec3 c = s.fr * traced_radiance(o, p, s.r);
+    vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
     vec3 weight = s.ft;
     vec3 pos = p;
     vec3 dir = s.t;
     float ior = m.nu.x;
     for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
-        if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
-            c += weight * traced_radiance(o, pos, dir);
+        if (!REFRACTOR_EXIT(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
+            c += weight * REFRACTOR_ENV(o, pos, dir);
             weight = vec3(0.0);
             break;
         }
@@ -48,7 +57,7 @@ vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
         // Leaving the object: ν_i/ν_t = ior, the normal faces the inside (−n2).
         if (refract_dir(dir, -n2, ior, out_dir)) {
             vec3 f = material_fresnel(m, cos_i, 1.0 / ior);
-            c += weight * (1.0 - f) * traced_radiance(o, hit, out_dir);
+            c += weight * (1.0 - f) * REFRACTOR_ENV(o, hit, out_dir);
             weight *= f;
         }
         // Total internal reflection (or the reflected part): on inside the object.

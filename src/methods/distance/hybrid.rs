@@ -1,5 +1,6 @@
-//! The hybrid search (`hybrid=rays`): the distance-map camera pass (§4.2) traces in the map
-//! as always, and where its search cannot answer — the ray escaped (in a closed scene a gap
+//! The hybrid search (`hybrid=rays`): the distance-map camera pass (§4.2, and self
+//! refraction's, §4.4: inside the refractor map too) traces in the map as always, and where
+//! its search cannot answer — the ray escaped (in a closed scene a gap
 //! the map does not cover), or its hit is not the surface the map holds in that direction (a
 //! point hidden behind a silhouette from the reference point, beyond the search's tolerance)
 //! — fires a Vulkan ray query and shades what it meets (`glsl/distance/search.frag`,

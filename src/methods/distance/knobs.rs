@@ -28,9 +28,9 @@ knobs! {
         internal_bounces: u32 = 2, count(0..=16);
         /// distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)
         frame_latency: bool = "off", one_of()["on" => true, "off" => false];
-        /// distance: the camera pass's rays whose map search is unresolved (escaped, or a hit the map does not hold: a gap behind
-        /// a silhouette, beyond the search's tolerance) are traced through Vulkan ray queries and their hits shaded (`rays`; needs
-        /// a device with ray queries), or left to the map (`off`)
+        /// distance, distance-multi, refractor-map: the camera pass's searches that the map cannot answer (escaped, or a hit the
+        /// map does not hold: a gap behind a silhouette, beyond the search's tolerance; inside a refractor too) are traced through
+        /// Vulkan ray queries and their hits shaded (`rays`; needs a device with ray queries), or left to the map (`off`)
         hybrid: bool = "off", one_of()["off" => false, "rays" => true];
     }
 }

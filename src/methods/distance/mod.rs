@@ -105,25 +105,30 @@ const SEARCH: CameraPass = CameraPass {
     profiled: Profiled::OWN,
 };
 
+/// A camera pass of the plain shader, or with `hybrid=rays` its HYBRID variant and the ray
+/// queries it fires (hybrid.rs).
+fn create_hybrid_or_plain(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
+    if init.plan.quality.distance.hybrid {
+        let extra = hybrid::HybridRays::new(init, c)?;
+        return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
+            init.ctx,
+            init.layout,
+            c,
+            init.multisample,
+            Some("HYBRID"),
+            Some(Box::new(extra)),
+        )?));
+    }
+    Ok(Box::new(crate::frame::camera::CameraShade::new(init.ctx, init.layout, c, init.multisample)?))
+}
+
 /// `distance.search`, which the test knob `debug_fault=flip_reflection` breaks on purpose.
 fn create_search(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
     let mut c = c.clone();
     if init.plan.quality.frame.debug_fault == crate::quality::DebugFault::FlipReflection {
         c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_DEBUG_FLIP_REFLECTION);
     }
-    if init.plan.quality.distance.hybrid {
-        // The hybrid search: unresolved rays traced through ray queries (hybrid.rs).
-        let extra = hybrid::HybridRays::new(init, &c)?;
-        return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
-            init.ctx,
-            init.layout,
-            &c,
-            init.multisample,
-            Some("HYBRID"),
-            Some(Box::new(extra)),
-        )?));
-    }
-    Ok(Box::new(crate::frame::camera::CameraShade::new(init.ctx, init.layout, &c, init.multisample)?))
+    create_hybrid_or_plain(init, &c)
 }
 
 const SOLIDS: &[ObjectClass] = &[ObjectClass::SolidDielectric];
@@ -257,11 +262,11 @@ pub const REFRACTOR_MAP_INFO: &MethodInfo = &MethodInfo {
     summary: "self refraction: each solid refractor's own normal + distance cube map, the refracted ray searched inside it, refracted out (Snell) or internally reflected up to `internal_bounces` times, then traced in the environment's distance map",
     serves: SOLIDS,
     knobs: &[
-        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::internal_bounces,
+        CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance, DistanceKnobs::internal_bounces, DistanceKnobs::hybrid,
     ],
     gpu: Some(GpuSpec {
         maps: &[REFRACTOR_CUBES, DISTANCE_CUBES],
-        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: None, profiled: Profiled::OWN },
+        camera: CameraPass { name: "refractor.search", vertex: "scene/mesh.vert", fragment: "distance/refractor/search.frag", flags: 0, order: order::CAMERA + 1, create: Some(create_hybrid_or_plain), profiled: Profiled::OWN },
         map_shading: MapShading::Refractor,
         leaves_out: LeavesOut::Itself,
         cycles: one,
