@@ -31,12 +31,11 @@
 // Specular surfaces a photon passes after its generator before it is given up.
 const uint EXACT_BOUNCES = 8u;
 
-// The shading normal and material at hit h of a ray along d (set 5's triangle shading).
+// The shading normal and material at hit h of a ray along d.
 void exact_surface(RayHit h, vec3 d, out vec3 n, out Material m) {
-    TriangleShading sh = rq_shading[h.triangle];
-    n = sh.n0.xyz * (1.0 - h.u - h.v) + sh.n1.xyz * h.u + sh.n2.xyz * h.v;
-    n = dot(n, n) > 0.0 ? normalize(n) : -normalize(d);
-    m = materials[floatBitsToUint(sh.n0.w)];
+    RqSurface s = rq_surface(h, d);
+    n = s.n;
+    m = materials[s.material];
 }
 #endif
 

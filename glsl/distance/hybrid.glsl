@@ -63,14 +63,10 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     RayHit h = rq_trace_mesh(p, dir, 1e-5 * length(x) + 1e-30, push.object, false);
     // Nothing: the environment at infinity, as the map holds it in that direction.
     if (h.triangle == RAY_NO_TRIANGLE) return textureLod(distance_maps, vec4(dir, search_layer), 0.0).rgb;
-    TriangleShading sh = rq_shading[h.triangle];
-    float w = 1.0 - h.u - h.v;
-    vec3 n = sh.n0.xyz * w + sh.n1.xyz * h.u + sh.n2.xyz * h.v;
-    n = dot(n, n) > 0.0 ? normalize(n) : -dir;
-    vec2 uv = sh.uv01.xy * w + sh.uv01.zw * h.u + sh.uv2.xy * h.v;
-    Material m2 = materials[floatBitsToUint(sh.n0.w)];
+    RqSurface sf = rq_surface(h, dir);
+    Material m2 = materials[sf.material];
     vec3 q = p + dir * h.t;
-    if (m2.kind == KIND_DIFFUSE) return shade_diffuse(m2, q, n, p, uv);
+    if (m2.kind == KIND_DIFFUSE) return shade_diffuse(m2, q, sf.n, p, sf.uv);
     return textureLod(distance_maps, vec4(normalize(q - o.reference_point.xyz), search_layer), 0.0).rgb;
 }
 
@@ -96,10 +92,7 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     atomicAdd(rq_counts[2u * push.object + 1u], 1u);
     RayHit r = rq_trace_mesh(pos, dir, 1e-5 * length(pos - ref) + 1e-30, push.object, true);
     if (r.triangle == RAY_NO_TRIANGLE) return false;  // an open refractor: the ray is out
-    TriangleShading sh = rq_shading[r.triangle];
-    float w = 1.0 - r.u - r.v;
-    n2 = sh.n0.xyz * w + sh.n1.xyz * r.u + sh.n2.xyz * r.v;
-    n2 = dot(n2, n2) > 0.0 ? normalize(n2) : dir;
+    n2 = rq_surface(r, dir).n;
     if (dot(n2, dir) < 0.0) n2 = -n2;
     hit = pos + dir * r.t;
     return true;

@@ -40,4 +40,23 @@ RayHit rq_trace(vec3 o, vec3 d, float t_min, float t_max, uint skip, bool any_hi
     return best;
 }
 
+// The surface at ray-query hit h of a ray along d, from set 5's triangle shading: the
+// interpolated unit normal (−d where it degenerates), texture coordinates and material.
+struct RqSurface {
+    vec3 n;
+    vec2 uv;
+    uint material;
+};
+
+RqSurface rq_surface(RayHit h, vec3 d) {
+    TriangleShading sh = rq_shading[h.triangle];
+    float w = 1.0 - h.u - h.v;
+    vec3 n = sh.n0.xyz * w + sh.n1.xyz * h.u + sh.n2.xyz * h.v;
+    RqSurface s;
+    s.n = dot(n, n) > 0.0 ? normalize(n) : -normalize(d);
+    s.uv = sh.uv01.xy * w + sh.uv01.zw * h.u + sh.uv2.xy * h.v;
+    s.material = floatBitsToUint(sh.n0.w);
+    return s;
+}
+
 #endif

@@ -176,23 +176,32 @@ pub const RAY_QUERY_DEVICE_EXTENSIONS: &[&CStr] =
 /// Whether the device has what `ray-query` needs: [`RAY_QUERY_DEVICE_EXTENSIONS`] and the
 /// features accelerationStructure, rayQuery and bufferDeviceAddress; else which is missing.
 pub fn ray_query_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> std::result::Result<(), String> {
-    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-    for name in RAY_QUERY_DEVICE_EXTENSIONS {
-        if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == *name)) {
-            return Err(format!("the device lacks the extension {}", name.to_string_lossy()));
-        }
-    }
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut accel = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
     let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
     let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f12).push_next(&mut accel).push_next(&mut rq);
     unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    let checks = [
+    let features = [
         (accel.acceleration_structure, "accelerationStructure"),
         (rq.ray_query, "rayQuery"),
         (f12.buffer_device_address, "bufferDeviceAddress"),
     ];
-    match checks.iter().find(|(v, _)| *v == vk::FALSE) {
+    device_has(instance, pd, RAY_QUERY_DEVICE_EXTENSIONS, &features)
+}
+
+/// The first of `extensions` the device lacks, else the first of `features` it does not
+/// support, as a message; `Ok` when it has them all.
+fn device_has(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    extensions: &[&CStr],
+    features: &[(vk::Bool32, &str)],
+) -> std::result::Result<(), String> {
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    if let Some(name) = extensions.iter().find(|n| !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == **n))) {
+        return Err(format!("the device lacks the extension {}", name.to_string_lossy()));
+    }
+    match features.iter().find(|(v, _)| *v == vk::FALSE) {
         Some((_, name)) => Err(format!("the device lacks the feature {name}")),
         None => Ok(()),
     }
@@ -212,13 +221,7 @@ pub fn required_features_supported(instance: &ash::Instance, pd: vk::PhysicalDev
     let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f11).push_next(&mut f13).push_next(&mut robust);
     unsafe { instance.get_physical_device_features2(pd, &mut f2) };
     let f = f2.features;
-    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-    for name in REQUIRED_DEVICE_EXTENSIONS {
-        if !exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|x| x == *name)) {
-            return Err(format!("device lacks the extension {}", name.to_string_lossy()));
-        }
-    }
-    let checks = [
+    let features = [
         (f.image_cube_array, "imageCubeArray"),
         (f11.multiview, "multiview"),
         (robust.null_descriptor, "nullDescriptor (VK_EXT_robustness2)"),
@@ -226,10 +229,7 @@ pub fn required_features_supported(instance: &ash::Instance, pd: vk::PhysicalDev
         (f13.synchronization2, "synchronization2"),
         (f13.maintenance4, "maintenance4"),
     ];
-    match checks.iter().find(|(v, _)| *v == vk::FALSE) {
-        Some((_, name)) => Err(format!("device lacks the feature {name}")),
-        None => Ok(()),
-    }
+    device_has(instance, pd, REQUIRED_DEVICE_EXTENSIONS, &features)
 }
 
 /// Validation errors reported by any context of this process, ever: a leaked Vulkan object
