@@ -21,6 +21,9 @@ const SIZE: (u32, u32) = (64, 64);
 /// Three unseen scenes: a mirror torus in a far room; a glass sphere behind an occluder; a
 /// planar mirror beside a glass prism.
 const UNSEEN: [usize; 3] = [38, 49, 54];
+/// An unseen scene where auto is predicted to gain from anti-aliasing (a mirror sphere in a
+/// room: `proxy-box` with `aa=msaa4` inside the exact tracer's time).
+const AA_SCENE: usize = 36;
 /// PSNR is capped here (the stored corpus's cap: beyond it an image is the exact tracer's).
 const CAP: f64 = 60.0;
 const NOISE: f64 = 1.25;
@@ -50,6 +53,7 @@ struct Measured {
 struct Truth {
     reference: specula::Frame,
     ids: Vec<u32>,
+    size: (u32, u32),
 }
 
 fn measure(
@@ -77,7 +81,7 @@ fn measure_plan(
     truth: &Truth,
     frames: (u32, u32),
 ) -> Measured {
-    let frame = specula::render_plan(ctx, scene, plan, SIZE, frames).unwrap();
+    let frame = specula::render_plan(ctx, scene, plan, truth.size, frames).unwrap();
     let ms = frame.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum();
     let (reference, ids) = (&truth.reference, &truth.ids);
     let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();
@@ -127,7 +131,7 @@ fn auto_and_budgets_on_unseen_scenes() {
         let name = corpus::name(i);
         let reference =
             specula::render(&ctx, &scene, specula::methods::BVH, &specula::tradeoff::reference_quality(&q), SIZE, (1, 1)).unwrap();
-        let reference = Truth { reference, ids: specula::reference::object_ids(&scene, SIZE).unwrap() };
+        let reference = Truth { reference, ids: specula::reference::object_ids(&scene, SIZE).unwrap(), size: SIZE };
         // A method that serves none of the scene's objects falls back to one measured already:
         // the same plan (stages and per-object methods) is the same frame, measured once.
         let mut singles: Vec<Measured> = Vec::new();
@@ -178,8 +182,11 @@ fn auto_and_budgets_on_unseen_scenes() {
             };
             (again("auto", &Choices::all(Choice::Auto)).min(auto.ms), again(&best.label, &Choices::all(m)).min(best.ms))
         };
+        // (A knob variant auto took may spend more than the best single method for more
+        // accuracy, within the default budget.)
+        let richer = auto.psnr > best.psnr + 0.5 && auto_ms <= budget;
         assert!(
-            auto.psnr >= best.psnr - 0.5 && auto_ms <= CHOICE * best_ms,
+            auto.psnr >= best.psnr - 0.5 && (auto_ms <= CHOICE * best_ms || richer),
             "{name}: auto {:.2} ms {:.1} dB against the best single method {} {:.2} ms {:.1} dB:{table}",
             auto_ms,
             auto.psnr,
@@ -254,9 +261,10 @@ fn auto_keeps_its_choice_within_the_hysteresis_and_says_why_it_switches() {
     let auto = Choices { method: Choice::Auto, objects: p.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
     let envmap = on(specula::methods::ENVMAP);
     if auto != envmap {
-        let why = predict::switch(&scene, &facts, &envmap, &auto, &q, &t).unwrap().expect("auto's choice is far better than envmap");
+        let why =
+            predict::switch(&scene, &facts, (&envmap, &q), (&auto, &q), &t).unwrap().expect("auto's choice is far better than envmap");
         assert!(why.contains("envmap →"), "{why}");
-        assert_eq!(predict::switch(&scene, &facts, &auto, &envmap, &q, &t).unwrap(), None, "and not back");
+        assert_eq!(predict::switch(&scene, &facts, (&auto, &q), (&envmap, &q), &t).unwrap(), None, "and not back");
         let mut poor = p.clone();
         poor.objects.iter_mut().for_each(|o| o.method = specula::methods::ENVMAP);
         match poor.refresh_geometry(&scene) {
@@ -315,5 +323,78 @@ fn a_corrupt_cost_cache_is_named_and_replaced() {
     }
     assert!(dir.join(other.key.file_name()).exists(), "the other device's file is kept");
     std::fs::remove_dir_all(&dir).ok();
+    common::assert_clean(&ctx);
+}
+
+/// Auto chooses the frame's knobs too (`predict::auto_variants`): only those left at their
+/// defaults, none under `plan_knobs=keep`; a plan that took a variant names it in its reason,
+/// renders with it, and a small move keeps it (a re-plan starts from the asked knobs).
+#[test]
+fn auto_chooses_only_the_knobs_left_to_it() {
+    let _turn = turn();
+    let q = Quality::default();
+    assert_eq!(predict::auto_variants(&q), predict::budget_variants());
+    let with = |pairs: &[&str]| {
+        let mut q = Quality::default();
+        pairs.iter().for_each(|p| q.set_pair(p).unwrap());
+        q
+    };
+    let names = |q: &Quality| predict::auto_variants(q);
+    assert!(names(&with(&["aa=msaa8"])).iter().all(|v| !v.contains("aa=")), "{:?}", names(&with(&["aa=msaa8"])));
+    assert!(names(&with(&["cube_size=1024"])).iter().all(|v| !v.contains("cube_size")));
+    assert_eq!(names(&with(&["plan_knobs=keep"])), vec!["default".to_string()]);
+
+    let t = Target::nominal().unwrap();
+    let (scene, p) = (AA_SCENE..AA_SCENE + 1)
+        .map(|i| corpus::scene(i).unwrap())
+        .map(|s| {
+            let p = plan_for(&s, &Choices::all(Choice::Auto), &q, Some(&t)).unwrap();
+            (s, p)
+        })
+        .next()
+        .unwrap();
+    let knobs = p.prediction.as_ref().unwrap().knobs.clone();
+    assert_ne!(knobs, "default", "scene {AA_SCENE}: auto is predicted to gain from a knob variant here");
+    for pair in knobs.split_whitespace() {
+        let (k, v) = pair.split_once('=').unwrap();
+        assert_eq!(p.quality.get(k), v, "the plan renders with {pair}");
+    }
+    assert!(p.objects.iter().any(|o| o.reason.contains(&format!("with {knobs}"))), "{:?}", p.objects);
+    let kept = plan_for(&scene, &Choices::all(Choice::Auto), &with(&["plan_knobs=keep"]), Some(&t)).unwrap();
+    assert_eq!(kept.quality.get("aa"), "off");
+    assert_eq!(kept.quality.get("cube_size"), q.get("cube_size"));
+    let mut moved = scene.clone();
+    let mut cam = moved.camera_or_default();
+    cam.position += glam::Vec3::new(0.01, 0.0, 0.0);
+    moved.camera = Some(cam);
+    let mut again = p.clone();
+    again.refresh_geometry(&moved).expect("a small move keeps the plan and its knobs");
+    assert_eq!(again.quality, p.quality);
+
+    // Rendered (128²: at 64² the maps' fixed cost outweighs what anti-aliasing gains, and
+    // auto ray traces; this device's costs): the variant auto takes is more accurate than
+    // the same methods without it, and the exact tracer does not beat it in both time and
+    // error.
+    const AA_SIZE: (u32, u32) = (128, 128);
+    let ctx = common::gpu();
+    let target = specula::target_for(&ctx, AA_SIZE).expect("unit costs for this device");
+    let q = {
+        let mut q = Quality::default();
+        q.frame.map_updates_always = true;
+        q
+    };
+    let reference =
+        specula::render(&ctx, &scene, specula::methods::BVH, &specula::tradeoff::reference_quality(&q), AA_SIZE, (1, 1)).unwrap();
+    let truth = Truth { reference, ids: specula::reference::object_ids(&scene, AA_SIZE).unwrap(), size: AA_SIZE };
+    let auto = plan_for(&scene, &Choices::all(Choice::Auto), &q, Some(&target)).unwrap();
+    assert_ne!(auto.quality, q, "at 128² too auto takes a variant here: {:?}", auto.prediction);
+    let same = Choices { method: Choice::Auto, objects: auto.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
+    let a = measure_plan(&ctx, &scene, "auto", auto, &truth, TIMED);
+    let plain = measure(&ctx, &scene, "same methods, asked knobs", &same, &q, &target, &truth);
+    let bvh = measure(&ctx, &scene, "bvh", &Choices::all(Choice::Method(specula::methods::BVH)), &q, &target, &truth);
+    let table = format!("{:?}", [&a, &plain, &bvh].map(|m| format!("{} {:.2} ms {:.1} dB", m.label, m.ms, m.psnr)));
+    println!("{table}");
+    assert!(a.psnr > plain.psnr + 0.5, "the variant gains: {table}");
+    assert!(!(bvh.ms * NOISE < a.ms && bvh.psnr > a.psnr + 0.5), "bvh dominates auto: {table}");
     common::assert_clean(&ctx);
 }

@@ -12,6 +12,9 @@ knobs! {
         /// more than 1 dB or 20 % faster (on); off: every move re-chooses as a fresh plan would, so a frame equals a
         /// fresh context's, at the price of choices that may flicker between frames
         plan_hysteresis: bool = "on", one_of()["on" => true, "off" => false];
+        /// whether --method auto may also choose frame knobs that are left at their defaults (cube_size 128/512, aa msaa4/ssaa2)
+        /// when they are predicted to give a better image within its time (choose), or keeps every knob as asked (keep)
+        plan_knobs: bool = "choose", one_of()["choose" => true, "keep" => false];
     }
 }
 

@@ -64,8 +64,8 @@ impl Plan {
         // predicts the new choice better by more than its hysteresis (then a new renderer).
         let asked = Choices { method: self.choice, objects: self.overrides.clone() };
         let kept = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
-        let mut fresh = plan_inner(scene, &asked, &self.quality, true, self.target.as_ref())?;
-        if methods(&fresh) != methods(self) {
+        let mut fresh = plan_inner(scene, &asked, &self.asked_quality, true, self.target.as_ref())?;
+        if methods(&fresh) != methods(self) || fresh.quality != self.quality {
             if self.choice == Choice::Auto && !self.quality.plan.plan_hysteresis {
                 let changed: Vec<String> = fresh
                     .objects
@@ -73,6 +73,7 @@ impl Plan {
                     .zip(&self.objects)
                     .filter(|(n, o)| n.method != o.method)
                     .map(|(n, o)| format!("{} {} → {}", n.name, o.method, n.method))
+                    .chain(knob_changes(&self.quality, &fresh.quality))
                     .collect();
                 return Err(Error::PlanChanged(format!("auto: {} (plan_hysteresis=off: re-chosen as a fresh plan)", changed.join(", "))));
             }
@@ -81,7 +82,8 @@ impl Plan {
                 if let Some(t) = self.target.as_ref().or(nominal.as_ref()) {
                     let facts = facts::SceneFacts::new(scene, &self.quality, true);
                     let now = Choices { method: self.choice, objects: fresh.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
-                    if let Some(why) = predict::switch(scene, &facts, &kept, &now, &self.quality, t)? {
+                    let knobs = (&self.quality, &fresh.quality);
+                    if let Some(why) = predict::switch(scene, &facts, (&kept, knobs.0), (&now, knobs.1), t)? {
                         return Err(Error::PlanChanged(format!("auto: {why}")));
                     }
                 }
@@ -211,6 +213,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         target: None,
         prediction: None,
         quality: quality.clone(),
+        asked_quality: quality.clone(),
         shadow_cubes: Vec::new(),
         shadow_planes: Vec::new(),
         objects: Vec::new(),
@@ -317,6 +320,15 @@ fn check_names(scene: &Scene, choices: &Choices) -> Result<()> {
     Ok(())
 }
 
+/// The knobs `b` sets otherwise than `a`, as `knob a → b`.
+pub(crate) fn knob_changes(a: &Quality, b: &Quality) -> Vec<String> {
+    crate::quality::KNOBS
+        .iter()
+        .filter(|k| a.get(k.name) != b.get(k.name))
+        .map(|k| format!("{} {} → {}", k.name, a.get(k.name), b.get(k.name)))
+        .collect()
+}
+
 /// The plan for per-object choices (`auto` predicted for a nominal frame on the stored
 /// calibration's device: [`plan_for`] names the frame).
 pub fn plan_with(scene: &Scene, choices: &Choices, quality: &Quality) -> Result<Plan> {
@@ -377,6 +389,9 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
     let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();
     let scene_facts = facts::SceneFacts::new(scene, quality, !whole_scene);
     let auto = auto_plan(scene, &scene_facts, choices, quality, hints, target)?;
+    // The frame's knobs: the asked ones, with those `auto` chose over them.
+    let asked_quality = quality.clone();
+    let quality = auto.as_ref().map_or(quality, |a| &a.quality);
     let mut objects = Vec::new();
     for f in &scene_facts.objects {
         let (method, reason) = choose(scene, f, choices, hints, auto.as_ref())?;
@@ -402,6 +417,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         target: target.cloned(),
         prediction: auto.as_ref().map(|a| a.prediction.clone()),
         quality: quality.clone(),
+        asked_quality,
         shadow_cubes: Vec::new(),
         shadow_planes: Vec::new(),
         objects,
@@ -556,6 +572,10 @@ pub fn table(p: &Plan, scene: &Scene) -> String {
     let _ = writeln!(s, "method {} · {} specular object(s) · passes: {}", p.choice.name(), p.objects.len(), p.passes.join(", "));
     if p.inter_object {
         let _ = writeln!(s, "inter-object cycles: {}{}", p.cycles, if p.frame_latency { " (one per frame, frame latency)" } else { "" });
+    }
+    let chosen = knob_changes(&p.asked_quality, &p.quality);
+    if !chosen.is_empty() {
+        let _ = writeln!(s, "frame knobs chosen by auto: {}", chosen.join(", "));
     }
     for o in &p.objects {
         let mat = &scene.materials[scene.meshes[o.mesh].material];

@@ -200,7 +200,12 @@ pub struct Plan {
     /// to it).
     #[serde(skip)]
     pub prediction: Option<super::budget::prediction::Prediction>,
+    /// The frame's knobs: the asked ones, with any `auto` chose over them
+    /// (`predict::auto_variants`).
     pub quality: Quality,
+    /// The knobs as asked (what a re-plan starts from).
+    #[serde(skip)]
+    pub asked_quality: Quality,
     /// Lights that get a cube distance map (point and spot), in cube order.
     pub shadow_cubes: Vec<usize>,
     /// Directional lights, each with a planar distance map, in layer order.

@@ -21,7 +21,8 @@ pub struct Measure {
     pub scenes: Vec<usize>,
     pub sizes: Vec<(u32, u32)>,
     /// `default` or `knob=value …` over the base knobs; a method is measured in a variant
-    /// only when it reads every knob the variant sets (else the variant is its default).
+    /// only when it reads every knob the variant sets or the knob is frame-wide (`aa`),
+    /// else the variant is its default.
     pub variants: Vec<String>,
     pub methods: Vec<Method>,
     /// Methods measured on every n-th scene only (the slow exact schemes: their cost per
@@ -43,6 +44,11 @@ pub fn reference_quality(q: &Quality) -> Quality {
     let mut r = q.clone();
     r.frame.aa = crate::quality::Aa::Ssaa(4);
     r
+}
+
+/// Whether knob `k` is frame-wide (anti-aliasing, shading, depth: every method reads it).
+fn frame_wide(k: &str) -> bool {
+    crate::frame::knobs::FrameKnobs::KNOBS.iter().any(|f| f.name == k)
 }
 
 /// Every GPU method of the registry.
@@ -80,7 +86,7 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     // A method this device cannot run (ray-query without ray queries) would
                     // measure its fallback under its name: left out, so the planner never
                     // sees costs for it here.
-                    if !set.iter().all(|k| m.knobs.contains(k)) || m.needs.missing_on(ctx).is_some() {
+                    if !set.iter().all(|k| m.knobs.contains(k) || frame_wide(k)) || m.needs.missing_on(ctx).is_some() {
                         continue;
                     }
                     if cfg.sparse.iter().any(|(s, n)| *s == m && i % (*n).max(1) != 0) {

@@ -12,13 +12,40 @@ use crate::args::parse_size;
 
 /// Measures corpus scenes `scenes` (every one when empty) and writes the corpus file; prints
 /// the error models' leave-one-scene-out accuracy.
-pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, device: &Option<String>) -> specula::Result<()> {
+/// The knob variants `specula corpus` measures by default: the cube maps' size and the
+/// frame's anti-aliasing (the planner's candidates, `plan::predict::budget_variants`).
+pub fn default_variants() -> Vec<String> {
+    specula::plan::predict::budget_variants()
+}
+
+/// `variants` empty: [`default_variants`]; `merge`: the corpus file whose measurements the
+/// new ones join (replacing those they re-measure).
+pub fn run_corpus(
+    out: &Path,
+    size: &str,
+    scenes: &[usize],
+    variants: &[String],
+    merge: Option<&Path>,
+    validate: bool,
+    device: &Option<String>,
+) -> specula::Result<()> {
     let size = parse_size(size)?;
+    let variants = if variants.is_empty() { default_variants() } else { variants.to_vec() };
+    for v in variants.iter().filter(|v| *v != "default") {
+        specula::plan::budget::variant_quality(&specula::Quality::default(), v)?;
+    }
+    let old = match merge {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| specula::Error::io(p, e))?;
+            Some(specula::plan::predict::samples::Corpus::parse(&text, &p.display().to_string())?)
+        }
+        None => None,
+    };
     let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
     let cfg = Measure {
         scenes: if scenes.is_empty() { (0..corpus::SIZE).collect() } else { scenes.to_vec() },
         sizes: vec![size],
-        variants: vec!["default".into(), "cube_size=128".into(), "cube_size=512".into()],
+        variants,
         methods: tradeoff::gpu_methods(),
         sparse: vec![(specula::methods::RAY_ENGINE, 12), (specula::methods::RAY_HIERARCHY, 12)],
         warmup: 1,
@@ -27,7 +54,14 @@ pub fn run_corpus(out: &Path, size: &str, scenes: &[usize], validate: bool, devi
         errors: true,
     };
     let t = std::time::Instant::now();
-    let c = tradeoff::measure(&ctx, &cfg, &mut |s| eprintln!("[{:7.1} s] {s}", t.elapsed().as_secs_f64()))?;
+    let measured = tradeoff::measure(&ctx, &cfg, &mut |s| eprintln!("[{:7.1} s] {s}", t.elapsed().as_secs_f64()))?;
+    let c = match old {
+        Some(mut c) => {
+            c.merge(measured);
+            c
+        }
+        None => measured,
+    };
     specula::output::write_file(out, c.to_json().as_bytes())?;
     let held = error_model::leave_one_scene_out(&c.samples);
     let (median, p90) = error_model::abs_error_quantiles(&held);

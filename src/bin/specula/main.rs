@@ -131,6 +131,14 @@ enum Command {
         /// Only these corpus scene numbers (comma-separated); default all.
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<usize>,
+        /// A knob variant to measure, `default` or `KNOB=VALUE ...` (repeatable); default the
+        /// planner's candidates: default, cube_size=128/512, aa=msaa4, aa=ssaa2.
+        #[arg(long = "variant")]
+        variants: Vec<String>,
+        /// Join the measurements to this corpus file's (a re-measured sample replaces its
+        /// old one) and write the whole to --out.
+        #[arg(long)]
+        merge: Option<PathBuf>,
         /// Measure nothing: evaluate the error models on this corpus file (leave-one-scene-out
         /// per ridge penalty and per method) and write the scatter to --figure.
         #[arg(long)]
@@ -291,7 +299,9 @@ fn run(cmd: Command) -> specula::Result<()> {
             raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
         Command::Corpus { evaluate: Some(file), figure, .. } => corpus::run_evaluate(&file, &figure),
-        Command::Corpus { out, size, scenes, validate, device, .. } => corpus::run_corpus(&out, &size, &scenes, validate, &device),
+        Command::Corpus { out, size, scenes, variants, merge, validate, device, .. } => {
+            corpus::run_corpus(&out, &size, &scenes, &variants, merge.as_deref(), validate, &device)
+        }
         Command::Calibrate { out, validate, device } => corpus::run_calibrate(out.as_deref(), validate, &device),
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image, scene, mask } => {

@@ -34,15 +34,15 @@ fn print_candidates(job: &crate::args::Job) -> specula::Result<()> {
         return Err(specula::Error::invalid("--candidates", "no unit costs: run specula calibrate"));
     };
     let facts = specula::plan::facts::SceneFacts::new(&job.scene, &job.quality, true);
-    let models = predict::predict_models(&job.scene, &facts, &job.quality, &t, &["default".to_string()])?;
+    let models = predict::predict_models(&job.scene, &facts, &job.quality, &t, &predict::auto_variants(&job.quality))?;
     println!("candidates at {}x{}, {}:", t.size.0, t.size.1, predict::source(&t));
     for (name, front, dominated) in predict::pareto(&models) {
         println!("{name}: {} on the Pareto front, {dominated} dominated", front.len());
-        for o in front {
+        for (knobs, o) in front {
             let ms = o.cost.fixed_ms + o.cost.screen_ms + o.shared.screen_ms;
             println!(
-                "  {:<24} {:>10.2} ms {:>8.1} dB   (maps {:.2} ms, camera {:.2} ms, whole-screen {:.2} ms)",
-                o.method, ms, o.psnr_db, o.cost.fixed_ms, o.cost.screen_ms, o.shared.screen_ms
+                "  {:<24} {:<14} {:>10.2} ms {:>8.1} dB   (maps {:.2} ms, camera {:.2} ms, whole-screen {:.2} ms)",
+                o.method, knobs, ms, o.psnr_db, o.cost.fixed_ms, o.cost.screen_ms, o.shared.screen_ms
             );
         }
     }

@@ -20,7 +20,8 @@ use super::samples::Corpus;
 use crate::error::{Error, Result};
 
 /// The first line of every cost file's `format` field.
-pub const FORMAT: &str = "specula-costs 1";
+/// (2: anti-aliasing's samples as workload terms of their own.)
+pub const FORMAT: &str = "specula-costs 2";
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
 /// `SCREEN_FEATURES` (per object, its camera work) and `SHARED_FEATURES` (per frame, the
@@ -48,7 +49,7 @@ pub struct CostModel {
 }
 
 fn base_features(w: &Workload) -> Vec<f64> {
-    vec![1.0, w.screen / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
+    vec![1.0, w.screen * w.samples / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
 }
 
 impl CostModel {

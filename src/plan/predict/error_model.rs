@@ -17,10 +17,46 @@ pub const RIDGE: f64 = 0.03;
 /// and no object is predicted below a blank image's typical PSNR).
 pub const PSNR_FLOOR: f64 = 5.0;
 
-/// Per method its coefficients over `ERROR_FEATURES`, and how many samples fitted it.
+/// Per method its coefficients over `ERROR_FEATURES`, and how many samples fitted it
+/// (fitted on frames without anti-aliasing); per method and `aa` value the factor by which
+/// anti-aliasing scales the part of an object's error that is aliasing ([`ErrorModel::predict`]).
 #[derive(Clone, Debug, Default)]
 pub struct ErrorModel {
     pub methods: BTreeMap<String, (Vec<f64>, usize)>,
+    /// (model key, `aa` value) → (aliasing factor, samples).
+    pub aa: BTreeMap<(String, String), (f64, usize)>,
+}
+
+/// The frame's anti-aliasing as a sample's knobs or a quality name it (`off` when unset).
+pub fn aa_of(knobs: &str) -> &str {
+    knobs.split_whitespace().find_map(|p| p.strip_prefix("aa=")).unwrap_or("off")
+}
+
+/// The aliasing factor of an `aa` value the corpus did not measure: its resolved samples
+/// `n` (`features::aa_samples`) to the power −1.6 (the exact tracer's measured factors at
+/// 4 samples, 0.09 multisampled and 0.13 supersampled, lie either side of 4^−1.6 = 0.11).
+pub fn unmeasured_aa_factor(samples: f64) -> f64 {
+    samples.max(1.0).powf(-1.6)
+}
+
+fn mse(psnr: f64) -> f64 {
+    10f64.powf(-psnr.min(PSNR_CAP) / 10.0)
+}
+
+fn psnr(mse: f64) -> f64 {
+    if mse > 0.0 {
+        (-10.0 * mse.log10()).clamp(PSNR_FLOOR, PSNR_CAP)
+    } else {
+        PSNR_CAP
+    }
+}
+
+/// Anti-aliasing's effect on an object: its error without it (`mse_method`) is aliasing up
+/// to the exact tracer's error (`mse_exact`, which is aliasing alone) and a bias beyond it
+/// that more samples do not remove; anti-aliasing scales the aliasing part by `factor`.
+fn with_aa(mse_method: f64, mse_exact: f64, factor: f64) -> f64 {
+    let alias = mse_method.min(mse_exact);
+    (mse_method - alias) + alias * factor
 }
 
 /// The model a method's error comes from: every scheme of ray tracing in the original
@@ -50,7 +86,7 @@ impl ErrorModel {
     /// [`ErrorModel::fit`] with another ridge penalty.
     pub fn fit_with(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool, ridge: f64) -> ErrorModel {
         let mut by: BTreeMap<&str, Vec<&Sample>> = BTreeMap::new();
-        for s in samples.iter().filter(|s| keep(s)) {
+        for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) == "off") {
             by.entry(model_key(&s.method)).or_default().push(s);
         }
         let methods = by
@@ -70,15 +106,67 @@ impl ErrorModel {
                 (m.to_string(), (beta, ss.len()))
             })
             .collect();
-        ErrorModel { methods }
+        ErrorModel { methods, aa: fit_aa(samples, keep) }
     }
 
-    /// Predicted PSNR of `method` on an object with these features; `None` for a method
-    /// the corpus never measured.
-    pub fn predict(&self, method: &str, features: &[f64]) -> Option<f64> {
+    /// Predicted PSNR of `method` on an object with these features in a frame anti-aliased
+    /// by `aa` (a value of the `aa` knob) resolving `aa_samples` samples per pixel; `None`
+    /// for a method the corpus never measured.
+    pub fn predict(&self, method: &str, features: &[f64], aa: &str, aa_samples: f64) -> Option<f64> {
+        let own = self.predict_off(method, features)?;
+        if aa == "off" {
+            return Some(own);
+        }
+        let exact = self.predict_off(EXACT, features).unwrap_or(PSNR_CAP);
+        Some(psnr(with_aa(mse(own), mse(exact), self.aa_factor(method, aa, aa_samples))))
+    }
+
+    /// The aliasing factor of `method` under `aa`: measured on the corpus where it has at
+    /// least 4 samples, else the exact tracers', else [`unmeasured_aa_factor`].
+    pub fn aa_factor(&self, method: &str, aa: &str, aa_samples: f64) -> f64 {
+        let at = |m: &str| self.aa.get(&(m.to_string(), aa.to_string())).filter(|(_, n)| *n >= 4).map(|(f, _)| *f);
+        at(model_key(method)).or_else(|| at(EXACT)).unwrap_or_else(|| unmeasured_aa_factor(aa_samples))
+    }
+
+    /// The PSNR without anti-aliasing.
+    fn predict_off(&self, method: &str, features: &[f64]) -> Option<f64> {
         let (beta, _) = self.methods.get(model_key(method))?;
         Some(linear::dot(beta, features).clamp(PSNR_FLOOR, PSNR_CAP))
     }
+}
+
+/// Per method and measured `aa` value its aliasing factor: over the objects measured both
+/// with it and without (and by the exact tracer without), the median (in logarithm) of the
+/// factor [`with_aa`] needs to turn the measured error without into the measured error with.
+/// Objects whose exact error sits at the cap tell nothing and are left out.
+fn fit_aa(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<(String, String), (f64, usize)> {
+    type Key<'a> = (usize, &'a str, &'a str, u64);
+    fn key(s: &Sample) -> Key<'_> {
+        (s.scene, s.object.as_str(), model_key(&s.method), s.work.screen as u64)
+    }
+    let mut off: BTreeMap<Key, f64> = BTreeMap::new();
+    for s in samples.iter().filter(|s| keep(s) && s.knobs == "default") {
+        off.entry(key(s)).or_insert(s.psnr_db);
+    }
+    let mut logs: BTreeMap<(String, String), Vec<f64>> = BTreeMap::new();
+    for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) != "off") {
+        let (sc, o, m, px) = key(s);
+        let (Some(&own), Some(&exact)) = (off.get(&(sc, o, m, px)), off.get(&(sc, o, EXACT, px))) else { continue };
+        if exact >= PSNR_CAP - 1.0 {
+            continue;
+        }
+        let (mo, me, ma) = (mse(own), mse(exact), mse(s.psnr_db));
+        let alias = mo.min(me);
+        let factor = ((ma - (mo - alias)) / alias).clamp(1e-3, 10.0);
+        logs.entry((m.to_string(), aa_of(&s.knobs).to_string())).or_default().push(factor.ln());
+    }
+    logs.into_iter()
+        .map(|(k, mut v)| {
+            v.sort_by(f64::total_cmp);
+            let median = v[v.len() / 2];
+            (k, (median.exp(), v.len()))
+        })
+        .collect()
 }
 
 /// One held-out prediction.
@@ -107,7 +195,10 @@ pub fn leave_one_scene_out_with(samples: &[Sample], ridge: f64) -> Vec<Held> {
     for sc in scenes {
         let model = ErrorModel::fit_with(samples, &|s| s.scene != sc, ridge);
         for s in samples.iter().filter(|s| s.scene == sc) {
-            if let Some(p) = model.predict(&s.method, &s.features) {
+            let aa = aa_of(&s.knobs);
+            let n = crate::plan::budget::variant_quality(&crate::quality::Quality::default(), &s.knobs)
+                .map_or(1.0, |q| super::features::aa_samples(&q).1);
+            if let Some(p) = model.predict(&s.method, &s.features, aa, n) {
                 out.push(Held {
                     scene: sc,
                     object: s.object.clone(),

@@ -31,7 +31,8 @@ pub const ERROR_FEATURES: [&str; 16] = [
     "log2_cube_size",
 ];
 
-/// An object's error features.
+/// An object's error features (anti-aliasing is not one: `error_model` composes its effect
+/// with the exact tracer's predicted aliasing).
 pub fn error_features(f: &ObjectFacts, scene: &Scene, q: &Quality) -> Vec<f64> {
     let nu = match scene.materials[scene.meshes[f.mesh].material].kind {
         SurfaceKind::Dielectric { ior, .. } => ior as f64,
@@ -59,8 +60,24 @@ pub fn error_features(f: &ObjectFacts, scene: &Scene, q: &Quality) -> Vec<f64> {
     ]
 }
 
+/// Anti-aliasing's samples per output pixel as the cost and as the error see them:
+/// (shaded samples, samples that resolve detail). Supersampling n×n shades and resolves n²;
+/// multisampling n with sample-rate shading (`msaa_shading=sample`) shades and resolves n;
+/// with pixel-rate shading it shades once per covered pixel (plus its n-sample raster) and
+/// resolves only edges (counted as √n).
+pub fn aa_samples(q: &Quality) -> (f64, f64) {
+    let (s, m) = (q.frame.aa.ssaa() as f64, q.frame.aa.msaa() as f64);
+    if s > 1.0 {
+        (s * s, s * s)
+    } else if q.frame.msaa_per_sample {
+        (m, m)
+    } else {
+        (1.0, m.sqrt())
+    }
+}
+
 /// The work a frame does for an object (inputs of the cost model), at a frame size.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Workload {
     /// The object's pixels in the frame.
     pub pixels: f64,
@@ -81,6 +98,30 @@ pub struct Workload {
     /// 1 for a thin dielectric, 0 else: a reflected and a transmitted ray per hit.
     #[serde(default)]
     pub thin: f64,
+    /// Shaded samples per output pixel (anti-aliasing, [`aa_samples`]): camera work and
+    /// whole-screen kernels scale with it.
+    #[serde(default = "one")]
+    pub samples: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl Default for Workload {
+    fn default() -> Workload {
+        Workload {
+            pixels: 0.0,
+            screen: 0.0,
+            scene_triangles: 0.0,
+            triangles: 0.0,
+            cube_texels: 0.0,
+            lights: 0.0,
+            solid: 0.0,
+            thin: 0.0,
+            samples: 1.0,
+        }
+    }
 }
 
 /// Names of the per-object map features, in the order [`map_features`] returns them.
@@ -93,23 +134,28 @@ pub fn map_features(w: &Workload) -> Vec<f64> {
 }
 
 /// Names of the per-object screen features, in the order [`screen_features`] returns them.
-pub const SCREEN_FEATURES: [&str; 4] = ["pixels", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
+pub const SCREEN_FEATURES: [&str; 5] = ["pixels", "extra_samples", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
 
-/// What an object's camera work scales with: its pixels (1e4), and its pixels times the
-/// depth of a hierarchy over the scene's triangles (log₂ / 16: a traversal per ray), again
-/// for a solid dielectric's and a thin one's pixels (more rays per pixel).
+/// What an object's camera work scales with: its pixels (1e4), the anti-aliasing samples it
+/// shades beyond one per pixel (a unit cost of its own: a sample-rate search does not cost
+/// what a pixel's does), and its shaded samples times the depth of a hierarchy over the
+/// scene's triangles (log₂ / 16: a traversal per ray), again for a solid dielectric's and a
+/// thin one's (more rays per sample).
 pub fn screen_features(w: &Workload) -> Vec<f64> {
-    let rays = w.pixels / 1e4 * depth(w);
-    vec![w.pixels / 1e4, rays, rays * w.solid, rays * w.thin]
+    let px = w.pixels / 1e4;
+    let rays = px * w.samples * depth(w);
+    vec![px, px * (w.samples - 1.0).max(0.0), rays, rays * w.solid, rays * w.thin]
 }
 
 /// Names of the whole-screen features, in the order [`shared_features`] returns them.
-pub const SHARED_FEATURES: [&str; 2] = ["screen", "screen_rays"];
+pub const SHARED_FEATURES: [&str; 3] = ["screen", "screen_extra_samples", "screen_rays"];
 
-/// What a method's whole-screen kernels scale with: the frame's pixels (1e4), and times the
-/// hierarchy depth (every pixel's primary ray).
+/// What a method's whole-screen kernels scale with: the frame's pixels (1e4), its samples
+/// beyond one per pixel, and its samples times the hierarchy depth (every sample's primary
+/// ray).
 pub fn shared_features(w: &Workload) -> Vec<f64> {
-    vec![w.screen / 1e4, w.screen / 1e4 * depth(w)]
+    let px = w.screen / 1e4;
+    vec![px, px * (w.samples - 1.0).max(0.0), px * w.samples * depth(w)]
 }
 
 fn depth(w: &Workload) -> f64 {
@@ -128,5 +174,6 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         lights: scene.lights.len() as f64,
         solid: (f.class == ObjectClass::SolidDielectric) as u8 as f64,
         thin: (f.class == ObjectClass::ThinDielectric) as u8 as f64,
+        samples: aa_samples(q).0,
     }
 }

@@ -103,6 +103,7 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
     let mut out = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
+        let (aa, aa_n) = (q.get("aa"), features::aa_samples(&q).1);
         let mut objects = Vec::new();
         let mut base = 0.0;
         for f in &facts.objects {
@@ -111,7 +112,8 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             base = target.costs.base_ms(&work);
             let feats = error_features(f, scene, &q);
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
-                let (Some(psnr), Some((fixed, screen, shared))) = (errors.predict(m.name, &feats), target.costs.predict(m.name, &work))
+                let (Some(psnr), Some((fixed, screen, shared))) =
+                    (errors.predict(m.name, &feats, &aa, aa_n), target.costs.predict(m.name, &work))
                 else {
                     continue;
                 };
@@ -140,28 +142,37 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
     })
 }
 
-/// The knob variants a budget chooses among (besides the methods): the cube maps' size,
-/// the knob most of the map-based methods' error and cost turn on.
+/// The knob variants the planner chooses among (besides the methods): the cube maps' size,
+/// the knob most of the map-based methods' error and cost turn on, and the frame's
+/// anti-aliasing (4-sample multisampling shaded per sample, 2×2 supersampling).
 pub fn budget_variants() -> Vec<String> {
-    ["default", "cube_size=128", "cube_size=512"].iter().map(|s| s.to_string()).collect()
+    ["default", "cube_size=128", "cube_size=512", "aa=msaa4", "aa=ssaa2"].iter().map(|s| s.to_string()).collect()
 }
 
-/// Per object of the first variant of `models`, its candidates that no other candidate beats
-/// in both predicted time (its own share plus its method's whole-screen kernels) and error,
-/// fastest first, and how many were dominated.
-pub fn pareto(models: &Models) -> Vec<(String, Vec<&ObjectModel>, usize)> {
-    let Some(v) = models.variants.first() else { return Vec::new() };
+/// One object's Pareto front: its name, its undominated (knobs, candidate), how many were
+/// dominated.
+pub type Front<'a> = (String, Vec<(&'a str, &'a ObjectModel)>, usize);
+
+/// Per object, its candidates over every variant of `models` (knobs, method) that no other
+/// candidate beats in both predicted time (its own share plus its method's whole-screen
+/// kernels) and error, fastest first, and how many were dominated.
+pub fn pareto(models: &Models) -> Vec<Front<'_>> {
     let ms = |o: &ObjectModel| o.cost.fixed_ms + o.cost.screen_ms + o.shared.fixed_ms + o.shared.screen_ms;
-    let mut names: Vec<&str> = v.objects.iter().map(|o| o.object.as_str()).collect();
+    let Some(first) = models.variants.first() else { return Vec::new() };
+    let mut names: Vec<&str> = first.objects.iter().map(|o| o.object.as_str()).collect();
     names.dedup();
     names
         .into_iter()
         .map(|n| {
-            let all: Vec<&ObjectModel> = v.objects.iter().filter(|o| o.object == n).collect();
+            let all: Vec<(&str, &ObjectModel)> = models
+                .variants
+                .iter()
+                .flat_map(|v| v.objects.iter().filter(|o| o.object == n).map(move |o| (v.knobs.as_str(), o)))
+                .collect();
             let beats =
                 |a: &ObjectModel, b: &ObjectModel| ms(a) <= ms(b) && a.psnr_db >= b.psnr_db && (ms(a) < ms(b) || a.psnr_db > b.psnr_db);
-            let mut front: Vec<&ObjectModel> = all.iter().copied().filter(|c| !all.iter().any(|d| beats(d, c))).collect();
-            front.sort_by(|a, b| ms(a).total_cmp(&ms(b)));
+            let mut front: Vec<(&str, &ObjectModel)> = all.iter().copied().filter(|c| !all.iter().any(|d| beats(d.1, c.1))).collect();
+            front.sort_by(|a, b| ms(a.1).total_cmp(&ms(b.1)));
             let dominated = all.len() - front.len();
             (n.to_string(), front, dominated)
         })
@@ -189,11 +200,31 @@ pub fn choose(
     budget::choose_with(scene, &facts, choices, quality, budget, target.size, &[(&models, source(target))])
 }
 
-/// `auto`'s choice for a scene: per object its method, the prediction, and the candidates
-/// it was chosen from.
+/// The knob variants `auto` may choose for a frame asked with `quality`: those of
+/// [`budget_variants`] whose every knob the caller left at its default (a knob the caller
+/// set is the caller's), none but `default` under `plan_knobs=keep`.
+pub fn auto_variants(quality: &Quality) -> Vec<String> {
+    let defaults = Quality::default();
+    budget_variants()
+        .into_iter()
+        .filter(|v| {
+            v == "default"
+                || (quality.plan.plan_knobs
+                    && v.split_whitespace().all(|pair| {
+                        let k = pair.split('=').next().unwrap_or(pair);
+                        crate::quality::knob(k).is_some_and(|k| quality.get(k.name) == defaults.get(k.name))
+                    }))
+        })
+        .collect()
+}
+
+/// `auto`'s choice for a scene: per object its method, the frame's knobs (`quality`, the
+/// asked ones with the chosen variant's over them), the prediction, and the candidates it
+/// was chosen from.
 #[derive(Clone, Debug)]
 pub struct AutoPlan {
     pub choices: Choices,
+    pub quality: Quality,
     pub prediction: Prediction,
     pub models: Models,
 }
@@ -206,25 +237,30 @@ impl AutoPlan {
         let Some(o) = self.prediction.objects.iter().find(|o| o.name == name) else {
             return format!("auto ({})", b.describe());
         };
-        let others = self.models.variants.first().map(|v| v.objects.iter().filter(|c| c.object == name && c.method != method.name));
+        let chosen = self.models.variants.iter().find(|v| v.knobs == self.prediction.knobs).or(self.models.variants.first());
+        let others = chosen.map(|v| v.objects.iter().filter(|c| c.object == name && c.method != method.name));
         let runner =
             others.and_then(|it| it.max_by(|a, b| a.psnr_db.total_cmp(&b.psnr_db).then(b.cost.fixed_ms.total_cmp(&a.cost.fixed_ms))));
         let runner = runner.map_or(String::new(), |r| {
             let ms = r.cost.fixed_ms + r.cost.screen_ms + r.shared.screen_ms;
             format!("; runner-up {} ({:.1} dB, {:.1} ms)", r.method, r.psnr_db, ms)
         });
-        format!("auto: predicted {:.1} dB, {:.1} ms{runner}; budget {}", o.psnr_db, o.ms, b.describe())
+        let knobs = if self.prediction.knobs == "default" { String::new() } else { format!(" with {}", self.prediction.knobs) };
+        format!("auto: predicted {:.1} dB, {:.1} ms{knobs}{runner}; budget {}", o.psnr_db, o.ms, b.describe())
     }
 }
 
-/// `auto` without a budget: the exact tracer's predicted frame is the budget; within it,
-/// the fastest choice within the tolerance of the most accurate. `None` when some object
-/// has no prediction.
+/// `auto` without a budget: the exact tracer's predicted frame (at the asked knobs) is the
+/// budget; within it, over the methods and [`auto_variants`], the fastest choice within the
+/// tolerance of the most accurate. `None` when some object has no prediction.
 pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Quality, target: &Target) -> Result<Option<AutoPlan>> {
     if facts.objects.is_empty() {
         return Ok(None);
     }
-    let models = predict_models(scene, facts, quality, target, &["default".to_string()])?;
+    let asked = predict_models(scene, facts, quality, target, &["default".to_string()])?;
+    let variants = auto_variants(quality);
+    let models = if variants.len() > 1 { predict_models(scene, facts, quality, target, &variants)? } else { asked.clone() };
+    let exact_src = [(&asked, source(target))];
     let src = [(&models, source(target))];
     let run = |c: &Choices, b: Budget| budget::choose_with(scene, facts, c, quality, b, target.size, &src);
     // The exact tracer for every object the caller left to auto.
@@ -234,12 +270,20 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
             exact.objects.push((scene.meshes[f.mesh].name.clone(), BVH));
         }
     }
-    let Some((_, _, exact)) = run(&exact, Budget::MaxMs(f64::INFINITY))? else { return Ok(None) };
+    let Some((_, _, exact)) = budget::choose_with(scene, facts, &exact, quality, Budget::MaxMs(f64::INFINITY), target.size, &exact_src)?
+    else {
+        return Ok(None);
+    };
     let max_ms = exact.frame_ms;
     let Some((_, _, best)) = run(choices, Budget::MaxMs(max_ms))? else { return Ok(None) };
     let tolerance = if quality.plan.planner.speed() { SPEED_TOLERANCE_DB } else { TOLERANCE_DB };
     let floor_db = best.specular_psnr_db - tolerance;
-    Ok(run(choices, Budget::Near { max_ms, floor_db })?.map(|(choices, _, prediction)| AutoPlan { choices, prediction, models }))
+    Ok(run(choices, Budget::Near { max_ms, floor_db })?.map(|(choices, quality, prediction)| AutoPlan {
+        choices,
+        quality,
+        prediction,
+        models,
+    }))
 }
 
 /// Hysteresis: switching from `current` to `next` (per-object methods, every object named)
@@ -249,23 +293,27 @@ pub const SWITCH_DB: f64 = 1.0;
 /// frame more than 10 % over the budget back within it.
 pub const SWITCH_SAVING: f64 = 0.2;
 
-/// Whether `auto` should leave `current` for `next` on the scene as it is now, and why
-/// (both predicted: the frame's ms and its specular PSNR, the budget being the exact
-/// tracer's predicted frame as in [`auto`]); `None`: keep `current` (the difference is within
-/// the hysteresis, so a choice does not flicker frame to frame).
+/// Whether `auto` should leave `current` for `next` (each: per-object methods, every
+/// object named, and the frame's knobs) on the scene as it is now, and why (both
+/// predicted: the frame's ms and its specular PSNR, the budget being the exact tracer's
+/// predicted frame at `current`'s knobs as in [`auto`]); `None`: keep `current` (the
+/// difference is within the hysteresis, so a choice does not flicker frame to frame).
 pub fn switch(
     scene: &Scene,
     facts: &SceneFacts,
-    current: &Choices,
-    next: &Choices,
-    quality: &Quality,
+    current: (&Choices, &Quality),
+    next: (&Choices, &Quality),
     target: &Target,
 ) -> Result<Option<String>> {
-    let models = predict_models(scene, facts, quality, target, &["default".to_string()])?;
-    let src = [(&models, source(target))];
-    let eval = |c: &Choices| budget::choose_with(scene, facts, c, quality, Budget::MaxMs(f64::INFINITY), target.size, &src);
-    let exact = Choices { method: current.method, objects: current.objects.iter().map(|(n, _)| (n.clone(), BVH)).collect() };
-    let (Some((_, _, a)), Some((_, _, b)), Some((_, _, e))) = (eval(current)?, eval(next)?, eval(&exact)?) else { return Ok(None) };
+    let eval = |c: &Choices, q: &Quality| -> Result<Option<Prediction>> {
+        let models = predict_models(scene, facts, q, target, &["default".to_string()])?;
+        let src = [(&models, source(target))];
+        Ok(budget::choose_with(scene, facts, c, q, Budget::MaxMs(f64::INFINITY), target.size, &src)?.map(|r| r.2))
+    };
+    let exact = Choices { method: current.0.method, objects: current.0.objects.iter().map(|(n, _)| (n.clone(), BVH)).collect() };
+    let (Some(a), Some(b), Some(e)) = (eval(current.0, current.1)?, eval(next.0, next.1)?, eval(&exact, current.1)?) else {
+        return Ok(None);
+    };
     let max_ms = e.frame_ms;
     let better = b.specular_psnr_db > a.specular_psnr_db + SWITCH_DB && b.frame_ms <= max_ms;
     let cheaper = b.frame_ms < a.frame_ms * (1.0 - SWITCH_SAVING) && b.specular_psnr_db >= a.specular_psnr_db - TOLERANCE_DB;
@@ -279,6 +327,7 @@ pub fn switch(
         .zip(&a.objects)
         .filter(|(n, o)| n.method != o.method)
         .map(|(n, o)| format!("{} {} → {}", n.name, o.method.name, n.method.name))
+        .chain(super::knob_changes(current.1, next.1))
         .collect();
     Ok(Some(format!(
         "{} (predicted {:.1} dB, {:.2} ms against {:.1} dB, {:.2} ms: {})",

@@ -105,6 +105,19 @@ impl Corpus {
         serde_json::to_string(self).unwrap_or_default()
     }
 
+    /// Adds `other`'s measurements; a (scene, object, method, knobs, frame size) that both
+    /// hold keeps `other`'s (a re-measurement replaces the old one).
+    pub fn merge(&mut self, other: Corpus) {
+        let key = |s: &Sample| (s.scene, s.object.clone(), s.method.clone(), s.knobs.clone(), s.work.screen as u64);
+        let fkey = |f: &FrameSample| (f.scene, f.method.clone(), f.knobs.clone(), f.work.screen as u64);
+        let new: Vec<_> = other.samples.iter().map(key).collect();
+        let fnew: Vec<_> = other.frames.iter().map(fkey).collect();
+        self.samples.retain(|s| !new.contains(&key(s)));
+        self.frames.retain(|f| !fnew.contains(&fkey(f)));
+        self.samples.extend(other.samples);
+        self.frames.extend(other.frames);
+    }
+
     /// The scene numbers it measured.
     pub fn scenes(&self) -> Vec<usize> {
         let mut s: Vec<usize> = self.samples.iter().map(|s| s.scene).collect();
@@ -116,7 +129,7 @@ impl Corpus {
 
 fn check_work(w: &Workload, what: &str) -> Result<()> {
     let all = [w.pixels, w.screen, w.scene_triangles, w.triangles, w.cube_texels, w.lights];
-    if all.iter().any(|x| !x.is_finite() || *x < 0.0) {
+    if all.iter().any(|x| !x.is_finite() || *x < 0.0) || !(w.samples.is_finite() && w.samples >= 1.0) {
         return Err(Error::invalid(what.to_string(), format!("{w:?}: every count must be finite and non-negative")));
     }
     Ok(())
