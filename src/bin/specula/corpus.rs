@@ -141,6 +141,20 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
     }
     let (med, p90) = error_model::abs_error_quantiles(&held);
     println!("{:<24} {:>6} {med:>14.2} {p90:>12.2}", "all", held.len());
+    println!("\nper knob variant (held-out scenes):");
+    let mut variants: Vec<&str> = held.iter().map(|h| h.knobs.as_str()).collect();
+    variants.sort();
+    variants.dedup();
+    for v in variants {
+        let hs: Vec<error_model::Held> = held.iter().filter(|h| h.knobs == v).cloned().collect();
+        let (med, p90) = error_model::abs_error_quantiles(&hs);
+        println!("{v:<24} {:>6} {med:>14.2} {p90:>12.2}", hs.len());
+    }
+    let model = error_model::ErrorModel::fit(&c.samples, &|_| true);
+    println!("\nanti-aliasing's factor on the aliasing part of the error (per method; measured samples):");
+    for ((m, aa), (f, n)) in &model.aa {
+        println!("{m:<28} {aa:<8} {f:>8.3} {n:>6}");
+    }
     let points: Vec<(f64, f64, String)> = held.iter().map(|h| (h.measured_db, h.predicted_db, h.method.clone())).collect();
     let title = format!("Held-out PSNR per object: predicted against measured ({} scenes, leave-one-scene-out)", c.scenes().len());
     let f = specula::tradeoff::scatter(

@@ -136,6 +136,8 @@ pub struct RayTrace {
     cull_stats: Buffer,
     stats: bool,
     capacity: u64,
+    /// The shadow queue's rays (the budget times the lights, clamped like `capacity`).
+    shadow_capacity: u64,
     lights: u64,
     ray_texture: (u32, u32),
     tiles: u32,
@@ -188,6 +190,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         cull_stats: Buffer::placeholder(),
         stats: q.raytrace.ray_stats,
         capacity: 0,
+        shadow_capacity: 0,
         lights: 1,
         ray_texture: (0, 0),
         tiles: 0,
@@ -259,19 +262,44 @@ impl RayTrace {
 
         // One camera ray per sample: each (pixel, sample) pair accumulates on its own.
         let pixels = self.width as u64 * self.height as u64 * self.samples as u64;
-        let capacity = pixels * q.raytrace.ray_budget as u64;
         let lights = scene.lights.len().max(1) as u64;
-        if capacity > u32::MAX as u64 / 2 || capacity * lights > u32::MAX as u64 / 2 {
+        if pixels * q.raytrace.ray_budget as u64 * lights > u32::MAX as u64 / 2 {
             return Err(Error::invalid(
                 "knob ray_budget",
-                format!("{} rays per bounce exceed the queues' 32-bit indices", capacity * lights),
+                format!("{} rays per bounce exceed the queues' 32-bit indices", pixels * q.raytrace.ray_budget as u64 * lights),
             ));
         }
+        // A queue's buffers are bound whole: none may exceed the device's storage-buffer
+        // range. Every camera ray must fit (else an error naming the frame); the budget's
+        // further rays are clamped there, and the rays a bounce then cannot queue are dropped
+        // and counted (`raytrace.dropped_rays`), as past the budget itself.
+        let limit = ctx.properties.limits.max_storage_buffer_range as u64;
+        let widest = [std::mem::size_of::<GpuRayQuery>(), std::mem::size_of::<GpuRayHit>(), std::mem::size_of::<GpuRayPayload>()]
+            .into_iter()
+            .max()
+            .unwrap_or(64) as u64;
+        let fits = limit / widest;
+        if pixels > fits || pixels * 24 > limit {
+            return Err(Error::invalid(
+                "frame size",
+                format!(
+                    "{}x{} × {} samples: {pixels} camera rays need {} MiB per ray queue, over this device's storage-buffer range ({} MiB); a smaller frame or aa (ssaa renders N² rays per pixel, msaaN N)",
+                    self.width,
+                    self.height,
+                    self.samples,
+                    (pixels * widest) >> 20,
+                    limit >> 20
+                ),
+            ));
+        }
+        let capacity = (pixels * q.raytrace.ray_budget as u64).min(fits);
+        let shadow_capacity = (capacity * lights).min(fits);
         for i in 0..2 {
             self.queues.push(Queue::new(ctx, &format!("raytrace.queue{i}"), capacity)?);
         }
-        self.shadow = Some(Queue::new(ctx, "raytrace.shadow", capacity * lights)?);
+        self.shadow = Some(Queue::new(ctx, "raytrace.shadow", shadow_capacity)?);
         self.lights = lights;
+        self.shadow_capacity = shadow_capacity;
         let align = ctx.properties.limits.min_storage_buffer_offset_alignment.max(4);
         self.stride = 64u64.div_ceil(align) * align;
         let bounces = self.depth as u64 + 1;
@@ -280,7 +308,7 @@ impl RayTrace {
         self.counters = Buffer::new(ctx, "raytrace.counters", self.stride * (2 * bounces + 1), counter_usage, MemoryLocation::GpuToCpu)?;
         self.capacity = capacity;
         // The ray texture of the rasterising schemes: every queue's rays, row by row.
-        let most = capacity.max(capacity * lights);
+        let most = capacity.max(shadow_capacity);
         let width = ((most as f64).sqrt().ceil() as u32).div_ceil(32).max(1) * 32;
         let height = most.div_ceil(width as u64) as u32;
         let limit = ctx.properties.limits.max_image_dimension2_d;
@@ -319,7 +347,7 @@ impl RayTrace {
                 bounce: k as u32,
                 last: (k + 1 == bounces) as u32,
                 capacity: capacity as u32,
-                shadow_capacity: (capacity * lights) as u32,
+                shadow_capacity: shadow_capacity as u32,
                 t_min: list_offset(&list),
                 ray_texture_width: width,
                 tile_size: tile.max(1),
@@ -827,7 +855,7 @@ impl Stage for RayTrace {
         for k in 0..bounces {
             let rays = word(k * self.stride);
             let shadows = word((bounces + 1 + k) * self.stride);
-            dropped += rays.saturating_sub(self.capacity) + shadows.saturating_sub(self.capacity * self.lights);
+            dropped += rays.saturating_sub(self.capacity) + shadows.saturating_sub(self.shadow_capacity);
             out.push((format!("raytrace.rays.bounce{k}"), rays as f64));
             out.push((format!("raytrace.shadow_rays.bounce{k}"), shadows as f64));
         }
