@@ -89,9 +89,9 @@ fn main() -> specula::Result<()> {
             rows.push((label, ms, all));
             Ok((ms, all, chosen.join(", ")))
         };
-        for k in 0..variants.len() {
+        for (k, v) in variants.iter().enumerate() {
             for &m in &methods {
-                let label = if variants[k] == "default" { m.name.to_string() } else { format!("{} {}", m.name, variants[k]) };
+                let label = if v == "default" { m.name.to_string() } else { format!("{} {v}", m.name) };
                 run(label, &Choices::all(m), Some(k))?;
             }
         }
