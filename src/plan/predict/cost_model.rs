@@ -20,7 +20,8 @@ use super::samples::Corpus;
 use crate::error::{Error, Result};
 
 /// The first line of every cost file's `format` field.
-/// (2: anti-aliasing's samples as workload terms of their own.)
+/// (2: anti-aliasing's samples, multisampled and supersampled, as workload terms of their
+/// own.)
 pub const FORMAT: &str = "specula-costs 2";
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
@@ -48,8 +49,11 @@ pub struct CostModel {
     pub calibration_s: f64,
 }
 
+/// The base's screen term counts supersamples (the whole frame renders larger), not
+/// multisamples (diffuse surfaces shade once per pixel).
 fn base_features(w: &Workload) -> Vec<f64> {
-    vec![1.0, w.screen * w.samples / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
+    let screen = w.screen * if w.supersampled > 0.0 { w.samples } else { 1.0 };
+    vec![1.0, screen / 1e4, w.lights, w.lights * w.scene_triangles / 1e4]
 }
 
 impl CostModel {

@@ -102,6 +102,10 @@ pub struct Workload {
     /// whole-screen kernels scale with it.
     #[serde(default = "one")]
     pub samples: f64,
+    /// 1 when those samples are supersampled (the whole frame rendered larger), 0 when
+    /// multisampled (one raster, shading per sample): the two cost differently.
+    #[serde(default)]
+    pub supersampled: f64,
 }
 
 fn one() -> f64 {
@@ -120,6 +124,7 @@ impl Default for Workload {
             solid: 0.0,
             thin: 0.0,
             samples: 1.0,
+            supersampled: 0.0,
         }
     }
 }
@@ -134,28 +139,38 @@ pub fn map_features(w: &Workload) -> Vec<f64> {
 }
 
 /// Names of the per-object screen features, in the order [`screen_features`] returns them.
-pub const SCREEN_FEATURES: [&str; 5] = ["pixels", "extra_samples", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
+pub const SCREEN_FEATURES: [&str; 6] =
+    ["pixels", "extra_msaa_samples", "extra_ssaa_samples", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
 
 /// What an object's camera work scales with: its pixels (1e4), the anti-aliasing samples it
-/// shades beyond one per pixel (a unit cost of its own: a sample-rate search does not cost
-/// what a pixel's does), and its shaded samples times the depth of a hierarchy over the
+/// shades beyond one per pixel, multisampled and supersampled (unit costs of their own: a
+/// sample-rate search does not cost what a pixel's does, nor a multisample what a
+/// supersample does), and its shaded samples times the depth of a hierarchy over the
 /// scene's triangles (log₂ / 16: a traversal per ray), again for a solid dielectric's and a
 /// thin one's (more rays per sample).
 pub fn screen_features(w: &Workload) -> Vec<f64> {
     let px = w.pixels / 1e4;
     let rays = px * w.samples * depth(w);
-    vec![px, px * (w.samples - 1.0).max(0.0), rays, rays * w.solid, rays * w.thin]
+    let [msaa, ssaa] = extra(w);
+    vec![px, px * msaa, px * ssaa, rays, rays * w.solid, rays * w.thin]
 }
 
 /// Names of the whole-screen features, in the order [`shared_features`] returns them.
-pub const SHARED_FEATURES: [&str; 3] = ["screen", "screen_extra_samples", "screen_rays"];
+pub const SHARED_FEATURES: [&str; 4] = ["screen", "screen_extra_msaa_samples", "screen_extra_ssaa_samples", "screen_rays"];
 
 /// What a method's whole-screen kernels scale with: the frame's pixels (1e4), its samples
 /// beyond one per pixel, and its samples times the hierarchy depth (every sample's primary
 /// ray).
 pub fn shared_features(w: &Workload) -> Vec<f64> {
     let px = w.screen / 1e4;
-    vec![px, px * (w.samples - 1.0).max(0.0), px * w.samples * depth(w)]
+    let [msaa, ssaa] = extra(w);
+    vec![px, px * msaa, px * ssaa, px * w.samples * depth(w)]
+}
+
+/// Samples beyond one per pixel, multisampled and supersampled.
+fn extra(w: &Workload) -> [f64; 2] {
+    let e = (w.samples - 1.0).max(0.0);
+    [e * (1.0 - w.supersampled), e * w.supersampled]
 }
 
 fn depth(w: &Workload) -> f64 {
@@ -175,5 +190,6 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         solid: (f.class == ObjectClass::SolidDielectric) as u8 as f64,
         thin: (f.class == ObjectClass::ThinDielectric) as u8 as f64,
         samples: aa_samples(q).0,
+        supersampled: (q.frame.aa.ssaa() > 1) as u8 as f64,
     }
 }
