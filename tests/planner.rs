@@ -371,6 +371,29 @@ fn auto_chooses_only_the_knobs_left_to_it() {
     again.refresh_geometry(&moved).expect("a small move keeps the plan and its knobs");
     assert_eq!(again.quality, p.quality);
 
+    // The hybrid search is a candidate of its own where the calibration measured it (this
+    // machine's, with ray queries): its own error and cost (it traces where maps fail).
+    let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
+    let models = predict::predict_models(&scene, &facts, &q, &t, &["default".into(), "hybrid=rays".into()]).unwrap();
+    let get = |k: usize| {
+        let o = models.variants[k].objects.iter().find(|o| o.method == "distance").expect("distance serves the mirror");
+        (o.psnr_db, o.cost.fixed_ms + o.cost.screen_ms + o.shared.screen_ms)
+    };
+    let (plain, hybrid) = (get(0), get(1));
+    assert!(hybrid.0 != plain.0 && hybrid.1 > plain.1, "plain {plain:?}, hybrid {hybrid:?}");
+
+    // The hybrid search, chosen by auto on costs of a device with ray queries, is turned off
+    // (with the reason) on a device without them; asked for, it is the caller's.
+    let distance = Choices::all(Choice::Method(specula::methods::DISTANCE));
+    let mut chose = plan_for(&scene, &distance, &q, Some(&t)).unwrap();
+    chose.quality.distance.hybrid = true;
+    let none = |m: Method| (m == specula::methods::RAY_QUERY).then(|| (specula::methods::BVH, "no ray queries".to_string()));
+    let off = chose.clone().for_device(&scene, none).unwrap();
+    assert!(!off.quality.distance.hybrid);
+    assert!(off.objects.iter().all(|o| o.reason.contains("hybrid=rays cannot run on this device (no ray queries)")), "{:?}", off.objects);
+    let asked = plan_for(&scene, &distance, &with(&["hybrid=rays"]), Some(&t)).unwrap().for_device(&scene, none).unwrap();
+    assert!(asked.quality.distance.hybrid, "asked for: kept (the stage then refuses with its reason)");
+
     // Rendered (128²: at 64² the maps' fixed cost outweighs what anti-aliasing gains, and
     // auto ray traces; this device's costs): the variant auto takes is more accurate than
     // the same methods without it, and the exact tracer does not beat it in both time and

@@ -127,7 +127,19 @@ impl Plan {
     /// that serves instead of `m`, and why; `DeviceNeeds::missing_on`): every object whose
     /// method the device cannot run gets that fallback, planned as if it had been asked for,
     /// and its reason says so. The plan itself when nothing is missing.
-    pub fn for_device(self, scene: &Scene, missing: impl Fn(Method) -> Option<(Method, String)>) -> Result<Plan> {
+    pub fn for_device(mut self, scene: &Scene, missing: impl Fn(Method) -> Option<(Method, String)>) -> Result<Plan> {
+        // The hybrid search auto chose (on another device's costs) needs ray queries too:
+        // off where the device has none, said in the reasons of the objects that read it.
+        // (Asked for by the caller, it stays, and the stage refuses with the reason.)
+        if self.quality.distance.hybrid && !self.asked_quality.distance.hybrid {
+            if let Some((_, why)) = missing(crate::methods::RAY_QUERY) {
+                self.quality.distance.hybrid = false;
+                for o in self.objects.iter_mut().filter(|o| o.method.knobs.contains(&"hybrid")) {
+                    o.knobs = o.method.knobs.iter().map(|k| (*k, self.quality.get(k))).collect();
+                    o.reason = format!("{}; hybrid=rays cannot run on this device ({why}): off", o.reason);
+                }
+            }
+        }
         let lacking: Vec<(usize, Method, Method, String)> =
             self.objects.iter().filter_map(|o| missing(o.method).map(|(f, why)| (o.mesh, o.method, f, why))).collect();
         let whole = match self.choice {
@@ -151,6 +163,7 @@ impl Plan {
             }
         }
         let mut fresh = plan_inner(scene, &Choices { method, objects }, &self.quality, true, self.target.as_ref())?;
+        fresh.asked_quality = self.asked_quality.clone();
         for o in &mut fresh.objects {
             if let Some((_, m, f, why)) = lacking.iter().find(|(mesh, ..)| *mesh == o.mesh) {
                 let before = self.objects.iter().find(|x| x.mesh == o.mesh).map_or(String::new(), |x| x.reason.clone());

@@ -27,8 +27,9 @@ pub fn plan() -> Measure {
         sizes: SIZES.to_vec(),
         // The second variant tells the cube maps' texel costs and multisampling's per-sample
         // costs from the rest at once (they fall in separate terms: maps, camera work); the
-        // third supersampling's.
-        variants: vec!["default".into(), "cube_size=128 aa=msaa4".into(), "aa=ssaa2".into()],
+        // third supersampling's; the fourth (the methods that read it, where the device has
+        // ray queries) the hybrid search's.
+        variants: vec!["default".into(), "cube_size=128 aa=msaa4".into(), "aa=ssaa2".into(), "hybrid=rays".into()],
         methods: gpu_methods(),
         // The software ray engine and ray hierarchy take 50–100× bvh's time on lavapipe:
         // two scenes give their unit costs.

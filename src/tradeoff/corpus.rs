@@ -86,7 +86,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     // A method this device cannot run (ray-query without ray queries) would
                     // measure its fallback under its name: left out, so the planner never
                     // sees costs for it here.
-                    if !set.iter().all(|k| m.knobs.contains(k) || frame_wide(k)) || m.needs.missing_on(ctx).is_some() {
+                    // Nor a variant whose knob needs what the device lacks (the hybrid
+                    // search's ray queries) for a method that reads it.
+                    let unrunnable = set.contains(&"hybrid") && m.knobs.contains(&"hybrid") && ctx.ray_query.is_err();
+                    if !set.iter().all(|k| m.knobs.contains(k) || frame_wide(k)) || m.needs.missing_on(ctx).is_some() || unrunnable {
                         continue;
                     }
                     if cfg.sparse.iter().any(|(s, n)| *s == m && i % (*n).max(1) != 0) {

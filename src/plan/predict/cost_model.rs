@@ -59,9 +59,9 @@ fn base_features(w: &Workload) -> Vec<f64> {
 impl CostModel {
     /// Fits unit costs from a measurement run on the device `key`.
     pub fn fit(corpus: &Corpus, key: DeviceKey, calibration_s: f64) -> CostModel {
-        let mut by: BTreeMap<&str, Vec<&super::samples::Sample>> = BTreeMap::new();
+        let mut by: BTreeMap<String, Vec<&super::samples::Sample>> = BTreeMap::new();
         for s in &corpus.samples {
-            by.entry(s.method.as_str()).or_default().push(s);
+            by.entry(super::error_model::candidate(&s.method, &s.knobs)).or_default().push(s);
         }
         let methods = by
             .into_iter()
@@ -105,7 +105,7 @@ impl CostModel {
                     cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
                     samples: ss.len(),
                 };
-                (m.to_string(), cost)
+                (m, cost)
             })
             .collect();
         let xb: Vec<Vec<f64>> = corpus.frames.iter().map(|f| base_features(&f.work)).collect();
@@ -115,8 +115,9 @@ impl CostModel {
         CostModel { format: FORMAT.into(), key, methods, base, calibration_s }
     }
 
-    /// Predicted (map, camera, whole-screen) milliseconds of `method` for an object of this
-    /// workload; `None` for a method the calibration did not measure.
+    /// Predicted (map, camera, whole-screen) milliseconds of `method` (an
+    /// `error_model::candidate` name) for an object of this workload; `None` for one the
+    /// calibration did not measure.
     pub fn predict(&self, method: &str, w: &Workload) -> Option<(f64, f64, f64)> {
         let c = self.methods.get(method)?;
         Some((
@@ -138,7 +139,8 @@ impl CostModel {
         }
         let ok = |v: &[f64], n: usize| v.len() == n && v.iter().all(|x| x.is_finite() && *x >= 0.0);
         for (m, mc) in &c.methods {
-            crate::plan::Method::parse(m).map_err(|e| Error::invalid(format!("{what} methods"), e.to_string()))?;
+            crate::plan::Method::parse(super::error_model::candidate_method(m))
+                .map_err(|e| Error::invalid(format!("{what} methods"), e.to_string()))?;
             if !ok(&mc.fixed, MAP_FEATURES.len())
                 || !ok(&mc.screen, SCREEN_FEATURES.len())
                 || !ok(&mc.shared, SHARED_FEATURES.len())

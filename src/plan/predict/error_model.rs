@@ -72,6 +72,22 @@ pub fn model_key(method: &str) -> &str {
 /// The shared model of the exact tracers.
 pub const EXACT: &str = "ray tracing (every scheme)";
 
+/// The candidate a (method, knob variant) pair is, for the models: the method, or
+/// `METHOD+hybrid` where the variant turns on the hybrid search (`hybrid=rays`) of a method
+/// that reads it (its error and its cost are another method's).
+pub fn candidate(method: &str, knobs: &str) -> String {
+    let hybrid = knobs.split_whitespace().any(|p| p == "hybrid=rays");
+    match crate::plan::Method::parse(method) {
+        Ok(m) if hybrid && m.knobs.contains(&"hybrid") => format!("{method}+hybrid"),
+        _ => method.to_string(),
+    }
+}
+
+/// The method of a [`candidate`] name.
+pub fn candidate_method(name: &str) -> &str {
+    name.split('+').next().unwrap_or(name)
+}
+
 /// A sample's weight: objects of few pixels measure their PSNR noisily.
 fn weight(s: &Sample) -> f64 {
     (s.work.pixels / 400.0).clamp(0.05, 1.0)
@@ -85,9 +101,9 @@ impl ErrorModel {
 
     /// [`ErrorModel::fit`] with another ridge penalty.
     pub fn fit_with(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool, ridge: f64) -> ErrorModel {
-        let mut by: BTreeMap<&str, Vec<&Sample>> = BTreeMap::new();
+        let mut by: BTreeMap<String, Vec<&Sample>> = BTreeMap::new();
         for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) == "off") {
-            by.entry(model_key(&s.method)).or_default().push(s);
+            by.entry(model_key(&candidate(&s.method, &s.knobs)).to_string()).or_default().push(s);
         }
         let methods = by
             .into_iter()
@@ -103,7 +119,7 @@ impl ErrorModel {
                 } else {
                     linear::fit(&x, &y, &w, ridge, false)
                 };
-                (m.to_string(), (beta, ss.len()))
+                (m, (beta, ss.len()))
             })
             .collect();
         ErrorModel { methods, aa: fit_aa(samples, keep) }
@@ -140,9 +156,9 @@ impl ErrorModel {
 /// factor [`with_aa`] needs to turn the measured error without into the measured error with.
 /// Objects whose exact error sits at the cap tell nothing and are left out.
 fn fit_aa(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<(String, String), (f64, usize)> {
-    type Key<'a> = (usize, &'a str, &'a str, u64);
+    type Key<'a> = (usize, &'a str, String, u64);
     fn key(s: &Sample) -> Key<'_> {
-        (s.scene, s.object.as_str(), model_key(&s.method), s.work.screen as u64)
+        (s.scene, s.object.as_str(), model_key(&candidate(&s.method, &s.knobs)).to_string(), s.work.screen as u64)
     }
     let mut off: BTreeMap<Key, f64> = BTreeMap::new();
     for s in samples.iter().filter(|s| keep(s) && s.knobs == "default") {
@@ -151,14 +167,14 @@ fn fit_aa(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<(Strin
     let mut logs: BTreeMap<(String, String), Vec<f64>> = BTreeMap::new();
     for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) != "off") {
         let (sc, o, m, px) = key(s);
-        let (Some(&own), Some(&exact)) = (off.get(&(sc, o, m, px)), off.get(&(sc, o, EXACT, px))) else { continue };
+        let (Some(&own), Some(&exact)) = (off.get(&(sc, o, m.clone(), px)), off.get(&(sc, o, EXACT.to_string(), px))) else { continue };
         if exact >= PSNR_CAP - 1.0 {
             continue;
         }
         let (mo, me, ma) = (mse(own), mse(exact), mse(s.psnr_db));
         let alias = mo.min(me);
         let factor = ((ma - (mo - alias)) / alias).clamp(1e-3, 10.0);
-        logs.entry((m.to_string(), aa_of(&s.knobs).to_string())).or_default().push(factor.ln());
+        logs.entry((m, aa_of(&s.knobs).to_string())).or_default().push(factor.ln());
     }
     logs.into_iter()
         .map(|(k, mut v)| {
@@ -198,11 +214,12 @@ pub fn leave_one_scene_out_with(samples: &[Sample], ridge: f64) -> Vec<Held> {
             let aa = aa_of(&s.knobs);
             let n = crate::plan::budget::variant_quality(&crate::quality::Quality::default(), &s.knobs)
                 .map_or(1.0, |q| super::features::aa_samples(&q).1);
-            if let Some(p) = model.predict(&s.method, &s.features, aa, n) {
+            let name = candidate(&s.method, &s.knobs);
+            if let Some(p) = model.predict(&name, &s.features, aa, n) {
                 out.push(Held {
                     scene: sc,
                     object: s.object.clone(),
-                    method: s.method.clone(),
+                    method: name.clone(),
                     knobs: s.knobs.clone(),
                     predicted_db: p,
                     measured_db: s.psnr_db.min(PSNR_CAP),

@@ -112,12 +112,13 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             base = target.costs.base_ms(&work);
             let feats = error_features(f, scene, &q);
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
+                let key = error_model::candidate(m.name, v);
                 let (Some(psnr), Some((fixed, screen, shared))) =
-                    (errors.predict(m.name, &feats, &aa, aa_n), target.costs.predict(m.name, &work))
+                    (errors.predict(&key, &feats, &aa, aa_n), target.costs.predict(&key, &work))
                 else {
                     continue;
                 };
-                let cycles = target.costs.methods.get(m.name).map_or(1, |c| c.cycles);
+                let cycles = target.costs.methods.get(&key).map_or(1, |c| c.cycles);
                 objects.push(ObjectModel {
                     object: name.clone(),
                     class: f.class.label().to_string(),
@@ -143,10 +144,12 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
 }
 
 /// The knob variants the planner chooses among (besides the methods): the cube maps' size,
-/// the knob most of the map-based methods' error and cost turn on, and the frame's
-/// anti-aliasing (4-sample multisampling shaded per sample, 2×2 supersampling).
+/// the knob most of the map-based methods' error and cost turn on, the frame's
+/// anti-aliasing (4-sample multisampling shaded per sample, 2×2 supersampling), and the
+/// distance family's hybrid search (ray queries where its maps cannot answer; a candidate
+/// only on devices whose calibration measured it, i.e. that have ray queries).
 pub fn budget_variants() -> Vec<String> {
-    ["default", "cube_size=128", "cube_size=512", "aa=msaa4", "aa=ssaa2"].iter().map(|s| s.to_string()).collect()
+    ["default", "cube_size=128", "cube_size=512", "aa=msaa4", "aa=ssaa2", "hybrid=rays"].iter().map(|s| s.to_string()).collect()
 }
 
 /// One object's Pareto front: its name, its undominated (knobs, candidate), how many were
