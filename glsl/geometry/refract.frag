@@ -31,6 +31,10 @@ void main() {
         // The face's plane, towards the eye; its child views keep that side (reflection)
         // or the other (refraction), `dir.w` beyond the plane.
         vec3 towards = dot(n, eye - in_position) >= 0.0 ? n : -n;
+        // Positions interpolated at a sample (PER_SAMPLE) rather than the pixel centre
+        // were measured off the face's plane by ~25 hairs on lavapipe (a quarter of a
+        // pixel's footprint at most): the plane test allows a quarter footprint too.
+        float slack = 0.25 * length(fwidth(in_position));
         uint first = (push.flags >> MIRROR_LAYER_SHIFT) & 0xffu;
         uint count = push.flags >> MIRROR_COUNT_SHIFT;
         for (uint i = 0u; i < count; ++i) {
@@ -40,7 +44,7 @@ void main() {
             float offset = abs(dot(c.clip.xyz, in_position) + c.clip.w);
             // Its plane: the normals agree and the pixel lies `hair` from the clip plane
             // (within a few hairs for the rounding of the interpolated position).
-            if (abs(abs(facing) - 1.0) > 1e-3 || offset > 4.0 * c.dir.w) {
+            if (abs(abs(facing) - 1.0) > 1e-3 || offset > 4.0 * c.dir.w + slack) {
                 continue;
             }
             vec3 texel = texelFetch(mirror_views, ivec3(ivec2(gl_FragCoord.xy), int(layer)), 0).rgb;

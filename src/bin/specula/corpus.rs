@@ -18,17 +18,25 @@ pub fn default_variants() -> Vec<String> {
     specula::plan::predict::budget_variants()
 }
 
-/// `variants` empty: [`default_variants`]; `merge`: the corpus file whose measurements the
-/// new ones join (replacing those they re-measure).
+/// `variants` empty: [`default_variants`]; `methods` empty: every GPU method; `merge`: the
+/// corpus file whose measurements the new ones join (replacing those they re-measure).
+/// What `specula corpus` measures: scene numbers, knob variants and methods (each empty:
+/// all of them).
+pub struct Selection<'a> {
+    pub scenes: &'a [usize],
+    pub variants: &'a [String],
+    pub methods: &'a [String],
+}
+
 pub fn run_corpus(
     out: &Path,
     size: &str,
-    scenes: &[usize],
-    variants: &[String],
+    pick: Selection,
     merge: Option<&Path>,
     validate: bool,
     device: &Option<String>,
 ) -> specula::Result<()> {
+    let Selection { scenes, variants, methods } = pick;
     let size = parse_size(size)?;
     let variants = if variants.is_empty() { default_variants() } else { variants.to_vec() };
     for v in variants.iter().filter(|v| *v != "default") {
@@ -46,7 +54,11 @@ pub fn run_corpus(
         scenes: if scenes.is_empty() { (0..corpus::SIZE).collect() } else { scenes.to_vec() },
         sizes: vec![size],
         variants,
-        methods: tradeoff::gpu_methods(),
+        methods: if methods.is_empty() {
+            tradeoff::gpu_methods()
+        } else {
+            methods.iter().map(|m| specula::Method::parse(m)).collect::<specula::Result<Vec<_>>>()?
+        },
         sparse: vec![(specula::methods::RAY_ENGINE, 12), (specula::methods::RAY_HIERARCHY, 12)],
         warmup: 1,
         frames: 1,

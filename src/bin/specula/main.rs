@@ -135,6 +135,10 @@ enum Command {
         /// planner's candidates: default, cube_size=128/512, aa=msaa4, aa=ssaa2.
         #[arg(long = "variant")]
         variants: Vec<String>,
+        /// Only these methods (repeatable; default every GPU method). Objects a method does
+        /// not serve are measured under its fallback.
+        #[arg(long = "method")]
+        methods: Vec<String>,
         /// Join the measurements to this corpus file's (a re-measured sample replaces its
         /// old one) and write the whole to --out.
         #[arg(long)]
@@ -299,8 +303,9 @@ fn run(cmd: Command) -> specula::Result<()> {
             raytrace::run(&triangles, &size, depth, budget_s, frames, &headline_size, &parts, &out, &device)
         }
         Command::Corpus { evaluate: Some(file), figure, .. } => corpus::run_evaluate(&file, &figure),
-        Command::Corpus { out, size, scenes, variants, merge, validate, device, .. } => {
-            corpus::run_corpus(&out, &size, &scenes, &variants, merge.as_deref(), validate, &device)
+        Command::Corpus { out, size, scenes, variants, methods, merge, validate, device, .. } => {
+            let pick = corpus::Selection { scenes: &scenes, variants: &variants, methods: &methods };
+            corpus::run_corpus(&out, &size, pick, merge.as_deref(), validate, &device)
         }
         Command::Calibrate { out, validate, device } => corpus::run_calibrate(out.as_deref(), validate, &device),
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
