@@ -198,6 +198,12 @@ fn hidden_extensions_fall_back_to_bvh_with_a_reason() {
     let plan = plan_with(&scene, &Choices::all(specula::methods::DISTANCE), &q).unwrap();
     let e = Renderer::new(&ctx, &scene, plan, SIZE.0, SIZE.1).err().expect("refused").to_string();
     assert!(e.contains("hybrid=rays") && e.contains("hidden"), "{e}");
+    // Nor are they candidates of auto or a budget here, although the device (its key) is one
+    // whose calibration measured them.
+    let t = specula::target_for(&ctx, SIZE).expect("unit costs");
+    let names: Vec<&String> = t.costs.methods.keys().collect();
+    assert!(names.iter().all(|n| *n != "ray-query" && !n.ends_with("+hybrid")), "{names:?}");
+    assert!(t.costs.methods.contains_key("bvh") && t.costs.methods.contains_key("distance"), "{names:?}");
     common::assert_clean(&ctx);
 }
 

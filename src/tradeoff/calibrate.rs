@@ -78,7 +78,22 @@ fn known() -> &'static Known {
 /// `ctx`'s unit costs: from this process, the cache (`dir`, else `cost_model::cache_dir`),
 /// the stored corpus when it was measured on this device, or a calibration run now (and
 /// cached). A cache file that cannot be read is reported through `warn` and replaced.
+/// Candidates this context cannot run are left out (a device key names the hardware and
+/// driver, not what a host enabled: `ray-query` and the hybrid search need ray queries).
 pub fn costs_for(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(String)) -> Result<(Arc<CostModel>, Source)> {
+    let (c, source) = costs_found(ctx, dir, warn)?;
+    if ctx.ray_query.is_ok() {
+        return Ok((c, source));
+    }
+    let mut runnable = (*c).clone();
+    runnable.methods.retain(|name, _| {
+        let method = crate::plan::predict::error_model::candidate_method(name);
+        !name.ends_with("+hybrid") && crate::methods::Method::parse(method).is_ok_and(|m| m.needs.missing_on(ctx).is_none())
+    });
+    Ok((Arc::new(runnable), source))
+}
+
+fn costs_found(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(String)) -> Result<(Arc<CostModel>, Source)> {
     let key = DeviceKey::of(ctx);
     let dir = dir.or_else(cache_dir);
     let id = (key.clone(), dir.clone());
