@@ -142,11 +142,7 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
     let held = error_model::leave_one_scene_out(&c.samples);
     println!("\nper method at ridge {} (held-out scenes):", error_model::RIDGE);
     println!("{:<24} {:>6} {:>14} {:>12} {:>10}", "method", "n", "median |err|", "90th pct", "bias");
-    let mut methods: Vec<&str> = held.iter().map(|h| h.method.as_str()).collect();
-    methods.sort();
-    methods.dedup();
-    for m in methods {
-        let hs: Vec<error_model::Held> = held.iter().filter(|h| h.method == m).cloned().collect();
+    for (m, hs) in grouped(&held, |h| &h.method) {
         let (med, p90) = error_model::abs_error_quantiles(&hs);
         let bias = hs.iter().map(|h| h.predicted_db - h.measured_db).sum::<f64>() / hs.len() as f64;
         println!("{m:<24} {:>6} {med:>14.2} {p90:>12.2} {bias:>10.2}", hs.len());
@@ -154,11 +150,7 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
     let (med, p90) = error_model::abs_error_quantiles(&held);
     println!("{:<24} {:>6} {med:>14.2} {p90:>12.2}", "all", held.len());
     println!("\nper knob variant (held-out scenes):");
-    let mut variants: Vec<&str> = held.iter().map(|h| h.knobs.as_str()).collect();
-    variants.sort();
-    variants.dedup();
-    for v in variants {
-        let hs: Vec<error_model::Held> = held.iter().filter(|h| h.knobs == v).cloned().collect();
+    for (v, hs) in grouped(&held, |h| &h.knobs) {
         let (med, p90) = error_model::abs_error_quantiles(&hs);
         println!("{v:<24} {:>6} {med:>14.2} {p90:>12.2}", hs.len());
     }
@@ -180,4 +172,12 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
     )?;
     println!("wrote {} and {}", f.svg.display(), f.png.display());
     Ok(())
+}
+
+/// Held-out predictions grouped by `key`, in its order.
+fn grouped<'a>(held: &'a [error_model::Held], key: impl Fn(&error_model::Held) -> &String) -> Vec<(&'a str, Vec<error_model::Held>)> {
+    let mut keys: Vec<&str> = held.iter().map(|h| key(h).as_str()).collect();
+    keys.sort();
+    keys.dedup();
+    keys.into_iter().map(|k| (k, held.iter().filter(|h| key(h) == k).cloned().collect())).collect()
 }

@@ -45,6 +45,7 @@ mod search;
 pub use attribute::{attribute, measured_by_object, Cost};
 pub use choose::{choose, choose_with};
 pub use fit::{fit, Measured};
+pub(crate) use models::{mse_of, psnr_of};
 pub use models::{variant_quality, Models, ObjectModel, RowBase, VariantModel, FORMAT, PSNR_CAP};
 pub use prediction::{report, Budget, FrameMeasured, ObjectMeasured, ObjectPrediction, Prediction};
 pub use search::MAX_COMBINATIONS;

@@ -168,11 +168,11 @@ pub fn variant_quality(base: &Quality, knobs: &str) -> Result<Quality> {
     Ok(q)
 }
 
-pub(super) fn mse_of(psnr: f64) -> f64 {
+pub(crate) fn mse_of(psnr: f64) -> f64 {
     10f64.powf(-psnr.min(PSNR_CAP) / 10.0)
 }
 
-pub(super) fn psnr_of(mse: f64) -> f64 {
+pub(crate) fn psnr_of(mse: f64) -> f64 {
     if mse > 0.0 {
         (-10.0 * mse.log10()).min(PSNR_CAP)
     } else {

@@ -39,16 +39,10 @@ pub fn unmeasured_aa_factor(samples: f64) -> f64 {
     samples.max(1.0).powf(-1.6)
 }
 
-fn mse(psnr: f64) -> f64 {
-    10f64.powf(-psnr.min(PSNR_CAP) / 10.0)
-}
+use crate::plan::budget::{mse_of as mse, psnr_of};
 
 fn psnr(mse: f64) -> f64 {
-    if mse > 0.0 {
-        (-10.0 * mse.log10()).clamp(PSNR_FLOOR, PSNR_CAP)
-    } else {
-        PSNR_CAP
-    }
+    psnr_of(mse).max(PSNR_FLOOR)
 }
 
 /// Anti-aliasing's effect on an object: its error without it (`mse_method`) is aliasing up

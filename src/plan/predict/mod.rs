@@ -260,9 +260,9 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
     if facts.objects.is_empty() {
         return Ok(None);
     }
-    let asked = predict_models(scene, facts, quality, target, &["default".to_string()])?;
-    let variants = auto_variants(quality);
-    let models = if variants.len() > 1 { predict_models(scene, facts, quality, target, &variants)? } else { asked.clone() };
+    // One prediction for every variant; the asked knobs are its first ("default").
+    let models = predict_models(scene, facts, quality, target, &auto_variants(quality))?;
+    let asked = Models { variants: models.variants.iter().take(1).cloned().collect(), ..models.clone() };
     let exact_src = [(&asked, source(target))];
     let src = [(&models, source(target))];
     let run = |c: &Choices, b: Budget| budget::choose_with(scene, facts, c, quality, b, target.size, &src);
@@ -308,13 +308,17 @@ pub fn switch(
     next: (&Choices, &Quality),
     target: &Target,
 ) -> Result<Option<String>> {
-    let eval = |c: &Choices, q: &Quality| -> Result<Option<Prediction>> {
-        let models = predict_models(scene, facts, q, target, &["default".to_string()])?;
-        let src = [(&models, source(target))];
+    // Predicted once per distinct set of knobs.
+    let now = predict_models(scene, facts, current.1, target, &["default".to_string()])?;
+    let then = if next.1 == current.1 { None } else { Some(predict_models(scene, facts, next.1, target, &["default".to_string()])?) };
+    let eval = |c: &Choices, q: &Quality, models: &Models| -> Result<Option<Prediction>> {
+        let src = [(models, source(target))];
         Ok(budget::choose_with(scene, facts, c, q, Budget::MaxMs(f64::INFINITY), target.size, &src)?.map(|r| r.2))
     };
     let exact = Choices { method: current.0.method, objects: current.0.objects.iter().map(|(n, _)| (n.clone(), BVH)).collect() };
-    let (Some(a), Some(b), Some(e)) = (eval(current.0, current.1)?, eval(next.0, next.1)?, eval(&exact, current.1)?) else {
+    let (a, b, e) =
+        (eval(current.0, current.1, &now)?, eval(next.0, next.1, then.as_ref().unwrap_or(&now))?, eval(&exact, current.1, &now)?);
+    let (Some(a), Some(b), Some(e)) = (a, b, e) else {
         return Ok(None);
     };
     let max_ms = e.frame_ms;
