@@ -175,7 +175,7 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
 }
 
 /// Held-out predictions grouped by `key`, in its order.
-fn grouped<'a>(held: &'a [error_model::Held], key: impl Fn(&error_model::Held) -> &String) -> Vec<(&'a str, Vec<error_model::Held>)> {
+fn grouped(held: &[error_model::Held], key: impl Fn(&error_model::Held) -> &String) -> Vec<(&str, Vec<error_model::Held>)> {
     let mut keys: Vec<&str> = held.iter().map(|h| key(h).as_str()).collect();
     keys.sort();
     keys.dedup();
