@@ -9,7 +9,6 @@ layout(local_size_x = 64) in;
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
-    uint w = trace.ray_texture_width;
     uint ts = trace.tile_size;
     uint rows = engine_rows();
     uint tiles_y = (rows + ts - 1u) / ts;
@@ -19,8 +18,10 @@ void main() {
     vec3 sum_d = vec3(0.0);
     vec3 sum_o = vec3(0.0);
     for (uint j = 0u; j < ts * ts; ++j) {
-        uint i = (t0.y + j / ts) * w + t0.x + j % ts;
-        if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+        uint t = texel_slot(t0 + uvec2(j % ts, j / ts));
+        if (t >= queue_rays()) continue;
+        uint i = ray_at(t);
+        if ((queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
         sum_d += normalize(queries[i].direction.xyz);
         sum_o += queries[i].origin.xyz;
         n++;
@@ -34,8 +35,10 @@ void main() {
     float cos_t = 1.0;
     float r = 0.0;
     for (uint j = 0u; j < ts * ts; ++j) {
-        uint i = (t0.y + j / ts) * w + t0.x + j % ts;
-        if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+        uint t = texel_slot(t0 + uvec2(j % ts, j / ts));
+        if (t >= queue_rays()) continue;
+        uint i = ray_at(t);
+        if ((queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
         cos_t = min(cos_t, dot(normalize(queries[i].direction.xyz), axis));
         r = max(r, length(queries[i].origin.xyz - c));
     }
@@ -44,8 +47,10 @@ void main() {
     bool bounded = true;
     vec3 sum_e = vec3(0.0);
     for (uint j = 0u; j < ts * ts && bounded; ++j) {
-        uint i = (t0.y + j / ts) * w + t0.x + j % ts;
-        if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+        uint t = texel_slot(t0 + uvec2(j % ts, j / ts));
+        if (t >= queue_rays()) continue;
+        uint i = ray_at(t);
+        if ((queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
         float t_max = queries[i].direction.w;
         bounded = !isinf(t_max);
         sum_e += queries[i].origin.xyz + queries[i].direction.xyz * t_max;
@@ -55,8 +60,10 @@ void main() {
         float re = 0.0;
         float scale = 0.0;
         for (uint j = 0u; j < ts * ts; ++j) {
-            uint i = (t0.y + j / ts) * w + t0.x + j % ts;
-            if (i >= ray_count || (queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
+            uint t = texel_slot(t0 + uvec2(j % ts, j / ts));
+            if (t >= queue_rays()) continue;
+            uint i = ray_at(t);
+            if ((queries[i].flags & RAY_HIT_KNOWN) != 0u) continue;
             vec3 o = queries[i].origin.xyz;
             vec4 d = queries[i].direction;
             re = max(re, length(o + d.xyz * d.w - e));

@@ -8,9 +8,9 @@ layout(location = 0) flat in uint triangle_id;
 layout(location = 0) out uvec4 record;
 
 void main() {
-    uint i = uint(gl_FragCoord.y) * trace.ray_texture_width + uint(gl_FragCoord.x);
-    if (i >= ray_count) discard;
-    RayQuery q = queries[i];
+    uint t = texel_slot(uvec2(gl_FragCoord.xy));
+    if (t >= queue_rays()) discard;
+    RayQuery q = queries[ray_at(t)];
     if ((q.flags & RAY_HIT_KNOWN) != 0u || triangle_id == q.skip) discard;
     Triangle tr = triangles[triangle_id];
     vec3 tuv;

@@ -77,7 +77,9 @@ gpu_structs! {
         tiles_per_row: uint,
         /// camera rays per pixel (MSAA samples; 1 without)
         samples: uint,
-        pad: uint,
+        /// 1: the ray texture holds the queue's rays in `ray_order` (the ray hierarchy's
+        /// pixel order, raytrace/sort.glsl); 0: texel t is ray t
+        ordered: uint,
     }
 
     /// What an acceleration scheme's kernel needs besides its node and reference buffers.
@@ -163,6 +165,15 @@ descriptor_sets! {
         /// The ray hierarchy's culling counts (with the ray_stats knob): per bounce and
         /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
         CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
+        /// The ray hierarchy's ray order: the ray at each texel of the ray texture, the
+        /// queue's rays by pixel (raytrace/sort.glsl)
+        RAY_ORDER = 16: STORAGE_BUFFER => "buffer RayOrder { uint ray_order[]; }";
+        /// The ray order's pixel counters, then (scanned) where each pixel's rays start
+        SORT_OFFSETS = 17: STORAGE_BUFFER => "buffer SortOffsets { uint sort_offsets[]; }";
+        /// Each ray's rank among its pixel's rays
+        SORT_RANKS = 18: STORAGE_BUFFER => "buffer SortRanks { uint sort_ranks[]; }";
+        /// The scan's block totals
+        SORT_BLOCKS = 19: STORAGE_BUFFER => "buffer SortBlocks { uint sort_blocks[]; }";
     }
 
     /// The `ray-query` scheme's own set 5 (src/methods/raytrace/ray_query/): the TLAS over

@@ -30,6 +30,7 @@ pub mod gpu;
 pub mod grid;
 pub mod kdtree;
 pub mod knobs;
+mod ray_order;
 pub mod ray_query;
 pub mod stage;
 

@@ -21,6 +21,7 @@
 use ash::vk;
 
 use super::gpu::Structure;
+use super::ray_order::RayOrder;
 use super::ray_query::accel::{AccelStructures, MeshInput};
 use super::{Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
@@ -132,6 +133,8 @@ pub struct RayTrace {
     engine_depth: Option<Image>,
     /// The ray hierarchy's cone per tile.
     cones: Buffer,
+    /// The ray hierarchy's ray order (each queue's rays by pixel, before its cones).
+    order: Option<RayOrder>,
     /// With the ray_stats knob: the hierarchy's culling counts (`cull_stats.comp`).
     cull_stats: Buffer,
     stats: bool,
@@ -187,6 +190,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         engine: None,
         engine_depth: None,
         cones: Buffer::placeholder(),
+        order: None,
         cull_stats: Buffer::placeholder(),
         stats: q.raytrace.ray_stats,
         capacity: 0,
@@ -310,12 +314,14 @@ impl RayTrace {
         // The ray texture of the rasterising schemes: every queue's rays, row by row.
         let most = capacity.max(shadow_capacity);
         let width = ((most as f64).sqrt().ceil() as u32).div_ceil(32).max(1) * 32;
-        let height = most.div_ceil(width as u64) as u32;
-        let limit = ctx.properties.limits.max_image_dimension2_d;
         let tile = match self.scheme {
             Scheme::RayHierarchy { tile } => tile,
             _ => 0,
         };
+        // The hierarchy fills its texture tile by tile (engine.glsl's texel_slot): whole rows
+        // of tiles (the width is a multiple of 32, every tile size divides it).
+        let height = (most.div_ceil(width as u64) as u32).div_ceil(tile.max(1)) * tile.max(1);
+        let limit = ctx.properties.limits.max_image_dimension2_d;
         if matches!(self.scheme, Scheme::RayEngine | Scheme::RayHierarchy { .. }) {
             if width > limit || height > limit {
                 return Err(Error::invalid(
@@ -353,7 +359,7 @@ impl RayTrace {
                 tile_size: tile.max(1),
                 tiles_per_row,
                 samples: self.samples,
-                pad: 0,
+                ordered: (tile > 0) as u32,
             };
             let at = (k * self.stride) as usize;
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
@@ -382,6 +388,10 @@ impl RayTrace {
         }
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
         self.create_pipelines(ctx)?;
+        if tile > 0 {
+            let keys = (self.width.div_ceil(tile) * self.height.div_ceil(tile)) as u64 * (tile * tile * self.samples) as u64;
+            self.order = Some(RayOrder::new(ctx, self.layout, most, keys)?);
+        }
         self.create_sets(ctx)
     }
 
@@ -541,6 +551,7 @@ impl RayTrace {
                     .image_info(&img);
                 unsafe { ctx.device.update_descriptor_sets(&[w], &[]) };
             }
+            RayOrder::write(self.order.as_ref(), ctx, set);
             write_buffer(ctx, set, binding::TILE_CONES, sb, if self.tiles > 0 { self.cones.raw } else { vk::Buffer::null() });
             write_buffer(
                 ctx,
@@ -583,7 +594,8 @@ impl RayTrace {
 
     /// The nearest hits of the queue bound in `sets`: the scheme's kernel (indirect, from the
     /// queue's counter), or the ray engine's raster pass over the ray texture and its copy
-    /// into the hit buffer (the ray hierarchy first builds its tiles' cones).
+    /// into the hit buffer (the ray hierarchy first orders the queue by pixel, then builds its
+    /// tiles' cones).
     fn intersect(&mut self, rec: &mut Recorder, f: &FrameInputs, sets: [vk::DescriptorSet; 2], at: u64, view: u32, queue: u32) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let name = self.scheme.pass_name();
@@ -596,8 +608,15 @@ impl RayTrace {
         let open =
             rec.pass(name).after_buffer_writes().writes(engine, Access::ColorAttachment).writes(depth, Access::DepthAttachment).begin();
         if self.tiles > 0 {
+            if let Some(order) = &self.order {
+                let bind = |p| {
+                    self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, p, f, sets);
+                    self.push_object(ctx, cmd, f, view, queue);
+                };
+                order.record(ctx, cmd, &bind, (self.dispatch.raw, at));
+            }
             self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.p.cones, f, sets);
-            self.push(ctx, cmd, f, view);
+            self.push_object(ctx, cmd, f, view, queue);
             unsafe { ctx.device.cmd_dispatch(cmd, self.tiles.div_ceil(64), 1, 1) };
             let b = [vk::MemoryBarrier2::default()
                 .src_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER)
@@ -630,7 +649,7 @@ impl RayTrace {
             },
         );
         self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.p.engine, f, sets);
-        self.push(ctx, cmd, f, view);
+        self.push_object(ctx, cmd, f, view, queue);
         let vertices = 6 * self.tiles.max(1);
         unsafe {
             ctx.device.cmd_draw(cmd, vertices, self.triangle_count, 0, 0);
@@ -639,7 +658,9 @@ impl RayTrace {
         rec.end(open);
         let engine = self.engine.as_mut().expect("checked");
         let open = rec.pass(name).after_buffer_writes().writes(engine, Access::ComputeStorage).begin();
-        self.dispatch_indirect((ctx, cmd), self.p.engine_copy, f, sets, at, view);
+        self.bind(ctx, cmd, vk::PipelineBindPoint::COMPUTE, self.p.engine_copy, f, sets);
+        self.push_object(ctx, cmd, f, view, queue);
+        unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, at) };
         rec.end(open);
     }
 
@@ -902,6 +923,9 @@ impl Stage for RayTrace {
             ],
         );
         self.p = Pipelines::default();
+        if let Some(mut o) = self.order.take() {
+            o.destroy(ctx);
+        }
         crate::vk::pipeline::destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
         self.rq_set = vk::DescriptorSet::null();
         if let Some(s) = self.structure.as_mut() {
