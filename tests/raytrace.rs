@@ -315,9 +315,25 @@ fn ray_statistics_count_rays_and_overflow() {
     let f = specula::render(&ctx, &s, BVH, &tight, (32, 32), (0, 1)).unwrap();
     eprintln!("glass stats: {:?}", f.stats);
     // Every pixel sees the glass: two children each (reflected, refracted), 2048 (measured
-    // 2048), of which the budget of 1024 keeps half: 1024 dropped (measured 1024).
+    // 2048), of which the budget of 1024 keeps the heaviest weight bins that fit (spawn.comp).
     assert_eq!(stat(&f, "raytrace.rays.bounce1"), Some(2048.0), "{:?}", f.stats);
-    assert_eq!(stat(&f, "raytrace.dropped_rays"), Some(1024.0), "{:?}", f.stats);
+    let dropped = stat(&f, "raytrace.dropped_rays").unwrap();
+    assert!(dropped >= 1024.0, "{:?}", f.stats);
+    // What a full queue keeps depends on the paths' weights alone: the same image in every
+    // run, and the light missing against an unlimited budget is the light of the lightest
+    // paths (the reflections, Fresnel ≈ 4 % at normal incidence). Measured: 2048 rays
+    // dropped (1024 at each bounce) of path weight 83.2 in all (0.04 each, where a refracted
+    // child weighs ≈ 0.96); PSNR against ray_budget=8 33.65 dB. Asserted: the dropped rays
+    // weigh under 0.1 each on average, and the PSNR within 1 dB of the measured.
+    let again = specula::render(&ctx, &s, BVH, &tight, (32, 32), (0, 1)).unwrap();
+    assert!(f.image.data == again.image.data, "an overflowing frame differs between runs");
+    let weight = stat(&f, "raytrace.dropped_weight").unwrap();
+    let full = specula::render(&ctx, &s, BVH, &quality(&["depth=2", "ray_budget=8"]), (32, 32), (0, 1)).unwrap();
+    assert_eq!(stat(&full, "raytrace.dropped_rays"), Some(0.0));
+    let psnr = psnr(&f.image, &full.image);
+    eprintln!("dropped weight {weight}, PSNR against an unlimited budget {psnr:.2} dB");
+    assert!(weight > 0.0 && weight < 0.1 * dropped, "{:?}", f.stats);
+    assert!(psnr >= 32.65, "{psnr:.2} dB");
 
     // The ray hierarchy orders each queue by pixel before building its tiles' cones
     // (src/methods/raytrace/ray_order.rs): its culling is the same in every run. Measured

@@ -48,8 +48,9 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
         println!("{name:<40} {value:>12.4}");
     }
     if let Some((_, n)) = frame.stats.iter().find(|(k, _)| k == "raytrace.dropped_rays").filter(|(_, n)| *n > 0.0) {
+        let weight = frame.stats.iter().find(|(k, _)| k == "raytrace.dropped_weight").map_or(0.0, |(_, w)| *w);
         eprintln!(
-            "specula: warning: {n} rays did not fit in their queues and were dropped (their light is missing); raise the ray_budget knob"
+            "specula: warning: {n} rays did not fit in their queues and were dropped, the lightest paths first (path weight {weight:.3} in all, a camera ray weighing 1: their light is missing); raise the ray_budget knob"
         );
     }
     if let (Some(pr), Some(plan)) = (&prediction, &budget_plan) {

@@ -5,7 +5,7 @@ use crate::quality::knob::knobs;
 knobs! {
     /// Ray tracing in the original geometry (§2).
     pub struct RaytraceKnobs {
-        /// ray tracing (§2): capacity of each bounce's ray queue; rays beyond it are dropped (and counted)
+        /// ray tracing (§2): capacity of each bounce's ray queue; beyond it the lightest paths are dropped (counted, with their weight)
         ray_budget: u32 = 4, count(1..=64, "rays per pixel");
         /// bvh (§2.3.5): nearest child first with a short stack, or stackless along hit/miss links (CHCH06)
         bvh_stackless as bvh_traversal: bool = "stack", one_of()["stack" => false, "stackless" => true];

@@ -82,6 +82,19 @@ gpu_structs! {
         ordered: uint,
     }
 
+    /// One bounce's spawn budget (raytrace/spawn.comp): which children the next queue keeps.
+    struct GpuSpawnBudget => struct SpawnBudgetState {
+        /// children per weight bin (bin 0: the heaviest)
+        hist: [uint; 64],
+        /// the first bin not kept (SPAWN_BINS: every child kept)
+        cutoff: uint,
+        /// children dropped
+        dropped: uint,
+        /// their path weights (largest channel), 64-bit fixed point 2^-20 (lo, hi)
+        dropped_weight: [uint; 2],
+        pad: [uint; 12],
+    }
+
     /// What an acceleration scheme's kernel needs besides its node and reference buffers.
     struct GpuAccel => struct Accel {
         /// uniform grid: world-space minimum corner (xyz)
@@ -105,6 +118,9 @@ gpu_structs! {
 }
 
 gpu_consts! {
+    /// Bins of the spawn budget's weight histogram: a quarter octave each, from weight 1 down
+    /// to 2^-16 (the last bin holds everything lighter).
+    SPAWN_BINS: uint = 64;
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
     RAY_NO_TRIANGLE: uint = 4294967295;
     /// `RayQuery.flags`: any hit will do (shadow rays).
@@ -174,6 +190,9 @@ descriptor_sets! {
         SORT_RANKS = 18: STORAGE_BUFFER => "buffer SortRanks { uint sort_ranks[]; }";
         /// The scan's block totals
         SORT_BLOCKS = 19: STORAGE_BUFFER => "buffer SortBlocks { uint sort_blocks[]; }";
+        /// This bounce's spawn budget (raytrace/spawn.comp): the children's weights in
+        /// SPAWN_BINS bins, the first bin dropped, and the rays and path weight dropped
+        SPAWN_BUDGET = 20: STORAGE_BUFFER => "buffer SpawnBudget { SpawnBudgetState spawn_budget; }";
     }
 
     /// The `ray-query` scheme's own set 5 (src/methods/raytrace/ray_query/): the TLAS over

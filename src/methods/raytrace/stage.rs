@@ -16,7 +16,10 @@
 //!
 //! Radiance accumulates per pixel in 64-bit fixed point through integer atomics
 //! (`glsl/raytrace/trace.glsl`), so the image does not depend on the order in which the
-//! GPU processes rays, and a host-device frame equals a standalone one bit for bit.
+//! GPU processes rays, and a host-device frame equals a standalone one bit for bit. A full
+//! queue keeps the heaviest children by a histogram of their weights (`spawn.comp`, run
+//! twice around `spawn_cutoff.comp`), not the first to arrive, so an overflowing frame is
+//! the same in every run too; the dropped rays and their path weight are stats.
 
 use ash::vk;
 
@@ -26,7 +29,8 @@ use super::ray_query::accel::{AccelStructures, MeshInput};
 use super::{Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
-    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, RAY_QUERY_BINDINGS, TRACE_BINDINGS,
+    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuSpawnBudget, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, RAY_QUERY_BINDINGS,
+    TRACE_BINDINGS,
 };
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
@@ -88,6 +92,7 @@ struct Pipelines {
     intersect: vk::Pipeline,
     shade: vk::Pipeline,
     spawn: vk::Pipeline,
+    spawn_cutoff: vk::Pipeline,
     shadow: vk::Pipeline,
     args: vk::Pipeline,
     resolve: vk::Pipeline,
@@ -123,6 +128,10 @@ pub struct RayTrace {
     counters: Buffer,
     /// One `TraceParams` per bounce, `stride` apart.
     params: Buffer,
+    /// One `GpuSpawnBudget` per bounce, `budget_stride` apart (host-visible: the dropped
+    /// rays and weight are stats).
+    spawn_budget: Buffer,
+    budget_stride: u64,
     /// 8 words per bounce: the rays' and the shadow queries' dispatch arguments.
     dispatch: Buffer,
     accum: Buffer,
@@ -183,6 +192,8 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         shadow: None,
         counters: Buffer::placeholder(),
         params: Buffer::placeholder(),
+        spawn_budget: Buffer::placeholder(),
+        budget_stride: 0,
         dispatch: Buffer::placeholder(),
         accum: Buffer::placeholder(),
         vis: None,
@@ -365,6 +376,10 @@ impl RayTrace {
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
         }
         self.params = Buffer::with_data(ctx, "raytrace.params", &params, STORAGE)?;
+        let budget = std::mem::size_of::<GpuSpawnBudget>() as u64;
+        self.budget_stride = budget.div_ceil(align) * align;
+        self.spawn_budget =
+            Buffer::new(ctx, "raytrace.spawn_budget", self.budget_stride * bounces, counter_usage, MemoryLocation::GpuToCpu)?;
         self.dispatch =
             Buffer::new(ctx, "raytrace.dispatch", 32 * bounces, STORAGE | vk::BufferUsageFlags::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
         self.accum = Buffer::new(ctx, "raytrace.accum", pixels * 24, counter_usage, MemoryLocation::GpuOnly)?;
@@ -452,6 +467,7 @@ impl RayTrace {
         self.p.primary = compute_pipeline(ctx, self.layout, "raytrace/primary.comp")?;
         self.p.shade = compute_pipeline(ctx, self.layout, "raytrace/shade.comp")?;
         self.p.spawn = compute_pipeline(ctx, self.layout, "raytrace/spawn.comp")?;
+        self.p.spawn_cutoff = compute_pipeline(ctx, self.layout, "raytrace/spawn_cutoff.comp")?;
         self.p.shadow = compute_pipeline(ctx, self.layout, "raytrace/shadow.comp")?;
         self.p.args = compute_pipeline(ctx, self.layout, "raytrace/args.comp")?;
         Ok(())
@@ -539,6 +555,7 @@ impl RayTrace {
             write_buffer(ctx, set, binding::SHADING, sb, self.shading.raw);
             write_buffer(ctx, set, binding::HANDLED, sb, self.handled.raw);
             at(set, binding::TRACE, &self.params, k as u64 * stride, std::mem::size_of::<GpuTraceParams>() as u64);
+            at(set, binding::SPAWN_BUDGET, &self.spawn_budget, k as u64 * self.budget_stride, std::mem::size_of::<GpuSpawnBudget>() as u64);
             at(set, binding::DISPATCH, &self.dispatch, 0, whole);
             let engine = self.engine.as_ref().map_or(vk::ImageView::null(), |e| e.view);
             for (b, view) in [(binding::VISIBILITY, vis.view), (binding::ENGINE_HITS, engine)] {
@@ -771,6 +788,7 @@ impl Stage for RayTrace {
         unsafe {
             ctx.device.cmd_fill_buffer(cmd, self.counters.raw, 0, vk::WHOLE_SIZE, 0);
             ctx.device.cmd_fill_buffer(cmd, self.accum.raw, 0, vk::WHOLE_SIZE, 0);
+            ctx.device.cmd_fill_buffer(cmd, self.spawn_budget.raw, 0, vk::WHOLE_SIZE, 0);
             if self.cull_stats.size > 0 {
                 ctx.device.cmd_fill_buffer(cmd, self.cull_stats.raw, 0, vk::WHOLE_SIZE, 0);
             }
@@ -834,8 +852,19 @@ impl Stage for RayTrace {
             rec.end(open);
             let open = rec.pass("raytrace.spawn").after_buffer_writes().begin();
             if k < self.depth as usize {
-                self.dispatch_indirect((ctx, cmd), self.p.spawn, f, sets, rays_at, view);
-                Self::barrier(ctx, cmd);
+                // Twice: the children's weights counted, the budget's cut, the kept appended
+                // (spawn.comp: which rays a full queue keeps does not depend on the order).
+                for mode in 0..2 {
+                    if mode == 1 {
+                        self.bind(ctx, cmd, compute, self.p.spawn_cutoff, f, sets);
+                        unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
+                        Self::barrier(ctx, cmd);
+                    }
+                    self.bind(ctx, cmd, compute, self.p.spawn, f, sets);
+                    self.push_object(ctx, cmd, f, view, mode);
+                    unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, rays_at) };
+                    Self::barrier(ctx, cmd);
+                }
             }
             // The shadow queries' count is known now.
             self.bind(ctx, cmd, compute, self.p.args, f, sets);
@@ -872,14 +901,30 @@ impl Stage for RayTrace {
         let Ok(words) = self.counters.read() else { return out };
         let word = |at: u64| words.get(at as usize..at as usize + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64;
         let bounces = self.depth as u64 + 1;
+        // The spawn budget of bounce k decides queue k + 1: its dropped children were rays
+        // of bounce k + 1 too.
+        let budget = self.spawn_budget.read().map(|b| b.to_vec()).unwrap_or_default();
+        let budget_word = |k: u64, field: usize| {
+            let at = (k * self.budget_stride) as usize + 4 * field;
+            budget.get(at..at + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64
+        };
+        let bins = crate::frame::layout::SPAWN_BINS as usize;
         let mut dropped = 0;
+        let mut dropped_weight = 0.0;
         for k in 0..bounces {
-            let rays = word(k * self.stride);
+            let spawn_dropped = if k > 0 { budget_word(k - 1, bins + 1) } else { 0 };
+            if k > 0 {
+                let fixed = budget_word(k - 1, bins + 2) | (budget_word(k - 1, bins + 3) << 32);
+                dropped_weight += fixed as f64 / (1u64 << 20) as f64;
+            }
+            let rays = word(k * self.stride) + spawn_dropped;
             let shadows = word((bounces + 1 + k) * self.stride);
-            dropped += rays.saturating_sub(self.capacity) + shadows.saturating_sub(self.shadow_capacity);
+            dropped += spawn_dropped + word(k * self.stride).saturating_sub(self.capacity) + shadows.saturating_sub(self.shadow_capacity);
             out.push((format!("raytrace.rays.bounce{k}"), rays as f64));
             out.push((format!("raytrace.shadow_rays.bounce{k}"), shadows as f64));
         }
+        // The dropped children's path weights (largest channel; a camera ray weighs 1).
+        out.push(("raytrace.dropped_weight".to_string(), dropped_weight));
         out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
         out.push(("raytrace.build_ms".to_string(), self.build_ms));
         if let Some(a) = &self.accel {
@@ -913,6 +958,7 @@ impl Stage for RayTrace {
                 p.intersect,
                 p.shade,
                 p.spawn,
+                p.spawn_cutoff,
                 p.shadow,
                 p.args,
                 p.resolve,
@@ -945,6 +991,7 @@ impl Stage for RayTrace {
             &mut self.handled,
             &mut self.counters,
             &mut self.params,
+            &mut self.spawn_budget,
             &mut self.dispatch,
             &mut self.accum,
             &mut self.cones,
