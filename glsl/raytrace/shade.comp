@@ -4,6 +4,12 @@
 // environment, a diffuse hit its emission and, per light, one shadow query carrying the
 // unshadowed Lambertian contribution (added by shadow.comp when nothing occludes it), all
 // weighted by the ray's path weight. Specular hits are spawn.comp's.
+//
+// Where the shadow queue may overflow (its capacity clamped by the device's storage-buffer
+// range below one query per light and ray), the shadow queries go through a budget as
+// spawn.comp's children do (push.object: BUDGET_COUNT and BUDGET_SUB count and add nothing,
+// BUDGET_KEEP shades and queues the kept ones, raytrace/trace.glsl); elsewhere the kernel
+// runs once, BUDGET_ALL.
 layout(local_size_x = 64) in;
 #include "raytrace/trace.glsl"
 
@@ -15,18 +21,22 @@ void main() {
     RayPayload pl = payloads[i];
     vec3 w = pl.weight.rgb;
     vec3 d = normalize(q.direction.xyz);
+    bool count_only = push.object == BUDGET_COUNT || push.object == BUDGET_SUB;
+    if (push.object == BUDGET_SUB && shadow_budget.cutoff == SPAWN_BINS) return;  // nothing cut
     if (h.triangle == RAY_NO_TRIANGLE) {
-        accumulate(pl.pixel, w * sky_radiance(d));
+        if (!count_only) accumulate(pl.pixel, w * sky_radiance(d));
         return;
     }
     Surface s = hit_surface(h);
     Material m = materials[s.material];
     if (m.kind != KIND_DIFFUSE) return;
-    accumulate(pl.pixel, w * material_emission(m, s.uv));
     vec3 albedo = material_base_color(m, s.uv);
     vec3 n = dot(s.n, -d) < 0.0 ? -s.n : s.n;  // two-sided
-    // Caustics (§6.3.3): light through specular objects, from their light cube maps.
-    accumulate(pl.pixel, w * albedo / PI * caustic_irradiance(s.p, n));
+    if (!count_only) {
+        accumulate(pl.pixel, w * material_emission(m, s.uv));
+        // Caustics (§6.3.3): light through specular objects, from their light cube maps.
+        accumulate(pl.pixel, w * albedo / PI * caustic_irradiance(s.p, n));
+    }
     for (uint k = 0u; k < push.light_count; ++k) {
         vec3 wi;
         float dist;
@@ -37,9 +47,11 @@ void main() {
         // Up to the light, short of it by the offset the ray starts with.
         float t_max = isinf(dist) ? dist : dist - trace.t_min;
         if ((push.flags & FLAG_UNSHADOWED) != 0u) {
-            accumulate(pl.pixel, c);  // shadows=off: unoccluded, as the reference then
+            if (!count_only) accumulate(pl.pixel, c);  // shadows=off: unoccluded, as the reference then
             continue;
         }
-        push_shadow(make_query(s.p, wi, trace.t_min, t_max, h.triangle, RAY_ANY_HIT), make_payload(c, pl.pixel));
+        if (budget_admit(1u, push.object, c, pl.pixel, wi)) {
+            push_shadow(make_query(s.p, wi, trace.t_min, t_max, h.triangle, RAY_ANY_HIT), make_payload(c, pl.pixel));
+        }
     }
 }

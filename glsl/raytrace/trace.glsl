@@ -51,6 +51,76 @@ void accumulate(uint pixel, vec3 c) {
     }
 }
 
+// Queue budgets: which rays a queue keeps when more arrive than it holds must not depend on
+// the order the GPU runs the kernels that make them, or an overflowing frame would differ
+// from run to run. The kernel that makes them runs in modes (push.object):
+//   BUDGET_COUNT: counts its rays per weight bin (half an octave of the largest channel),
+//   BUDGET_SUB: counts the rays of the cut bin per sub-bin (a hash of pixel and direction),
+//   BUDGET_KEEP: queues the rays of the bins before the cut and of the sub-bins before the
+//     sub-cut, and counts the others as dropped with their weight;
+// spawn_cutoff.comp cuts between them. The heaviest paths are kept; within the cut bin a
+// spatially even subset. BUDGET_ALL (shade.comp only): no budget, everything queued.
+const uint BUDGET_ALL = 0u;
+const uint BUDGET_COUNT = 1u;
+const uint BUDGET_SUB = 2u;
+const uint BUDGET_KEEP = 3u;
+
+uint weight_bin(vec3 w) {
+    float m = max(max(w.x, w.y), w.z);
+    return uint(clamp(floor((16.0 - log2(max(m, 1e-30))) * 2.0), 0.0, float(SPAWN_BINS - 1u)));
+}
+
+uint budget_hash(uint x) {
+    x ^= x >> 16;
+    x *= 0x7feb352du;
+    x ^= x >> 15;
+    x *= 0x846ca68bu;
+    x ^= x >> 16;
+    return x;
+}
+
+uint sub_bin(uint pixel, vec3 d) {
+    uint h = budget_hash(pixel);
+    h = budget_hash(h ^ floatBitsToUint(d.x));
+    h = budget_hash(h ^ floatBitsToUint(d.y));
+    h = budget_hash(h ^ floatBitsToUint(d.z));
+    return h >> 26;  // 0 … 63
+}
+
+// Budget `which` (0: the next ray queue, spawn_budget; 1: the shadow queue, shadow_budget)
+// in `mode` for a ray of weight w: true where the ray is to be queued now.
+bool budget_admit(uint which, uint mode, vec3 w, uint pixel, vec3 d) {
+    if (mode == BUDGET_ALL) return true;
+    uint bin = weight_bin(w);
+    uint cutoff = which == 0u ? spawn_budget.cutoff : shadow_budget.cutoff;
+    if (mode == BUDGET_COUNT) {
+        if (which == 0u) atomicAdd(spawn_budget.hist[bin], 1u); else atomicAdd(shadow_budget.hist[bin], 1u);
+        return false;
+    }
+    if (mode == BUDGET_SUB) {
+        if (bin != cutoff) return false;
+        uint s = sub_bin(pixel, d);
+        if (which == 0u) atomicAdd(spawn_budget.sub[s], 1u); else atomicAdd(shadow_budget.sub[s], 1u);
+        return false;
+    }
+    if (bin < cutoff) return true;
+    if (bin == cutoff) {
+        uint sub_cutoff = which == 0u ? spawn_budget.sub_cutoff : shadow_budget.sub_cutoff;
+        if (sub_bin(pixel, d) < sub_cutoff) return true;
+    }
+    uint add = uint(clamp(max(max(w.x, w.y), w.z), 0.0, 2048.0) * ACCUM_SCALE + 0.5);
+    if (which == 0u) {
+        atomicAdd(spawn_budget.dropped, 1u);
+        uint old = atomicAdd(spawn_budget.dropped_weight[0], add);
+        if (old + add < old) atomicAdd(spawn_budget.dropped_weight[1], 1u);
+    } else {
+        atomicAdd(shadow_budget.dropped, 1u);
+        uint old = atomicAdd(shadow_budget.dropped_weight[0], add);
+        if (old + add < old) atomicAdd(shadow_budget.dropped_weight[1], 1u);
+    }
+    return false;
+}
+
 RayQuery make_query(vec3 o, vec3 d, float t_min, float t_max, uint skip, uint flags) {
     return RayQuery(vec4(o, t_min), vec4(d, t_max), skip, flags, uint[2](0u, 0u));
 }

@@ -82,17 +82,24 @@ gpu_structs! {
         ordered: uint,
     }
 
-    /// One bounce's spawn budget (raytrace/spawn.comp): which children the next queue keeps.
+    /// One bounce's budget for a queue (raytrace/trace.glsl's budget_*): which rays the
+    /// queue keeps when more arrive than it holds.
     struct GpuSpawnBudget => struct SpawnBudgetState {
-        /// children per weight bin (bin 0: the heaviest)
+        /// rays per weight bin (bin 0: the heaviest)
         hist: [uint; 64],
-        /// the first bin not kept (SPAWN_BINS: every child kept)
+        /// the cut bin's rays per sub-bin (a hash of the pixel and direction)
+        sub: [uint; 64],
+        /// the first bin not kept whole (SPAWN_BINS: every ray kept)
         cutoff: uint,
-        /// children dropped
+        /// the first sub-bin of the cut bin not kept
+        sub_cutoff: uint,
+        /// rays the bins before the cut hold
+        kept: uint,
+        /// rays dropped
         dropped: uint,
         /// their path weights (largest channel), 64-bit fixed point 2^-20 (lo, hi)
         dropped_weight: [uint; 2],
-        pad: [uint; 12],
+        pad: [uint; 2],
     }
 
     /// What an acceleration scheme's kernel needs besides its node and reference buffers.
@@ -118,8 +125,9 @@ gpu_structs! {
 }
 
 gpu_consts! {
-    /// Bins of the spawn budget's weight histogram: a quarter octave each, from weight 1 down
-    /// to 2^-16 (the last bin holds everything lighter).
+    /// Bins of a queue budget's weight histogram: half an octave each, from 2^16 down to
+    /// 2^-16 (the first and last bins hold everything heavier and lighter); and sub-bins of
+    /// the cut bin.
     SPAWN_BINS: uint = 64;
     /// `RayHit.triangle` and `RayQuery.skip`: no triangle.
     RAY_NO_TRIANGLE: uint = 4294967295;
@@ -193,6 +201,9 @@ descriptor_sets! {
         /// This bounce's spawn budget (raytrace/spawn.comp): the children's weights in
         /// SPAWN_BINS bins, the first bin dropped, and the rays and path weight dropped
         SPAWN_BUDGET = 20: STORAGE_BUFFER => "buffer SpawnBudget { SpawnBudgetState spawn_budget; }";
+        /// The same for this bounce's shadow queries (raytrace/shade.comp), where the shadow
+        /// queue may overflow (its capacity clamped by the device's storage-buffer range)
+        SHADOW_BUDGET = 21: STORAGE_BUFFER => "buffer ShadowBudget { SpawnBudgetState shadow_budget; }";
     }
 
     /// The `ray-query` scheme's own set 5 (src/methods/raytrace/ray_query/): the TLAS over

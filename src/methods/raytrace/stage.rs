@@ -17,9 +17,9 @@
 //! Radiance accumulates per pixel in 64-bit fixed point through integer atomics
 //! (`glsl/raytrace/trace.glsl`), so the image does not depend on the order in which the
 //! GPU processes rays, and a host-device frame equals a standalone one bit for bit. A full
-//! queue keeps the heaviest children by a histogram of their weights (`spawn.comp`, run
-//! twice around `spawn_cutoff.comp`), not the first to arrive, so an overflowing frame is
-//! the same in every run too; the dropped rays and their path weight are stats.
+//! queue keeps the heaviest paths by a histogram of their weights (the budget modes of
+//! `trace.glsl`, cut by `spawn_cutoff.comp`), not the first to arrive, so an overflowing
+//! frame is the same in every run too; the dropped rays and their path weight are stats.
 
 use ash::vk;
 
@@ -128,8 +128,8 @@ pub struct RayTrace {
     counters: Buffer,
     /// One `TraceParams` per bounce, `stride` apart.
     params: Buffer,
-    /// One `GpuSpawnBudget` per bounce, `budget_stride` apart (host-visible: the dropped
-    /// rays and weight are stats).
+    /// Two `GpuSpawnBudget` per bounce, `budget_stride` apart: the next queue's and the
+    /// shadow queue's (host-visible: the dropped rays and weight are stats).
     spawn_budget: Buffer,
     budget_stride: u64,
     /// 8 words per bounce: the rays' and the shadow queries' dispatch arguments.
@@ -379,7 +379,7 @@ impl RayTrace {
         let budget = std::mem::size_of::<GpuSpawnBudget>() as u64;
         self.budget_stride = budget.div_ceil(align) * align;
         self.spawn_budget =
-            Buffer::new(ctx, "raytrace.spawn_budget", self.budget_stride * bounces, counter_usage, MemoryLocation::GpuToCpu)?;
+            Buffer::new(ctx, "raytrace.queue_budgets", 2 * self.budget_stride * bounces, counter_usage, MemoryLocation::GpuToCpu)?;
         self.dispatch =
             Buffer::new(ctx, "raytrace.dispatch", 32 * bounces, STORAGE | vk::BufferUsageFlags::INDIRECT_BUFFER, MemoryLocation::GpuOnly)?;
         self.accum = Buffer::new(ctx, "raytrace.accum", pixels * 24, counter_usage, MemoryLocation::GpuOnly)?;
@@ -555,7 +555,9 @@ impl RayTrace {
             write_buffer(ctx, set, binding::SHADING, sb, self.shading.raw);
             write_buffer(ctx, set, binding::HANDLED, sb, self.handled.raw);
             at(set, binding::TRACE, &self.params, k as u64 * stride, std::mem::size_of::<GpuTraceParams>() as u64);
-            at(set, binding::SPAWN_BUDGET, &self.spawn_budget, k as u64 * self.budget_stride, std::mem::size_of::<GpuSpawnBudget>() as u64);
+            let budget = std::mem::size_of::<GpuSpawnBudget>() as u64;
+            at(set, binding::SPAWN_BUDGET, &self.spawn_budget, 2 * k as u64 * self.budget_stride, budget);
+            at(set, binding::SHADOW_BUDGET, &self.spawn_budget, (2 * k as u64 + 1) * self.budget_stride, budget);
             at(set, binding::DISPATCH, &self.dispatch, 0, whole);
             let engine = self.engine.as_ref().map_or(vk::ImageView::null(), |e| e.view);
             for (b, view) in [(binding::VISIBILITY, vis.view), (binding::ENGINE_HITS, engine)] {
@@ -679,6 +681,33 @@ impl RayTrace {
         self.push_object(ctx, cmd, f, view, queue);
         unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, at) };
         rec.end(open);
+    }
+
+    /// `kernel` over the queue at `rays_at` in a queue budget's modes (raytrace/trace.glsl):
+    /// counted per weight bin, cut, the cut bin counted per sub-bin, cut, kept. `which`: 0
+    /// the next ray queue's budget, 1 the shadow queue's.
+    fn budgeted(
+        &self,
+        rec: &mut Recorder,
+        f: &FrameInputs,
+        sets: [vk::DescriptorSet; 2],
+        (rays_at, view): (u64, u32),
+        (kernel, which): (vk::Pipeline, u32),
+    ) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let compute = vk::PipelineBindPoint::COMPUTE;
+        for mode in 1..=3 {
+            if mode > 1 {
+                self.bind(ctx, cmd, compute, self.p.spawn_cutoff, f, sets);
+                self.push_object(ctx, cmd, f, view, 2 * which + (mode - 2));
+                unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
+                Self::barrier(ctx, cmd);
+            }
+            self.bind(ctx, cmd, compute, kernel, f, sets);
+            self.push_object(ctx, cmd, f, view, mode);
+            unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, rays_at) };
+            Self::barrier(ctx, cmd);
+        }
     }
 
     /// Compute writes before the next dispatch's reads (and its indirect arguments).
@@ -848,23 +877,18 @@ impl Stage for RayTrace {
             // the pixels whose raster triangle failed the exact test (RAY_HIT_KNOWN unset).
             self.intersect(rec, f, sets, rays_at, view, 0);
             let open = rec.pass("raytrace.shade").after_buffer_writes().begin();
-            self.dispatch_indirect((ctx, cmd), self.p.shade, f, sets, rays_at, view);
+            if self.shadow_capacity < self.capacity * self.lights {
+                // The shadow queue may overflow: its queries go through their budget.
+                self.budgeted(rec, f, sets, (rays_at, view), (self.p.shade, 1));
+            } else {
+                self.dispatch_indirect((ctx, cmd), self.p.shade, f, sets, rays_at, view);
+            }
             rec.end(open);
             let open = rec.pass("raytrace.spawn").after_buffer_writes().begin();
             if k < self.depth as usize {
-                // Twice: the children's weights counted, the budget's cut, the kept appended
-                // (spawn.comp: which rays a full queue keeps does not depend on the order).
-                for mode in 0..2 {
-                    if mode == 1 {
-                        self.bind(ctx, cmd, compute, self.p.spawn_cutoff, f, sets);
-                        unsafe { ctx.device.cmd_dispatch(cmd, 1, 1, 1) };
-                        Self::barrier(ctx, cmd);
-                    }
-                    self.bind(ctx, cmd, compute, self.p.spawn, f, sets);
-                    self.push_object(ctx, cmd, f, view, mode);
-                    unsafe { ctx.device.cmd_dispatch_indirect(cmd, self.dispatch.raw, rays_at) };
-                    Self::barrier(ctx, cmd);
-                }
+                // spawn.comp in the budget's modes (trace.glsl): which children a full queue
+                // keeps does not depend on the order the GPU runs it in.
+                self.budgeted(rec, f, sets, (rays_at, view), (self.p.spawn, 0));
             }
             // The shadow queries' count is known now.
             self.bind(ctx, cmd, compute, self.p.args, f, sets);
@@ -902,29 +926,39 @@ impl Stage for RayTrace {
         let word = |at: u64| words.get(at as usize..at as usize + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64;
         let bounces = self.depth as u64 + 1;
         // The spawn budget of bounce k decides queue k + 1: its dropped children were rays
-        // of bounce k + 1 too.
+        // of bounce k + 1 too; the shadow budget of bounce k its shadow queue.
         let budget = self.spawn_budget.read().map(|b| b.to_vec()).unwrap_or_default();
-        let budget_word = |k: u64, field: usize| {
-            let at = (k * self.budget_stride) as usize + 4 * field;
+        let budget_word = |entry: u64, field: usize| {
+            let at = (entry * self.budget_stride) as usize + 4 * field;
             budget.get(at..at + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64
         };
-        let bins = crate::frame::layout::SPAWN_BINS as usize;
+        // Fields of GpuSpawnBudget: hist, sub, cutoff, sub_cutoff, kept, dropped, weight.
+        let field = 2 * crate::frame::layout::SPAWN_BINS as u64 + 3;
         let mut dropped = 0;
-        let mut dropped_weight = 0.0;
+        let mut weights = [0.0; 2];
+        let mut budget_dropped = |entry: u64| {
+            let fixed = budget_word(entry, field as usize + 1) | (budget_word(entry, field as usize + 2) << 32);
+            weights[(entry % 2) as usize] += fixed as f64 / (1u64 << 20) as f64;
+            budget_word(entry, field as usize)
+        };
         for k in 0..bounces {
-            let spawn_dropped = if k > 0 { budget_word(k - 1, bins + 1) } else { 0 };
-            if k > 0 {
-                let fixed = budget_word(k - 1, bins + 2) | (budget_word(k - 1, bins + 3) << 32);
-                dropped_weight += fixed as f64 / (1u64 << 20) as f64;
-            }
+            let spawn_dropped = if k > 0 { budget_dropped(2 * (k - 1)) } else { 0 };
+            let shadow_dropped = budget_dropped(2 * k + 1);
             let rays = word(k * self.stride) + spawn_dropped;
-            let shadows = word((bounces + 1 + k) * self.stride);
-            dropped += spawn_dropped + word(k * self.stride).saturating_sub(self.capacity) + shadows.saturating_sub(self.shadow_capacity);
+            let shadows = word((bounces + 1 + k) * self.stride) + shadow_dropped;
+            dropped += spawn_dropped
+                + shadow_dropped
+                + word(k * self.stride).saturating_sub(self.capacity)
+                + word((bounces + 1 + k) * self.stride).saturating_sub(self.shadow_capacity);
             out.push((format!("raytrace.rays.bounce{k}"), rays as f64));
             out.push((format!("raytrace.shadow_rays.bounce{k}"), shadows as f64));
         }
-        // The dropped children's path weights (largest channel; a camera ray weighs 1).
-        out.push(("raytrace.dropped_weight".to_string(), dropped_weight));
+        // The dropped rays' path weights (largest channel; a camera ray weighs 1), and the
+        // dropped shadow queries' (the light each would have added, largest channel).
+        out.push(("raytrace.dropped_weight".to_string(), weights[0]));
+        if weights[1] > 0.0 {
+            out.push(("raytrace.dropped_shadow_weight".to_string(), weights[1]));
+        }
         out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
         out.push(("raytrace.build_ms".to_string(), self.build_ms));
         if let Some(a) = &self.accel {
