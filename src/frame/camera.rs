@@ -113,8 +113,12 @@ impl Stage for CameraShade {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         begin_camera_rendering(ctx, cmd, io.target, io.depth, io.area, false);
         f.bind(ctx, cmd, self.pipeline);
-        if let Some(&set) = io.sets.camera.get(io.maps.latest) {
-            f.bind_maps(ctx, cmd, set);
+        // Without maps, the set of null descriptors: a pass that reads a map only where its
+        // object has one (a planar mirror's fallback) still has set 1 bound.
+        match io.sets.camera.get(io.maps.latest) {
+            Some(&set) => f.bind_maps(ctx, cmd, set),
+            None if io.sets.empty != vk::DescriptorSet::null() => f.bind_maps(ctx, cmd, io.sets.empty),
+            None => {}
         }
         if let Some(x) = &self.extra {
             x.bind(ctx, cmd);

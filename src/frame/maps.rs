@@ -231,14 +231,11 @@ impl Maps {
     }
 
     /// How many set-1 descriptor sets the maps need: per set pair one for map generation and
-    /// one for the camera passes, an all-null one and one of the geometry maps alone; none
-    /// without set-1 maps.
+    /// one for the camera passes, an all-null one and one of the geometry maps alone. Without
+    /// set-1 maps the last two still exist: a camera pass that reads a map only where its
+    /// object has one (a planar mirror's fallback, geometry/mirror.frag) binds the null one.
     pub fn set_count(&self) -> usize {
-        if self.set_pairs() == 0 && !self.all_slots().any(|s| s.needs_sets && self.has(s)) {
-            0
-        } else {
-            2 * self.set_pairs() + 2
-        }
+        2 * self.set_pairs() + 2
     }
 
     /// Assigns `set_count()` allocated sets to their roles.

@@ -632,6 +632,12 @@ pub fn plane_count(scene: &Scene, mesh: usize) -> u32 {
 /// The most views a frame of `planes` planes (planar mirrors, and two per refracting face:
 /// its reflection and its refraction) can have up to recursion `depth`, within `budget`:
 /// the layers of the views' image. Level k can have m(m − 1)^(k−1) views.
+/// Whether the views that `planes` planes can need within `depth` exceed `budget` (each
+/// plane sees every other, as `layers_needed` counts).
+pub fn budget_cuts(planes: u32, depth: u32, budget: u32) -> bool {
+    planes > 0 && layers_needed(planes, depth, budget.saturating_add(1)) > budget
+}
+
 pub fn layers_needed(planes: u32, depth: u32, budget: u32) -> u32 {
     let mut total = 0u64;
     let mut at_level = planes as u64;

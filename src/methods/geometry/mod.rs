@@ -26,6 +26,7 @@ pub const FAMILY: Family = Family {
     name: "geometry",
     slots: slots::SLOTS,
     methods: &[PLANAR_MIRROR_INFO, PLANAR_REFRACTION_INFO, CURVED_REFLECTOR_INFO],
+    plan_stages: Some(plan_fallback_maps),
     plan_views: Some(plan_views),
     views: Some(view_blocks),
     frame_part: Some(views::create_frame_part),
@@ -55,6 +56,25 @@ fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::types::Plan) {
     if !p.envmaps.is_empty() && q.geometry.map_mirrors {
         let mirrors = p.objects.iter().filter(|o| o.method == PLANAR_MIRROR).map(|o| o.mesh);
         p.map_mirrors = mirrors.take(q.geometry.mirror_budget as usize).collect();
+    }
+}
+
+/// Planar mirrors whose views the budget can cut (more views within the recursion depth
+/// than `mirror_budget`) get a distance map of their own (§4.1): a view the budget or the
+/// depth leaves out continues there — the search from the mirror's pixel along the
+/// reflected ray, in the map around the mirror's centre — instead of with the environment
+/// along that ray (black in a closed room). Mirrors whose every view fits keep no map.
+fn plan_fallback_maps(scene: &crate::scene::Scene, p: &mut crate::plan::types::Plan, st: &mut crate::plan::types::PlanStages) {
+    let q = p.quality.clone();
+    let planar = [PLANAR_MIRROR, PLANAR_REFRACTION];
+    let planes = p.objects.iter().filter(|o| planar.contains(&o.method)).map(|o| mirror::plane_count(scene, o.mesh)).sum();
+    if !mirror::budget_cuts(planes, q.frame.depth, q.geometry.mirror_budget) {
+        return;
+    }
+    for o in p.objects.iter_mut().filter(|o| o.method == PLANAR_MIRROR) {
+        let what = crate::frame::stage::describe_cube(&q) + " for the views the budget cuts";
+        st.add_map(o, crate::methods::distance::DISTANCE_CUBES.kind(), what);
+        o.reason += " · views beyond mirror_budget or depth: traced in a distance map of its own (§4.1)";
     }
 }
 
