@@ -4,9 +4,10 @@
 // geometry.mirror: a planar mirror (survey §5, DB97/MBGN00). Its reflection is the scene
 // rendered from the camera mirrored through its plane, which lands on the mirror's own
 // pixels: the pixel's texel of that view, weighted by the mirror's Fresnel reflectance at
-// the eye ray's incidence. Beyond the recursion depth or the view budget, the reflected ray
-// is traced in the mirror's own distance map where the plan gave it one (a mirror whose
-// views the budget can cut, src/methods/geometry/mod.rs), else the environment along it.
+// the eye ray's incidence. Beyond the view budget the reflected ray is traced in the
+// mirror's own distance map where the plan gave it one (a mirror whose views the budget
+// can cut, src/methods/geometry/mod.rs); at the recursion depth (FLAG_MIRROR_DEPTH_END), or
+// without the map, the environment along it (where the reference's paths end).
 #include "common/specular.glsl"
 #include "common/sky.glsl"
 #include "common/traced.glsl"
@@ -25,7 +26,7 @@ void main() {
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
         ivec3 texel = ivec3(ivec2(gl_FragCoord.xy), int((push.flags >> MIRROR_LAYER_SHIFT) & 0xffu));
         reflected = texelFetch(mirror_views, texel, 0).rgb;
-    } else if (o.envmap_layer >= 0) {
+    } else if (o.envmap_layer >= 0 && (push.flags & FLAG_MIRROR_DEPTH_END) == 0u) {
         reflected = traced_radiance(o, in_position, s.r);
     } else {
         reflected = sky_radiance(s.r);

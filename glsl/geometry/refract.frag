@@ -8,10 +8,22 @@
 // per face that is exact for the face's central ray; a pane's is exact, it transmits
 // undeviated). From inside the solid, the faces are seen from within: internal
 // reflections and the refraction out. The Fresnel split is the pixel's own, at its eye
-// ray's incidence (total internal reflection included). A face whose view the depth or the
-// budget left out shows the environment along that branch's ray.
+// ray's incidence (total internal reflection included). A branch whose view the budget left
+// out continues in the object's own maps where the plan gave it them (its views can be cut
+// by the budget, src/methods/geometry/mod.rs): outside, traced in its distance map (§4.1);
+// inside a solid, through its refractor map (§4.4) as refractor-map traces it. At the
+// recursion depth (FLAG_MIRROR_DEPTH_END), or without the maps, the environment along that
+// branch's ray (where the reference's paths end).
 #include "common/specular.glsl"
 #include "common/sky.glsl"
+#include "distance/refractor/trace.glsl"
+
+// Radiance along a branch (p, dir) the views left out: `inside` the solid or not.
+vec3 fallback(Object o, Material m, vec3 p, vec3 dir, bool inside) {
+    if (o.envmap_layer < 0 || (push.flags & FLAG_MIRROR_DEPTH_END) != 0u) return sky_radiance(dir);
+    if (inside && o.refractor_layer >= 0) return refractor_inside(o, m, p, dir, vec3(1.0), vec3(0.0));
+    return traced_radiance(o, p, dir);
+}
 
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
@@ -25,8 +37,13 @@ void main() {
     vec3 eye = views[in_view].eye.xyz;
     vec3 n = normalize(in_normal);
     SpecularSplit s = specular_split(m, in_position, n, eye);
-    vec3 reflected = sky_radiance(s.r);
-    vec3 refracted = any(greaterThan(s.ft, vec3(0.0))) ? sky_radiance(s.t) : vec3(0.0);
+    // The eye inside the solid (a view through one of its faces): the reflection stays
+    // inside, the refraction leaves; outside, the other way round. The interpolated normal
+    // points out.
+    bool eye_inside = dot(n, eye - in_position) < 0.0;
+    bool solid = o.refractor_layer >= 0;
+    vec3 reflected = fallback(o, m, in_position, s.r, eye_inside && solid);
+    vec3 refracted = any(greaterThan(s.ft, vec3(0.0))) ? fallback(o, m, in_position, s.t, !eye_inside && solid) : vec3(0.0);
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
         // The face's plane, towards the eye; its child views keep that side (reflection)
         // or the other (refraction), `dir.w` beyond the plane.

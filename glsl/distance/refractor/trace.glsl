@@ -36,14 +36,11 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 #define REFRACTOR_EXIT refractor_exit
 #endif
 
-// Radiance leaving point p of solid refractor o (material m, interpolated normal n)
-// towards eye.
-vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
-    SpecularSplit s = specular_split(m, p, n, eye);
-    vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
-    vec3 weight = s.ft;
+// c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
+// ray that runs inside it, times weight: searched in its refractor map to the surface it
+// meets, refracted out there (Fresnel) or reflected on inside, up to internal_bounces times.
+vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c) {
     vec3 pos = p;
-    vec3 dir = s.t;
     float ior = m.nu.x;
     for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
@@ -65,5 +62,12 @@ vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
         pos = hit;
     }
     return c;
+}
+
+// Radiance leaving point p of solid refractor o (material m, interpolated normal n)
+// towards eye.
+vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
+    SpecularSplit s = specular_split(m, p, n, eye);
+    return refractor_inside(o, m, p, s.t, s.ft, s.fr * REFRACTOR_ENV(o, p, s.r));
 }
 #endif

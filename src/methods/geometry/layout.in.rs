@@ -39,6 +39,10 @@ gpu_consts! {
     /// MIRROR_LAYER_SHIFT) & 0xff` on; without the flag (or for a plane none of them is
     /// of), the budget's fallback (the environment along the ray).
     FLAG_MIRROR_VIEW: uint = 32768;
+    /// `geometry.mirror` and `geometry.refract` drawn in a view at the recursion depth: what
+    /// the object reflects or refracts there ends as the reference's paths end (the
+    /// environment along the ray), not in the budget's fallback maps.
+    FLAG_MIRROR_DEPTH_END: uint = 8192;
     MIRROR_LAYER_SHIFT: uint = 16;
     MIRROR_COUNT_SHIFT: uint = 24;
 
@@ -62,6 +66,7 @@ gpu_consts! {
 flag_bits! {
     /// Planar mirrors' child views on `geometry.mirror` and `geometry.refract` draws; the curved
     /// reflector's layer on `geometry.curved` and `geometry.virtual` draws.
+    own_passes 13..14 { FLAG_MIRROR_DEPTH_END }
     own_passes 15..32 { FLAG_MIRROR_VIEW, MIRROR_LAYER_SHIFT: 8, MIRROR_COUNT_SHIFT: 8, CURVED_REFLECTOR_SHIFT: 16 }
 }
 

@@ -59,22 +59,32 @@ fn plan_views(scene: &crate::scene::Scene, p: &mut crate::plan::types::Plan) {
     }
 }
 
-/// Planar mirrors whose views the budget can cut (more views within the recursion depth
-/// than `mirror_budget`) get a distance map of their own (§4.1): a view the budget or the
-/// depth leaves out continues there — the search from the mirror's pixel along the
-/// reflected ray, in the map around the mirror's centre — instead of with the environment
-/// along that ray (black in a closed room). Mirrors whose every view fits keep no map.
+/// Planar mirrors and refractors whose views the budget can cut (more views within the
+/// recursion depth than `mirror_budget`) get maps of their own: a distance map (§4.1), and a
+/// refractor map (§4.4) for a solid refractor. A branch the budget or the depth leaves out
+/// continues there — searched from the face's pixel along its ray in the distance map
+/// around the object's centre, or inside a solid through its refractor map, as
+/// refractor-map traces it — instead of with the environment along that ray (black in a
+/// closed room). Objects whose every view fits keep no map.
 fn plan_fallback_maps(scene: &crate::scene::Scene, p: &mut crate::plan::types::Plan, st: &mut crate::plan::types::PlanStages) {
+    use crate::methods::distance::{DISTANCE_CUBES, REFRACTOR_CUBES};
     let q = p.quality.clone();
     let planar = [PLANAR_MIRROR, PLANAR_REFRACTION];
     let planes = p.objects.iter().filter(|o| planar.contains(&o.method)).map(|o| mirror::plane_count(scene, o.mesh)).sum();
     if !mirror::budget_cuts(planes, q.frame.depth, q.geometry.mirror_budget) {
         return;
     }
-    for o in p.objects.iter_mut().filter(|o| o.method == PLANAR_MIRROR) {
-        let what = crate::frame::stage::describe_cube(&q) + " for the views the budget cuts";
-        st.add_map(o, crate::methods::distance::DISTANCE_CUBES.kind(), what);
-        o.reason += " · views beyond mirror_budget or depth: traced in a distance map of its own (§4.1)";
+    let cube = crate::frame::stage::describe_cube(&q);
+    for o in p.objects.iter_mut().filter(|o| planar.contains(&o.method)) {
+        if o.class == ObjectClass::SolidDielectric {
+            st.add_map(o, REFRACTOR_CUBES.kind(), cube.clone() + " (normal, distance) for the views the budget cuts");
+        }
+        st.add_map(o, DISTANCE_CUBES.kind(), cube.clone() + " for the views the budget cuts");
+        o.reason += if o.class == ObjectClass::SolidDielectric {
+            " · views beyond mirror_budget or depth: traced in a distance and a refractor map of its own (§4.1, §4.4)"
+        } else {
+            " · views beyond mirror_budget or depth: traced in a distance map of its own (§4.1)"
+        };
     }
 }
 

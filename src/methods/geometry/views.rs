@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3, Vec4};
 use super::mirror::{oblique, reflection, Limits, Mirror, MirrorFrame, Rect};
 use crate::cube::face_view_proj;
 use crate::frame::direct::{DEPTH_FORMAT, TARGET_FORMAT};
-use crate::frame::layout::{FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
+use crate::frame::layout::{FLAG_MIRROR_DEPTH_END, FLAG_MIRROR_VIEW, MIRROR_COUNT_SHIFT, MIRROR_LAYER_SHIFT};
 use crate::frame::stage::{FramePart, Maps, StageInit, ViewFrame, ViewLayout, ViewPass, EXTRA_VIEWS};
 use crate::frame::FrameInputs;
 use crate::gpu_scene::GpuView;
@@ -109,7 +109,12 @@ impl MirrorViews {
 
     /// The push flags of the planar mirrors the camera (`None`) or view `v` sees: which
     /// layer of which image holds each one's reflection. Mirrors not listed fall back.
+    /// A view at the recursion depth has no children: its planar objects get
+    /// FLAG_MIRROR_DEPTH_END instead (their paths end there, as the reference's do).
     pub fn child_flags(&self, v: Option<usize>) -> Vec<(usize, u32)> {
+        if v.is_some_and(|v| self.frame.views[v].level >= self.limits.depth) {
+            return self.meshes.iter().map(|&m| (m, FLAG_MIRROR_DEPTH_END)).collect();
+        }
         let flags = |first: u32, count: u32| FLAG_MIRROR_VIEW | (first << MIRROR_LAYER_SHIFT) | (count << MIRROR_COUNT_SHIFT);
         self.frame.children(v).into_iter().map(|(mesh, first, count)| (mesh, flags(first, count))).collect()
     }
