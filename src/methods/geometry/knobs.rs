@@ -7,8 +7,10 @@ knobs! {
     pub struct GeometryKnobs {
         /// planar-mirror and planar-refraction (§5): the most mirrored or refracted views a frame renders, chosen best first (the
         /// pixels a view covers times its path's Fresnel weight: mirrors and refractions seen from the camera before weak
-        /// reflections and views seen in views); planes beyond it, or deeper than depth, show the environment along their rays
-        /// (black in a closed room). A flat-faced solid needs about two views per pair of faces a ray crosses
+        /// reflections and views seen in views); where the budget can cut views, each planar object gets a distance map (and a
+        /// solid a refractor map) of its own, in which planes beyond the budget are traced; planes deeper than depth end with
+        /// the environment along their rays, as the reference's paths end. A flat-faced solid needs about two views per pair of
+        /// faces a ray crosses
         mirror_budget: u32 = 8, count(0..=64, "views");
         /// planar mirrors (planar-mirror, §5) inside the other objects' cube maps (envmap, proxy-sphere, proxy-box, distance,
         /// distance-multi, refractor-map): per map face that sees one, the scene drawn again from the reference point mirrored
