@@ -102,10 +102,32 @@ pub fn render_cube_faces(
     view_base: u32,
     mode: CubeMode,
     clear_color: [f32; 4],
+    draw: impl FnMut(vk::CommandBuffer, u32),
+) {
+    render_cube_faces_of(rec, color, depth, (cube, ALL_FACES), view_base, mode, clear_color, draw)
+}
+
+/// Every face of a cube (bit f: face f).
+pub const ALL_FACES: u8 = 0x3F;
+
+/// `render_cube_faces` for the faces of `faces` (bit f: face f) only: the others keep what
+/// they hold. Multiview renders the six together, so any face renders all.
+#[allow(clippy::too_many_arguments)]
+pub fn render_cube_faces_of(
+    rec: &Recorder,
+    color: &Image,
+    depth: &mut Image,
+    (cube, faces): (u32, u8),
+    view_base: u32,
+    mode: CubeMode,
+    clear_color: [f32; 4],
     mut draw: impl FnMut(vk::CommandBuffer, u32),
 ) {
     let (ctx, cmd) = (rec.ctx, rec.cmd);
     let size = color.width;
+    if faces & ALL_FACES == 0 {
+        return;
+    }
     match mode {
         CubeMode::Multiview => {
             rec.barrier(depth, Access::DepthAttachment);
@@ -128,7 +150,7 @@ pub fn render_cube_faces(
             unsafe { ctx.device.cmd_end_rendering(cmd) };
         }
         CubeMode::SixPasses => {
-            for face in 0..6 {
+            for face in (0..6).filter(|f| faces & (1 << f) != 0) {
                 rec.barrier(depth, Access::DepthAttachment);
                 let colors = [color.layer_view(6 * cube + face)];
                 begin_rendering(

@@ -6,7 +6,7 @@ use ash::vk;
 
 use super::maps::{Sampler, Slot};
 use super::stage::{FrameIo, Maps, Stage, StageInit};
-use super::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
+use super::{cube_depth, destroy_pipelines, render_cube_faces_of, view_mask, FrameInputs};
 use crate::plan::types::Plan;
 use crate::quality::CubeMode;
 use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
@@ -36,6 +36,12 @@ pub struct ShadowMaps {
     mode: Option<CubeMode>,
     /// Mesh draws per cube face in the last frame recorded, over all shadow cubes.
     face_draws: [u32; 6],
+    /// Which cube faces the next record draws: those whose frusta from the light saw a
+    /// caster move (`methods::cube_deps`); all on a light change.
+    deps: crate::methods::cube_deps::FaceDeps,
+    /// Directional lights' planar maps: drawn again on any move.
+    planes_dirty: bool,
+    always: bool,
 }
 
 impl ShadowMaps {
@@ -45,6 +51,9 @@ impl ShadowMaps {
     }
 
     fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, maps: &mut Maps) -> Result<()> {
+        self.deps = crate::methods::cube_deps::FaceDeps::new(plan.shadow_cubes.len());
+        self.planes_dirty = true;
+        self.always = plan.quality.frame.map_updates_always;
         let size = plan.quality.frame.shadow_size;
         let mode = plan.quality.cube.cube_mode;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -100,6 +109,13 @@ impl ShadowMaps {
     }
 }
 
+impl ShadowMaps {
+    /// Each shadow cube's centre: its light's position (the cube views' eye).
+    fn eyes(scene: &crate::scene::Scene, plan: &Plan) -> Vec<glam::Vec3> {
+        plan.shadow_cubes.iter().map(|&i| scene.lights.get(i).map_or(glam::Vec3::ZERO, |l| l.position)).collect()
+    }
+}
+
 impl Stage for ShadowMaps {
     fn name(&self) -> &'static str {
         "shadow.generate"
@@ -111,7 +127,29 @@ impl Stage for ShadowMaps {
         (0..6).map(|k| (format!("shadow.generate.draws.face{k}"), self.face_draws[k] as f64)).collect()
     }
 
+    /// The cube faces that saw a caster move (or all, the lights changed); the planar maps on
+    /// any move. Materials do not matter to distances.
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+        let geometry = crate::scene::update::Changes { materials: Vec::new(), camera: false, ..changes.clone() };
+        let eyes = Self::eyes(init.scene, init.plan);
+        let lighting = crate::methods::cube_deps::Lighting::default();
+        self.deps.mark(init.scene, &init.plan.shadow_cubes, &eyes, &init.gpu.draws, &geometry, (false, &[]), &lighting);
+        self.planes_dirty |= !changes.moved.is_empty() || !changes.lights.is_empty();
+        Ok(())
+    }
+
+    fn redraw(&self) -> Option<(u32, u32)> {
+        let (faces, all) = self.deps.count();
+        let planes = 6 * u32::from(self.planes_dirty) * self.plane_depth.is_some() as u32;
+        let plane_all = 6 * self.plane_depth.is_some() as u32;
+        (!self.always).then_some((faces + planes, all + plane_all))
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        if self.always {
+            self.deps.all();
+            self.planes_dirty = true;
+        }
         // Taken out of the table while recorded (both are written at once), put back after.
         let (mut cubes, mut planes) = (io.maps.take_image(&SHADOW_CUBES), io.maps.take_image(&SHADOW_PLANES));
         if cubes.is_none() && planes.is_none() {
@@ -131,7 +169,8 @@ impl Stage for ShadowMaps {
             self.face_draws = [0; 6];
             let (eyes, six, face_draws) = (io.view_eyes, mode == CubeMode::SixPasses, &mut self.face_draws);
             for (k, &view) in io.views.shadow_cubes.iter().enumerate() {
-                render_cube_faces(rec, cubes, depth, k as u32, view, mode, clear, |cmd, v| {
+                let faces = self.deps.faces.get(k).copied().unwrap_or(super::ALL_FACES);
+                render_cube_faces_of(rec, cubes, depth, (k as u32, faces), view, mode, clear, |cmd, v| {
                     // Six passes: each face draws only the objects inside its frustum.
                     let face = (v - view) as usize;
                     let eye = eyes.get(v as usize).copied().unwrap_or_default();
@@ -145,7 +184,7 @@ impl Stage for ShadowMaps {
                 });
             }
         }
-        if let (Some(planes), Some(depth)) = (planes.as_ref(), self.plane_depth.as_mut()) {
+        if let (Some(planes), Some(depth), true) = (planes.as_ref(), self.plane_depth.as_mut(), self.planes_dirty) {
             for (j, &view) in io.views.shadow_planes.iter().enumerate() {
                 rec.barrier(depth, Access::DepthAttachment);
                 let colors = [planes.layer_view(j as u32)];
@@ -168,6 +207,9 @@ impl Stage for ShadowMaps {
             }
         }
         rec.end(open);
+        let eyes = io.views.shadow_cubes.iter().map(|&v| io.view_eyes.get(v as usize).copied().unwrap_or_default()).collect();
+        self.deps.drawn(eyes, &f.scene.draws);
+        self.planes_dirty = false;
         for (slot, image) in [(&SHADOW_CUBES, cubes), (&SHADOW_PLANES, planes)] {
             if let Some(image) = image {
                 io.maps.set_image(slot, image);

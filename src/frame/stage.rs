@@ -35,6 +35,12 @@ pub trait Stage {
     fn update(&mut self, _init: &StageInit, _changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
         Ok(())
     }
+    /// After `update`: the part of its maps the next record draws again, as (faces to draw,
+    /// faces in all), where the stage tracks what each face saw (cube maps, `cube_deps`); a
+    /// frame records no stage with nothing to draw. None: the whole stage.
+    fn redraw(&self) -> Option<(u32, u32)> {
+        None
+    }
     /// Flags `scene.direct` shades with because this stage exists (e.g. a pass of its own
     /// projects the caustics: `FLAG_CAUSTICS_APART`).
     fn direct_flags(&self) -> u32 {

@@ -13,7 +13,7 @@ use ash::vk;
 
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::stage::{FrameIo, Maps, Slot, Stage, StageInit};
-use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
+use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces_of, view_mask, FrameInputs, FLAG_FIRST_CYCLE, FLAG_INTER_OBJECT};
 use crate::methods::registry::LeavesOut;
 use crate::plan::types::Plan;
 use crate::quality::{CubeMode, Precision};
@@ -64,6 +64,12 @@ pub struct CubeMaps {
     frames: u64,
     /// Mesh draws the last frame recorded per cube face (per-face culling), over all cubes.
     face_draws: [u32; 6],
+    /// Which faces the next record draws (what changed in their frusta, `cube_deps`).
+    deps: crate::methods::cube_deps::FaceDeps,
+    /// `map_updates=always`: every face every frame.
+    always: bool,
+    /// Faces drawn by the last record.
+    faces_drawn: u32,
 }
 
 /// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
@@ -100,6 +106,9 @@ impl CubeMaps {
             inter_object,
             frames: 0,
             face_draws: [0; 6],
+            deps: crate::methods::cube_deps::FaceDeps::new(objects.len()),
+            always: q.frame.map_updates_always,
+            faces_drawn: 0,
         };
         build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
@@ -180,6 +189,18 @@ impl CubeMaps {
         Ok(())
     }
 
+    /// Each layer's centre in `plan` (its cube views' eye).
+    fn eyes(&self, plan: &Plan) -> Vec<glam::Vec3> {
+        let eye = |m: usize| plan.envmaps.iter().find(|e| e.mesh == m).map_or(glam::Vec3::ZERO, |e| e.reference_point);
+        self.objects.iter().map(|&m| eye(m)).collect()
+    }
+
+    /// Whether the next record draws every face (`map_updates=always`; frame latency, whose
+    /// cycles start again from the sky after any change).
+    fn every_face(&self) -> bool {
+        self.always || self.frame_latency
+    }
+
     /// The images of this kind in the frame's maps.
     fn images(&self, maps: &mut Maps) -> Vec<Image> {
         maps.take_images(self.kind.slot())
@@ -219,19 +240,34 @@ impl Stage for CubeMaps {
     /// (distance-map shaders always declare set 1).
     /// Mesh draws per cube face in the last frame this stage recorded (six-pass mode culls
     /// each face to the objects in its frustum; multiview draws every object in every face).
+    /// And the faces it drew (`<name>.faces_drawn`: those whose frusta saw what changed).
     fn stats(&self, _ctx: &Context) -> Vec<(String, f64)> {
-        (0..6).map(|k| (format!("{}.draws.face{k}", self.name()), self.face_draws[k] as f64)).collect()
+        let mut out: Vec<(String, f64)> = (0..6).map(|k| (format!("{}.draws.face{k}", self.name()), self.face_draws[k] as f64)).collect();
+        out.push((format!("{}.faces_drawn", self.name()), self.faces_drawn as f64));
+        out
     }
 
     /// With frame latency the inter-object cycles run one per frame on the previous frame's
     /// maps: after a change they start again from the sky, like a fresh renderer's, so that
     /// no bounce keeps the old scene.
-    fn update(&mut self, _init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
         let seen = !changes.moved.is_empty() || !changes.materials.is_empty() || !changes.lights.is_empty();
         if self.frame_latency && seen {
             self.frames = 0;
         }
+        if self.every_face() {
+            self.deps.all();
+        } else {
+            let eyes = self.eyes(init.plan);
+            let lighting = crate::methods::cube_deps::Lighting::of(init.scene, init.plan);
+            self.deps.mark(init.scene, &self.objects, &eyes, &init.gpu.draws, changes, (self.inter_object, &self.map_mirrors), &lighting);
+        }
         Ok(())
+    }
+
+    /// Faces the next record draws, of all (`cube_deps`), unless it draws every face.
+    fn redraw(&self) -> Option<(u32, u32)> {
+        (!self.every_face()).then(|| self.deps.count())
     }
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
@@ -253,6 +289,10 @@ impl Stage for CubeMaps {
         let ctx = rec.ctx;
         let mut latest = 0;
         self.face_draws = [0; 6];
+        if self.every_face() {
+            self.deps.all();
+        }
+        self.faces_drawn = self.deps.count().0;
         let (eyes, six) = (io.view_eyes, self.mode == CubeMode::SixPasses);
         for cycle in 0..cycles {
             let write = (first_write + cycle as usize) % count;
@@ -285,7 +325,8 @@ impl Stage for CubeMaps {
                     .zip(io.views.first(MAP_MIRROR_VIEWS))
                     .map(|(i, first)| first + (6 * map_mirrors.len() * i) as u32);
                 let (mirror_mask, mirror_weight, surface) = (self.mirror_mask, self.mirror_weight, self.surface);
-                render_cube_faces(rec, target, depth, layer as u32, view, self.mode, clear, |cmd, v| {
+                let faces = self.deps.faces.get(layer).copied().unwrap_or(crate::frame::ALL_FACES);
+                render_cube_faces_of(rec, target, depth, (layer as u32, faces), view, self.mode, clear, |cmd, v| {
                     // Six passes: each face draws only the objects inside its frustum.
                     let face = (v - view) as usize;
                     let eye = eyes.get(v as usize).copied().unwrap_or_default();
@@ -344,6 +385,7 @@ impl Stage for CubeMaps {
         self.frames += 1;
         rec.end(open);
         self.put_back(io.maps, images);
+        self.deps.drawn(self.eyes(io.plan), &f.scene.draws);
         if self.kind == MapKind::Distance {
             io.maps.latest = latest;
         }

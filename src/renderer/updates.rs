@@ -13,6 +13,9 @@ use crate::vk::Context;
 
 use super::{bindings, stage_init, Renderer};
 
+/// `Stage::redraw`: (faces to draw, faces in all), or None for the whole stage.
+type Redraw = Option<(u32, u32)>;
+
 /// A map stage the frame recorded, and why: its first frame, `map_updates=always`, or what
 /// it depends on that changed.
 #[derive(Clone, Debug, PartialEq)]
@@ -71,7 +74,8 @@ impl Updates {
     }
 
     /// Decides which map stages this frame records, after changes `c`.
-    fn invalidate(&mut self, plan: &Plan, deps: &[Deps], names: &[&'static str], c: &Changes) {
+    /// `redraw`: each stage's `Stage::redraw` after the changes.
+    fn invalidate(&mut self, plan: &Plan, deps: &[Deps], (names, redraw): (&[&'static str], &[Redraw]), c: &Changes) {
         self.recorded.clear();
         let list = |ids: &[usize], name: &dyn Fn(usize) -> String| ids.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ");
         let moved = list(&c.moved, &|i| format!("'{}'", self.cpu.meshes[i].name));
@@ -107,6 +111,12 @@ impl Updates {
                 }
                 if cam {
                     why.push("camera".to_string());
+                }
+                // A stage that tracks what each face saw draws only the faces that saw it.
+                match redraw.get(i).copied().flatten() {
+                    Some((0, _)) if !cam => why.clear(),
+                    Some((k, n)) if k < n && !why.is_empty() => why.push(format!("{k} of {n} faces")),
+                    _ => {}
                 }
             }
             if *deps == Deps::EveryFrame {
@@ -236,7 +246,8 @@ impl Renderer {
             }
         }
         let names: Vec<&'static str> = self.stages.iter().map(|s| s.name()).collect();
-        self.updates.invalidate(&self.plan, &self.deps, &names, c);
+        let redraw: Vec<Redraw> = self.stages.iter().map(|s| s.redraw()).collect();
+        self.updates.invalidate(&self.plan, &self.deps, (&names, &redraw), c);
         Ok(())
     }
 }

@@ -22,6 +22,11 @@ pub struct RefractorMaps {
     depth: Image,
     pipeline: vk::Pipeline,
     mode: CubeMode,
+    /// Per layer: its refractor moved since its cube was drawn (a refractor map sees its own
+    /// object alone: nothing else moves it, issue 33 item 4).
+    dirty: Vec<bool>,
+    /// `map_updates=always`: every cube every frame.
+    always: bool,
 }
 
 /// `REFRACTOR_CUBES`' constructor.
@@ -38,6 +43,8 @@ impl RefractorMaps {
             depth: Image::placeholder(),
             pipeline: vk::Pipeline::null(),
             mode: q.cube.cube_mode,
+            dirty: vec![true; objects.len()],
+            always: q.frame.map_updates_always,
         };
         build(ctx, me, |me| {
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -79,12 +86,14 @@ impl Stage for RefractorMaps {
         "refractor.generate"
     }
 
-    /// Each refractor alone, from its reference point (its cube views).
+    /// Each refractor alone, from its reference point (its cube views): those that moved
+    /// since their cube was drawn.
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let Some(maps) = io.maps.image_mut(&super::slots::REFRACTOR) else { return };
         let open = rec.pass("refractor.generate").writes(maps, Access::ColorAttachment).begin();
         let ctx = rec.ctx;
-        for (k, &mesh) in self.objects.iter().enumerate() {
+        let always = self.always;
+        for (k, &mesh) in self.objects.iter().enumerate().filter(|&(k, _)| always || self.dirty[k]) {
             let view = io.views.cube_of(io.plan, mesh).expect("refractor has cube views");
             // Far clear: directions where the refractor is absent read as "nothing there".
             render_cube_faces(rec, maps, &mut self.depth, k as u32, view, self.mode, [0.0, 0.0, 0.0, 1e30], |cmd, v| {
@@ -95,6 +104,20 @@ impl Stage for RefractorMaps {
             });
         }
         rec.end(open);
+        self.dirty.iter_mut().for_each(|d| *d = false);
+    }
+
+    /// A refractor's cube is drawn again when it moved (or was hidden or shown).
+    fn update(&mut self, _init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+        for (k, &mesh) in self.objects.iter().enumerate() {
+            self.dirty[k] |= changes.moved.contains(&mesh);
+        }
+        Ok(())
+    }
+
+    fn redraw(&self) -> Option<(u32, u32)> {
+        let n = 6 * self.objects.len() as u32;
+        (!self.always).then(|| (6 * self.dirty.iter().filter(|&&d| d).count() as u32, n))
     }
 
     fn destroy(&mut self, ctx: &Context) {
