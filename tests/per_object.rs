@@ -112,9 +112,15 @@ fn mixed_methods_compose() {
     };
     let (g, mi) = (same(&img, &all_rm, &glass), same(&img, &all_d, &mirror));
     eprintln!("glass pixels equal to all-refractor-map: {:.1} %, mirror pixels equal to all-distance: {:.1} %", 100.0 * g, 100.0 * mi);
-    // Measured 100 % and 94.3 %: the glass sees the mirror only through its thin rim, the
-    // mirror's right side reflects the glass.
-    assert!(g > 0.99 && mi > 0.9, "glass {g}, mirror {mi}");
+    // Measured 94.1 % and 94.3 %: the glass's rim shows the mirror (traced in the mirror's
+    // own distance map, which composition now shades it by: it was the sky there, 100 %
+    // equal), the mirror's right side reflects the glass.
+    assert!(g > 0.9 && mi > 0.9, "glass {g}, mirror {mi}");
+    let reference = render_reference(&scene, &quality(&["spp=1"]), (w, h)).unwrap();
+    let (gm, gr) = (masked_psnr(&img, &reference, &glass), masked_psnr(&all_rm, &reference, &glass));
+    eprintln!("glass pixels: mixed {gm:.2} dB, all-refractor-map {gr:.2} dB");
+    // Measured 33.73 vs 33.41 dB: the mixed glass no worse than all-refractor-map's (0.1 dB).
+    assert!(gm >= gr - 0.1, "glass: mixed {gm} vs all-refractor-map {gr}");
     // Where the mirror sees the glass, the all-distance image is black (the glass in its
     // map reflects and refracts the empty sky); the mixed one shows the refracted room.
     let mut seen = Vec::new();
@@ -139,7 +145,6 @@ fn mixed_methods_compose() {
     assert!(bright > 0.95, "the reflected glass is lit: {bright}");
     assert!(spread >= 0.0365, "and not one flat colour: mean {mean}, spread {spread}");
     // Against the reference, the mirror of the mixed image is better than all-distance's.
-    let reference = render_reference(&scene, &quality(&["spp=1"]), (w, h)).unwrap();
     let (pm, pd) = (masked_psnr(&img, &reference, &mirror), masked_psnr(&all_d, &reference, &mirror));
     eprintln!("mirror pixels: mixed {pm:.2} dB, all-distance {pd:.2} dB");
     // Measured 29.81 vs 25.74 dB: the floor and the 4.07 dB margin each 1 dB under.
@@ -402,4 +407,116 @@ fn plan_command_prints_per_object_methods() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!((o.status.code(), err.lines().count()), (Some(1), 1), "{err}");
     assert!(err.contains("teapot"), "{err}");
+}
+
+/// Pixels of the sphere (centre `c`) whose reflected ray meets the sphere `other` first of
+/// the two: where the first object shows the second (issue 33's composition).
+fn sees_mask(scene: &Scene, c: Vec3, other: Vec3, (w, h): (u32, u32)) -> Vec<bool> {
+    let rays = CameraRays::new(&scene.camera.unwrap(), w, h);
+    let hit = |o: glam::DVec3, d: glam::DVec3, c: Vec3| {
+        let oc = o - c.as_dvec3();
+        let b = oc.dot(d);
+        let disc = b * b - (oc.length_squared() - (R as f64).powi(2));
+        (disc > 0.0).then(|| -b - disc.sqrt()).filter(|&t| t > 1e-6)
+    };
+    let mut mask = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let (o, d, _) = rays.ray(x as f64 + 0.5, y as f64 + 0.5);
+            let seen = hit(o, d, c).filter(|&t| hit(o, d, other).is_none_or(|u| t < u)).is_some_and(|t| {
+                let p = o + d * t;
+                let n = (p - c.as_dvec3()).normalize();
+                let r = d - 2.0 * d.dot(n) * n;
+                hit(p + n * 1e-6, r, other).is_some()
+            });
+            mask.push(seen);
+        }
+    }
+    mask
+}
+
+/// Mean and standard deviation of the luminance sum over the masked pixels.
+fn luminance_stats(img: &ImageData, mask: &[bool]) -> (f64, f64) {
+    let l: Vec<f64> = mask.iter().enumerate().filter(|(_, &m)| m).map(|(i, _)| (0..3).map(|c| img.data[4 * i + c] as f64).sum()).collect();
+    let mean = l.iter().sum::<f64>() / l.len().max(1) as f64;
+    let var = l.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / l.len().max(1) as f64;
+    (mean, var.sqrt())
+}
+
+/// Issue 33's composition matrix: a mirror sphere and a glass sphere in mutual view, each
+/// pair of the methods that serve them (`--object mirror=A --object glass=B`), against the
+/// exact reference. Per pair, on the mirror's pixels that reflect the glass (and the glass's
+/// pixels that reflect the mirror): the other object is not a black or flat blob (its
+/// luminance at least a quarter of the reference's in mean and spread), and each object is
+/// no worse than under its own method alone (1 dB). The table is printed (BENCHMARKS.md).
+/// Measured at 64×44: before composition covered them, the glass in the mirror was black
+/// (mean 0.02–0.09 of the reference's 0.589) with the mirror on curved-reflector (every glass
+/// method) and on distance or distance-multi beside a glass on distance or image-space
+/// refraction (the mirror 25.87 dB where alone it had 29.41); now 1.02–1.25 of it, the
+/// curved mirror 31.0 dB (24.9 alone). The environment-mapping methods show the glass at
+/// 0.32–0.50 of it (their radiance cubes reflect the sky there, as designed).
+#[test]
+fn composition_matrix() {
+    use specula::methods::*;
+    let ctx = common::gpu();
+    let scene = common::mirror_and_glass(32);
+    let q = quality(&["depth=4"]);
+    let size = (64, 44);
+    let reference = render_reference(&scene, &quality(&["depth=4", "spp=1"]), size).unwrap();
+    let (mirror, glass) = (sphere_mask(&scene, MIRROR, R, size.0, size.1), sphere_mask(&scene, GLASS, R, size.0, size.1));
+    let (mirror_sees, glass_sees) = (sees_mask(&scene, MIRROR, GLASS, size), sees_mask(&scene, GLASS, MIRROR, size));
+    let count = |m: &[bool]| m.iter().filter(|&&x| x).count();
+    eprintln!(
+        "mirror pixels {} ({} reflect the glass), glass pixels {} ({} reflect the mirror)",
+        count(&mirror),
+        count(&mirror_sees),
+        count(&glass),
+        count(&glass_sees)
+    );
+    let mirror_methods = [ENVMAP, PROXY_SPHERE, DISTANCE, DISTANCE_MULTI, LAYERED, CURVED_REFLECTOR, BVH];
+    let glass_methods = [REFRACTOR_MAP, IMAGE_SPACE_REFRACTION, DISTANCE, LAYERED, BVH];
+    let alone = |m: Method| render(&ctx, &scene, &whole(m), &q, size);
+    let own_mirror: Vec<f64> = mirror_methods.iter().map(|&m| masked_psnr(&alone(m), &reference, &mirror)).collect();
+    let own_glass: Vec<f64> = glass_methods.iter().map(|&m| masked_psnr(&alone(m), &reference, &glass)).collect();
+    let (ref_ms, ref_gs) = (luminance_stats(&reference, &mirror_sees), luminance_stats(&reference, &glass_sees));
+    eprintln!(
+        "reference: mirror-sees-glass mean {:.3} sd {:.3}; glass-sees-mirror mean {:.3} sd {:.3}",
+        ref_ms.0, ref_ms.1, ref_gs.0, ref_gs.1
+    );
+    eprintln!("| mirror \\ glass | {} |", glass_methods.map(|m| m.name()).join(" | "));
+    let mut bad = Vec::new();
+    for (i, &a) in mirror_methods.iter().enumerate() {
+        let mut row = Vec::new();
+        for (j, &b) in glass_methods.iter().enumerate() {
+            let pair = Choices { method: Choice::Auto, objects: vec![("mirror".into(), a), ("glass".into(), b)] };
+            let img = render(&ctx, &scene, &pair, &q, size);
+            let (pm, pg) = (masked_psnr(&img, &reference, &mirror), masked_psnr(&img, &reference, &glass));
+            let (ms, gs) = (luminance_stats(&img, &mirror_sees), luminance_stats(&img, &glass_sees));
+            row.push(format!("{pm:.1} / {pg:.1} dB, seen {:.2}/{:.2}, {:.2}", ms.0 / ref_ms.0, ms.1 / ref_ms.1, gs.0 / ref_gs.0));
+            let name = format!("mirror={} glass={}", a.name(), b.name());
+            // No blob: the glass in the mirror has at least a quarter of the reference's
+            // luminance and spread.
+            if ms.0 < 0.25 * ref_ms.0 || ms.1 < 0.25 * ref_ms.1 {
+                bad.push(format!(
+                    "{name}: the glass in the mirror mean {:.3} sd {:.3} (reference {:.3} / {:.3})",
+                    ms.0, ms.1, ref_ms.0, ref_ms.1
+                ));
+            }
+            // And the mirror in the glass's reflection (a weak reflection, a flat spot in the
+            // reference: its mean only).
+            if gs.0 < 0.25 * ref_gs.0 {
+                bad.push(format!("{name}: the mirror in the glass mean {:.3} (reference {:.3})", gs.0, ref_gs.0));
+            }
+            // Composition makes no object worse than its method alone (1 dB).
+            if pm < own_mirror[i] - 1.0 || pg < own_glass[j] - 1.0 {
+                bad.push(format!("{name}: mirror {pm:.2} dB (alone {:.2}), glass {pg:.2} dB (alone {:.2})", own_mirror[i], own_glass[j]));
+            }
+        }
+        eprintln!("| {} | {} |", a.name(), row.join(" | "));
+    }
+    for b in &bad {
+        eprintln!("{b}");
+    }
+    assert!(bad.is_empty(), "{} pair(s) do not compose:\n{}", bad.len(), bad.join("\n"));
+    common::assert_clean(&ctx);
 }

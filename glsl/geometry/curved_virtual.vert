@@ -9,6 +9,7 @@ layout(location = 1) out vec3 out_normal;
 layout(location = 2) out vec2 out_uv;
 layout(location = 3) flat out uint out_view;
 layout(location = 4) out float out_valid;
+layout(location = 5) out vec3 out_virtual;
 
 void main() {
     CurvedVertex v = curved_vertices[gl_VertexIndex];
@@ -18,5 +19,6 @@ void main() {
     out_uv = v.uv.xy;
     out_view = push.view;
     out_valid = w.w;
+    out_virtual = w.xyz;
     gl_Position = views[push.view].view_proj * vec4(w.xyz, 1.0);
 }

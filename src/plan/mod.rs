@@ -51,8 +51,18 @@ impl Plan {
     /// would have another structure (other stages, maps or shadow maps).
     pub fn refresh_geometry(&mut self, scene: &Scene) -> Result<()> {
         let methods = |p: &Plan| p.objects.iter().map(|o| (o.mesh, o.method.name())).collect::<Vec<_>>();
+        // How each object shows in the others' maps, and the maps it keeps (composition may
+        // change with a move: who sees a self-refracting object decides the cycles).
+        let shading = |p: &Plan| {
+            p.objects
+                .iter()
+                .map(|o| (o.map_shading, o.leaves_out, o.maps.iter().map(|m| (m.pass, m.layer)).collect::<Vec<_>>()))
+                .collect::<Vec<_>>()
+        };
         let same = |fresh: &Plan| {
             fresh.stages == self.stages
+                && (fresh.inter_object, fresh.cycles, fresh.frame_latency) == (self.inter_object, self.cycles, self.frame_latency)
+                && shading(fresh) == shading(self)
                 && fresh.shadow_cubes == self.shadow_cubes
                 && fresh.shadow_planes == self.shadow_planes
                 && methods(fresh) == methods(self)
@@ -95,6 +105,10 @@ impl Plan {
         if !same(&fresh) {
             let what = match fresh.stages.iter().zip(&self.stages).find(|(a, b)| a != b) {
                 Some((a, b)) => format!("{} was {b:?}, now {a:?}", a.name()),
+                None if fresh.cycles != self.cycles || fresh.inter_object != self.inter_object => {
+                    format!("inter-object cycles {} → {}", self.cycles * self.inter_object as u32, fresh.cycles * fresh.inter_object as u32)
+                }
+                None if shading(&fresh) != shading(self) => "how the objects show in each other's maps (composition)".to_string(),
                 None => format!(
                     "passes now {}, maps of {:?}",
                     fresh.passes.join(", "),

@@ -145,20 +145,25 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     ..crate::methods::registry::Family::NONE
 };
 
-/// The objects of `methods` that composition gives maps of their own: a method with no cube
-/// map of its own that shades it in maps, not drawn by planar views, where another object's
-/// method keeps distance maps.
+/// The objects of `methods` that composition gives maps of their own (or shades by the
+/// distance map it keeps): a method that shades its object as the sky in maps — with no
+/// cube map of its own, or with a distance map of its own (distance, image-space
+/// refraction: single-bounce methods) — not drawn by planar views, where another object's
+/// method keeps distance maps or is a curved reflector (which shows them by their maps).
 fn composed(methods: &[Method]) -> Vec<bool> {
     let gpu = |m: &Method| m.gpu.expect("GPU method");
     let distance = |m: &Method| gpu(m).maps.iter().any(|i| i.name == DISTANCE_CUBES.name);
     let needs = |m: &Method| {
         let g = gpu(m);
         let own_cube = g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap));
-        !own_cube && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
+        (!own_cube || distance(m)) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
-    let mapped: Vec<bool> = methods.iter().map(distance).collect();
+    // Curved reflectors show the specular objects of their environment by those objects'
+    // own maps too (geometry/curved_virtual.frag).
+    let shows = |m: &Method| distance(m) || *m == crate::methods::geometry::CURVED_REFLECTOR;
+    let mapped: Vec<bool> = methods.iter().map(shows).collect();
     let count = mapped.iter().filter(|&&d| d).count();
-    // Another object than itself keeps distance maps.
+    // Another object than itself keeps distance maps (or draws the others by theirs).
     methods.iter().zip(&mapped).map(|(m, &d)| needs(m) && count > usize::from(d)).collect()
 }
 
@@ -166,7 +171,9 @@ fn composed(methods: &[Method]) -> Vec<bool> {
 /// map of its own (the ray tracers, layered maps, curved reflectors, planar refraction) would
 /// show in the other objects' distance maps as a reflection of the sky only (black in a closed
 /// room). Where some object has a distance map, each such object gets one of its own, around
-/// its own reference point, used only for how it looks in the others' maps — traced in it
+/// its own reference point, used only for how it looks in the others' maps (an object whose
+/// single-bounce method keeps one already, `distance` or `image-space-refraction`, uses
+/// that one: it showed as the sky there, black beside a mirror on distance-multi) — traced in it
 /// (a solid dielectric: refracted through its own refractor map first), as distance-multi's
 /// objects are — with the inter-object cycles that needs. Planar mirrors are drawn into the
 /// maps by their mirrored views instead (geometry family); objects with radiance cubes of

@@ -554,10 +554,13 @@ impl Stage for CurvedReflectors {
             .after_buffer_writes()
             .writes(&mut self.virtual_images, Access::ColorAttachment)
             .writes(&mut self.virtual_depth, Access::DepthAttachment);
-        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()) {
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(io.maps.camera_reads()) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
+        // Specular objects of the environment are shaded by their own maps where they have
+        // them (curved_virtual.frag): the camera's set 1, or the null one.
+        let maps = io.sets.camera.get(io.maps.latest).copied().unwrap_or(io.sets.empty);
         for (k, &reflector) in self.reflectors.iter().enumerate() {
             if k > 0 {
                 rec.barrier(&mut self.virtual_depth, Access::DepthAttachment);
@@ -575,6 +578,9 @@ impl Stage for CurvedReflectors {
             };
             begin_rendering(ctx, cmd, &target);
             self.bind(ctx, cmd, vk::PipelineBindPoint::GRAPHICS, self.virtual_pipeline, f);
+            if maps != vk::DescriptorSet::null() {
+                unsafe { ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::GRAPHICS, self.layout, 1, &[maps], &[]) };
+            }
             unsafe { ctx.device.cmd_bind_index_buffer(cmd, self.indices.raw, 0, vk::IndexType::UINT32) };
             let flags = f.flags | ((k as u32) << CURVED_REFLECTOR_SHIFT);
             // Hidden objects draw nothing (their scene draw has no index).
