@@ -5,6 +5,7 @@
 //! close. Mirrors `glsl/scene/` and `glsl/shadow/`.
 
 pub mod camera;
+pub mod cube_deps;
 pub mod direct;
 pub mod ids;
 pub mod knobs;

@@ -37,8 +37,8 @@ pub struct ShadowMaps {
     /// Mesh draws per cube face in the last frame recorded, over all shadow cubes.
     face_draws: [u32; 6],
     /// Which cube faces the next record draws: those whose frusta from the light saw a
-    /// caster move (`methods::cube_deps`); all on a light change.
-    deps: crate::methods::cube_deps::FaceDeps,
+    /// caster move (`frame::cube_deps`); all on a light change.
+    deps: crate::frame::cube_deps::FaceDeps,
     /// Directional lights' planar maps: drawn again on any move.
     planes_dirty: bool,
     always: bool,
@@ -51,7 +51,7 @@ impl ShadowMaps {
     }
 
     fn init(&mut self, ctx: &Context, plan: &Plan, layout: vk::PipelineLayout, maps: &mut Maps) -> Result<()> {
-        self.deps = crate::methods::cube_deps::FaceDeps::new(plan.shadow_cubes.len());
+        self.deps = crate::frame::cube_deps::FaceDeps::new(plan.shadow_cubes.len());
         self.planes_dirty = true;
         self.always = plan.quality.frame.map_updates_always;
         let size = plan.quality.frame.shadow_size;
@@ -132,7 +132,7 @@ impl Stage for ShadowMaps {
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
         let geometry = crate::scene::update::Changes { materials: Vec::new(), camera: false, ..changes.clone() };
         let eyes = Self::eyes(init.scene, init.plan);
-        let lighting = crate::methods::cube_deps::Lighting::default();
+        let lighting = crate::frame::cube_deps::Lighting::default();
         self.deps.mark(init.scene, &init.plan.shadow_cubes, &eyes, &init.gpu.draws, &geometry, (false, &[]), &lighting);
         self.planes_dirty |= !changes.moved.is_empty() || !changes.lights.is_empty();
         Ok(())

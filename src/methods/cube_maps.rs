@@ -65,7 +65,7 @@ pub struct CubeMaps {
     /// Mesh draws the last frame recorded per cube face (per-face culling), over all cubes.
     face_draws: [u32; 6],
     /// Which faces the next record draws (what changed in their frusta, `cube_deps`).
-    deps: crate::methods::cube_deps::FaceDeps,
+    deps: crate::frame::cube_deps::FaceDeps,
     /// `map_updates=always`: every face every frame.
     always: bool,
     /// Faces drawn by the last record.
@@ -106,7 +106,7 @@ impl CubeMaps {
             inter_object,
             frames: 0,
             face_draws: [0; 6],
-            deps: crate::methods::cube_deps::FaceDeps::new(objects.len()),
+            deps: crate::frame::cube_deps::FaceDeps::new(objects.len()),
             always: q.frame.map_updates_always,
             faces_drawn: 0,
         };
@@ -259,13 +259,13 @@ impl Stage for CubeMaps {
             self.deps.all();
         } else {
             let eyes = self.eyes(init.plan);
-            let lighting = crate::methods::cube_deps::Lighting::of(init.scene, init.plan);
+            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
             self.deps.mark(init.scene, &self.objects, &eyes, &init.gpu.draws, changes, (self.inter_object, &self.map_mirrors), &lighting);
         }
         Ok(())
     }
 
-    /// Faces the next record draws, of all (`cube_deps`), unless it draws every face.
+    /// Faces the next record draws, of all (`frame::cube_deps`), unless it draws every face.
     fn redraw(&self) -> Option<(u32, u32)> {
         (!self.every_face()).then(|| self.deps.count())
     }

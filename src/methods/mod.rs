@@ -9,7 +9,6 @@
 //! `quality::compose!`; with GPU declarations, one of `build/layout.rs`'s `declarations!`).
 
 pub mod caustics;
-pub mod cube_deps;
 pub mod cube_knobs;
 pub mod cube_maps;
 pub mod distance;

@@ -192,6 +192,10 @@ pub struct Family {
     /// what the budget adds to their cost (their cheapest candidate that shades itself in
     /// maps) and the inter-object cycles that needs.
     pub composes: Option<Composes>,
+    /// Its methods that draw the other specular objects by those objects' own maps (curved
+    /// reflectors: their environment's specular objects), so that composition gives those
+    /// objects maps as it does beside a distance-mapped object.
+    pub shows_others_by_maps: &'static [Method],
     /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame.
     pub push_words: Option<fn(&Quality, &mut crate::frame::words::PushWords)>,
     /// Its part of `specula plan`'s table, if it planned anything.
@@ -222,6 +226,7 @@ impl Family {
         refresh: None,
         push_words: None,
         composes: None,
+        shows_others_by_maps: &[],
         describe: None,
         frame_part: None,
     };

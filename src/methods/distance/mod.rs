@@ -159,8 +159,8 @@ fn composed(methods: &[Method]) -> Vec<bool> {
         (!own_cube || distance(m)) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
     // Curved reflectors show the specular objects of their environment by those objects'
-    // own maps too (geometry/curved_virtual.frag).
-    let shows = |m: &Method| distance(m) || *m == crate::methods::geometry::CURVED_REFLECTOR;
+    // own maps too (`Family::shows_others_by_maps`).
+    let shows = |m: &Method| distance(m) || crate::methods::FAMILIES.iter().any(|f| f.shows_others_by_maps.contains(m));
     let mapped: Vec<bool> = methods.iter().map(shows).collect();
     let count = mapped.iter().filter(|&&d| d).count();
     // Another object than itself keeps distance maps (or draws the others by theirs).

@@ -27,6 +27,7 @@ pub const FAMILY: Family = Family {
     slots: slots::SLOTS,
     methods: &[PLANAR_MIRROR_INFO, PLANAR_REFRACTION_INFO, CURVED_REFLECTOR_INFO],
     plan_stages: Some(plan_fallback_maps),
+    shows_others_by_maps: &[CURVED_REFLECTOR],
     plan_views: Some(plan_views),
     views: Some(view_blocks),
     frame_part: Some(views::create_frame_part),

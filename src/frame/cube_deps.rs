@@ -12,8 +12,8 @@
 
 use glam::Vec3;
 
+use super::ALL_FACES;
 use crate::cube::face_sees_box;
-use crate::frame::ALL_FACES;
 use crate::gpu_scene::Draw;
 use crate::scene::update::Changes;
 use crate::scene::Scene;
