@@ -52,8 +52,17 @@ pub(super) struct RayOrder {
 }
 
 impl RayOrder {
-    /// For queues of at most `rays` rays over `keys` pixel keys.
-    pub fn new(ctx: &Context, layout: vk::PipelineLayout, rays: u64, keys: u64) -> Result<RayOrder> {
+    /// For queues of at most `rays` rays of a `width`×`height` frame of `samples` rays per
+    /// pixel, in tiles of `tile`² rays: the pixel keys are the frame padded to whole
+    /// `tile`² blocks, times the samples (glsl/raytrace/sort.glsl's sort_keys).
+    pub fn new(
+        ctx: &Context,
+        layout: vk::PipelineLayout,
+        rays: u64,
+        (width, height, samples, tile): (u32, u32, u32, u32),
+    ) -> Result<RayOrder> {
+        let tile = tile.max(1) as u64;
+        let keys = (width as u64).div_ceil(tile) * (height as u64).div_ceil(tile) * tile * tile * samples as u64;
         let mut me = RayOrder {
             order: Buffer::placeholder(),
             offsets: Buffer::placeholder(),

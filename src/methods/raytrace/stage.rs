@@ -404,8 +404,7 @@ impl RayTrace {
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
         self.create_pipelines(ctx)?;
         if tile > 0 {
-            let keys = (self.width.div_ceil(tile) * self.height.div_ceil(tile)) as u64 * (tile * tile * self.samples) as u64;
-            self.order = Some(RayOrder::new(ctx, self.layout, most, keys)?);
+            self.order = Some(RayOrder::new(ctx, self.layout, most, (self.width, self.height, self.samples, tile))?);
         }
         self.create_sets(ctx)
     }
@@ -928,18 +927,17 @@ impl Stage for RayTrace {
         // The spawn budget of bounce k decides queue k + 1: its dropped children were rays
         // of bounce k + 1 too; the shadow budget of bounce k its shadow queue.
         let budget = self.spawn_budget.read().map(|b| b.to_vec()).unwrap_or_default();
-        let budget_word = |entry: u64, field: usize| {
-            let at = (entry * self.budget_stride) as usize + 4 * field;
-            budget.get(at..at + 4).map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]])) as u64
-        };
-        // Fields of GpuSpawnBudget: hist, sub, cutoff, sub_cutoff, kept, dropped, weight.
-        let field = 2 * crate::frame::layout::SPAWN_BINS as u64 + 3;
+        let size = std::mem::size_of::<GpuSpawnBudget>();
         let mut dropped = 0;
         let mut weights = [0.0; 2];
+        // Entry 2k: bounce k's spawn budget, 2k + 1: its shadow budget; (rays, weight).
         let mut budget_dropped = |entry: u64| {
-            let fixed = budget_word(entry, field as usize + 1) | (budget_word(entry, field as usize + 2) << 32);
+            let at = (entry * self.budget_stride) as usize;
+            let Some(bytes) = budget.get(at..at + size) else { return 0 };
+            let b: GpuSpawnBudget = bytemuck::pod_read_unaligned(bytes);
+            let fixed = b.dropped_weight[0] as u64 | (b.dropped_weight[1] as u64) << 32;
             weights[(entry % 2) as usize] += fixed as f64 / (1u64 << 20) as f64;
-            budget_word(entry, field as usize)
+            b.dropped as u64
         };
         for k in 0..bounces {
             let spawn_dropped = if k > 0 { budget_dropped(2 * (k - 1)) } else { 0 };
