@@ -207,6 +207,12 @@ typedef struct {
   float ior;
   // Dielectric: non-zero for a thin-walled surface (no bending).
   uint32_t thin;
+  // Solid dielectric (KHR_materials_volume): the colour white light turns into after
+  // `attenuation_distance` inside (each channel in 0..=1). Added after the first release:
+  // a caller whose `size` ends before it gets no absorption.
+  float attenuation_color[3];
+  // Solid dielectric: that distance [m] (> 0); 0: no absorption (glTF's infinity).
+  float attenuation_distance;
 } SpeculaMaterialDesc;
 
 // A triangle mesh. Arrays are read during the call only (the library copies them).
@@ -615,7 +621,7 @@ SpeculaResult specula_context_set_object_visible(SpeculaContext *ctx,
                                                  uint32_t object,
                                                  uint32_t visible);
 
-// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior; its
+// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption; its
 // textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 // again). Validated like specula_context_add_material; the GPU need not be idle.
 SpeculaResult specula_context_set_material(SpeculaContext *ctx,

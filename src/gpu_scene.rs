@@ -65,6 +65,7 @@ pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         base_texture: m.base_color_texture.map_or(-1, |t| t as i32),
         emissive_texture: m.emissive_texture.map_or(-1, |t| t as i32),
         thin,
+        absorption: if m.absorbs() { v4(m.absorption.to_array()) } else { [0.0; 4] },
     }
 }
 

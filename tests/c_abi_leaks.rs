@@ -111,6 +111,8 @@ unsafe fn build_scene(ctx: *mut SpeculaContext) {
             kappa: [3.0; 3],
             ior,
             thin: 0,
+            attenuation_color: [0.0; 3],
+            attenuation_distance: 0.0,
         };
         let mut i = 0;
         ok(specula_context_add_material(ctx, &m, &mut i), ctx);

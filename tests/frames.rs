@@ -468,6 +468,8 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
             kappa: [3.0; 3],
             ior,
             thin: 0,
+            attenuation_color: [0.0; 3],
+            attenuation_distance: 0.0,
         };
         let glass_material = scene
             .meshes

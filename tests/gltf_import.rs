@@ -422,10 +422,10 @@ fn materials_are_classified_with_their_extensions() {
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.33 } } },
         { "name": "solid_glass", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.7 },
-                          "KHR_materials_volume": { "thicknessFactor": 0.5 } } },
+                          "KHR_materials_volume": { "thicknessFactor": 0.5, "attenuationColor": [0.5, 0.25, 0.0], "attenuationDistance": 2.0 } } },
         { "name": "zero_thickness", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 },
-                          "KHR_materials_volume": { "thicknessFactor": 0.0 } } },
+                          "KHR_materials_volume": { "thicknessFactor": 0.0, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 1.0 } } },
         { "name": "grey_mirror", "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.0 } },
         { "name": "silver", "pbrMetallicRoughness": { "metallicFactor": 1.0, "roughnessFactor": 0.0 },
           "extras": { "specula": { "nu": [0.15, 0.12, 0.14], "kappa": [3.3, 2.3, 1.8] } } },
@@ -458,6 +458,15 @@ fn materials_are_classified_with_their_extensions() {
     assert_eq!(material(&s, "solid_glass").kind, SurfaceKind::Dielectric { ior: 1.7, thin: false });
     assert_eq!(material(&s, "zero_thickness").kind, SurfaceKind::Dielectric { ior: 1.5, thin: true });
     assert_eq!(material(&s, "solid_glass").kind.label(), "dielectric (solid)");
+    // KHR_materials_volume's attenuation: σ = −ln c / d (a colour of 0 absorbs as 10⁻³⁰
+    // does, finite); a thin-walled surface has no volume to absorb in, glass without the
+    // extension none either.
+    let sigma = material(&s, "solid_glass").absorption;
+    let expected = Vec3::new(2f32.ln() / 2.0, 4f32.ln() / 2.0, 1e30f32.ln() / 2.0);
+    assert!(close(sigma, expected), "{sigma} vs {expected}");
+    assert!(material(&s, "solid_glass").absorbs());
+    assert_eq!(material(&s, "zero_thickness").absorption, Vec3::ZERO);
+    assert_eq!(material(&s, "thin_glass").absorption, Vec3::ZERO);
 
     let SurfaceKind::Mirror { nu, kappa } = material(&s, "grey_mirror").kind else { panic!("grey_mirror is not a mirror") };
     let root = 0.5f32.sqrt();

@@ -109,6 +109,7 @@ void main() {
             vec3 n2;
             Material m2;
             exact_surface(h, dir, n2, m2);
+            w *= segment_transmittance(m2, n2, dir, h.t * length(dir));  // absorbed inside
             pos += dir * h.t;
             skip = h.triangle;
             SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
@@ -130,6 +131,7 @@ void main() {
         vec3 n2;
         Material m2;
         exact_surface(h, dir, n2, m2);
+        w *= segment_transmittance(m2, n2, dir, h.t * length(dir));  // absorbed inside a solid
         pos += dir * h.t;
         skip = h.triangle;
         if (m2.kind == KIND_DIFFUSE) {
@@ -172,6 +174,7 @@ void main() {
                 break;
             }
             vec3 out_dir;
+            w *= volume_transmittance(m, length(hit - pos));  // absorbed on the way through
             pos = hit;
             if (refract_dir(dir, -n2, ior, out_dir)) {
                 w *= 1.0 - material_fresnel(m, dot(dir, n2), 1.0 / ior);

@@ -41,4 +41,44 @@ SpecularSplit specular_split(Material m, vec3 p, vec3 n, vec3 eye) {
     s.ft = 1.0 - s.fr;
     return s;
 }
+
+// Absorption inside solid dielectrics (KHR_materials_volume, Beer–Lambert): what is left
+// of radiance after a path of length len inside material m (σ is zero elsewhere).
+vec3 volume_transmittance(Material m, float len) {
+    return exp(-m.absorption.rgb * max(len, 0.0));
+}
+
+// The transmittance of the segment a ray of direction d ran, `len` long, to the surface
+// (material m, normal n either way round) it hits: the segment lay inside m's solid when
+// the ray meets that surface from within (as specular_split tells entering from leaving).
+vec3 segment_transmittance(Material m, vec3 n, vec3 d, float len) {
+    if (m.kind != KIND_DIELECTRIC || m.thin != 0u || dot(n, d) <= 0.0) return vec3(1.0);
+    return volume_transmittance(m, len);
+}
+
+// The length of the ray p + t·dir, t ≥ 0, from a point of object o's surface into its
+// solid, up to where it leaves the object's bounding box and bounding sphere: for a
+// method that does not trace the inside (a single refraction, §3–4.1) the path its
+// absorption takes. Exact for spheres and axis-aligned boxes, at least the true chord
+// for every convex solid (p lies inside both bounds).
+float bounds_chord(Object o, vec3 p, vec3 dir) {
+    vec3 lo = o.bounds_min.xyz, hi = o.bounds_max.xyz;
+    vec3 inv = 1.0 / mix(dir, vec3(1e-20), equal(dir, vec3(0.0)));  // no 0 · ∞ below
+    vec3 t1 = (lo - p) * inv, t2 = (hi - p) * inv;
+    vec3 far = max(t1, t2);
+    float t_box = max(min(min(far.x, far.y), far.z), 0.0);
+    vec3 c = 0.5 * (lo + hi) - p;
+    float r = o.bounds_min.w;
+    float b = dot(c, dir);
+    float disc = b * b - (dot(c, c) - r * r);
+    float t_sphere = disc > 0.0 ? max(b + sqrt(disc), 0.0) : 0.0;
+    return min(t_box, t_sphere);
+}
+
+// Absorption along the refracted branch of a single-refraction method at point p of
+// object o (material m): the chord through its bounds, when the branch enters the solid.
+vec3 chord_transmittance(Object o, Material m, vec3 p, vec3 n, vec3 t) {
+    if (m.kind != KIND_DIELECTRIC || m.thin != 0u || dot(n, t) >= 0.0 || all(equal(m.absorption.rgb, vec3(0.0)))) return vec3(1.0);
+    return volume_transmittance(m, bounds_chord(o, p, t));
+}
 #endif

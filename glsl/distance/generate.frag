@@ -30,7 +30,7 @@ void main() {
             c = refractor_radiance(o, m, in_position, n, eye);
         } else {
             c = s.fr * (inter ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
-            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * (inter ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
+            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * (inter ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
         }
     }
     out_radiance_distance = vec4(c, length(in_position - eye));

@@ -36,6 +36,6 @@ void main() {
     // The test knob debug_fault=flip_reflection: a deliberately broken reflection.
     if ((push.flags & FLAG_DEBUG_FLIP_REFLECTION) != 0u) s.r = -s.r;
     vec3 c = s.fr * RADIANCE(o, in_position, s.r);
-    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * RADIANCE(o, in_position, s.t);
+    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, normalize(in_normal), s.t) * RADIANCE(o, in_position, s.t);
     out_color = vec4(c, 1.0);
 }

@@ -40,6 +40,6 @@ void main() {
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
     float layer = float(o.envmap_layer);
     vec3 c = s.fr * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.r), layer), 0.0).rgb;
-    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.t), layer), 0.0).rgb;
+    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, normalize(in_normal), s.t) * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.t), layer), 0.0).rgb;
     out_color = vec4(c, 1.0);
 }

@@ -40,7 +40,7 @@ void main() {
             c = refractor_radiance(o, m, in_position, n, eye);
         } else {
             c = s.fr * (own ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
-            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * (own ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
+            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * (own ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
         }
     }
     out_color = vec4(c, 1.0);

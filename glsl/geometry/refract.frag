@@ -44,6 +44,22 @@ void main() {
     bool solid = o.refractor_layer >= 0;
     vec3 reflected = fallback(o, m, in_position, s.r, eye_inside && solid);
     vec3 refracted = any(greaterThan(s.ft, vec3(0.0))) ? fallback(o, m, in_position, s.t, !eye_inside && solid) : vec3(0.0);
+    // Absorption inside the solid (KHR_materials_volume). A view from inside looks through
+    // one of its faces, its clip plane: the eye ray's part from that plane to this point
+    // ran inside (the length the mirrored view preserves; the refracted view's affine map
+    // keeps it exactly along its central ray), so everything this pixel shows is absorbed
+    // over it, and views nested in views multiply their segments up. A branch into the
+    // solid that no view follows is absorbed by its fallback: the refractor map traces the
+    // inside, the environment takes the chord through the object's bounds.
+    vec3 absorbed = vec3(1.0);
+    View here = views[in_view];
+    float across = dot(here.clip.xyz, in_position - eye);
+    if (eye_inside && m.thin == 0u && abs(across) > 0.0) {
+        float enters = -(dot(here.clip.xyz, eye) + here.clip.w) / across;  // where the eye ray crosses the face
+        absorbed = volume_transmittance(m, max(1.0 - enters, 0.0) * length(in_position - eye));
+    }
+    bool fallback_absorbs = !eye_inside && solid && o.envmap_layer >= 0 && (push.flags & FLAG_MIRROR_DEPTH_END) == 0u;
+    if (!fallback_absorbs && !eye_inside) refracted *= chord_transmittance(o, m, in_position, n, s.t);
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
         // The face's plane, towards the eye; its child views keep that side (reflection)
         // or the other (refraction), `dir.w` beyond the plane.
@@ -72,5 +88,5 @@ void main() {
             }
         }
     }
-    out_color = vec4(s.fr * reflected + s.ft * refracted, 1.0);
+    out_color = vec4(absorbed * (s.fr * reflected + s.ft * refracted), 1.0);
 }

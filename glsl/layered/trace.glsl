@@ -125,7 +125,8 @@ vec3 layered_radiance(vec3 centre, Material m, vec3 p, vec3 n, vec3 eye, uint le
         Material hm = materials[uint(surface.w + 0.5) - 1u];
         vec3 q = r.origin + r.dir * h.d;
         vec3 hn = normalize(surface.xyz);
-        layered_branch(specular_split(hm, q, hn, q - r.dir), q, hn, r.weight, r.left - 1u);
+        vec3 w = r.weight * segment_transmittance(hm, hn, r.dir, h.d * length(r.dir));  // absorbed inside a solid
+        layered_branch(specular_split(hm, q, hn, q - r.dir), q, hn, w, r.left - 1u);
     }
     return c;
 }

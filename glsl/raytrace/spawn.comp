@@ -30,6 +30,8 @@ void main() {
     RayPayload pl = payloads[i];
     vec3 d = normalize(queries[i].direction.xyz);
     SpecularSplit sp = specular_split(m, s.p, s.n, s.p - d);
-    child(s.p, normalize(sp.r), h.triangle, pl.weight.rgb * sp.fr, pl.pixel);
-    child(s.p, normalize(sp.t), h.triangle, pl.weight.rgb * sp.ft, pl.pixel);
+    // A ray that ran inside an absorbing solid to this hit (Beer–Lambert over its length).
+    vec3 w = pl.weight.rgb * segment_transmittance(m, s.n, d, h.t * length(queries[i].direction.xyz));
+    child(s.p, normalize(sp.r), h.triangle, w * sp.fr, pl.pixel);
+    child(s.p, normalize(sp.t), h.triangle, w * sp.ft, pl.pixel);
 }

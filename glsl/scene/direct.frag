@@ -12,7 +12,8 @@ layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 
 void main() {
-    Material m = materials[objects[push.object].material];
+    Object o = objects[push.object];
+    Material m = materials[o.material];
     vec3 n = normalize(in_normal);
     vec3 eye = views[in_view].eye.xyz;
     vec3 c;
@@ -21,7 +22,7 @@ void main() {
     } else {
         SpecularSplit s = specular_split(m, in_position, n, eye);
         c = s.fr * sky_radiance(s.r);
-        if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * sky_radiance(s.t);
+        if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * sky_radiance(s.t);
     }
     out_color = vec4(c, 1.0);
 }

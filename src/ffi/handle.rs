@@ -226,6 +226,30 @@ pub(super) unsafe fn header<'a, T>(p: *const T, tag: SpeculaStructType, what: &s
     Ok(&*p)
 }
 
+/// A struct that grew: checks its tag and that its size covers at least the first
+/// `min_size` bytes (the struct as first released), and returns a copy whose fields beyond
+/// the caller's size are zero (each such field documents that zero is its default), with
+/// the size the caller gave.
+pub(super) unsafe fn header_grown<T: Copy>(p: *const T, tag: SpeculaStructType, what: &str, min_size: usize) -> FfiResult<(T, usize)> {
+    if p.is_null() {
+        return fail(SPECULA_ERROR_NULL_POINTER, format!("{what} is NULL"));
+    }
+    let head = p as *const u32;
+    let (t, size) = (*head, *head.add(1) as usize);
+    if t != tag {
+        return fail(SPECULA_ERROR_STRUCT_MISMATCH, format!("{what}: type tag {t}, expected {tag}"));
+    }
+    if size < min_size {
+        return fail(SPECULA_ERROR_STRUCT_MISMATCH, format!("{what}: size {size}, expected at least {min_size}"));
+    }
+    let mut out = std::mem::MaybeUninit::<T>::zeroed();
+    let n = size.min(std::mem::size_of::<T>());
+    std::ptr::copy_nonoverlapping(p as *const u8, out.as_mut_ptr() as *mut u8, n);
+    // SAFETY: every T this is used with is plain data (integers and floats) for which
+    // all-zero bytes are a valid value.
+    Ok((out.assume_init(), size))
+}
+
 pub(super) unsafe fn cstr<'a>(p: *const c_char, what: &str) -> FfiResult<&'a str> {
     if p.is_null() {
         return fail(SPECULA_ERROR_NULL_POINTER, format!("{what} is NULL"));

@@ -4,7 +4,7 @@ use std::ffi::c_char;
 
 use glam::{Mat4, Vec3};
 
-use super::handle::{cstr, fail, header, vec3, with_ctx, FfiResult, SpeculaContext};
+use super::handle::{cstr, fail, header, header_grown, vec3, with_ctx, FfiResult, SpeculaContext};
 use super::types::*;
 use crate::scene::{Camera, Light, LightKind, Material, Mesh, SurfaceKind};
 
@@ -29,8 +29,8 @@ pub unsafe extern "C" fn specula_context_add_material(
     out_index: *mut u32,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        let d = header(desc, SPECULA_STRUCT_MATERIAL_DESC, "material")?;
-        let m = material_from_desc(d, format!("material{}", c.scene.materials.len()))?;
+        let (d, _) = material_desc(desc)?;
+        let m = material_from_desc(&d, format!("material{}", c.scene.materials.len()))?;
         let i = c.scene.add_material(m)?;
         c.scene_version += 1;
         if !out_index.is_null() {
@@ -38,6 +38,12 @@ pub unsafe extern "C" fn specula_context_add_material(
         }
         Ok(SPECULA_SUCCESS)
     })
+}
+
+/// A material descriptor of any released size, and whether it carries the volume fields.
+pub(super) unsafe fn material_desc(desc: *const SpeculaMaterialDesc) -> FfiResult<(SpeculaMaterialDesc, bool)> {
+    let (d, size) = header_grown(desc, SPECULA_STRUCT_MATERIAL_DESC, "material", MATERIAL_DESC_SIZE_V1)?;
+    Ok((d, size >= std::mem::size_of::<SpeculaMaterialDesc>()))
 }
 
 /// The material a descriptor describes (validated by the scene's setters).
@@ -48,7 +54,24 @@ pub(super) fn material_from_desc(d: &SpeculaMaterialDesc, name: String) -> FfiRe
         SPECULA_SURFACE_DIELECTRIC => SurfaceKind::Dielectric { ior: d.ior, thin: d.thin != 0 },
         s => return fail(SPECULA_ERROR_INVALID_ARGUMENT, format!("material.surface: unknown value {s}")),
     };
-    Ok(Material { name, base_color: vec3(d.base_color), emissive: vec3(d.emission), kind, ..Default::default() })
+    let absorption = match d.attenuation_distance {
+        0.0 => Vec3::ZERO,
+        dist => {
+            let c = vec3(d.attenuation_color);
+            match Material::absorption_from(c, dist) {
+                Some(s) => s,
+                None => {
+                    return fail(
+                        SPECULA_ERROR_INVALID_ARGUMENT,
+                        format!(
+                            "material.attenuation_color {c} and material.attenuation_distance {dist}: the colour must be in 0..=1 per channel and the distance > 0 (0: no absorption)"
+                        ),
+                    )
+                }
+            }
+        }
+    };
+    Ok(Material { name, base_color: vec3(d.base_color), emissive: vec3(d.emission), kind, absorption, ..Default::default() })
 }
 
 /// The light a descriptor describes (validated by the scene's setters).

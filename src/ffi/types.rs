@@ -181,6 +181,7 @@ pub struct SpeculaRequirements {
 }
 
 #[repr(C)]
+#[derive(Clone, Copy)]
 pub struct SpeculaMaterialDesc {
     /// SPECULA_STRUCT_MATERIAL_DESC
     pub r#type: SpeculaStructType,
@@ -200,7 +201,16 @@ pub struct SpeculaMaterialDesc {
     pub ior: f32,
     /// Dielectric: non-zero for a thin-walled surface (no bending).
     pub thin: u32,
+    /// Solid dielectric (KHR_materials_volume): the colour white light turns into after
+    /// `attenuation_distance` inside (each channel in 0..=1). Added after the first release:
+    /// a caller whose `size` ends before it gets no absorption.
+    pub attenuation_color: [f32; 3],
+    /// Solid dielectric: that distance [m] (> 0); 0: no absorption (glTF's infinity).
+    pub attenuation_distance: f32,
 }
+
+/// `sizeof(SpeculaMaterialDesc)` as first released (up to `thin`): still accepted.
+pub const MATERIAL_DESC_SIZE_V1: usize = std::mem::offset_of!(SpeculaMaterialDesc, attenuation_color);
 
 /// A triangle mesh. Arrays are read during the call only (the library copies them).
 #[repr(C)]

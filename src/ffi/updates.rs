@@ -6,7 +6,7 @@
 use glam::Mat4;
 
 use super::handle::{fail, fixed_str, header, list_args, with_ctx, write_list, FfiResult, SpeculaContext};
-use super::scene::{light_from_desc, material_from_desc};
+use super::scene::{light_from_desc, material_desc, material_from_desc};
 use super::types::*;
 use crate::scene::Scene;
 
@@ -82,7 +82,7 @@ pub unsafe extern "C" fn specula_context_set_object_visible(ctx: *mut SpeculaCon
     })
 }
 
-/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior; its
+/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption; its
 /// textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 /// again). Validated like specula_context_add_material; the GPU need not be idle.
 #[no_mangle]
@@ -92,12 +92,14 @@ pub unsafe extern "C" fn specula_context_set_material(
     desc: *const SpeculaMaterialDesc,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        let d = header(desc, SPECULA_STRUCT_MATERIAL_DESC, "material")?;
+        let (d, volume) = material_desc(desc)?;
         let i = self::index(index, c.scene.materials.len(), "material")?;
         let old = c.scene.materials[i].clone();
-        let d = material_from_desc(d, old.name.clone())?;
-        // What the descriptor does not carry (textures, KHR_materials_specular) stays.
-        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, ..old };
+        let d = material_from_desc(&d, old.name.clone())?;
+        // What the descriptor does not carry (textures, KHR_materials_specular; the
+        // absorption from a descriptor of the first release's size) stays.
+        let absorption = if volume { d.absorption } else { old.absorption };
+        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, absorption, ..old };
         apply(c, |s| &mut s.materials[i], |s| s.set_material(i, m))
     })
 }

@@ -45,6 +45,9 @@ gpu_structs! {
         emissive_texture: int,
         /// dielectric: thin-walled
         thin: uint,
+        /// rgb: a solid dielectric's absorption coefficient σ [1/m] (KHR_materials_volume,
+        /// Beer–Lambert inside); zero elsewhere. a: unused
+        absorption: vec4,
     }
 
     /// std430 twin of `Object`: one mesh as the passes see it.
@@ -65,6 +68,11 @@ gpu_structs! {
         /// xyz: the centre of the map its own search reads: the reference point, or the
         /// shared layered map's (§4.5) for an object that takes `layered`
         map_centre: vec4,
+        /// The mesh's world-space bounding box; min.w: the radius of its bounding sphere
+        /// about the box's centre. Where a method does not trace a solid's inside, the chord
+        /// through both bounds the path length its absorption needs (common/specular.glsl).
+        bounds_min: vec4,
+        bounds_max: vec4,
     }
 
     /// std430 twin of `Light`.

@@ -243,6 +243,7 @@ impl Tracer<'_> {
                 }
             }
             let m = &self.scene.materials[s.material];
+            power *= shade::segment_transmittance(m, s.normal, d, hit.t); // absorbed inside a solid
             if m.kind == SurfaceKind::Diffuse {
                 let normal = if s.normal.dot(d) > 0.0 { -s.normal } else { s.normal };
                 return Some(Photon { position: s.position, normal, power, bounces });

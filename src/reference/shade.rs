@@ -232,3 +232,15 @@ pub fn specular_split(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3) -> Sp
         _ => SpecularSplit { r, t: i, fr: material_fresnel(m, mode, cos_i, 1.0), ft: DVec3::ZERO },
     }
 }
+
+/// `segment_transmittance` of glsl/common/specular.glsl: what is left of radiance after the
+/// segment of length `len` a ray of direction `d` ran to a surface of material `m` (shading
+/// normal `n`, either way round): Beer–Lambert, exp(−σ·len), when the ray meets a solid
+/// dielectric's surface from within (as `specular_split` tells leaving from entering), else 1.
+pub fn segment_transmittance(m: &Material, n: DVec3, d: DVec3, len: f64) -> DVec3 {
+    if !m.absorbs() || n.dot(d) <= 0.0 {
+        return DVec3::ONE;
+    }
+    let sigma = m.absorption.as_dvec3();
+    DVec3::new((-sigma.x * len).exp(), (-sigma.y * len).exp(), (-sigma.z * len).exp())
+}

@@ -149,15 +149,22 @@ pub(super) fn object_table(scene: &Scene, plan: &Plan) -> Vec<GpuObject> {
     let mut objects: Vec<GpuObject> = scene
         .meshes
         .iter()
-        .map(|m| GpuObject {
-            material: m.material as u32,
-            envmap_layer: -1,
-            refractor_layer: -1,
-            map_shading: MAP_SHADING_SKY,
-            reference_point: [0.0; 4],
-            map_centre: [0.0; 4],
-            proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
-            proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
+        .map(|m| {
+            let b = m.bounds();
+            let centre = b.center();
+            let radius = m.positions.iter().map(|p| p.distance(centre)).fold(0.0f32, f32::max);
+            GpuObject {
+                material: m.material as u32,
+                envmap_layer: -1,
+                refractor_layer: -1,
+                map_shading: MAP_SHADING_SKY,
+                reference_point: [0.0; 4],
+                map_centre: [0.0; 4],
+                proxy_min: plan.proxy_box.0.extend(0.0).to_array(),
+                proxy_max: plan.proxy_box.1.extend(0.0).to_array(),
+                bounds_min: b.min.extend(radius).to_array(),
+                bounds_max: b.max.extend(0.0).to_array(),
+            }
         })
         .collect();
     for o in &plan.objects {

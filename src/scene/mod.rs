@@ -64,6 +64,11 @@ pub struct Material {
     /// (F0 colour and the strength at every angle); (1,1,1) and 1 without it.
     pub specular_color: Vec3,
     pub specular_factor: f32,
+    /// KHR_materials_volume: absorption coefficient σ per RGB channel [1/m] of a solid
+    /// dielectric's inside (Beer–Lambert: a path of length d inside keeps exp(−σd) of its
+    /// radiance); zero without absorption, ignored on other surfaces. From glTF's
+    /// attenuation colour c and distance d: σ = −ln c / d ([`Material::absorption_from`]).
+    pub absorption: Vec3,
 }
 
 impl Default for Material {
@@ -77,7 +82,31 @@ impl Default for Material {
             kind: SurfaceKind::Diffuse,
             specular_color: Vec3::ONE,
             specular_factor: 1.0,
+            absorption: Vec3::ZERO,
         }
+    }
+}
+
+impl Material {
+    /// σ = −ln c / d of KHR_materials_volume's `attenuationColor` c and `attenuationDistance`
+    /// d (the distance at which light of colour 1 is left with c): zero for d = ∞ (glTF's
+    /// default) or c = 1; a channel of c = 0 absorbs as c = 10⁻³⁰ does (σ ≈ 69/d), so that
+    /// σ stays finite. `None` for d ≤ 0, NaN, or c outside 0..=1.
+    pub fn absorption_from(color: Vec3, distance: f32) -> Option<Vec3> {
+        if distance.is_nan() || distance <= 0.0 || !color.is_finite() || color.min_element() < 0.0 || color.max_element() > 1.0 {
+            return None;
+        }
+        if distance.is_infinite() {
+            return Some(Vec3::ZERO);
+        }
+        let sigma = |c: f32| (-(c.max(1e-30) as f64).ln() / distance as f64).max(0.0) as f32;
+        let s = Vec3::new(sigma(color.x), sigma(color.y), sigma(color.z));
+        s.is_finite().then_some(s)
+    }
+
+    /// Whether light inside the surface's volume is absorbed: a solid dielectric with σ > 0.
+    pub fn absorbs(&self) -> bool {
+        matches!(self.kind, SurfaceKind::Dielectric { thin: false, .. }) && self.absorption.max_element() > 0.0
     }
 }
 
@@ -525,6 +554,9 @@ impl Material {
         }
         if !(0.0..=1.0).contains(&self.specular_factor) {
             return Err(Error::invalid(what("specular_factor"), format!("must be in 0..=1, got {}", self.specular_factor)));
+        }
+        if !non_negative(self.absorption) {
+            return Err(Error::invalid(what("absorption"), format!("σ must be finite and ≥ 0 per channel [1/m], got {}", self.absorption)));
         }
         match self.kind {
             SurfaceKind::Dielectric { ior, .. } if !(ior > 0.0 && ior.is_finite()) => {

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
+#include <stddef.h>
 
 #include "specula.h"
 
@@ -98,6 +99,26 @@ int main(int argc, char **argv) {
     expect("message names emission and the value", strstr(specula_context_last_error(ctx), "emission") && strstr(specula_context_last_error(ctx), "-1") ? 0 : -1, 0,
            specula_context_last_error(ctx));
     glass.emission[2] = 0.0f;
+    /* KHR_materials_volume's absorption: the colour in 0..1, the distance > 0 (0: none). */
+    glass.attenuation_color[1] = 1.5f;
+    glass.attenuation_distance = 2.0f;
+    CASE("material: attenuation colour above 1", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names attenuation_color and the value", strstr(specula_context_last_error(ctx), "attenuation_color") && strstr(specula_context_last_error(ctx), "1.5") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    glass.attenuation_color[1] = 0.5f;
+    glass.attenuation_distance = -1.0f;
+    CASE("material: negative attenuation distance", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.attenuation_distance = NAN;
+    CASE("material: NaN attenuation distance", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.attenuation_distance = 0.0f;
+    /* A host built against the first release's header (no volume fields) still adds glass. */
+    glass.size = (uint32_t)offsetof(SpeculaMaterialDesc, attenuation_color);
+    glass.attenuation_distance = -1.0f; /* beyond its size: never read */
+    CASE("material of the first release's size", specula_context_add_material(ctx, &glass, NULL), SPECULA_SUCCESS);
+    glass.size = (uint32_t)offsetof(SpeculaMaterialDesc, attenuation_color) - 4;
+    CASE("material shorter than the first release", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_STRUCT_MISMATCH);
+    glass.size = sizeof glass;
+    glass.attenuation_distance = 0.0f;
     uint32_t mat = 99;
     CASE("material: valid", specula_context_add_material(ctx, &glass, &mat), SPECULA_SUCCESS);
     float pos[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};

@@ -9,7 +9,9 @@ The conventions mapping, written down once (the Rust side writes the JSON in the
   Mitsuba's perspective sensor with fov_axis "y" and a look-at transform.
 - meshes: OBJ files in world space with per-vertex normals; `bsdf` one of
   diffuse {reflectance}, conductor {eta, k} (per channel, the glTF/specula ν, κ),
-  dielectric {ior} (solid, from air), thindielectric {ior}, black (emitters: reflectance 0);
+  dielectric {ior} (solid, from air; an optional `sigma_a` per channel [1/m] fills it with
+  a purely absorbing homogeneous medium: KHR_materials_volume's Beer–Lambert, rendered with
+  the volumetric path tracer), thindielectric {ior}, black (emitters: reflectance 0);
   an optional `radiance` makes the mesh an area emitter (specula's emission is radiance).
   An optional `radiance_texture` (a PNG of sRGB bytes, the glTF emissive texture with
   factor 1) makes the radiance a bilinear, repeating bitmap; glTF's uv has v = 0 at the
@@ -74,6 +76,12 @@ def main():
     }
     for i, m in enumerate(desc["meshes"]):
         shape = {"type": "obj", "filename": m["obj"], "face_normals": False, "bsdf": bsdf(m["bsdf"])}
+        if "sigma_a" in m["bsdf"]:
+            # Mitsuba takes colours in 0..1: σ as a colour times a scale.
+            sigma = [float(x) for x in m["bsdf"]["sigma_a"]]
+            scale = max(max(sigma), 1e-30)
+            shape["interior"] = {"type": "homogeneous", "sigma_t": rgb([x / scale for x in sigma]), "scale": scale, "albedo": rgb([0.0, 0.0, 0.0])}
+            scene["integrator"]["type"] = "volpath"
         if "radiance_texture" in m:
             shape["emitter"] = {"type": "area", "radiance": {"type": "bitmap", "filename": m["radiance_texture"], "filter_type": "bilinear", "wrap_mode": "repeat"}}
         elif "radiance" in m:

@@ -41,6 +41,7 @@ void main() {
         vec3 n2 = textureLod(backface_map, uv2, 0.0).xyz;
         n2 = dot(n2, n2) > 0.0 ? normalize(n2) : -n1;
         if (dot(n2, s.t) < 0.0) n2 = -n2;  // outward, along the leaving ray
+        s.ft *= volume_transmittance(m, d);  // absorbed on the way through
         vec3 t2;
         float ior = m.nu.x;
         if (refract_dir(s.t, -n2, ior, t2)) {

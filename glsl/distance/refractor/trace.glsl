@@ -1,7 +1,8 @@
 // Self refraction with a refractor map (survey §4.4): the refracted ray is searched inside
 // the object's own refractor map, refracted out with Snell's law, or reflected internally
 // on total internal reflection, up to `internal_bounces` times; each ray that leaves
-// searches the environment's distance map. Fresnel weights every interface. Used by the
+// searches the environment's distance map. Fresnel weights every interface, absorption
+// (KHR_materials_volume) every segment inside. Used by the
 // camera pass (refractor.search) and, for inter-object cycles, by distance-map generation.
 #ifndef REFRACTOR_TRACE_GLSL
 #define REFRACTOR_TRACE_GLSL
@@ -49,6 +50,7 @@ vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 
             weight = vec3(0.0);
             break;
         }
+        weight *= volume_transmittance(m, length(hit - pos));  // absorbed on the way there
         float cos_i = dot(dir, n2);
         vec3 out_dir;
         // Leaving the object: ν_i/ν_t = ior, the normal faces the inside (−n2).

@@ -451,6 +451,21 @@ impl Importer<'_> {
             Some(s) => (s.specular_factor(), Vec3::from(s.specular_color_factor())),
             None => (1.0, Vec3::ONE),
         };
+        // KHR_materials_volume's attenuation (world-space distance): absorption inside
+        // solid dielectrics; the schema check above has refused colours outside 0..=1 and
+        // distances ≤ 0.
+        let absorption = match material.volume() {
+            Some(v) if matches!(kind, SurfaceKind::Dielectric { thin: false, .. }) => {
+                let (c, d) = (Vec3::from(v.attenuation_color()), v.attenuation_distance());
+                Material::absorption_from(c, d).ok_or_else(|| {
+                    self.err(
+                        format!("{field}.extensions.KHR_materials_volume"),
+                        format!("attenuationColor {c} and attenuationDistance {d}: the colour must be in 0..=1 and the distance > 0"),
+                    )
+                })?
+            }
+            _ => Vec3::ZERO,
+        };
         let m = Material {
             name: material.name().map(str::to_string).unwrap_or_else(|| format!("material{i}")),
             base_color,
@@ -460,6 +475,7 @@ impl Importer<'_> {
             kind,
             specular_color,
             specular_factor,
+            absorption,
         };
         let file = self.file;
         self.scene.add_material(m).map_err(|e| {
@@ -470,6 +486,7 @@ impl Importer<'_> {
                 Some("emission") => format!("{field}.emissiveFactor"),
                 Some("specular_color") => format!("{field}.extensions.KHR_materials_specular.specularColorFactor"),
                 Some("specular_factor") => format!("{field}.extensions.KHR_materials_specular.specularFactor"),
+                Some("absorption") => format!("{field}.extensions.KHR_materials_volume"),
                 _ => field.clone(),
             })
         })
