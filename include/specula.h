@@ -213,6 +213,9 @@ typedef struct {
   float attenuation_color[3];
   // Solid dielectric: that distance [m] (> 0); 0: no absorption (glTF's infinity).
   float attenuation_distance;
+  // Solid dielectric (KHR_materials_dispersion): 20 / Abbe number (≥ 0); 0: none. Also
+  // added after the first release (zero for a caller whose `size` ends before it).
+  float dispersion;
 } SpeculaMaterialDesc;
 
 // A triangle mesh. Arrays are read during the call only (the library copies them).
@@ -621,7 +624,7 @@ SpeculaResult specula_context_set_object_visible(SpeculaContext *ctx,
                                                  uint32_t object,
                                                  uint32_t visible);
 
-// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption; its
+// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption, dispersion; its
 // textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 // again). Validated like specula_context_add_material; the GPU need not be idle.
 SpeculaResult specula_context_set_material(SpeculaContext *ctx,

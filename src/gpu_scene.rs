@@ -52,7 +52,10 @@ pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
     let (kind, nu, kappa, thin) = match m.kind {
         SurfaceKind::Diffuse => (KIND_DIFFUSE, [1.0; 3], [0.0; 3], 0),
         SurfaceKind::Mirror { nu, kappa } => (KIND_MIRROR, nu.to_array(), kappa.to_array(), 0),
-        SurfaceKind::Dielectric { ior, thin } => (KIND_DIELECTRIC, [ior; 3], [0.0; 3], thin as u32),
+        // ν per channel: the ior, or each channel's under KHR_materials_dispersion.
+        SurfaceKind::Dielectric { ior, thin } => {
+            (KIND_DIELECTRIC, m.channel_iors().unwrap_or(glam::Vec3::splat(ior)).to_array(), [0.0; 3], thin as u32)
+        }
     };
     let v4 = |a: [f32; 3]| [a[0], a[1], a[2], 0.0];
     GpuMaterial {

@@ -113,6 +113,7 @@ unsafe fn build_scene(ctx: *mut SpeculaContext) {
             thin: 0,
             attenuation_color: [0.0; 3],
             attenuation_distance: 0.0,
+            dispersion: 0.0,
         };
         let mut i = 0;
         ok(specula_context_add_material(ctx, &m, &mut i), ctx);

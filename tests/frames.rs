@@ -470,6 +470,7 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
             thin: 0,
             attenuation_color: [0.0; 3],
             attenuation_distance: 0.0,
+            dispersion: 0.0,
         };
         let glass_material = scene
             .meshes

@@ -422,7 +422,8 @@ fn materials_are_classified_with_their_extensions() {
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.33 } } },
         { "name": "solid_glass", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.7 },
-                          "KHR_materials_volume": { "thicknessFactor": 0.5, "attenuationColor": [0.5, 0.25, 0.0], "attenuationDistance": 2.0 } } },
+                          "KHR_materials_volume": { "thicknessFactor": 0.5, "attenuationColor": [0.5, 0.25, 0.0], "attenuationDistance": 2.0 },
+                          "KHR_materials_dispersion": { "dispersion": 0.5 } } },
         { "name": "zero_thickness", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
           "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 },
                           "KHR_materials_volume": { "thicknessFactor": 0.0, "attenuationColor": [0.5, 0.5, 0.5], "attenuationDistance": 1.0 } } },
@@ -442,6 +443,7 @@ fn materials_are_classified_with_their_extensions() {
         "KHR_materials_transmission",
         "KHR_materials_ior",
         "KHR_materials_volume",
+        "KHR_materials_dispersion",
         "KHR_materials_specular"
     ]);
     let s = load_doc("materials", &doc);
@@ -467,6 +469,14 @@ fn materials_are_classified_with_their_extensions() {
     assert!(material(&s, "solid_glass").absorbs());
     assert_eq!(material(&s, "zero_thickness").absorption, Vec3::ZERO);
     assert_eq!(material(&s, "thin_glass").absorption, Vec3::ZERO);
+    // KHR_materials_dispersion 0.5: Abbe number 40; ior is the d line's, the channels refract
+    // at the C and F lines: n_F − n_C = (n_d − 1)/V (the Abbe number's definition).
+    let glass = material(&s, "solid_glass");
+    assert_eq!(glass.dispersion, 0.5);
+    assert!(glass.disperses());
+    let n = glass.channel_iors().unwrap();
+    assert!((n.y - 1.7).abs() < 1e-3 && ((n.z - n.x) - 0.7 / 40.0).abs() < 1e-4, "{n}");
+    assert_eq!(material(&s, "thin_glass").channel_iors(), Some(Vec3::splat(1.33)));
 
     let SurfaceKind::Mirror { nu, kappa } = material(&s, "grey_mirror").kind else { panic!("grey_mirror is not a mirror") };
     let root = 0.5f32.sqrt();

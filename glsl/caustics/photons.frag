@@ -25,6 +25,30 @@
 // (mirrors reflect, dielectrics transmit, or reflect totally) up to EXACT_BOUNCES, to the
 // first diffuse hit.
 #include "distance/refractor/trace.glsl"
+
+// KHR_materials_dispersion: a photon refracts as one channel, the same all along its
+// path: chosen by its texel at the first dispersive surface it enters ((x + y) mod 3, so
+// that each channel has a third of the photons), its power ×3 in that channel and 0 in
+// the others. -1 until then. The splats resolve the channels' separate caustics; caustic
+// triangles, spanned by neighbouring texels, average them.
+int photon_channel = -1;
+
+// The direction the photon of weight w refracts along at a surface of material m (split
+// s), and its index there for the way out.
+vec3 photon_refraction(Material m, SpecularSplit s, inout vec3 w) {
+    if (!material_disperses(m)) return s.t;
+    if (photon_channel < 0) {
+        photon_channel = int((uint(gl_FragCoord.x) + uint(gl_FragCoord.y)) % 3u);
+        vec3 mask = vec3(0.0);
+        mask[photon_channel] = 3.0;
+        w *= mask;
+    }
+    return s.tc[photon_channel];
+}
+
+float photon_ior(Material m) {
+    return photon_channel >= 0 && material_disperses(m) ? m.nu[photon_channel] : material_ior(m);
+}
 #ifdef EXACT_PATHS
 #include "raytrace/ray_query.glsl"
 
@@ -100,8 +124,8 @@ void main() {
     } else {
         // Refracted in; branch k ≥ 2 reflects k − 1 times inside, then every branch leaves.
         if (all(lessThanEqual(s.ft, vec3(0.0)))) return;
-        dir = s.t;
         w = s.ft;
+        dir = photon_refraction(m, s, w);
         uint reflections = branch == 0u ? 0u : branch - 1u;
         for (uint k = 0u; k <= reflections; ++k) {
             RayHit h = rq_trace(pos, dir, offset, RQ_T_MAX, skip, false);
@@ -118,8 +142,8 @@ void main() {
                 w *= s2.fr;
             } else {
                 if (all(lessThanEqual(s2.ft, vec3(0.0)))) return;  // totally reflected: another branch's
-                dir = s2.t;
                 w *= s2.ft;
+                dir = photon_refraction(m2, s2, w);
             }
         }
     }
@@ -140,9 +164,9 @@ void main() {
             return;
         }
         SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
-        if (m2.kind != KIND_MIRROR && any(greaterThan(s2.ft, vec3(0.0)))) {
-            dir = s2.t;
+        if (m2.kind != KIND_MIRROR && any(greaterThan(s2.ft * w, vec3(0.0)))) {
             w *= s2.ft;
+            dir = photon_refraction(m2, s2, w);
         } else {
             dir = s2.r;
             w *= s2.fr;
@@ -164,8 +188,8 @@ void main() {
         // a partial reflection is not followed (the stronger branch, 1 − F, is).
         if (all(lessThanEqual(s.ft, vec3(0.0)))) return;
         w = s.ft;
-        dir = s.t;
-        float ior = m.nu.x;
+        dir = photon_refraction(m, s, w);
+        float ior = photon_ior(m);
         bool out_of_it = false;
         for (uint bounce = 0u; bounce <= push_internal_bounces(); ++bounce) {
             vec3 hit, n2;

@@ -7,10 +7,24 @@
 
 struct SpecularSplit {
     vec3 r;    // reflected direction
-    vec3 t;    // refracted direction (valid when any(ft > 0))
+    vec3 t;    // refracted direction (valid when any(ft > 0)): the d line's (green) under dispersion
     vec3 fr;   // weight of the reflected radiance
     vec3 ft;   // weight of the refracted radiance
+    // Under dispersion (material_disperses): each channel's refracted direction, its
+    // weights fr[k], ft[k] with its own index (total internal reflection per channel); a
+    // method that follows each channel's ray reads tc[k] (refracted_channels below), one
+    // that follows one ray takes t for all three. Without it, all three are t.
+    vec3 tc[3];
 };
+
+// The index of refraction of a dielectric: glTF's `ior` (the d line's under dispersion).
+float material_ior(Material m) { return m.nu.y; }
+
+// KHR_materials_dispersion: a solid dielectric whose channels refract with their own
+// indices (Material.nu holds one per channel, src/scene/mod.rs Material::channel_iors).
+bool material_disperses(Material m) {
+    return m.kind == KIND_DIELECTRIC && m.thin == 0u && (m.nu.x != m.nu.y || m.nu.z != m.nu.y);
+}
 
 SpecularSplit specular_split(Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s;
@@ -21,15 +35,35 @@ SpecularSplit specular_split(Material m, vec3 p, vec3 n, vec3 eye) {
     s.r = reflect_dir(i, n);
     s.t = i;
     s.ft = vec3(0.0);
+    s.tc[0] = i;
+    s.tc[1] = i;
+    s.tc[2] = i;
     if (m.kind == KIND_MIRROR) {
         s.fr = material_fresnel(m, cos_i, 1.0);
         return s;
     }
-    float ior = m.nu.x;
+    float ior = material_ior(m);
     if (m.thin != 0u) {
         // Thin-walled: the two interfaces are parallel, the ray leaves undeviated.
         s.fr = material_fresnel(m, cos_i, ior);
         s.ft = 1.0 - s.fr;
+        return s;
+    }
+    if (material_disperses(m)) {
+        bool any_t = false;
+        for (int k = 0; k < 3; ++k) {
+            float eta = entering ? m.nu[k] : 1.0 / m.nu[k];  // ν_t / ν_i
+            vec3 t;
+            if (refract_dir(i, n, 1.0 / eta, t)) {
+                s.tc[k] = t;
+                s.fr[k] = material_fresnel(m, cos_i, eta)[k];
+                s.ft[k] = 1.0 - s.fr[k];
+                if (!any_t || k == 1) s.t = t;
+                any_t = true;
+            } else {
+                s.fr[k] = 1.0;  // total internal reflection in this channel
+            }
+        }
         return s;
     }
     float eta = entering ? ior : 1.0 / ior;  // ν_t / ν_i
@@ -37,10 +71,34 @@ SpecularSplit specular_split(Material m, vec3 p, vec3 n, vec3 eye) {
         s.fr = vec3(1.0);  // total internal reflection
         return s;
     }
+    s.tc[0] = s.t;
+    s.tc[1] = s.t;
+    s.tc[2] = s.t;
     s.fr = material_fresnel(m, cos_i, eta);
     s.ft = 1.0 - s.fr;
     return s;
 }
+
+// The refracted branch's radiance for a method that looks radiance up along a direction:
+// `result` = s.ft · LOOKUP, where LOOKUP is an expression of `dir` (the direction looked
+// along); under dispersion one lookup per channel along its own direction, each keeping its
+// channel. Nothing where nothing is refracted.
+#define REFRACTED_RADIANCE(result, m, s, LOOKUP)                           \
+    {                                                                      \
+        result = vec3(0.0);                                                \
+        if (!material_disperses(m)) {                                      \
+            if (any(greaterThan(s.ft, vec3(0.0)))) {                       \
+                vec3 dir = s.t;                                            \
+                result = s.ft * (LOOKUP);                                  \
+            }                                                              \
+        } else {                                                           \
+            for (int k_ = 0; k_ < 3; ++k_) {                               \
+                if (s.ft[k_] <= 0.0) continue;                             \
+                vec3 dir = s.tc[k_];                                       \
+                result[k_] = s.ft[k_] * (LOOKUP)[k_];                      \
+            }                                                              \
+        }                                                                  \
+    }
 
 // Absorption inside solid dielectrics (KHR_materials_volume, Beer–Lambert): what is left
 // of radiance after a path of length len inside material m (σ is zero elsewhere).

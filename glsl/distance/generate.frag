@@ -30,7 +30,9 @@ void main() {
             c = refractor_radiance(o, m, in_position, n, eye);
         } else {
             c = s.fr * (inter ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
-            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * (inter ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
+            vec3 refracted;
+            REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, n, dir) * (inter ? traced_radiance(o, in_position, dir) : sky_radiance(dir)));
+            c += refracted;
         }
     }
     out_radiance_distance = vec4(c, length(in_position - eye));

@@ -36,6 +36,8 @@ void main() {
     // The test knob debug_fault=flip_reflection: a deliberately broken reflection.
     if ((push.flags & FLAG_DEBUG_FLIP_REFLECTION) != 0u) s.r = -s.r;
     vec3 c = s.fr * RADIANCE(o, in_position, s.r);
-    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, normalize(in_normal), s.t) * RADIANCE(o, in_position, s.t);
+    vec3 refracted;
+    REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, normalize(in_normal), dir) * RADIANCE(o, in_position, dir));
+    c += refracted;
     out_color = vec4(c, 1.0);
 }

@@ -40,6 +40,9 @@ void main() {
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
     float layer = float(o.envmap_layer);
     vec3 c = s.fr * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.r), layer), 0.0).rgb;
-    if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, normalize(in_normal), s.t) * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.t), layer), 0.0).rgb;
+    vec3 refracted;
+    REFRACTED_RADIANCE(refracted, m, s,
+                       chord_transmittance(o, m, in_position, normalize(in_normal), dir) * textureLod(envmaps, vec4(proxy_direction(o, in_position, dir), layer), 0.0).rgb);
+    c += refracted;
     out_color = vec4(c, 1.0);
 }

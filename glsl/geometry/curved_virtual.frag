@@ -40,7 +40,9 @@ void main() {
             c = refractor_radiance(o, m, in_position, n, eye);
         } else {
             c = s.fr * (own ? traced_radiance(o, in_position, s.r) : sky_radiance(s.r));
-            if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * (own ? traced_radiance(o, in_position, s.t) : sky_radiance(s.t));
+            vec3 refracted;
+            REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, n, dir) * (own ? traced_radiance(o, in_position, dir) : sky_radiance(dir)));
+            c += refracted;
         }
     }
     out_color = vec4(c, 1.0);

@@ -84,16 +84,27 @@ void layered_push(vec3 p, vec3 dir, vec3 n, vec3 w, uint left) {
     layered_top++;
 }
 
-// The children of a specular surface hit with weight w: both Fresnel branches while the
-// stack has room for both (and layered_branches=both), else the stronger one carrying the
-// weight of both.
-void layered_branch(SpecularSplit s, vec3 p, vec3 n, vec3 w, uint left) {
+// The children of a specular surface hit (material m) with weight w: both Fresnel branches
+// while the stack has room for both (and layered_branches=both), else the stronger one
+// carrying the weight of both. Under dispersion the refracted branch is one per channel
+// (each carrying its channel; a ray that carries one channel makes one), where the stack
+// has room for them; the stronger-branch mode refracts all three along the d line's.
+void layered_branch(Material m, SpecularSplit s, vec3 p, vec3 n, vec3 w, uint left) {
     bool refracts = any(greaterThan(s.ft, vec3(0.0)));
-    bool both = (push.flags & FLAG_LAYERED_STRONGEST) == 0u && layered_top + 2 <= int(LAYERED_STACK);
+    bool disperses = material_disperses(m);
+    bool both = (push.flags & FLAG_LAYERED_STRONGEST) == 0u && layered_top + (disperses ? 4 : 2) <= int(LAYERED_STACK);
     if (!refracts) {
         layered_push(p, s.r, n, w * s.fr, left);
     } else if (both) {
-        layered_push(p, s.t, n, w * s.ft, left);
+        if (disperses) {
+            for (int k = 0; k < 3; ++k) {
+                vec3 mask = vec3(0.0);
+                mask[k] = 1.0;
+                layered_push(p, s.tc[k], n, w * s.ft * mask, left);
+            }
+        } else {
+            layered_push(p, s.t, n, w * s.ft, left);
+        }
         layered_push(p, s.r, n, w * s.fr, left);
     } else {
         bool t = dot(s.ft, vec3(1.0)) > dot(s.fr, vec3(1.0));
@@ -105,7 +116,7 @@ void layered_branch(SpecularSplit s, vec3 p, vec3 n, vec3 w, uint left) {
 // object whose map's reference point is `centre`, with `left` more specular bounces.
 vec3 layered_radiance(vec3 centre, Material m, vec3 p, vec3 n, vec3 eye, uint left) {
     layered_top = 0;
-    layered_branch(specular_split(m, p, n, eye), p, n, vec3(1.0), left);
+    layered_branch(m, specular_split(m, p, n, eye), p, n, vec3(1.0), left);
     vec3 c = vec3(0.0);
     while (layered_top > 0) {
         layered_top--;
@@ -126,7 +137,7 @@ vec3 layered_radiance(vec3 centre, Material m, vec3 p, vec3 n, vec3 eye, uint le
         vec3 q = r.origin + r.dir * h.d;
         vec3 hn = normalize(surface.xyz);
         vec3 w = r.weight * segment_transmittance(hm, hn, r.dir, h.d * length(r.dir));  // absorbed inside a solid
-        layered_branch(specular_split(hm, q, hn, q - r.dir), q, hn, w, r.left - 1u);
+        layered_branch(hm, specular_split(hm, q, hn, q - r.dir), q, hn, w, r.left - 1u);
     }
     return c;
 }

@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // Spawning (survey §2.3.1): a specular hit with bounces left splits the ray into its
 // reflected and refracted children, each weighted by its Fresnel factor (survey eq. 1;
-// total internal reflection gives the reflected child weight 1), as the CPU reference's
-// recursion does; children below MIN_PATH_WEIGHT in every channel are not followed.
+// total internal reflection gives the reflected child weight 1; under dispersion a refracted
+// child per channel), as the CPU reference's recursion does; children below MIN_PATH_WEIGHT in every channel are not followed.
 //
 // The next queue holds at most trace.capacity rays (the ray_budget knob): the kernel runs
 // in the budget's three modes (push.object, raytrace/trace.glsl), so that a full queue keeps
@@ -33,5 +33,15 @@ void main() {
     // A ray that ran inside an absorbing solid to this hit (Beer–Lambert over its length).
     vec3 w = pl.weight.rgb * segment_transmittance(m, s.n, d, h.t * length(queries[i].direction.xyz));
     child(s.p, normalize(sp.r), h.triangle, w * sp.fr, pl.pixel);
-    child(s.p, normalize(sp.t), h.triangle, w * sp.ft, pl.pixel);
+    if (!material_disperses(m)) {
+        child(s.p, normalize(sp.t), h.triangle, w * sp.ft, pl.pixel);
+    } else {
+        // KHR_materials_dispersion: a child per channel along its own refraction, carrying
+        // that channel alone (a ray that carries one channel spawns one).
+        for (int k = 0; k < 3; ++k) {
+            vec3 mask = vec3(0.0);
+            mask[k] = 1.0;
+            child(s.p, normalize(sp.tc[k]), h.triangle, w * sp.ft * mask, pl.pixel);
+        }
+    }
 }

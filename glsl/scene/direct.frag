@@ -22,7 +22,9 @@ void main() {
     } else {
         SpecularSplit s = specular_split(m, in_position, n, eye);
         c = s.fr * sky_radiance(s.r);
-        if (any(greaterThan(s.ft, vec3(0.0)))) c += s.ft * chord_transmittance(o, m, in_position, n, s.t) * sky_radiance(s.t);
+        vec3 refracted;
+        REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, n, dir) * sky_radiance(dir));
+        c += refracted;
     }
     out_color = vec4(c, 1.0);
 }

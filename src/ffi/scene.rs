@@ -71,7 +71,15 @@ pub(super) fn material_from_desc(d: &SpeculaMaterialDesc, name: String) -> FfiRe
             }
         }
     };
-    Ok(Material { name, base_color: vec3(d.base_color), emissive: vec3(d.emission), kind, absorption, ..Default::default() })
+    Ok(Material {
+        name,
+        base_color: vec3(d.base_color),
+        emissive: vec3(d.emission),
+        kind,
+        absorption,
+        dispersion: d.dispersion,
+        ..Default::default()
+    })
 }
 
 /// The light a descriptor describes (validated by the scene's setters).

@@ -207,6 +207,9 @@ pub struct SpeculaMaterialDesc {
     pub attenuation_color: [f32; 3],
     /// Solid dielectric: that distance [m] (> 0); 0: no absorption (glTF's infinity).
     pub attenuation_distance: f32,
+    /// Solid dielectric (KHR_materials_dispersion): 20 / Abbe number (≥ 0); 0: none. Also
+    /// added after the first release (zero for a caller whose `size` ends before it).
+    pub dispersion: f32,
 }
 
 /// `sizeof(SpeculaMaterialDesc)` as first released (up to `thin`): still accepted.

@@ -82,7 +82,7 @@ pub unsafe extern "C" fn specula_context_set_object_visible(ctx: *mut SpeculaCon
     })
 }
 
-/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption; its
+/// Replaces material `index`'s parameters (base colour, emission, ν and κ, ior, absorption, dispersion; its
 /// textures and KHR_materials_specular colour and factor stay). Its surface kind must stay (a mirror stays a mirror: a new kind needs a new plan, configure
 /// again). Validated like specula_context_add_material; the GPU need not be idle.
 #[no_mangle]
@@ -98,8 +98,8 @@ pub unsafe extern "C" fn specula_context_set_material(
         let d = material_from_desc(&d, old.name.clone())?;
         // What the descriptor does not carry (textures, KHR_materials_specular; the
         // absorption from a descriptor of the first release's size) stays.
-        let absorption = if volume { d.absorption } else { old.absorption };
-        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, absorption, ..old };
+        let (absorption, dispersion) = if volume { (d.absorption, d.dispersion) } else { (old.absorption, old.dispersion) };
+        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, absorption, dispersion, ..old };
         apply(c, |s| &mut s.materials[i], |s| s.set_material(i, m))
     })
 }

@@ -32,7 +32,8 @@ gpu_structs! {
         base_color: vec4,
         /// rgb emitted radiance
         emissive: vec4,
-        /// mirror: ν per rgb; dielectric: x = ior
+        /// mirror: ν per rgb; dielectric: the ior per rgb (all three the same but under
+        /// KHR_materials_dispersion; y is glTF's `ior`, the d line's)
         nu: vec4,
         /// mirror: κ per rgb
         kappa: vec4,

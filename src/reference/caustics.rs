@@ -259,8 +259,22 @@ impl Tracer<'_> {
             }
             let p = pr / (pr + pt);
             let u = hash(i, bounces, seed) as f64 / 4_294_967_296.0;
-            let (dir, f, p) = if u < p { (split.r, split.fr, p) } else { (split.t, split.ft, 1.0 - p) };
+            let reflected = u < p;
+            let (mut dir, f, p) = if reflected { (split.r, split.fr, p) } else { (split.t, split.ft, 1.0 - p) };
             power *= f / p;
+            if !reflected && m.disperses() {
+                // KHR_materials_dispersion: the photon refracts as one channel, the one it
+                // carries alone, else one chosen uniformly (its power ×3 in that channel).
+                let carried: Vec<usize> = (0..3).filter(|&k| power[k] > 0.0).collect();
+                let k = if carried.len() == 1 {
+                    carried[0]
+                } else {
+                    let k = (hash(i ^ 0x9e37_79b9, bounces, seed) % 3) as usize;
+                    power = DVec3::from_array(std::array::from_fn(|j| if j == k { 3.0 * power[k] } else { 0.0 }));
+                    k
+                };
+                dir = split.tc[k];
+            }
             d = dir.normalize();
             bounces += 1;
             hit = self.bvh.intersect(s.position, d, self.epsilon, f64::INFINITY, Some(hit.triangle))?;

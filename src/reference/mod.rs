@@ -210,8 +210,15 @@ impl<'a> Tracer<'a> {
         // Absorbed on the way here when the ray ran inside a solid (KHR_materials_volume).
         let absorbed = shade::segment_transmittance(m, surface.normal, d, hit.t);
         let split = shade::specular_split(m, self.fresnel, d, surface.normal);
+        // Under dispersion a refracted branch per channel, carrying that channel alone.
+        let mask = |k: usize| DVec3::from_array(std::array::from_fn(|j| (j == k) as u32 as f64));
+        let refracted: [(DVec3, DVec3); 3] = if m.disperses() {
+            std::array::from_fn(|k| (split.tc[k], split.ft * absorbed * mask(k)))
+        } else {
+            [(split.t, split.ft * absorbed), (split.t, DVec3::ZERO), (split.t, DVec3::ZERO)]
+        };
         let mut c = DVec3::ZERO;
-        for (dir, f) in [(split.r, split.fr * absorbed), (split.t, split.ft * absorbed)] {
+        for (dir, f) in std::iter::once((split.r, split.fr * absorbed)).chain(refracted) {
             let w = weight * f;
             if w.max_element() >= MIN_PATH_WEIGHT {
                 c += f * self.trace(surface.position, dir.normalize(), self.epsilon, Some(hit.triangle), bounces - 1, w);

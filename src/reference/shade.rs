@@ -193,17 +193,21 @@ pub fn material_fresnel(m: &Material, mode: FresnelMode, cos_i: f64, eta: f64) -
 }
 
 /// `SpecularSplit` of glsl/common/specular.glsl: the reflected and the refracted direction
-/// with their weights (survey eq. 1). `t` is meaningful where `ft` is non-zero.
+/// with their weights (survey eq. 1). `t` is meaningful where `ft` is non-zero; under
+/// dispersion `tc[k]` is channel k's refraction, `fr[k]` and `ft[k]` its weights (`t` the
+/// d line's, green), without it all three are `t`.
 pub struct SpecularSplit {
     pub r: DVec3,
     pub t: DVec3,
     pub fr: DVec3,
     pub ft: DVec3,
+    pub tc: [DVec3; 3],
 }
 
 /// `specular_split(m, p, n, eye)` with i = the (unit) ray direction: entering or leaving
 /// is decided by the side of the shading normal the ray arrives from; thin-walled
-/// dielectrics let the ray pass undeviated, weighted 1 − F.
+/// dielectrics let the ray pass undeviated, weighted 1 − F; dispersive ones refract each
+/// channel with its own index (`Material::channel_iors`, rounded to f32 as the GPU's).
 pub fn specular_split(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3) -> SpecularSplit {
     let mut n = n;
     let mut cos_i = -n.dot(i);
@@ -218,18 +222,36 @@ pub fn specular_split(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3) -> Sp
             let ior = ior as f64;
             if thin {
                 let fr = material_fresnel(m, mode, cos_i, ior);
-                return SpecularSplit { r, t: i, fr, ft: DVec3::ONE - fr };
+                return SpecularSplit { r, t: i, fr, ft: DVec3::ONE - fr, tc: [i; 3] };
+            }
+            if m.disperses() {
+                let iors = m.channel_iors().unwrap_or(glam::Vec3::splat(ior as f32)).as_dvec3();
+                let mut s = SpecularSplit { r, t: i, fr: DVec3::ONE, ft: DVec3::ZERO, tc: [i; 3] };
+                let mut any = false;
+                for k in 0..3 {
+                    let eta = if entering { iors[k] } else { 1.0 / iors[k] };
+                    if let Some(t) = refract_dir(i, n, 1.0 / eta) {
+                        s.tc[k] = t;
+                        s.fr[k] = material_fresnel(m, mode, cos_i, eta)[k];
+                        s.ft[k] = 1.0 - s.fr[k];
+                        if !any || k == 1 {
+                            s.t = t;
+                        }
+                        any = true;
+                    }
+                }
+                return s;
             }
             let eta = if entering { ior } else { 1.0 / ior }; // ν_t / ν_i
             match refract_dir(i, n, 1.0 / eta) {
-                None => SpecularSplit { r, t: i, fr: DVec3::ONE, ft: DVec3::ZERO }, // total internal reflection
+                None => SpecularSplit { r, t: i, fr: DVec3::ONE, ft: DVec3::ZERO, tc: [i; 3] }, // total internal reflection
                 Some(t) => {
                     let fr = material_fresnel(m, mode, cos_i, eta);
-                    SpecularSplit { r, t, fr, ft: DVec3::ONE - fr }
+                    SpecularSplit { r, t, fr, ft: DVec3::ONE - fr, tc: [t; 3] }
                 }
             }
         }
-        _ => SpecularSplit { r, t: i, fr: material_fresnel(m, mode, cos_i, 1.0), ft: DVec3::ZERO },
+        _ => SpecularSplit { r, t: i, fr: material_fresnel(m, mode, cos_i, 1.0), ft: DVec3::ZERO, tc: [i; 3] },
     }
 }
 

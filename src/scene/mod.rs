@@ -69,6 +69,10 @@ pub struct Material {
     /// radiance); zero without absorption, ignored on other surfaces. From glTF's
     /// attenuation colour c and distance d: σ = −ln c / d ([`Material::absorption_from`]).
     pub absorption: Vec3,
+    /// KHR_materials_dispersion: 20 / V (V the Abbe number) of a solid dielectric, whose
+    /// index `ior` is then the d line's and each RGB channel refracts with its own
+    /// ([`Material::channel_iors`]); 0: none.
+    pub dispersion: f32,
 }
 
 impl Default for Material {
@@ -83,6 +87,7 @@ impl Default for Material {
             specular_color: Vec3::ONE,
             specular_factor: 1.0,
             absorption: Vec3::ZERO,
+            dispersion: 0.0,
         }
     }
 }
@@ -102,6 +107,34 @@ impl Material {
         let sigma = |c: f32| (-(c.max(1e-30) as f64).ln() / distance as f64).max(0.0) as f32;
         let s = Vec3::new(sigma(color.x), sigma(color.y), sigma(color.z));
         s.is_finite().then_some(s)
+    }
+
+    /// The wavelengths [nm] the RGB channels refract at under dispersion: Fraunhofer's C, d
+    /// and F lines, the ones the Abbe number V = (n_d − 1)/(n_F − n_C) is defined by.
+    pub const CHANNEL_WAVELENGTHS: [f32; 3] = [656.3, 587.6, 486.1];
+
+    /// The index of refraction per RGB channel: `ior` for each without dispersion; with it,
+    /// KHR_materials_dispersion's n(λ) = max(n + (n − 1)/V · (523655/λ² − 1.5168), 1) at
+    /// [`Material::CHANNEL_WAVELENGTHS`] (below 1 the formula is kept above 0 instead). `None`
+    /// for surfaces that do not refract.
+    pub fn channel_iors(&self) -> Option<Vec3> {
+        let SurfaceKind::Dielectric { ior, thin } = self.kind else { return None };
+        if thin || self.dispersion <= 0.0 {
+            return Some(Vec3::splat(ior));
+        }
+        let v = 20.0 / self.dispersion as f64;
+        let n = ior as f64;
+        let at = |lambda: f32| {
+            let x = n + (n - 1.0) / v * (523655.0 / (lambda as f64 * lambda as f64) - 1.5168);
+            (if n >= 1.0 { x.max(1.0) } else { x.max(1e-3) }) as f32
+        };
+        let [r, g, b] = Self::CHANNEL_WAVELENGTHS;
+        Some(Vec3::new(at(r), at(g), at(b)))
+    }
+
+    /// Whether the channels refract differently: a solid dielectric with dispersion.
+    pub fn disperses(&self) -> bool {
+        matches!(self.kind, SurfaceKind::Dielectric { thin: false, ior } if ior != 1.0) && self.dispersion > 0.0
     }
 
     /// Whether light inside the surface's volume is absorbed: a solid dielectric with σ > 0.
@@ -554,6 +587,9 @@ impl Material {
         }
         if !(0.0..=1.0).contains(&self.specular_factor) {
             return Err(Error::invalid(what("specular_factor"), format!("must be in 0..=1, got {}", self.specular_factor)));
+        }
+        if !(self.dispersion >= 0.0 && self.dispersion.is_finite()) {
+            return Err(Error::invalid(what("dispersion"), format!("must be finite and ≥ 0 (20 / Abbe number), got {}", self.dispersion)));
         }
         if !non_negative(self.absorption) {
             return Err(Error::invalid(what("absorption"), format!("σ must be finite and ≥ 0 per channel [1/m], got {}", self.absorption)));

@@ -111,6 +111,11 @@ int main(int argc, char **argv) {
     glass.attenuation_distance = NAN;
     CASE("material: NaN attenuation distance", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
     glass.attenuation_distance = 0.0f;
+    glass.dispersion = -0.5f;
+    CASE("material: negative dispersion", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names dispersion and the value", strstr(specula_context_last_error(ctx), "dispersion") && strstr(specula_context_last_error(ctx), "-0.5") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    glass.dispersion = 0.0f;
     /* A host built against the first release's header (no volume fields) still adds glass. */
     glass.size = (uint32_t)offsetof(SpeculaMaterialDesc, attenuation_color);
     glass.attenuation_distance = -1.0f; /* beyond its size: never read */

@@ -16,6 +16,35 @@ layout(location = 3) flat in uint in_view;
 layout(location = 4) SAMPLE_INTERP in float in_thickness;
 layout(location = 0) out vec4 out_color;
 
+// The radiance the refracted ray t (weight ft, refracting out with index ior) brings: its
+// second interface found in image space, then out (or, totally reflected, looked up there).
+vec3 through(Object o, Material m, View v, vec3 eye, vec3 p1, vec3 n1, vec3 t, vec3 ft, float ior) {
+    vec3 i = normalize(p1 - eye);
+    if (dot(n1, i) > 0.0) n1 = -n1;
+    float theta_i = acos(clamp(-dot(i, n1), -1.0, 1.0));
+    float theta_t = acos(clamp(-dot(t, n1), -1.0, 1.0));
+    float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / ior;  // Snell's small-angle limit
+    ivec2 size = textureSize(backface_map, 0);
+    vec2 uv = gl_FragCoord.xy / vec2(size);
+    float d_v = max(textureLod(backface_map, uv, 0.0).w - length(p1 - eye), 0.0);
+    float d = ratio * d_v + (1.0 - ratio) * in_thickness;
+    vec3 p2 = p1 + t * d;
+    vec4 clip = v.view_proj * vec4(p2, 1.0);
+    vec2 uv2 = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+    vec3 n2 = textureLod(backface_map, uv2, 0.0).xyz;
+    n2 = dot(n2, n2) > 0.0 ? normalize(n2) : -n1;
+    if (dot(n2, t) < 0.0) n2 = -n2;  // outward, along the leaving ray
+    ft *= volume_transmittance(m, d);  // absorbed on the way through
+    vec3 t2;
+    if (refract_dir(t, -n2, ior, t2)) {
+        vec3 f = material_fresnel(m, dot(t, n2), 1.0 / ior);
+        return ft * (1.0 - f) * traced_radiance(o, p2, t2);
+    }
+    // Total internal reflection: the two-pass method has no third interface; the
+    // internally reflected ray looks the environment up as if it left here.
+    return ft * traced_radiance(o, p2, reflect_dir(t, -n2));
+}
+
 void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
@@ -25,32 +54,14 @@ void main() {
     vec3 n1 = normalize(in_normal);
     SpecularSplit s = specular_split(m, p1, n1, eye);
     vec3 c = s.fr * traced_radiance(o, p1, s.r);
-    if (any(greaterThan(s.ft, vec3(0.0)))) {
-        vec3 i = normalize(p1 - eye);
-        if (dot(n1, i) > 0.0) n1 = -n1;
-        float theta_i = acos(clamp(-dot(i, n1), -1.0, 1.0));
-        float theta_t = acos(clamp(-dot(s.t, n1), -1.0, 1.0));
-        float ratio = theta_i > 1e-4 ? theta_t / theta_i : 1.0 / m.nu.x;  // Snell's small-angle limit
-        ivec2 size = textureSize(backface_map, 0);
-        vec2 uv = gl_FragCoord.xy / vec2(size);
-        float d_v = max(textureLod(backface_map, uv, 0.0).w - length(p1 - eye), 0.0);
-        float d = ratio * d_v + (1.0 - ratio) * in_thickness;
-        vec3 p2 = p1 + s.t * d;
-        vec4 clip = v.view_proj * vec4(p2, 1.0);
-        vec2 uv2 = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
-        vec3 n2 = textureLod(backface_map, uv2, 0.0).xyz;
-        n2 = dot(n2, n2) > 0.0 ? normalize(n2) : -n1;
-        if (dot(n2, s.t) < 0.0) n2 = -n2;  // outward, along the leaving ray
-        s.ft *= volume_transmittance(m, d);  // absorbed on the way through
-        vec3 t2;
-        float ior = m.nu.x;
-        if (refract_dir(s.t, -n2, ior, t2)) {
-            vec3 f = material_fresnel(m, dot(s.t, n2), 1.0 / ior);
-            c += s.ft * (1.0 - f) * traced_radiance(o, p2, t2);
-        } else {
-            // Total internal reflection: the two-pass method has no third interface; the
-            // internally reflected ray looks the environment up as if it left here.
-            c += s.ft * traced_radiance(o, p2, reflect_dir(s.t, -n2));
+    if (!material_disperses(m)) {
+        if (any(greaterThan(s.ft, vec3(0.0)))) c += through(o, m, v, eye, p1, n1, s.t, s.ft, material_ior(m));
+    } else {
+        // KHR_materials_dispersion: each channel along its own refraction.
+        for (int k = 0; k < 3; ++k) {
+            vec3 mask = vec3(0.0);
+            mask[k] = 1.0;
+            if (s.ft[k] > 0.0) c += through(o, m, v, eye, p1, n1, s.tc[k], s.ft * mask, m.nu[k]);
         }
     }
     out_color = vec4(c, 1.0);

@@ -40,9 +40,9 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 // c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
 // ray that runs inside it, times weight: searched in its refractor map to the surface it
 // meets, refracted out there (Fresnel) or reflected on inside, up to internal_bounces times.
-vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c) {
+// `ior`: the index the ray refracts out with (a channel's under dispersion).
+vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c, float ior) {
     vec3 pos = p;
-    float ior = m.nu.x;
     for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
         if (!REFRACTOR_EXIT(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
@@ -66,10 +66,21 @@ vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 
     return c;
 }
 
+vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c) {
+    return refractor_inside_ior(o, m, p, dir, weight, c, material_ior(m));
+}
+
 // Radiance leaving point p of solid refractor o (material m, interpolated normal n)
-// towards eye.
+// towards eye; under dispersion each channel traced inside along its own refraction.
 vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
-    return refractor_inside(o, m, p, s.t, s.ft, s.fr * REFRACTOR_ENV(o, p, s.r));
+    vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
+    if (!material_disperses(m)) return refractor_inside(o, m, p, s.t, s.ft, c);
+    for (int k = 0; k < 3; ++k) {
+        vec3 mask = vec3(0.0);
+        mask[k] = 1.0;
+        if (s.ft[k] > 0.0) c = refractor_inside_ior(o, m, p, s.tc[k], s.ft * mask, c, m.nu[k]);
+    }
+    return c;
 }
 #endif

@@ -28,6 +28,7 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_transmission",
     "KHR_materials_volume",
+    "KHR_materials_dispersion",
     "KHR_materials_specular",
     "KHR_materials_emissive_strength",
     "KHR_texture_transform",
@@ -195,6 +196,9 @@ pub fn check(file: &str, json: &Value) -> Result<()> {
             c.range(v, "attenuationDistance", &p, Some(0.0), None, true)?;
             c.components(v, "attenuationColor", &p, 0.0, Some(1.0))?;
         }
+        if let (Some(d), p) = e("KHR_materials_dispersion") {
+            c.range(d, "dispersion", &p, Some(0.0), None, false)?;
+        }
         if let (Some(s), p) = e("KHR_materials_specular") {
             c.range(s, "specularFactor", &p, Some(0.0), Some(1.0), false)?;
             c.components(s, "specularColorFactor", &p, 0.0, None)?;
@@ -342,6 +346,8 @@ mod tests {
         refused(m(json!({ "extensions": { "KHR_materials_ior": { "ior": 0.5 } } })), &["KHR_materials_ior.ior", "0.5"]);
         refused(m(json!({ "extensions": { "KHR_materials_ior": { "ior": "glass" } } })), &["KHR_materials_ior.ior", "number"]);
         refused(m(json!({ "extensions": { "KHR_materials_specular": { "specularFactor": 3 } } })), &["specularFactor"]);
+        refused(m(json!({ "extensions": { "KHR_materials_dispersion": { "dispersion": -0.1 } } })), &["dispersion", "-0.1"]);
+        ok(m(json!({ "extensions": { "KHR_materials_dispersion": { "dispersion": 0.5 } } })));
         refused(m(json!({ "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": -2 } } })), &["emissiveStrength"]);
     }
 

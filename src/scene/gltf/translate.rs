@@ -466,6 +466,12 @@ impl Importer<'_> {
             }
             _ => Vec3::ZERO,
         };
+        // KHR_materials_dispersion (not in the gltf crate: read from its JSON; the schema
+        // check has refused negative values).
+        let dispersion = match material.extension_value("KHR_materials_dispersion").and_then(|v| v.get("dispersion")) {
+            Some(v) if matches!(kind, SurfaceKind::Dielectric { thin: false, .. }) => v.as_f64().unwrap_or(0.0) as f32,
+            _ => 0.0,
+        };
         let m = Material {
             name: material.name().map(str::to_string).unwrap_or_else(|| format!("material{i}")),
             base_color,
@@ -476,6 +482,7 @@ impl Importer<'_> {
             specular_color,
             specular_factor,
             absorption,
+            dispersion,
         };
         let file = self.file;
         self.scene.add_material(m).map_err(|e| {
@@ -487,6 +494,7 @@ impl Importer<'_> {
                 Some("specular_color") => format!("{field}.extensions.KHR_materials_specular.specularColorFactor"),
                 Some("specular_factor") => format!("{field}.extensions.KHR_materials_specular.specularFactor"),
                 Some("absorption") => format!("{field}.extensions.KHR_materials_volume"),
+                Some("dispersion") => format!("{field}.extensions.KHR_materials_dispersion.dispersion"),
                 _ => field.clone(),
             })
         })
