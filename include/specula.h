@@ -61,6 +61,10 @@
 #define SPECULA_METHOD_KD_TREE 9
 /* grid (§2.3.1) */
 #define SPECULA_METHOD_GRID 8
+/* octree (§2.3.2) */
+#define SPECULA_METHOD_OCTREE 17
+/* bih (§2.3.4) */
+#define SPECULA_METHOD_BIH 18
 /* ray-engine (§2.2) */
 #define SPECULA_METHOD_RAY_ENGINE 10
 /* ray-hierarchy (§2.2.1) */

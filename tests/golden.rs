@@ -31,6 +31,8 @@ fn cases() -> Vec<(String, Method, Vec<&'static str>, u32)> {
         ("distance-multi+latency", specula::methods::DISTANCE_MULTI, &["frame_latency=on"], 2),
         ("refractor-map+bounces0", specula::methods::REFRACTOR_MAP, &["internal_bounces=0"], 1),
         ("envmap+multiview", specula::methods::ENVMAP, &["cube_mode=multiview"], 1),
+        ("kd-tree+ropes", specula::methods::KD_TREE, &["kd_traversal=ropes"], 1),
+        ("octree+volume", specula::methods::OCTREE, &["octree_volume=on"], 1),
     ];
     for (label, m, knobs, frames) in variants {
         v.push((label.to_string(), *m, knobs.to_vec(), *frames));

@@ -13,6 +13,7 @@ mod common;
 use glam::{DVec3, Vec3};
 use specula::frame::layout::{GpuRayHit, GpuRayQuery, RAY_ANY_HIT, RAY_NO_TRIANGLE};
 use specula::methods::raytrace::gpu::Intersector;
+use specula::methods::raytrace::knobs::KdTraversal;
 use specula::methods::raytrace::{Scheme, TriangleList};
 use specula::optics::ray_triangle;
 
@@ -138,8 +139,13 @@ fn schemes() -> Vec<Scheme> {
         Scheme::Grid { density: 2.0, skip_empty: false },
         Scheme::Grid { density: 2.0, skip_empty: true },
         Scheme::Grid { density: 0.25, skip_empty: true },
-        Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: false },
-        Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: true },
+        Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::ShortStack },
+        Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::Restart },
+        Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::Ropes },
+        Scheme::Octree { max_depth: 0, leaf_size: 2, volume: false },
+        Scheme::Octree { max_depth: 3, leaf_size: 4, volume: false },
+        Scheme::Bih { max_depth: 0, leaf_size: 2 },
+        Scheme::Bih { max_depth: 4, leaf_size: 1 },
     ]
 }
 
@@ -286,8 +292,11 @@ fn triangles_beyond_the_loop_budget_are_tested() {
             Scheme::Brute,
             Scheme::Bvh { stackless: false },
             Scheme::Bvh { stackless: true },
-            Scheme::KdTree { max_depth: 0, leaf_size: 2, restart: false },
-            Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, restart: true },
+            Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::ShortStack },
+            Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, traversal: KdTraversal::Restart },
+            Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::Ropes },
+            Scheme::Octree { max_depth: 0, leaf_size: 4, volume: false },
+            Scheme::Bih { max_depth: 0, leaf_size: 4 },
             Scheme::RayQuery,
         ] {
             let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
@@ -300,8 +309,10 @@ fn triangles_beyond_the_loop_budget_are_tested() {
     let mut tris = vec![[Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.1, 0.0, 5.0), Vec3::new(0.0, 0.1, 5.0)]; 100_000];
     tris[99_999] = [Vec3::new(-1.0, -1.0, 4.0), Vec3::new(1.0, -1.0, 4.0), Vec3::new(0.0, 1.0, 4.0)];
     let list = TriangleList::from_soup(tris).unwrap();
-    for scheme in [Scheme::Grid { density: 1e-3, skip_empty: false }, Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, restart: false }]
-    {
+    for scheme in [
+        Scheme::Grid { density: 1e-3, skip_empty: false },
+        Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, traversal: KdTraversal::ShortStack },
+    ] {
         let mut x = Intersector::new(&ctx, scheme, &list, &scheme.build(&list).unwrap()).unwrap();
         let (hits, _) = x.intersect(&ctx, &[query(Vec3::new(0.01, 0.01, 0.0), Vec3::Z, 0.0, f32::INFINITY, RAY_NO_TRIANGLE, 0)]).unwrap();
         x.destroy(&ctx);

@@ -24,7 +24,7 @@ pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
 pub use geometry::{CURVED_REFLECTOR, PLANAR_MIRROR, PLANAR_REFRACTION};
 pub use layered::LAYERED;
 pub use raytrace::ray_query::RAY_QUERY;
-pub use raytrace::{BVH, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY};
+pub use raytrace::{BIH, BVH, GRID, KD_TREE, OCTREE, RAY_ENGINE, RAY_HIERARCHY};
 pub use registry::{map_named, Choice, Method, MethodInfo, ObjectClass, EVERY_CLASS};
 
 use crate::error::{Error, Result};

@@ -11,7 +11,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use crate::error::{Error, Result};
-use crate::methods::{Method, BVH, DISTANCE, DISTANCE_MULTI, GRID, KD_TREE, RAY_ENGINE, RAY_HIERARCHY, RAY_QUERY};
+use crate::methods::{Method, BIH, BVH, DISTANCE, DISTANCE_MULTI, GRID, KD_TREE, OCTREE, RAY_ENGINE, RAY_HIERARCHY, RAY_QUERY};
 use crate::quality::Quality;
 use crate::scene::{shapes, Scene};
 use crate::vk::Context;
@@ -156,7 +156,7 @@ pub struct Config {
 /// Runs the benchmark; prints its tables and returns them as Markdown, writing the plot
 /// (`table1.svg`) and the rows (`table1.csv`) into `out`.
 pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
-    let methods = [BVH, KD_TREE, GRID, RAY_QUERY, RAY_HIERARCHY, RAY_ENGINE];
+    let methods = [BVH, KD_TREE, GRID, OCTREE, BIH, RAY_QUERY, RAY_HIERARCHY, RAY_ENGINE];
     let q = {
         let mut knobs = Quality::default();
         knobs.frame.depth = c.depth;

@@ -32,9 +32,20 @@
 //!
 //! Node 0 is the root; `accel.bounds_min/max` hold its box (the scene's bounds widened by
 //! `slack`, as f32 values), which the traversal clips each ray to.
+//!
+//! **Ropes** (PGSS07, `kd_traversal=ropes`): a leaf's third word is the offset of its 12
+//! auxiliary words: its box (lo xyz, hi xyz as f32 bits) and its six ropes, one per face in
+//! the order −x, +x, −y, +y, −z, +z: the node across that face (`NO_ROPE` outside the
+//! root). Built top-down (a split makes each child the other's rope across the plane) and
+//! pushed down ("optimised ropes"): from a rope's node, into the child that holds all of the
+//! face's region, while one does. The traversal locates the leaf of the ray's entry point
+//! from the root, then, leaf by leaf, follows the rope of the face the ray leaves through and
+//! descends from there to the leaf holding the exit point: no stack, no restart. A rope
+//! always crosses a face in the ray's direction, so the walk cannot return to a leaf.
 
 use glam::DVec3;
 
+use super::knobs::KdTraversal;
 use super::{Packed, TriangleList};
 use crate::error::{Error, Result};
 use crate::frame::layout::GpuAccel;
@@ -45,6 +56,8 @@ use crate::frame::layout::GpuAccel;
 pub const MAX_DEPTH: u32 = 64;
 /// The axis word of a leaf (glsl/raytrace/kdtree.glsl KD_LEAF).
 pub const LEAF: u32 = 3;
+/// A rope out of the root's box (glsl/raytrace/intersect_kdtree_ropes.comp KD_NO_ROPE).
+pub const NO_ROPE: u32 = u32::MAX;
 /// The SAH cost of one traversal step (the unit).
 pub const COST_TRAVERSAL: f64 = 1.0;
 /// The SAH cost of one ray–triangle test: a 48-byte fetch and Möller–Trumbore, against a
@@ -58,8 +71,6 @@ const EXACT_MAX: usize = 1024;
 const BINS: usize = 64;
 /// Nodes with more references build their two subtrees in parallel.
 const PARALLEL_MIN: usize = 4096;
-/// The slack relative to the scene's extent plus its largest coordinate.
-const SLACK: f64 = 1e-5;
 
 /// The usual depth limit 8 + 1.3 log₂ N (PBRT, after Havran), capped at `MAX_DEPTH`.
 pub fn auto_depth(n: usize) -> u32 {
@@ -121,20 +132,10 @@ struct Builder<'a> {
 impl KdTree {
     /// Builds the tree over `list`; `max_depth` 0 means [`auto_depth`].
     pub fn build(list: &TriangleList, max_depth: u32, leaf_size: u32) -> Result<KdTree> {
-        if max_depth > MAX_DEPTH {
-            return Err(Error::invalid(
-                "knob kd_max_depth",
-                format!("{max_depth} exceeds the deepest tree the GPU traversal takes ({MAX_DEPTH}); 0 picks 8 + 1.3 log2 N"),
-            ));
-        }
-        if leaf_size == 0 {
-            return Err(Error::invalid("knob kd_leaf_size", "must be at least 1"));
-        }
+        super::check_tree_knobs(max_depth, MAX_DEPTH, leaf_size, ("kd_max_depth", "kd_leaf_size"), "8 + 1.3 log2 N")?;
         let max_depth = if max_depth == 0 { auto_depth(list.len()) } else { max_depth };
         let triangles: Vec<[DVec3; 3]> = list.triangles.iter().map(|t| t.map(|v| v.as_dvec3())).collect();
-        let (lo, hi) = if list.is_empty() { (glam::Vec3::ZERO, glam::Vec3::ONE) } else { list.bounds() };
-        let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
-        let slack = SLACK * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element()).max(1e-30);
+        let (lo, hi, slack) = list.slack_bounds();
         // The root's box as f32 values (rounding moves it by far less than the slack).
         let f32_box = |v: DVec3| v.as_vec3().as_dvec3();
         let (lo, hi) = (f32_box(lo - DVec3::splat(slack)), f32_box(hi + DVec3::splat(slack)));
@@ -177,6 +178,72 @@ impl KdTree {
             }
         }
         k
+    }
+
+    /// Per node its box, the root's split down the tree.
+    pub fn boxes(&self) -> Vec<(DVec3, DVec3)> {
+        let mut boxes = vec![(self.lo, self.hi); self.nodes.len()];
+        // Pre-order: a parent comes before its children.
+        for k in 0..self.nodes.len() {
+            if let Node::Interior { axis, split, left, right } = self.nodes[k] {
+                let (lo, hi) = boxes[k];
+                let (mut hi_left, mut lo_right) = (hi, lo);
+                hi_left[axis] = split as f64;
+                lo_right[axis] = split as f64;
+                boxes[left as usize] = (lo, hi_left);
+                boxes[right as usize] = (lo_right, hi);
+            }
+        }
+        boxes
+    }
+
+    /// Per leaf (node index) its six ropes, pushed down (see the module documentation).
+    pub fn ropes(&self) -> Vec<(u32, [u32; 6])> {
+        let boxes = self.boxes();
+        let mut out = Vec::new();
+        let mut todo = vec![(0u32, [NO_ROPE; 6])];
+        while let Some((k, ropes)) = todo.pop() {
+            match self.nodes[k as usize] {
+                Node::Interior { axis, left, right, .. } => {
+                    let (mut l, mut r) = (ropes, ropes);
+                    l[2 * axis + 1] = right;
+                    r[2 * axis] = left;
+                    todo.push((right, r));
+                    todo.push((left, l));
+                }
+                Node::Leaf { .. } => {
+                    let (lo, hi) = boxes[k as usize];
+                    let pushed = std::array::from_fn(|f| self.push_down(ropes[f], f, lo, hi));
+                    out.push((k, pushed));
+                }
+            }
+        }
+        out
+    }
+
+    /// From `rope` (across face `face` of the box [lo, hi]) down to the deepest node that
+    /// still holds all of the region across the face.
+    fn push_down(&self, mut rope: u32, face: usize, lo: DVec3, hi: DVec3) -> u32 {
+        let (fa, high) = (face / 2, face % 2 == 1);
+        while rope != NO_ROPE {
+            let Node::Interior { axis, split, left, right } = self.nodes[rope as usize] else { break };
+            let s = split as f64;
+            rope = if axis == fa {
+                // Split parallel to the face: the child next to it holds the region.
+                if high {
+                    left
+                } else {
+                    right
+                }
+            } else if s >= hi[axis] {
+                left
+            } else if s <= lo[axis] {
+                right
+            } else {
+                break; // the face straddles the split
+            };
+        }
+        rope
     }
 
     /// The GPU form (see the module documentation).
@@ -338,7 +405,7 @@ fn binned_split(refs: &[Ref], lo: DVec3, hi: DVec3, slack: f64) -> Option<Split>
 
 /// The bounds of the part of triangle `t` inside the box [lo, hi] (the triangle clipped
 /// to the box's six planes, Sutherland–Hodgman), or None when it misses the box.
-fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3)> {
+pub(super) fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3)> {
     // Each plane adds at most one corner to a convex polygon: at most 3 + 6.
     let mut poly = [DVec3::ZERO; 9];
     let mut next = [DVec3::ZERO; 9];
@@ -373,13 +440,24 @@ fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3)> {
     Some((a.max(lo), b.min(hi)))
 }
 
-pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, restart: bool) -> Result<Packed> {
+pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, traversal: KdTraversal) -> Result<Packed> {
     let tree = KdTree::build(list, max_depth, leaf_size)?;
     let b = |v: DVec3| (v.as_vec3()).extend(0.0).to_array();
+    let mut nodes = tree.words();
+    let mut aux = Vec::new();
+    if traversal == KdTraversal::Ropes {
+        let boxes = tree.boxes();
+        for (leaf, ropes) in tree.ropes() {
+            nodes[leaf as usize][2] = aux.len() as u32;
+            let (lo, hi) = boxes[leaf as usize];
+            aux.extend([lo.x, lo.y, lo.z, hi.x, hi.y, hi.z].map(|v| (v as f32).to_bits()));
+            aux.extend(ropes);
+        }
+    }
     Ok(Packed {
-        nodes: tree.words(),
+        nodes,
         refs: tree.refs.clone(),
-        aux: Vec::new(),
+        aux,
         accel: GpuAccel {
             bounds_min: b(tree.lo),
             bounds_max: b(tree.hi),
@@ -387,7 +465,11 @@ pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, restart: bool) 
             node_count: if list.is_empty() { 0 } else { tree.nodes.len() as u32 },
             ..bytemuck::Zeroable::zeroed()
         },
-        shader: if restart { "raytrace/intersect_kdtree_restart.comp" } else { "raytrace/intersect_kdtree.comp" },
+        shader: match traversal {
+            KdTraversal::ShortStack => "raytrace/intersect_kdtree.comp",
+            KdTraversal::Restart => "raytrace/intersect_kdtree_restart.comp",
+            KdTraversal::Ropes => "raytrace/intersect_kdtree_ropes.comp",
+        },
     })
 }
 
@@ -519,7 +601,7 @@ mod tests {
     #[test]
     fn packing_encodes_nodes_and_bounds() {
         let list = TriangleList::from_soup(soup(200, 11)).unwrap();
-        let p = pack(&list, 0, 2, false).unwrap();
+        let p = pack(&list, 0, 2, KdTraversal::ShortStack).unwrap();
         assert_eq!(p.accel.node_count as usize, p.nodes.len());
         for w in &p.nodes {
             if w[3] == LEAF {
@@ -530,8 +612,41 @@ mod tests {
         }
         let (lo, hi) = list.bounds();
         assert!(Vec3::from_slice(&p.accel.bounds_min[..3]).cmplt(lo).all() && Vec3::from_slice(&p.accel.bounds_max[..3]).cmpgt(hi).all());
-        let empty = pack(&TriangleList::from_soup(vec![]).unwrap(), 0, 2, true).unwrap();
+        let empty = pack(&TriangleList::from_soup(vec![]).unwrap(), 0, 2, KdTraversal::Ropes).unwrap();
         assert_eq!(empty.accel.node_count, 0);
-        assert_eq!(empty.shader, "raytrace/intersect_kdtree_restart.comp");
+        assert_eq!(empty.shader, "raytrace/intersect_kdtree_ropes.comp");
+    }
+
+    /// Every rope leads to a node whose box holds all of the face's region just across the
+    /// face (its centre and corners nudged outwards), pushed down as far as one child does;
+    /// no rope only on the root's boundary.
+    #[test]
+    fn ropes_lead_across_each_face() {
+        let list = TriangleList::from_soup(soup(400, 5)).unwrap();
+        let tree = KdTree::build(&list, 0, 2).unwrap();
+        let boxes = tree.boxes();
+        let inside = |p: DVec3, (lo, hi): (DVec3, DVec3)| p.cmpge(lo).all() && p.cmple(hi).all();
+        let ropes = tree.ropes();
+        assert_eq!(ropes.len(), tree.nodes.iter().filter(|n| matches!(n, Node::Leaf { .. })).count());
+        for (leaf, r) in ropes {
+            let (lo, hi) = boxes[leaf as usize];
+            for f in 0..6 {
+                let (a, high) = (f / 2, f % 2 == 1);
+                let plane = if high { hi[a] } else { lo[a] };
+                let out = if high { 1e-9 } else { -1e-9 };
+                if r[f] == NO_ROPE {
+                    assert_eq!(plane, if high { tree.hi[a] } else { tree.lo[a] }, "leaf {leaf} face {f}: no rope inside the root");
+                    continue;
+                }
+                let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+                for (u, v) in [(0.5, 0.5), (0.0, 0.0), (1.0, 1.0), (0.0, 1.0), (1.0, 0.0)] {
+                    let mut p = DVec3::ZERO;
+                    p[a] = plane + out;
+                    p[b] = lo[b] + u * (hi[b] - lo[b]);
+                    p[c] = lo[c] + v * (hi[c] - lo[c]);
+                    assert!(inside(p, boxes[r[f] as usize]), "leaf {leaf} face {f}: rope {} misses {p}", r[f]);
+                }
+            }
+        }
     }
 }

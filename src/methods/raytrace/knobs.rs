@@ -17,11 +17,34 @@ knobs! {
         kd_max_depth: u32 = 0, count(0..=64, "levels");
         /// kd-tree: nodes of at most this many triangles are not split
         kd_leaf_size: u32 = 4, count(1..=64, "triangles");
-        /// kd-tree: a short stack with push-down (HSHH07), or kd-restart from the root (FS05)
-        kd_restart as kd_traversal: bool = "short-stack", one_of()["short-stack" => false, "restart" => true];
+        /// kd-tree: a short stack with push-down (HSHH07), kd-restart from the root (FS05), or stackless along each leaf's ropes to its neighbours (PGSS07)
+        kd_traversal: KdTraversal = "short-stack", one_of()["short-stack" => KdTraversal::ShortStack, "restart" => KdTraversal::Restart, "ropes" => KdTraversal::Ropes];
+        /// octree (§2.3.2): the deepest level; 0: from the triangle count (cells of about octree_leaf_size triangles on a surface)
+        octree_max_depth: u32 = 0, count(0..=20, "levels");
+        /// octree: cells of at most this many triangles are not halved
+        octree_leaf_size: u32 = 4, count(1..=64, "triangles");
+        /// octree: MGK05's volumetric approximation, one averaged plane per leaf instead of its triangles (approximate)
+        octree_volume: bool = "off", one_of()["off" => false, "on" => true];
+        /// bih (§2.3.4): the deepest level; 0: 2 log₂ N + 8
+        bih_max_depth: u32 = 0, count(0..=48, "levels");
+        /// bih: nodes of at most this many triangles are leaves
+        bih_leaf_size: u32 = 4, count(1..=64, "triangles");
         /// ray-hierarchy (§2.2.1): edge of the ray-texture tiles bounded by one cone each
         tile_size: u32 = "16", one_of("rays")["8" => 8, "16" => 16, "32" => 32];
         /// ray tracing: report rays per bounce, dropped rays and the ray hierarchy's culling rate (an extra pass)
         ray_stats: bool = "off", one_of()["on" => true, "off" => false];
     }
+}
+
+/// How the kd-tree is traversed (survey §2.3.3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum KdTraversal {
+    /// Front to back with a short stack that falls back to restarting from the push-down
+    /// node (HSHH07).
+    ShortStack,
+    /// kd-restart from the root at each leaf's exit (FS05).
+    Restart,
+    /// Stackless: each leaf's six ropes name its neighbours across its faces (PGSS07).
+    Ropes,
 }

@@ -15,8 +15,15 @@
 //!   skipping empty space by each empty cell's Chebyshev distance to the nearest
 //!   non-empty cell (KL04).
 //! - [`Scheme::KdTree`]: an SAH kd-tree over clipped triangle boxes, traversed front to
-//!   back with a short stack that falls back to kd-restart (HSHH07), or by pure kd-restart
-//!   (FS05).
+//!   back with a short stack that falls back to kd-restart (HSHH07), by pure kd-restart
+//!   (FS05), or stackless along ropes, each leaf's links to its neighbours (PGSS07).
+//!
+//! - [`Scheme::Octree`]: cells halved on all three axes (§2.3.2), traversed by MGK05's
+//!   exit point and top-down descent, optionally over one averaged plane per leaf (MGK05's
+//!   volumetric approximation);
+//! - [`Scheme::Bih`]: the bounding interval hierarchy / skd-tree (§2.3.4, WMS06): two
+//!   planes per node, every triangle in one child, built by the global heuristic without a
+//!   sort, traversed with a stack in one pass (SKSS06).
 //!
 //! - [`Scheme::RayQuery`]: Vulkan's ray queries through acceleration structures that the
 //!   driver builds on the GPU (`ray_query`).
@@ -25,11 +32,13 @@
 //! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
 
 pub mod bench;
+pub mod bih;
 pub mod bvh;
 pub mod gpu;
 pub mod grid;
 pub mod kdtree;
 pub mod knobs;
+pub mod octree;
 mod ray_order;
 pub mod ray_query;
 pub mod stage;
@@ -92,6 +101,16 @@ const RAY_KNOBS_KD: &[&str] = &[
 ];
 pub(crate) const RAY_KNOBS_ENGINE: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget];
 const RAY_KNOBS_HIERARCHY: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::tile_size];
+const RAY_KNOBS_OCTREE: &[&str] = &[
+    FrameKnobs::depth,
+    FrameKnobs::fresnel,
+    RaytraceKnobs::ray_budget,
+    RaytraceKnobs::octree_max_depth,
+    RaytraceKnobs::octree_leaf_size,
+    RaytraceKnobs::octree_volume,
+];
+const RAY_KNOBS_BIH: &[&str] =
+    &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::bih_max_depth, RaytraceKnobs::bih_leaf_size];
 const RAY_KNOBS_GRID: &[&str] =
     &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::grid_density, RaytraceKnobs::grid_skip];
 
@@ -99,7 +118,7 @@ const RAY_KNOBS_GRID: &[&str] =
 /// pipeline; no hooks.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "raytrace",
-    methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO, ray_query::RAY_QUERY_INFO],
+    methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, OCTREE_INFO, BIH_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO, ray_query::RAY_QUERY_INFO],
     ..crate::methods::registry::Family::NONE
 };
 
@@ -158,12 +177,12 @@ pub const KD_TREE_INFO: &MethodInfo = &MethodInfo {
     abi: 9,
     section: "§2.3.3",
     family: "raytrace",
-    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through an SAH kd-tree over clipped triangle boxes, traversed with a short stack and push-down (HSHH07) or by kd-restart (FS05)",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through an SAH kd-tree over clipped triangle boxes, traversed with a short stack and push-down (HSHH07), by kd-restart (FS05) or stackless along ropes between neighbouring leaves (PGSS07)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_KD,
     gpu: Some(ray_tracer("raytrace.kd-tree", |init, plan| {
             let q = &init.plan.quality;
-            stage::create(init, plan, Scheme::KdTree { max_depth: q.raytrace.kd_max_depth, leaf_size: q.raytrace.kd_leaf_size, restart: q.raytrace.kd_restart })
+            stage::create(init, plan, Scheme::KdTree { max_depth: q.raytrace.kd_max_depth, leaf_size: q.raytrace.kd_leaf_size, traversal: q.raytrace.kd_traversal })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -188,6 +207,42 @@ pub const GRID_INFO: &MethodInfo = &MethodInfo {
     needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const GRID: Method = Method(GRID_INFO.name);
+
+pub const OCTREE_INFO: &MethodInfo = &MethodInfo {
+    name: "octree",
+    abi: 17,
+    section: "§2.3.2",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through an octree, cells halved on all axes until a few triangles remain, traversed by the exit point and a top-down descent from the root (MGK05); octree_volume=on traces one averaged plane per leaf instead (MGK05's volumetric approximation, approximate)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_OCTREE,
+    gpu: Some(ray_tracer("raytrace.octree", |init, plan| {
+            let q = &init.plan.quality;
+            stage::create(init, plan, Scheme::Octree { max_depth: q.raytrace.octree_max_depth, leaf_size: q.raytrace.octree_leaf_size, volume: q.raytrace.octree_volume })
+        })),
+    fallback: None,
+    shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
+};
+pub const OCTREE: Method = Method(OCTREE_INFO.name);
+
+pub const BIH_INFO: &MethodInfo = &MethodInfo {
+    name: "bih",
+    abi: 18,
+    section: "§2.3.4",
+    family: "raytrace",
+    summary: "exact ray tracing in the original geometry (the `bvh` pipeline) through a bounding interval hierarchy (skd-tree): two planes per node, every triangle in exactly one child, built by WMS06's global heuristic without a sort, traversed with a stack in one pass (SKSS06)",
+    serves: EVERY_CLASS,
+    knobs: RAY_KNOBS_BIH,
+    gpu: Some(ray_tracer("raytrace.bih", |init, plan| {
+            let q = &init.plan.quality;
+            stage::create(init, plan, Scheme::Bih { max_depth: q.raytrace.bih_max_depth, leaf_size: q.raytrace.bih_leaf_size })
+        })),
+    fallback: None,
+    shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
+};
+pub const BIH: Method = Method(BIH_INFO.name);
 
 /// The scene's triangles in world space in scene order (mesh by mesh, index by index):
 /// the ids that every scheme's hits refer to.
@@ -229,6 +284,17 @@ impl TriangleList {
         self.triangles.is_empty()
     }
 
+    /// What the tree builders (kd-tree, octree, bih) start from: the bounds of every corner
+    /// in f64 (a unit box for an empty list) and the slack they list triangles within, 1e-5
+    /// of the extent plus the largest coordinate: far above the f32 rounding of any point
+    /// in the scene, so that a point the GPU attributes to a neighbouring cell still finds
+    /// its triangle.
+    pub(crate) fn slack_bounds(&self) -> (glam::DVec3, glam::DVec3, f64) {
+        let (lo, hi) = if self.is_empty() { (Vec3::ZERO, Vec3::ONE) } else { self.bounds() };
+        let (lo, hi) = (lo.as_dvec3(), hi.as_dvec3());
+        (lo, hi, 1e-5 * ((hi - lo).max_element() + lo.abs().max(hi.abs()).max_element()).max(1e-30))
+    }
+
     /// The world-space bounds (min, max) of every corner.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         self.triangles.iter().flatten().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)))
@@ -253,9 +319,15 @@ pub enum Scheme {
     Grid { density: f32, skip_empty: bool },
     /// SAH kd-tree of at most `max_depth` levels (0: 8 + 1.3 log₂ N, at most
     /// `kdtree::MAX_DEPTH`), nodes of at most `leaf_size` (≥ 1) references left unsplit;
-    /// `restart`: pure kd-restart (FS05) instead of the short stack with restart fallback
-    /// and push-down (HSHH07).
-    KdTree { max_depth: u32, leaf_size: u32, restart: bool },
+    /// traversed by `traversal`: the short stack with restart fallback and push-down
+    /// (HSHH07), pure kd-restart (FS05) or ropes (PGSS07).
+    KdTree { max_depth: u32, leaf_size: u32, traversal: knobs::KdTraversal },
+    /// Octree of at most `max_depth` levels (0: `octree::auto_depth`), cells of at most
+    /// `leaf_size` triangles left whole; `volume`: MGK05's volumetric approximation.
+    Octree { max_depth: u32, leaf_size: u32, volume: bool },
+    /// Bounding interval hierarchy of at most `max_depth` levels (0: `bih::auto_depth`),
+    /// leaves of at most `leaf_size` triangles.
+    Bih { max_depth: u32, leaf_size: u32 },
     /// The ray engine (§2.2, CHH02): the rays as a texture, every triangle rasterised over
     /// it as a quad, Möller–Trumbore in the fragment shader, the z-test keeping the nearest.
     RayEngine,
@@ -279,6 +351,8 @@ impl Scheme {
             Scheme::Bvh { .. } => "raytrace.intersect.bvh",
             Scheme::Grid { .. } => "raytrace.intersect.grid",
             Scheme::KdTree { .. } => "raytrace.intersect.kdtree",
+            Scheme::Octree { .. } => "raytrace.intersect.octree",
+            Scheme::Bih { .. } => "raytrace.intersect.bih",
             Scheme::RayQuery => "raytrace.intersect.ray-query",
         }
     }
@@ -304,9 +378,32 @@ impl Scheme {
             }),
             Scheme::Bvh { stackless } => bvh::pack(list, stackless),
             Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),
-            Scheme::KdTree { max_depth, leaf_size, restart } => kdtree::pack(list, max_depth, leaf_size, restart),
+            Scheme::KdTree { max_depth, leaf_size, traversal } => kdtree::pack(list, max_depth, leaf_size, traversal),
+            Scheme::Octree { max_depth, leaf_size, volume } => octree::pack(list, max_depth, leaf_size, volume),
+            Scheme::Bih { max_depth, leaf_size } => bih::pack(list, max_depth, leaf_size),
         }
     }
+}
+
+/// Checks a tree's depth and leaf-size knobs (named `depth_knob`, `leaf_knob`): the depth
+/// at most `limit` (0 picks `auto`, described by `auto_text`), the leaf size at least 1.
+pub(crate) fn check_tree_knobs(
+    max_depth: u32,
+    limit: u32,
+    leaf_size: u32,
+    (depth_knob, leaf_knob): (&str, &str),
+    auto_text: &str,
+) -> Result<()> {
+    if max_depth > limit {
+        return Err(Error::invalid(
+            format!("knob {depth_knob}"),
+            format!("{max_depth} exceeds the deepest tree the GPU traversal takes ({limit}); 0 picks {auto_text}"),
+        ));
+    }
+    if leaf_size == 0 {
+        return Err(Error::invalid(format!("knob {leaf_knob}"), "must be at least 1"));
+    }
+    Ok(())
 }
 
 /// A scheme in its GPU form (see the module documentation).
