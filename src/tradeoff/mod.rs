@@ -12,7 +12,7 @@ pub mod calibrate;
 pub mod corpus;
 mod csv;
 mod labels;
-mod plot;
+pub(crate) mod plot;
 mod rows;
 mod scatter;
 mod study;

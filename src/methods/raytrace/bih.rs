@@ -12,8 +12,9 @@
 //! shrinks to the other half and the step repeats, making no node (at most `MAX_EMPTY`
 //! times, then the node is a leaf). A node of at most `leaf_size` triangles, or `max_depth`
 //! levels down, is a leaf. Each step is one pass over the node's triangles: O(N log N) in
-//! all, about 0.1–0.3 µs per triangle on this project's 2-core machine for 10⁴–10⁶
-//! triangles (BENCHMARKS.md, Table 1), against the SAH kd-tree's several µs.
+//! all, 0.10–0.19 µs per triangle on this project's 2-core machine for 10⁴–10⁶ triangles,
+//! against the SAH BVH's 0.46–0.74 µs and the SAH kd-tree's 3.9–5.1 µs (BENCHMARKS.md,
+//! Table 1); its traversal pays for it, about 1.9× the BVH's frame at 10⁶ triangles.
 //!
 //! **Robustness.** The planes are widened by a `slack` (the kd-tree's: 1e-5 of the scene's
 //! extent plus its largest coordinate), so that the f32 crossings the GPU computes never cut
