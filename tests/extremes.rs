@@ -114,11 +114,14 @@ fn glass_of_index_almost_one_is_invisible() {
 /// stays the same) must render the same image: nothing in either renderer may depend on
 /// absolute size (ray epsilons, cube-map near planes, shadow biases are all relative).
 /// The demo scene at s = 1e-3 and 1e3, 64², compared with s = 1:
-/// - GPU environment mapping (caustics on, the default): measured PSNR 87.25 dB (1e-3) and
-///   85.07 dB (1e3); asserted ≥ 80 dB (a mean FLIP bound beside it could not fail while
-///   this holds, and was dropped). This test caught an absolute 1e-4 m slack in the
-///   point-light shadow test: at 1 mm it lit a floor pixel in the box's shadow (0.003 →
-///   0.52, 43 dB) once the demo's light moved to the room's middle;
+/// - GPU environment mapping (caustics on, the default): measured PSNR 76.52 dB (1e-3) and
+///   74.40 dB (1e3) since the caustics' photon images are fitted to their generators'
+///   corners (87.25 and 85.07 dB with the bounding cone's images before): which texels at a
+///   generator's silhouette hold a photon turns on f32 rounding, and one caustic triangle
+///   more or less moves a pixel by up to 0.015; asserted ≥ 70 dB (a mean FLIP bound beside
+///   it could not fail while this holds, and was dropped). This test caught an absolute
+///   1e-4 m slack in the point-light shadow test: at 1 mm it lit a floor pixel in the box's
+///   shadow (0.003 → 0.52, 43 dB) once the demo's light moved to the room's middle;
 /// - reference (1 spp): measured RMSE 1.6e-7 and 2.9e-7 (f32 rounding of the scaled
 ///   vertices); asserted ≤ 1e-5 (100 dB, 30 dB under the measured 131 dB).
 #[test]
@@ -134,7 +137,7 @@ fn scaled_scenes_render_the_same_image() {
         let e = errors(&gpu.image, &gpu1.image);
         println!("GPU, scale {s:e}: {e}");
         assert!(all_finite(&gpu.image));
-        assert!(e.psnr >= 80.0, "GPU at scale {s:e}: {e}");
+        assert!(e.psnr >= 70.0, "GPU at scale {s:e}: {e}");
         let cpu = render_reference(&scaled, &q, (64, 64)).unwrap();
         let e = errors(&cpu, &ref1);
         println!("reference, scale {s:e}: {e} (RMSE {:e})", e.rmse);

@@ -323,8 +323,9 @@ pub fn photon_views(p: &CausticsPlan, scene: &Scene, lights: &[GpuLight], q: &Qu
     let mut views = Vec::with_capacity(p.photon_layers as usize);
     for g in &p.generators {
         let (centre, radius) = bounding_sphere(scene, g.mesh);
+        let positions = &scene.meshes[g.mesh].positions;
         for lv in &g.lights {
-            let v = light_views(lv, scene.lights[lv.light].kind, &lights[lv.light], n, near_scale, (centre, radius));
+            let v = light_views(lv, scene.lights[lv.light].kind, &lights[lv.light], n, near_scale, (centre, radius), positions);
             // The reflected branch looks from the same place.
             for _ in 0..lv.branches {
                 views.extend_from_slice(&v);
@@ -334,8 +335,17 @@ pub fn photon_views(p: &CausticsPlan, scene: &Scene, lights: &[GpuLight], q: &Qu
     views
 }
 
-/// The views from which light `lv` sees the sphere (centre, radius): one per face.
-fn light_views(lv: &LightViews, kind: LightKind, l: &GpuLight, n: f32, near_scale: f32, (centre, radius): (Vec3, f32)) -> Vec<GpuView> {
+/// The views from which light `lv` sees the generator (its bounding sphere (centre, radius),
+/// its corners `positions`): one per face.
+fn light_views(
+    lv: &LightViews,
+    kind: LightKind,
+    l: &GpuLight,
+    n: f32,
+    near_scale: f32,
+    (centre, radius): (Vec3, f32),
+    positions: &[Vec3],
+) -> Vec<GpuView> {
     let pos = Vec3::from_slice(&l.position_range[..3]);
     if kind == LightKind::Directional {
         let dir = Vec3::from_slice(&l.direction_kind[..3]).normalize();
@@ -354,15 +364,53 @@ fn light_views(lv: &LightViews, kind: LightKind, l: &GpuLight, n: f32, near_scal
     let to = centre - pos;
     let d = to.length();
     let axis = to / d;
-    // The bounding cone, a little wider so that the silhouette's texels are whole.
-    let half = ((radius / d).min(1.0).asin() * 1.02).min(1.5);
     let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
     let near = ((d - radius) * 0.5).max(near_scale);
-    let mut proj = Mat4::perspective_infinite_reverse_rh(2.0 * half, 1.0, near);
-    proj.y_axis.y = -proj.y_axis.y;
-    let vp = proj * Mat4::look_to_rh(pos, axis, up);
-    let t = half.tan();
-    vec![view(vp, pos.extend(0.0), axis.extend((2.0 * t / n).powi(2)))]
+    let look = Mat4::look_to_rh(pos, axis, up);
+    // The image fitted to the generator's corners as the light sees them (an off-centre
+    // frustum: every photon on the generator, where the bounding sphere's cone spends most
+    // of a flat or long generator's photons beside it), two texels wider on each side so
+    // that the silhouette's texels are whole; the cone where a corner lies near or behind
+    // the light's plane.
+    let (r_x, r_y) = fitted_extent(&look, positions, 1e-3 * d).unwrap_or_else(|| {
+        let t = (((radius / d).min(1.0).asin() * 1.02).min(1.5)).tan();
+        ((-t, t), (-t, t))
+    });
+    let ((l0, r0), (b0, t0)) = (r_x, r_y);
+    let (mx, my) = (2.0 * (r0 - l0) / n, 2.0 * (t0 - b0) / n);
+    let ((l0, r0), (b0, t0)) = ((l0 - mx, r0 + mx), (b0 - my, t0 + my));
+    // Reversed-Z, infinite far plane, as glam's perspective_infinite_reverse_rh but
+    // off-centre; y flipped for Vulkan.
+    let proj = Mat4::from_cols(
+        glam::Vec4::new(2.0 / (r0 - l0), 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, -2.0 / (t0 - b0), 0.0, 0.0),
+        glam::Vec4::new((r0 + l0) / (r0 - l0), -(t0 + b0) / (t0 - b0), 0.0, -1.0),
+        glam::Vec4::new(0.0, 0.0, near, 0.0),
+    );
+    // The texel's area on the image plane at unit distance (photons.frag: its solid angle
+    // times cos³ of its angle to the axis).
+    let texel_area = (r0 - l0) / n * ((t0 - b0) / n);
+    vec![view(proj * look, pos.extend(0.0), axis.extend(texel_area))]
+}
+
+/// The extent (x: left, right; y: bottom, top) on the image plane at unit distance of
+/// `points` seen through `look` (a right-handed view looking down −z), or `None` when one
+/// lies closer to the light's plane than `min_z` (behind it, or beside the light) or the
+/// extent is degenerate or wider than the bounding cone may be (tan 86°).
+fn fitted_extent(look: &Mat4, points: &[Vec3], min_z: f32) -> Option<((f32, f32), (f32, f32))> {
+    let (mut lx, mut hx, mut ly, mut hy) = (f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY, f32::NEG_INFINITY);
+    for p in points {
+        let v = look.transform_point3(*p);
+        let z = -v.z;
+        if !(z >= min_z) {
+            return None;
+        }
+        let (x, y) = (v.x / z, v.y / z);
+        (lx, hx, ly, hy) = (lx.min(x), hx.max(x), ly.min(y), hy.max(y));
+    }
+    let wide = 14.3; // tan 86°
+    let ok = hx > lx && hy > ly && [lx, hx, ly, hy].iter().all(|v| v.abs() < wide);
+    ok.then_some(((lx, hx), (ly, hy)))
 }
 
 /// After objects moved: the generators' reference points follow their objects'.
