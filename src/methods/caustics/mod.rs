@@ -402,7 +402,7 @@ fn fitted_extent(look: &Mat4, points: &[Vec3], min_z: f32) -> Option<((f32, f32)
     for p in points {
         let v = look.transform_point3(*p);
         let z = -v.z;
-        if !(z >= min_z) {
+        if z.is_nan() || z < min_z {
             return None;
         }
         let (x, y) = (v.x / z, v.y / z);
