@@ -142,12 +142,28 @@ impl PhotonMap {
         if n == 0 {
             return Err(Error::invalid("knob reference_photons", "must be at least 1"));
         }
-        let scene_box = tracer.scene.bounds();
-        let diag = scene_box.diagonal() as f64;
+        let radius = Self::radius_for(tracer, quality)?;
+        Self::trace(tracer, n, 0, radius)
+    }
+
+    /// The density estimate's radius under `quality`: `caustic_radius`, auto 0.5 % of the
+    /// scene's bounding-box diagonal.
+    pub(super) fn radius_for(tracer: &Tracer, quality: &Quality) -> Result<f64> {
+        let diag = tracer.scene.bounds().diagonal() as f64;
         let radius = quality.reference.caustic_radius.map_or(0.005 * diag, |r| r as f64);
         if !(radius > 0.0 && radius.is_finite()) {
             return Err(Error::invalid("knob caustic_radius", format!("{radius} m is not a radius > 0")));
         }
+        Ok(radius)
+    }
+
+    /// Pass `pass` of `n` photons per light and generator (the sequence's photons
+    /// `pass·n … (pass + 1)·n − 1`, each carrying 1/n of the light's power into the
+    /// generator's cone), in a grid of cells of `radius`.
+    pub(super) fn trace(tracer: &Tracer, n: u32, pass: u32, radius: f64) -> Result<PhotonMap> {
+        let first = pass.checked_mul(n).ok_or_else(|| Error::invalid("knob ppm_passes", "passes × photons exceed 2³²"))?;
+        let scene_box = tracer.scene.bounds();
+        let diag = scene_box.diagonal() as f64;
         let generators: Vec<(u32, DVec3, f64)> = (tracer.scene.meshes.iter().enumerate())
             .filter(|(_, m)| !m.hidden && tracer.scene.materials[m.material].kind.is_specular())
             .map(|(g, m)| {
@@ -162,7 +178,7 @@ impl PhotonMap {
                 let upstream = (centre - scene_box.center().as_dvec3()).length() + diag + r;
                 let emitter = Emitter::new(light, centre, r, upstream);
                 let seed = hash(l as u32, g, 0xca05_7105);
-                photons.par_extend((0..n).into_par_iter().filter_map(|i| tracer.trace_photon(&emitter, g, i, seed, n)));
+                photons.par_extend((first..first + n).into_par_iter().filter_map(|i| tracer.trace_photon(&emitter, g, i, seed, n)));
             }
         }
         Ok(PhotonMap::new(photons, radius))
@@ -195,24 +211,33 @@ impl PhotonMap {
     pub fn irradiance(&self, x: DVec3, n: DVec3) -> DVec3 {
         let (r, r2) = (self.radius, self.radius * self.radius);
         let norm = 2.0 / (PI * r2);
-        let k = cell_of(x, r);
-        let mut e = DVec3::ZERO;
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let key = [k[0].saturating_add(dx), k[1].saturating_add(dy), k[2].saturating_add(dz)];
-                    let Some(&(a, b)) = self.cells.get(&key) else { continue };
-                    for p in &self.photons[a..b] {
-                        let v = p.position - x;
-                        let d2 = v.length_squared();
-                        if d2 < r2 && n.dot(p.normal) > 0.5 && v.dot(n).abs() < 0.5 * r {
-                            e += p.power * (norm * (1.0 - d2 / r2));
-                        }
-                    }
-                }
-            }
-        }
-        e
+        self.around(x, n, r).map(|(p, d2)| p.power * (norm * (1.0 - d2 / r2))).sum()
+    }
+
+    /// The photons within `r` (at most the grid's cell) of `x` that the kernel's tests
+    /// accept (same side, normal within 60°, within half the radius of the plane), with
+    /// their squared distances.
+    fn around(&self, x: DVec3, n: DVec3, r: f64) -> impl Iterator<Item = (&Photon, f64)> + '_ {
+        let r = r.min(self.radius);
+        let k = cell_of(x, self.radius);
+        (-1..=1)
+            .flat_map(move |dz| {
+                (-1..=1)
+                    .flat_map(move |dy| (-1..=1).map(move |dx| [k[0].saturating_add(dx), k[1].saturating_add(dy), k[2].saturating_add(dz)]))
+            })
+            .filter_map(|key| self.cells.get(&key))
+            .flat_map(|&(a, b)| &self.photons[a..b])
+            .filter_map(move |p| {
+                let v = p.position - x;
+                let d2 = v.length_squared();
+                (d2 < r * r && n.dot(p.normal) > 0.5 && v.dot(n).abs() < 0.5 * r).then_some((p, d2))
+            })
+    }
+
+    /// The photons [`around`](Self::around) `x` within `r`: their number and their summed
+    /// power (progressive photon mapping's gather, `ppm.rs`).
+    pub(super) fn within(&self, x: DVec3, n: DVec3, r: f64) -> (usize, DVec3) {
+        self.around(x, n, r).fold((0, DVec3::ZERO), |(c, f), (p, _)| (c + 1, f + p.power))
     }
 }
 

@@ -12,5 +12,19 @@ knobs! {
         /// CPU reference: radius of the caustics' density estimate on the receivers (Epanechnikov kernel); auto: 0.5 % of the
         /// scene's bounding-box diagonal
         caustic_radius: Option<f32> = auto, auto_metres();
+        /// CPU reference: the caustics' density estimate: one photon map with the fixed caustic_radius kernel, or progressive photon mapping (Hachisuka et al. 2008: reference_photons split into ppm_passes passes, each camera hit point's radius shrinking from caustic_radius as photons arrive, α 0.7), which converges to the sharp caustic
+        caustic_estimate: CausticEstimate = "kernel", one_of()["kernel" => CausticEstimate::Kernel, "progressive" => CausticEstimate::Progressive];
+        /// CPU reference, caustic_estimate=progressive: photon passes (each of reference_photons / ppm_passes photons per light and generator)
+        ppm_passes: u32 = 16, count(1..=4096, "passes");
     }
+}
+
+/// How the reference estimates caustic irradiance (issue 34).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CausticEstimate {
+    /// One photon map, a fixed Epanechnikov kernel of `caustic_radius`: biased (blurred).
+    Kernel,
+    /// Progressive photon mapping: consistent, the error falls as photons grow.
+    Progressive,
 }

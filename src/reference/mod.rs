@@ -24,6 +24,7 @@
 pub mod bvh;
 pub mod caustics;
 pub mod knobs;
+pub mod ppm;
 pub mod shade;
 
 use glam::{DVec2, DVec3};
@@ -51,7 +52,16 @@ pub const REFERENCE_INFO: &crate::methods::registry::MethodInfo = &crate::method
     family: "reference",
     summary: "the exact CPU reference (f64, SAH BVH, Möller–Trumbore): Whitted recursion through both the reflected and the refracted branch weighted by Fresnel, up to `depth` bounces, the GPU's non-specular shading with exact shadow rays, `spp` stratified samples per pixel, both cores (rayon). Ground truth for the tests and `specula tradeoff`",
     serves: crate::methods::registry::EVERY_CLASS,
-    knobs: &[FrameKnobs::depth, ReferenceKnobs::spp, FrameKnobs::fresnel, CausticsKnobs::caustics, ReferenceKnobs::reference_photons, ReferenceKnobs::caustic_radius],
+    knobs: &[
+        FrameKnobs::depth,
+        ReferenceKnobs::spp,
+        FrameKnobs::fresnel,
+        CausticsKnobs::caustics,
+        ReferenceKnobs::reference_photons,
+        ReferenceKnobs::caustic_radius,
+        ReferenceKnobs::caustic_estimate,
+        ReferenceKnobs::ppm_passes,
+    ],
     gpu: None,
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -74,8 +84,12 @@ pub struct Tracer<'a> {
     /// Secondary and shadow rays start this far from the surface they leave (and skip its
     /// triangle): a fixed fraction of the scene's size, so scaling the scene scales it.
     epsilon: f64,
-    /// The caustic photons, built only when `Quality::caustics` is not off.
+    /// The caustic photons, built only when `Quality::caustics` is not off (and the
+    /// estimate is the fixed kernel's).
     caustics: Option<PhotonMap>,
+    /// `caustic_estimate=progressive` with caustics on: `render_reference` gathers them by
+    /// progressive photon mapping at the camera paths' diffuse hits (`ppm`).
+    progressive: bool,
     /// `shadows=off`: no shadow rays (every light reaches what faces it).
     shadows: bool,
 }
@@ -167,10 +181,15 @@ impl<'a> Tracer<'a> {
             depth: quality.frame.depth,
             epsilon: diag.max(f64::MIN_POSITIVE) * 1e-9,
             caustics: None,
+            progressive: false,
             shadows: quality.frame.shadows,
         };
         if quality.caustics.caustics != Caustics::Off {
-            tracer.caustics = Some(PhotonMap::build(&tracer, quality)?);
+            if quality.reference.caustic_estimate == knobs::CausticEstimate::Progressive {
+                tracer.progressive = true;
+            } else {
+                tracer.caustics = Some(PhotonMap::build(&tracer, quality)?);
+            }
         }
         Ok(tracer)
     }
@@ -189,10 +208,13 @@ impl<'a> Tracer<'a> {
     /// Radiance arriving at `o` from direction `-d` (d a unit vector): what the ray
     /// o + t d, t > t_min, sees, with `bounces` specular bounces left.
     pub fn radiance(&self, o: DVec3, d: DVec3, t_min: f64, bounces: u32) -> DVec3 {
-        self.trace(o, d, t_min, None, bounces, DVec3::ONE)
+        self.trace(Ray { o, d, t_min, skip: None }, bounces, DVec3::ONE, None)
     }
 
-    fn trace(&self, o: DVec3, d: DVec3, t_min: f64, skip: Option<u32>, bounces: u32, weight: DVec3) -> DVec3 {
+    /// `radiance`, recording the path's diffuse hits in `sink` for progressive photon
+    /// mapping instead of adding a photon map's estimate there.
+    fn trace(&self, ray: Ray, bounces: u32, weight: DVec3, mut sink: Option<&mut HitSink>) -> DVec3 {
+        let Ray { o, d, t_min, skip } = ray;
         if !d.is_finite() || !o.is_finite() {
             return DVec3::ZERO; // never a NaN colour
         }
@@ -202,7 +224,7 @@ impl<'a> Tracer<'a> {
         let surface = self.surface(&hit);
         let m = &self.scene.materials[surface.material];
         if m.kind == SurfaceKind::Diffuse {
-            return self.shade_diffuse(&surface, hit.triangle, d);
+            return self.shade_diffuse(&surface, hit.triangle, d, weight, sink);
         }
         if bounces == 0 {
             return DVec3::ZERO;
@@ -221,7 +243,8 @@ impl<'a> Tracer<'a> {
         for (dir, f) in std::iter::once((split.r, split.fr * absorbed)).chain(refracted) {
             let w = weight * f;
             if w.max_element() >= MIN_PATH_WEIGHT {
-                c += f * self.trace(surface.position, dir.normalize(), self.epsilon, Some(hit.triangle), bounces - 1, w);
+                let next = Ray { o: surface.position, d: dir.normalize(), t_min: self.epsilon, skip: Some(hit.triangle) };
+                c += f * self.trace(next, bounces - 1, w, sink.as_deref_mut());
             }
         }
         c
@@ -249,7 +272,7 @@ impl<'a> Tracer<'a> {
     /// `shade_diffuse` of glsl/common/shading.glsl, seen along `d`: emission +
     /// albedo/π Σ E cos θ · visibility, visibility by an exact shadow ray, plus the caustic
     /// irradiance when caustics are on.
-    fn shade_diffuse(&self, s: &Surface, triangle: u32, d: DVec3) -> DVec3 {
+    fn shade_diffuse(&self, s: &Surface, triangle: u32, d: DVec3, weight: DVec3, sink: Option<&mut HitSink>) -> DVec3 {
         let m = &self.scene.materials[s.material];
         let albedo = shade::base_color(m, &self.textures, s.uv);
         let n = if s.normal.dot(-d) < 0.0 { -s.normal } else { s.normal }; // two-sided
@@ -268,8 +291,31 @@ impl<'a> Tracer<'a> {
         if let Some(map) = &self.caustics {
             sum += map.irradiance(s.position, n);
         }
+        if let Some(sink) = sink {
+            let w = weight * albedo / std::f64::consts::PI * sink.scale;
+            if w.max_element() > 0.0 {
+                sink.points.push(ppm::HitPoint::new(sink.pixel, s.position, n, w));
+            }
+        }
         shade::emission(m, &self.textures, s.uv) + albedo / std::f64::consts::PI * sum
     }
+}
+
+/// A ray o + t d, t > t_min, that does not hit triangle `skip` (the one it leaves).
+#[derive(Clone, Copy)]
+struct Ray {
+    o: DVec3,
+    d: DVec3,
+    t_min: f64,
+    skip: Option<u32>,
+}
+
+/// Where a camera sample's diffuse hits go (progressive photon mapping): its pixel and the
+/// sample's share of it.
+struct HitSink<'a> {
+    points: &'a mut Vec<ppm::HitPoint>,
+    pixel: u32,
+    scale: f64,
 }
 
 struct Surface {
@@ -295,20 +341,36 @@ pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32,
     let tracer = Tracer::new(scene, quality)?;
     let rays = CameraRays::new(&camera, width, height);
     let mut data = vec![0f32; (width * height * 4) as usize];
-    data.par_chunks_mut(width as usize * 4).enumerate().for_each(|(y, row)| {
+    // Progressive photon mapping: each row's camera paths record their diffuse hits.
+    let mut rows: Vec<Vec<ppm::HitPoint>> = (0..height).map(|_| Vec::new()).collect();
+    data.par_chunks_mut(width as usize * 4).zip(rows.par_iter_mut()).enumerate().for_each(|(y, (row, points))| {
         let y = y as u32;
         for x in 0..width {
             let mut c = DVec3::ZERO;
             for s in 0..spp {
                 let (jx, jy) = sample_offset(x, y, s, spp);
                 let (o, d, t_min) = rays.ray(x as f64 + jx, y as f64 + jy);
-                c += tracer.radiance(o, d, t_min, tracer.depth);
+                let mut sink = HitSink { points: &mut *points, pixel: y * width + x, scale: 1.0 / spp as f64 };
+                let sink = tracer.progressive.then_some(&mut sink);
+                c += tracer.trace(Ray { o, d, t_min, skip: None }, tracer.depth, DVec3::ONE, sink);
             }
             c /= spp as f64;
             let px = &mut row[4 * x as usize..4 * x as usize + 4];
             px.copy_from_slice(&[c.x as f32, c.y as f32, c.z as f32, 1.0]);
         }
     });
+    if tracer.progressive {
+        let mut points: Vec<ppm::HitPoint> = rows.into_iter().flatten().collect();
+        ppm::gather(&tracer, quality, &mut points)?;
+        let passes = quality.reference.ppm_passes.max(1);
+        for p in &points {
+            let c = p.weight * p.irradiance(passes);
+            let px = &mut data[4 * p.pixel as usize..4 * p.pixel as usize + 3];
+            for k in 0..3 {
+                px[k] += c[k] as f32;
+            }
+        }
+    }
     Ok(ImageData { width, height, layers: 1, channels: 4, data })
 }
 
