@@ -54,6 +54,22 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     })
 }
 
+/// DejaVu Sans (assets/fonts/, Bitstream Vera licence): every figure's text, in the PNGs
+/// rasterised by ab_glyph, so no system font is needed.
+static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+
+/// Registers the bundled font as plotters' `sans-serif` (once): every figure the library
+/// writes (tradeoff plots, raytrace-bench's Table 1) draws its text in it.
+pub fn register_font() -> Result<()> {
+    static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    let ok = *DONE.get_or_init(|| plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT).is_ok());
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::Image("the bundled font assets/fonts/DejaVuSans.ttf does not parse".into()))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -12,7 +12,7 @@ pub mod calibrate;
 pub mod corpus;
 mod csv;
 mod labels;
-pub(crate) mod plot;
+mod plot;
 mod rows;
 mod scatter;
 mod study;

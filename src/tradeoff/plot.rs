@@ -16,20 +16,8 @@ pub struct Figure {
     pub png: PathBuf,
 }
 
-/// DejaVu Sans (assets/fonts/, Bitstream Vera licence): every figure's text, in the PNGs
-/// rasterised by ab_glyph, so no system font is needed.
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
-
-/// Registers the bundled font as plotters' `sans-serif` (once).
-pub(crate) fn register_font() -> Result<()> {
-    static DONE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    let ok = *DONE.get_or_init(|| plotters::style::register_font("sans-serif", plotters::style::FontStyle::Normal, FONT).is_ok());
-    if ok {
-        Ok(())
-    } else {
-        Err(Error::Image("the bundled font assets/fonts/DejaVuSans.ttf does not parse".into()))
-    }
-}
+/// The bundled font as plotters' `sans-serif` (`output::register_font`).
+pub(super) use crate::output::register_font;
 
 /// Renders `draw` into an RGB bitmap of `size` through plotters' bitmap backend and writes
 /// it as a PNG; `base` is the bitmap before drawing (white where `None`).

@@ -341,7 +341,7 @@ fn write_table1(rows: &[Row], c: &Config, out: &Path) -> Result<()> {
     }
     crate::output::write_file(&out.join("table1.csv"), csv.as_bytes())?;
     let mut svg = String::new();
-    crate::tradeoff::plot::register_font()?;
+    crate::output::register_font()?;
     plot(&mut svg, rows, c).map_err(|e| Error::invalid("table1.svg", e))?;
     crate::output::write_file(&out.join("table1.svg"), svg.as_bytes())
 }
