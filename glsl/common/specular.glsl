@@ -20,6 +20,11 @@ struct SpecularSplit {
 // The index of refraction of a dielectric: glTF's `ior` (the d line's under dispersion).
 float material_ior(Material m) { return m.nu.y; }
 
+// Channel k alone (1 there, 0 in the others): the weight mask of a dispersed ray.
+vec3 channel_mask(int k) {
+    return vec3(equal(ivec3(0, 1, 2), ivec3(k)));
+}
+
 // KHR_materials_dispersion: a solid dielectric whose channels refract with their own
 // indices (Material.nu holds one per channel, src/scene/mod.rs Material::channel_iors).
 bool material_disperses(Material m) {

@@ -98,9 +98,7 @@ void layered_branch(Material m, SpecularSplit s, vec3 p, vec3 n, vec3 w, uint le
     } else if (both) {
         if (disperses) {
             for (int k = 0; k < 3; ++k) {
-                vec3 mask = vec3(0.0);
-                mask[k] = 1.0;
-                layered_push(p, s.tc[k], n, w * s.ft * mask, left);
+                layered_push(p, s.tc[k], n, w * s.ft * channel_mask(k), left);
             }
         } else {
             layered_push(p, s.t, n, w * s.ft, left);

@@ -22,17 +22,6 @@ uint bih_stack_node[BIH_MAX_DEPTH];
 float bih_stack_t0[BIH_MAX_DEPTH];
 float bih_stack_t1[BIH_MAX_DEPTH];
 
-// Tests leaf w's triangles, four per iteration; true when an any-hit query may stop.
-bool bih_leaf(uvec4 w, RayQuery q, inout RayHit best) {
-    bool any_hit = (q.flags & RAY_ANY_HIT) != 0u;
-    uint end = w.x + w.y;
-#define BIH_TEST(j) \
-    if (i + j < end && test_triangle(accel_refs[i + j], q, best) && any_hit) return true;
-    for (uint i = w.x; i < end; i += 4u) {
-        BIH_TEST(0u) BIH_TEST(1u) BIH_TEST(2u) BIH_TEST(3u)
-    }
-    return false;
-}
 
 RayHit intersect_bih(RayQuery q) {
     RayHit best = no_hit(q);
@@ -85,7 +74,7 @@ RayHit intersect_bih(RayQuery q) {
                 pop = true;
             }
         } else {
-            if (bih_leaf(w, q, best)) return best;
+            if (test_leaf(w.x, w.y, q, best)) return best;
             pop = true;
         }
         if (pop) {

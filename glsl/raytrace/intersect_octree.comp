@@ -56,18 +56,6 @@ bool oct_volume(uvec4 w, RayQuery q, float t0, float t1, inout RayHit best) {
     best = RayHit(t, uv.x, uv.y, tri);
     return true;
 }
-#else
-// Tests leaf w's triangles, four per iteration; true when an any-hit query may stop.
-bool oct_leaf(uvec4 w, RayQuery q, inout RayHit best) {
-    bool any_hit = (q.flags & RAY_ANY_HIT) != 0u;
-    uint end = w.x + w.y;
-#define OCT_TEST(j) \
-    if (i + j < end && test_triangle(accel_refs[i + j], q, best) && any_hit) return true;
-    for (uint i = w.x; i < end; i += 4u) {
-        OCT_TEST(0u) OCT_TEST(1u) OCT_TEST(2u) OCT_TEST(3u)
-    }
-    return false;
-}
 #endif
 
 RayHit intersect_octree(RayQuery q) {
@@ -110,7 +98,7 @@ RayHit intersect_octree(RayQuery q) {
         oct_volume(w, q, t, t_exit, best);
         if ((q.flags & RAY_ANY_HIT) != 0u && best.triangle != RAY_NO_TRIANGLE) return best;
 #else
-        if (oct_leaf(w, q, best)) return best;
+        if (test_leaf(w.x, w.y, q, best)) return best;
 #endif
         if (best.t <= t_exit * 1.0000004) return best;
         if (t_exit >= t_end) return best;

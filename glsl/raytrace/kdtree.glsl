@@ -31,17 +31,9 @@ const uint KD_MAX_DEPTH = 64u;   // src/methods/raytrace/kdtree.rs MAX_DEPTH
 // descents of the deepest tree (KD_MAX_DEPTH nodes each).
 const uint KD_STEPS = 32768u;
 
-// Tests leaf w's triangles, four per iteration (lavapipe's loop budget: a leaf may list
-// many triangles that no plane separates); true when an any-hit query may stop.
+// Tests leaf w's triangles (rays.glsl test_leaf).
 bool kd_leaf(uvec4 w, RayQuery q, inout RayHit best) {
-    bool any_hit = (q.flags & RAY_ANY_HIT) != 0u;
-    uint end = w.x + w.y;
-#define KD_TEST(j) \
-    if (i + j < end && test_triangle(accel_refs[i + j], q, best) && any_hit) return true;
-    for (uint i = w.x; i < end; i += 4u) {
-        KD_TEST(0u) KD_TEST(1u) KD_TEST(2u) KD_TEST(3u)
-    }
-    return false;
+    return test_leaf(w.x, w.y, q, best);
 }
 
 #if KD_SHORT_STACK > 0

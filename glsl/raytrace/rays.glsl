@@ -44,6 +44,20 @@ bool test_triangle(uint id, RayQuery q, inout RayHit best) {
     return true;
 }
 
+// Tests the triangles refs[first..first + count] (a tree's leaf), four per iteration
+// (lavapipe's loop budget: a leaf may list many triangles that no plane separates); true
+// when an any-hit query may stop.
+bool test_leaf(uint first, uint count, RayQuery q, inout RayHit best) {
+    bool any_hit = (q.flags & RAY_ANY_HIT) != 0u;
+    uint end = first + count;
+#define LEAF_TEST(j) \
+    if (i + j < end && test_triangle(accel_refs[i + j], q, best) && any_hit) return true;
+    for (uint i = first; i < end; i += 4u) {
+        LEAF_TEST(0u) LEAF_TEST(1u) LEAF_TEST(2u) LEAF_TEST(3u)
+    }
+    return false;
+}
+
 // 1 / d with zero components replaced by ±1e-30 (so that slab products never form 0 · ∞).
 vec3 safe_inverse(vec3 d) {
     vec3 s = mix(vec3(1.0), vec3(-1.0), lessThan(d, vec3(0.0)));

@@ -39,9 +39,7 @@ void main() {
         // KHR_materials_dispersion: a child per channel along its own refraction, carrying
         // that channel alone (a ray that carries one channel spawns one).
         for (int k = 0; k < 3; ++k) {
-            vec3 mask = vec3(0.0);
-            mask[k] = 1.0;
-            child(s.p, normalize(sp.tc[k]), h.triangle, w * sp.ft * mask, pl.pixel);
+            child(s.p, normalize(sp.tc[k]), h.triangle, w * sp.ft * channel_mask(k), pl.pixel);
         }
     }
 }

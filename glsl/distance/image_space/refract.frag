@@ -59,9 +59,7 @@ void main() {
     } else {
         // KHR_materials_dispersion: each channel along its own refraction.
         for (int k = 0; k < 3; ++k) {
-            vec3 mask = vec3(0.0);
-            mask[k] = 1.0;
-            if (s.ft[k] > 0.0) c += through(o, m, v, eye, p1, n1, s.tc[k], s.ft * mask, m.nu[k]);
+            if (s.ft[k] > 0.0) c += through(o, m, v, eye, p1, n1, s.tc[k], s.ft * channel_mask(k), m.nu[k]);
         }
     }
     out_color = vec4(c, 1.0);

@@ -77,9 +77,7 @@ vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
     if (!material_disperses(m)) return refractor_inside(o, m, p, s.t, s.ft, c);
     for (int k = 0; k < 3; ++k) {
-        vec3 mask = vec3(0.0);
-        mask[k] = 1.0;
-        if (s.ft[k] > 0.0) c = refractor_inside_ior(o, m, p, s.tc[k], s.ft * mask, c, m.nu[k]);
+        if (s.ft[k] > 0.0) c = refractor_inside_ior(o, m, p, s.tc[k], s.ft * channel_mask(k), c, m.nu[k]);
     }
     return c;
 }

@@ -33,7 +33,6 @@ use glam::DVec3;
 
 use super::{Packed, TriangleList};
 use crate::error::{Error, Result};
-use crate::frame::layout::GpuAccel;
 
 /// The axis word of a leaf (glsl BIH_LEAF).
 pub const LEAF: u32 = 3;
@@ -177,18 +176,11 @@ fn f32_up(v: f64) -> f32 {
 
 pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32) -> Result<Packed> {
     let tree = Bih::build(list, max_depth, leaf_size)?;
-    let b = |v: DVec3| v.as_vec3().extend(0.0).to_array();
     Ok(Packed {
         nodes: tree.nodes,
         refs: tree.refs,
         aux: Vec::new(),
-        accel: GpuAccel {
-            bounds_min: b(tree.lo),
-            bounds_max: b(tree.hi),
-            triangle_count: list.len() as u32,
-            node_count: if list.is_empty() { 0 } else { 1 },
-            ..bytemuck::Zeroable::zeroed()
-        },
+        accel: super::tree_accel(list, tree.lo.as_vec3(), tree.hi.as_vec3(), 1),
         shader: "raytrace/intersect_bih.comp",
     })
 }

@@ -48,7 +48,6 @@ use glam::DVec3;
 use super::knobs::KdTraversal;
 use super::{Packed, TriangleList};
 use crate::error::{Error, Result};
-use crate::frame::layout::GpuAccel;
 
 /// The deepest tree: glsl/raytrace/kdtree.glsl KD_MAX_DEPTH. One restart descends at most
 /// this many nodes, which keeps a ray's steps well inside the kernel's step budget (and
@@ -442,7 +441,6 @@ pub(super) fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3
 
 pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, traversal: KdTraversal) -> Result<Packed> {
     let tree = KdTree::build(list, max_depth, leaf_size)?;
-    let b = |v: DVec3| (v.as_vec3()).extend(0.0).to_array();
     let mut nodes = tree.words();
     let mut aux = Vec::new();
     if traversal == KdTraversal::Ropes {
@@ -458,13 +456,7 @@ pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, traversal: KdTr
         nodes,
         refs: tree.refs.clone(),
         aux,
-        accel: GpuAccel {
-            bounds_min: b(tree.lo),
-            bounds_max: b(tree.hi),
-            triangle_count: list.len() as u32,
-            node_count: if list.is_empty() { 0 } else { tree.nodes.len() as u32 },
-            ..bytemuck::Zeroable::zeroed()
-        },
+        accel: super::tree_accel(list, tree.lo.as_vec3(), tree.hi.as_vec3(), tree.nodes.len() as u32),
         shader: match traversal {
             KdTraversal::ShortStack => "raytrace/intersect_kdtree.comp",
             KdTraversal::Restart => "raytrace/intersect_kdtree_restart.comp",

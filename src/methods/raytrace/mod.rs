@@ -406,6 +406,18 @@ pub(crate) fn check_tree_knobs(
     Ok(())
 }
 
+/// The parameters of a tree scheme's kernel: the root's box (f32 values), the triangle
+/// count and `nodes` (0 for an empty list, which every kernel then answers with no hit).
+pub(crate) fn tree_accel(list: &TriangleList, lo: Vec3, hi: Vec3, nodes: u32) -> GpuAccel {
+    GpuAccel {
+        bounds_min: lo.extend(0.0).to_array(),
+        bounds_max: hi.extend(0.0).to_array(),
+        triangle_count: list.len() as u32,
+        node_count: if list.is_empty() { 0 } else { nodes },
+        ..bytemuck::Zeroable::zeroed()
+    }
+}
+
 /// A scheme in its GPU form (see the module documentation).
 #[derive(Clone, Debug)]
 pub struct Packed {

@@ -34,7 +34,7 @@ use glam::{DVec3, Vec3};
 
 use super::{Packed, TriangleList};
 use crate::error::{Error, Result};
-use crate::frame::layout::{GpuAccel, RAY_NO_TRIANGLE};
+use crate::frame::layout::RAY_NO_TRIANGLE;
 
 /// The type word of an interior node (glsl/raytrace/intersect_octree.comp OCT_INTERIOR).
 pub const INTERIOR: u32 = 0;
@@ -211,18 +211,11 @@ impl Builder<'_> {
 
 pub fn pack(list: &TriangleList, max_depth: u32, leaf_size: u32, volume: bool) -> Result<Packed> {
     let tree = Octree::build(list, max_depth, leaf_size, volume)?;
-    let b = |v: Vec3| v.extend(0.0).to_array();
     Ok(Packed {
         nodes: tree.nodes,
         refs: tree.refs,
         aux: tree.aux,
-        accel: GpuAccel {
-            bounds_min: b(tree.lo),
-            bounds_max: b(tree.hi),
-            triangle_count: list.len() as u32,
-            node_count: if list.is_empty() { 0 } else { 1 },
-            ..bytemuck::Zeroable::zeroed()
-        },
+        accel: super::tree_accel(list, tree.lo, tree.hi, 1),
         shader: if volume { "raytrace/intersect_octree.comp#OCTREE_VOLUME" } else { "raytrace/intersect_octree.comp" },
     })
 }
