@@ -10,6 +10,7 @@ use super::corpus::{gpu_methods, measure, Measure};
 use crate::error::Result;
 use crate::methods::{RAY_ENGINE, RAY_HIERARCHY};
 use crate::plan::predict::cost_model::{cache_dir, load_cached, store, CostModel, DeviceKey};
+use crate::plan::predict::samples::Corpus;
 use crate::quality::Quality;
 use crate::vk::Context;
 
@@ -49,9 +50,15 @@ pub fn plan() -> Measure {
 
 /// Measures and fits `ctx`'s unit costs.
 pub fn calibrate(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<CostModel> {
+    calibrate_measured(ctx, progress).map(|(_, c)| c)
+}
+
+/// [`calibrate`], with the measurements the unit costs were fitted on.
+pub fn calibrate_measured(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<(Corpus, CostModel)> {
     let t = std::time::Instant::now();
     let corpus = measure(ctx, &plan(), progress)?;
-    Ok(CostModel::fit(&corpus, DeviceKey::of(ctx), t.elapsed().as_secs_f64()))
+    let c = CostModel::fit(&corpus, DeviceKey::of(ctx), t.elapsed().as_secs_f64());
+    Ok((corpus, c))
 }
 
 /// Where `ctx`'s costs came from.

@@ -19,7 +19,7 @@ mod study;
 mod sweep;
 mod ticks;
 
-pub use calibrate::{calibrate, costs_for, Source};
+pub use calibrate::{calibrate, calibrate_measured, costs_for, Source};
 pub use corpus::{gpu_methods, measure, reference_quality, Measure};
 pub use csv::csv;
 pub use labels::{place_labels, PixelRect};

@@ -99,10 +99,33 @@ pub fn run_corpus(
 }
 
 /// Calibrates this device's unit costs and writes them to `out`, or to the cache.
-pub fn run_calibrate(out: Option<&Path>, validate: bool, device: &Option<String>) -> specula::Result<()> {
-    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
-    let t = std::time::Instant::now();
-    let c = tradeoff::calibrate(&ctx, &mut |s| eprintln!("[{:6.1} s] {s}", t.elapsed().as_secs_f64()))?;
+/// `samples`: also write the measurements; `refit`: fit from such measurements instead of
+/// measuring (no device is opened).
+pub fn run_calibrate(
+    out: Option<&Path>,
+    samples: Option<&Path>,
+    refit: Option<&Path>,
+    validate: bool,
+    device: &Option<String>,
+) -> specula::Result<()> {
+    use specula::plan::predict::cost_model::CostModel;
+    let c = match refit {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|e| specula::Error::io(path, e))?;
+            let measured = specula::plan::predict::samples::Corpus::parse(&text, &path.display().to_string())?;
+            let key = measured.device.clone();
+            CostModel::fit(&measured, key, 0.0)
+        }
+        None => {
+            let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
+            let t = std::time::Instant::now();
+            let (measured, c) = tradeoff::calibrate_measured(&ctx, &mut |s| eprintln!("[{:6.1} s] {s}", t.elapsed().as_secs_f64()))?;
+            if let Some(p) = samples {
+                specula::output::write_file(p, measured.to_json().as_bytes())?;
+            }
+            c
+        }
+    };
     let path = match out {
         Some(p) => {
             specula::output::write_file(p, c.to_json().as_bytes())?;

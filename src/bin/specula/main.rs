@@ -161,6 +161,13 @@ enum Command {
     Calibrate {
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Also write the measurements the unit costs are fitted on (a corpus file)
+        #[arg(long)]
+        samples: Option<PathBuf>,
+        /// Measure nothing: fit the unit costs from measurements written by --samples
+        /// (after a change to the cost model; the device is the one they were measured on)
+        #[arg(long, conflicts_with = "samples")]
+        refit: Option<PathBuf>,
         #[arg(long)]
         validate: bool,
         #[arg(long)]
@@ -307,7 +314,9 @@ fn run(cmd: Command) -> specula::Result<()> {
             let pick = corpus::Selection { scenes: &scenes, variants: &variants, methods: &methods };
             corpus::run_corpus(&out, &size, pick, merge.as_deref(), validate, &device)
         }
-        Command::Calibrate { out, validate, device } => corpus::run_calibrate(out.as_deref(), validate, &device),
+        Command::Calibrate { out, samples, refit, validate, device } => {
+            corpus::run_calibrate(out.as_deref(), samples.as_deref(), refit.as_deref(), validate, &device)
+        }
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())

@@ -63,56 +63,82 @@ impl CostModel {
         for s in &corpus.samples {
             by.entry(super::error_model::candidate(&s.method, &s.knobs)).or_default().push(s);
         }
-        let methods = by
-            .into_iter()
-            .map(|(m, ss)| {
-                // Relative error matters (a 1 ms part beside a 100 ms one): weight by 1/y².
-                let nnls = |x: Vec<Vec<f64>>, y: Vec<f64>| {
-                    let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
-                    let w: Vec<f64> = y.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
-                    linear::fit(&x, &y, &w, 1e-4, true)
-                };
-                // Maps: per object.
-                let fixed = nnls(ss.iter().map(|s| map_features(&s.work)).collect(), ss.iter().map(|s| s.fixed_ms).collect());
-                // Camera work and whole-screen kernels: per frame (a ray tracer's kernels serve
-                // every object at once; its time is the frame's, its features the sum of its
-                // objects' and the screen's).
-                let mut frames: Vec<(Vec<f64>, f64)> = Vec::new();
-                let mut keys: Vec<(usize, &str, u64)> = Vec::new();
-                for s in &ss {
-                    let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
-                    let per = screen_features(&s.work);
-                    match keys.iter().position(|k| *k == key) {
-                        Some(k) => {
-                            let (x, y) = &mut frames[k];
-                            per.iter().enumerate().for_each(|(j, v)| x[j] += v);
-                            *y += s.screen_ms;
-                        }
-                        None => {
-                            keys.push(key);
-                            let mut x = per;
-                            x.extend(shared_features(&s.work));
-                            frames.push((x, s.screen_ms + s.shared_ms));
-                        }
-                    }
-                }
-                let beta = nnls(frames.iter().map(|f| f.0.clone()).collect(), frames.iter().map(|f| f.1).collect());
-                let n = SCREEN_FEATURES.len();
-                let cost = MethodCost {
-                    fixed,
-                    screen: beta[..n].to_vec(),
-                    shared: beta[n..].to_vec(),
-                    cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
-                    samples: ss.len(),
-                };
-                (m, cost)
-            })
-            .collect();
+        // Plain methods first: a `METHOD+hybrid` candidate is fitted as its method's unit
+        // costs plus non-negative extra ones (its ray queries come on top of the method's
+        // own passes; fitted alone, its few frames at one cube size put the cube maps' cost
+        // into the constant, and it could be predicted cheaper than its method).
+        let mut order: Vec<(String, Vec<&super::samples::Sample>)> = by.into_iter().collect();
+        order.sort_by_key(|(m, _)| m.contains('+'));
+        let mut methods: BTreeMap<String, MethodCost> = BTreeMap::new();
+        for (m, ss) in order {
+            let plain = methods.get(super::error_model::candidate_method(&m)).filter(|_| m.contains('+')).cloned();
+            let cost = Self::fit_method(&ss, plain.as_ref());
+            methods.insert(m, cost);
+        }
         let xb: Vec<Vec<f64>> = corpus.frames.iter().map(|f| base_features(&f.work)).collect();
         let yb: Vec<f64> = corpus.frames.iter().map(|f| f.base_ms).collect();
         let wb = vec![1.0; yb.len()];
         let base = linear::fit(&xb, &yb, &wb, 1e-4, true);
         CostModel { format: FORMAT.into(), key, methods, base, calibration_s }
+    }
+
+    /// One candidate's unit costs from its samples; over `plain` (its method's), as extra
+    /// non-negative unit costs added to them.
+    fn fit_method(ss: &[&super::samples::Sample], plain: Option<&MethodCost>) -> MethodCost {
+        // Relative error matters (a 1 ms part beside a 100 ms one): weight by 1/y².
+        let nnls = |x: Vec<Vec<f64>>, y: Vec<f64>| {
+            let mean = y.iter().sum::<f64>() / y.len().max(1) as f64;
+            let w: Vec<f64> = y.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
+            linear::fit(&x, &y, &w, 1e-4, true)
+        };
+        let on_plain = |beta: &[f64], x: &[f64]| plain.map_or(0.0, |_| linear::dot(beta, x));
+        let add = |extra: Vec<f64>, beta: Option<Vec<f64>>| match beta {
+            Some(b) => extra.iter().zip(b).map(|(e, b)| e + b).collect(),
+            None => extra,
+        };
+        // Maps: per object.
+        let plain_fixed = plain.map(|p| p.fixed.clone()).unwrap_or_default();
+        let fixed = nnls(
+            ss.iter().map(|s| map_features(&s.work)).collect(),
+            ss.iter().map(|s| (s.fixed_ms - on_plain(&plain_fixed, &map_features(&s.work))).max(0.0)).collect(),
+        );
+        let fixed = add(fixed, plain.map(|p| p.fixed.clone()));
+        // Camera work and whole-screen kernels: per frame (a ray tracer's kernels serve
+        // every object at once; its time is the frame's, its features the sum of its
+        // objects' and the screen's).
+        let mut frames: Vec<(Vec<f64>, f64)> = Vec::new();
+        let mut keys: Vec<(usize, &str, u64)> = Vec::new();
+        for s in ss {
+            let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
+            let per = screen_features(&s.work);
+            match keys.iter().position(|k| *k == key) {
+                Some(k) => {
+                    let (x, y) = &mut frames[k];
+                    per.iter().enumerate().for_each(|(j, v)| x[j] += v);
+                    *y += s.screen_ms;
+                }
+                None => {
+                    keys.push(key);
+                    let mut x = per;
+                    x.extend(shared_features(&s.work));
+                    frames.push((x, s.screen_ms + s.shared_ms));
+                }
+            }
+        }
+        let plain_frame: Vec<f64> = plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()).unwrap_or_default();
+        let beta = nnls(
+            frames.iter().map(|f| f.0.clone()).collect(),
+            frames.iter().map(|f| (f.1 - on_plain(&plain_frame, &f.0)).max(0.0)).collect(),
+        );
+        let beta = add(beta, plain.map(|_| plain_frame.clone()));
+        let n = SCREEN_FEATURES.len();
+        MethodCost {
+            fixed,
+            screen: beta[..n].to_vec(),
+            shared: beta[n..].to_vec(),
+            cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
+            samples: ss.len(),
+        }
     }
 
     /// Predicted (map, camera, whole-screen) milliseconds of `method` (an
