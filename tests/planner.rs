@@ -421,3 +421,33 @@ fn auto_chooses_only_the_knobs_left_to_it() {
     assert!(!(bvh.ms * NOISE < a.ms && bvh.psnr > a.psnr + 0.5), "bvh dominates auto: {table}");
     common::assert_clean(&ctx);
 }
+
+/// A calibration (timing only, no errors) measures each object's pixels — its camera-work
+/// unit costs are fitted on them — and times a method under every variant knob it reads: the
+/// ray tracers under `cube_size=128 aa=msaa4` (they read `aa`, not `cube_size`).
+#[test]
+fn a_calibration_measures_pixels_and_the_knobs_a_method_reads() {
+    let _turn = turn();
+    let ctx = common::gpu();
+    let cfg = specula::tradeoff::Measure {
+        scenes: vec![0],
+        sizes: vec![(32, 32)],
+        variants: vec!["cube_size=128 aa=msaa4".into()],
+        methods: vec![specula::methods::ENVMAP, specula::methods::BVH],
+        sparse: Vec::new(),
+        warmup: 1,
+        frames: 1,
+        base: Quality::default(),
+        errors: false,
+    };
+    let c = specula::tradeoff::measure(&ctx, &cfg, &mut |_| {}).unwrap();
+    let scene = corpus::scene(0).unwrap();
+    let ids = specula::reference::object_ids(&scene, (32, 32)).unwrap();
+    for m in ["envmap", "bvh"] {
+        let s = c.samples.iter().find(|s| s.method == m).unwrap_or_else(|| panic!("{m} was not measured"));
+        let mesh = scene.meshes.iter().position(|x| x.name == s.object).unwrap();
+        let px = ids.iter().filter(|&&id| id as usize == mesh + 1).count() as f64;
+        assert!(px > 0.0 && s.work.pixels == px, "{m}: {} pixels measured, {px} in the frame", s.work.pixels);
+    }
+    common::assert_clean(&ctx);
+}

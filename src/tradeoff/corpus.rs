@@ -65,6 +65,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
         let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
         for &size in &cfg.sizes {
             let ids = crate::reference::object_ids(&scene, size)?;
+            // Each object's pixels, from the exact first hits (with or without errors: a
+            // calibration measures none, and its camera-work terms need them).
+            let mut object_pixels = vec![0usize; scene.meshes.len() + 1];
+            ids.iter().for_each(|&id| object_pixels[(id as usize).min(scene.meshes.len())] += 1);
             for v in &cfg.variants {
                 let q = crate::plan::budget::variant_quality(&cfg.base, v)?;
                 let set: Vec<&str> =
@@ -114,9 +118,7 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     let mut any = None;
                     for (o, (mesh, own, shared)) in plan.objects.iter().zip(costs) {
                         let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
-                        // Its pixels from the exact first hits (with or without errors: a
-                        // calibration measures none, and its camera-work terms need them).
-                        let pixels = ids.iter().filter(|&&id| id as usize == mesh + 1).count();
+                        let pixels = object_pixels[mesh + 1];
                         let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
                         let work = workload(f, &scene, &q, size, pixels as f64);
                         any = Some(work);

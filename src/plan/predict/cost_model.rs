@@ -91,18 +91,21 @@ impl CostModel {
             let w: Vec<f64> = y.iter().map(|v| 1.0 / (v + 0.1 * mean + 1e-3).powi(2)).collect();
             linear::fit(&x, &y, &w, 1e-4, true)
         };
-        let on_plain = |beta: &[f64], x: &[f64]| plain.map_or(0.0, |_| linear::dot(beta, x));
-        let add = |extra: Vec<f64>, beta: Option<Vec<f64>>| match beta {
-            Some(b) => extra.iter().zip(b).map(|(e, b)| e + b).collect(),
-            None => extra,
+        // Fits `x → y` as `plain`'s costs (if any) plus non-negative extra ones.
+        let fit_over = |x: Vec<Vec<f64>>, y: Vec<f64>, plain: Option<Vec<f64>>| {
+            let own = |x: &[f64]| plain.as_ref().map_or(0.0, |b| linear::dot(b, x));
+            let extra = nnls(x.clone(), x.iter().zip(&y).map(|(x, y)| (y - own(x)).max(0.0)).collect());
+            match &plain {
+                Some(b) => extra.iter().zip(b).map(|(e, b)| e + b).collect(),
+                None => extra,
+            }
         };
         // Maps: per object.
-        let plain_fixed = plain.map(|p| p.fixed.clone()).unwrap_or_default();
-        let fixed = nnls(
+        let fixed = fit_over(
             ss.iter().map(|s| map_features(&s.work)).collect(),
-            ss.iter().map(|s| (s.fixed_ms - on_plain(&plain_fixed, &map_features(&s.work))).max(0.0)).collect(),
+            ss.iter().map(|s| s.fixed_ms).collect(),
+            plain.map(|p| p.fixed.clone()),
         );
-        let fixed = add(fixed, plain.map(|p| p.fixed.clone()));
         // Camera work and whole-screen kernels: per frame (a ray tracer's kernels serve
         // every object at once; its time is the frame's, its features the sum of its
         // objects' and the screen's).
@@ -125,12 +128,8 @@ impl CostModel {
                 }
             }
         }
-        let plain_frame: Vec<f64> = plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()).unwrap_or_default();
-        let beta = nnls(
-            frames.iter().map(|f| f.0.clone()).collect(),
-            frames.iter().map(|f| (f.1 - on_plain(&plain_frame, &f.0)).max(0.0)).collect(),
-        );
-        let beta = add(beta, plain.map(|_| plain_frame.clone()));
+        let (x, y): (Vec<Vec<f64>>, Vec<f64>) = frames.into_iter().unzip();
+        let beta = fit_over(x, y, plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()));
         let n = SCREEN_FEATURES.len();
         MethodCost {
             fixed,
@@ -235,6 +234,36 @@ mod tests {
 
     fn model(device: u32) -> CostModel {
         CostModel { format: FORMAT.into(), key: key(device), methods: BTreeMap::new(), base: vec![1.0, 0.5, 0.0, 0.0], calibration_s: 1.0 }
+    }
+
+    /// A `METHOD+hybrid` candidate costs at least its method: fitted over the method's unit
+    /// costs, even where its own frames alone would fit cheaper ones.
+    #[test]
+    fn a_hybrid_candidate_is_fitted_over_its_method() {
+        use super::super::samples::{Corpus, Sample};
+        let sample = |knobs: &str, px: f64, ms: f64| Sample {
+            scene: px as usize,
+            object: "o".into(),
+            method: "distance".into(),
+            knobs: knobs.into(),
+            features: vec![0.0; super::super::features::ERROR_FEATURES.len()],
+            work: Workload { pixels: px, screen: 4.0 * px, cube_texels: 1e5, ..Workload::default() },
+            psnr_db: 30.0,
+            fixed_ms: 1.0,
+            screen_ms: ms,
+            shared_ms: 0.0,
+            cycles: 1,
+        };
+        let mut c = Corpus::new(key(1));
+        for px in [1e3, 4e3, 9e3] {
+            c.samples.push(sample("default", px, px / 1e3));
+            // The hybrid's frames measured cheaper than the plain method's (noise).
+            c.samples.push(sample("hybrid=rays", px, 0.8 * px / 1e3));
+        }
+        let m = CostModel::fit(&c, key(1), 0.0);
+        let w = Workload { pixels: 5e3, screen: 2e4, cube_texels: 1e5, ..Workload::default() };
+        let (plain, hybrid) = (m.predict("distance", &w).unwrap(), m.predict("distance+hybrid", &w).unwrap());
+        assert!(plain.1 > 0.0 && hybrid.0 >= plain.0 && hybrid.1 + hybrid.2 >= plain.1 + plain.2, "{plain:?} {hybrid:?}");
     }
 
     /// Two device keys side by side in one cache; a corrupt or truncated file is an error
