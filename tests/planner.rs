@@ -219,20 +219,75 @@ fn auto_and_budgets_on_unseen_scenes() {
 /// The error models generalise: fitted with each corpus scene left out in turn, they predict
 /// that scene's objects within a median of `BOUND` dB (the stored corpus: 36 scenes, every
 /// method and three cube-map sizes; measured 1.85 dB, BENCHMARKS.md has the distribution).
+/// And they follow the frame's size: fitted at 128², they predict the corpus's frames at
+/// 256² closer (median and bias) with the size exponents than with the size ignored, and
+/// the exact tracers' exponent is edge aliasing's (1: +3 dB per doubling) within ±0.5 while a
+/// cube map's error does not fall with the frame.
 #[test]
-fn error_models_predict_held_out_scenes() {
+fn error_models_predict_held_out_scenes_and_frame_sizes() {
     let _turn = turn();
     const BOUND: f64 = 3.0;
-    use specula::plan::predict::error_model::{abs_error_quantiles, leave_one_scene_out};
+    use specula::plan::predict::error_model::{
+        abs_error_quantiles, leave_one_scene_out, leave_one_scene_out_unsized, ErrorModel, Held, BASE_SCREEN, EXACT,
+    };
     let c = predict::stored_corpus().unwrap();
     assert!(c.scenes().len() >= 30, "{} scenes", c.scenes().len());
     let held = leave_one_scene_out(&c.samples);
     assert_eq!(held.len(), c.samples.len(), "every sample predicted with its scene held out");
     // The approximate methods alone (the exact ones sit at the cap and are easy).
-    let approx: Vec<_> =
-        held.into_iter().filter(|h| !["bvh", "kd-tree", "grid", "ray-engine", "ray-hierarchy"].contains(&h.method.as_str())).collect();
+    let exact = |h: &Held| ["bvh", "kd-tree", "grid", "ray-engine", "ray-hierarchy"].contains(&h.method.as_str());
+    let approx: Vec<_> = held.iter().filter(|h| !exact(h)).cloned().collect();
     let (median, p90) = abs_error_quantiles(&approx);
     assert!(median <= BOUND, "held-out median |predicted − measured| {median:.2} dB (90th percentile {p90:.2})");
+
+    let larger = |h: &Held| h.screen > BASE_SCREEN + 0.5;
+    let sized: Vec<Held> = held.into_iter().filter(larger).collect();
+    let ignored: Vec<Held> = leave_one_scene_out_unsized(&c.samples).into_iter().filter(larger).collect();
+    assert!(sized.len() >= 300 && sized.len() == ignored.len(), "{} samples at a larger size", sized.len());
+    let bias = |hs: &[Held]| hs.iter().map(|h| h.predicted_db - h.measured_db).sum::<f64>() / hs.len() as f64;
+    let ((m1, _), (m0, _)) = (abs_error_quantiles(&sized), abs_error_quantiles(&ignored));
+    let (b1, b0) = (bias(&sized), bias(&ignored));
+    assert!(m1 < m0 && b1.abs() < b0.abs(), "at 256²: median {m1:.2} dB, bias {b1:.2} with the size; {m0:.2}, {b0:.2} without");
+    let model = ErrorModel::fit(&c.samples, &|_| true);
+    let k = |m: &str| model.size.get(m).map_or(f64::NAN, |(k, _)| *k);
+    assert!((0.5..=1.5).contains(&k(EXACT)) && k("envmap") < 0.3, "exponents: {:?}", model.size);
+}
+
+/// The budget search reaches what it is measured against: within the exact tracer's
+/// predicted frame (bvh on every object, the default budget) it finds a choice predicted at
+/// least as accurate, on unseen scenes at 64² and 512². (Pruning each object's candidates
+/// by their own parts once dropped bvh where another method beat it counting bvh's
+/// whole-frame kernels as the object's alone, so bvh on every object, which pays them once,
+/// was out of reach: corpus-49's best within that frame came out 5 dB under it.)
+#[test]
+fn the_search_within_the_exact_frame_is_at_least_as_accurate_as_the_exact_tracer() {
+    let _turn = turn();
+    let nominal = Target::nominal().unwrap();
+    let q = Quality::default();
+    for size in [(64, 64), (512, 512)] {
+        let t = Target { size, ..nominal.clone() };
+        for i in [36, 38, 41, 45, 49, 54] {
+            let scene = corpus::scene(i).unwrap();
+            let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
+            let exact = Choices {
+                method: Choice::Auto,
+                objects: facts.objects.iter().map(|f| (scene.meshes[f.mesh].name.clone(), specula::methods::BVH)).collect(),
+            };
+            let run = |c: &Choices, b: Budget| predict::choose(&scene, c, &q, b, &t, &predict::budget_variants()).unwrap().unwrap().2;
+            let e = run(&exact, Budget::MaxMs(f64::INFINITY));
+            let best = run(&Choices::all(Choice::Auto), Budget::MaxMs(e.frame_ms));
+            assert!(
+                best.met && best.frame_ms <= e.frame_ms && best.specular_psnr_db >= e.specular_psnr_db - 1e-9,
+                "{} at {size:?}: best within bvh's {:.2} ms is {:.2} ms {:.2} dB, bvh {:.2} dB ({:?})",
+                corpus::name(i),
+                e.frame_ms,
+                best.frame_ms,
+                best.specular_psnr_db,
+                e.specular_psnr_db,
+                best.objects.iter().map(|o| o.method.name).collect::<Vec<_>>()
+            );
+        }
+    }
 }
 
 /// Frames over time: a small camera move keeps `auto`'s choice (hysteresis); a plan whose

@@ -18,8 +18,9 @@ use crate::vk::Context;
 /// near and far rooms, an occluder, a light, two objects, and tessellations from 600 to 10⁴
 /// triangles.
 pub const SCENES: [usize; 6] = [0, 3, 6, 7, 14, 22];
-/// Its two frame sizes (screen-proportional costs are told from fixed ones by the pair).
-pub const SIZES: [(u32, u32); 2] = [(64, 64), (128, 128)];
+/// Its two frame sizes, 9× apart in pixels (screen-proportional costs are told from the
+/// per-frame ones by the pair).
+pub const SIZES: [(u32, u32); 2] = [(64, 64), (192, 192)];
 
 /// What a calibration renders.
 pub fn plan() -> Measure {

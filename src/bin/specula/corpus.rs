@@ -177,10 +177,29 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
         let (med, p90) = error_model::abs_error_quantiles(&hs);
         println!("{v:<24} {:>6} {med:>14.2} {p90:>12.2}", hs.len());
     }
+    println!("\nper frame size (held-out scenes), with the size exponents and with the size ignored:");
+    let ignored = error_model::leave_one_scene_out_unsized(&c.samples);
+    let size_of = |h: &error_model::Held| format!("{0}x{0}", h.screen.sqrt().round());
+    let mut sizes: Vec<String> = held.iter().map(size_of).collect();
+    sizes.sort();
+    sizes.dedup();
+    for size in sizes {
+        let stats = |hs: &[error_model::Held]| {
+            let hs: Vec<_> = hs.iter().filter(|h| size_of(h) == size).cloned().collect();
+            let (med, p90) = error_model::abs_error_quantiles(&hs);
+            let bias = hs.iter().map(|h| h.predicted_db - h.measured_db).sum::<f64>() / hs.len().max(1) as f64;
+            format!("{:>6} {med:>8.2} {p90:>8.2} {bias:>8.2}", hs.len())
+        };
+        println!("{size:<10} sized: n, median, 90th pct, bias {}   ignored: {}", stats(&held), stats(&ignored));
+    }
     let model = error_model::ErrorModel::fit(&c.samples, &|_| true);
     println!("\nanti-aliasing's factor on the aliasing part of the error (per method; measured samples):");
     for ((m, aa), (f, n)) in &model.aa {
         println!("{m:<28} {aa:<8} {f:>8.3} {n:>6}");
+    }
+    println!("\nsize exponent k: the aliasing part scales as (N / 128)^-k (per method; measured samples):");
+    for (m, (k, n)) in &model.size {
+        println!("{m:<28} {k:>8.2} {n:>6}");
     }
     let points: Vec<(f64, f64, String)> = held.iter().map(|h| (h.measured_db, h.predicted_db, h.method.clone())).collect();
     let title = format!("Held-out PSNR per object: predicted against measured ({} scenes, leave-one-scene-out)", c.scenes().len());

@@ -130,13 +130,21 @@ pub(super) fn candidates(
                 per_object.clear();
                 break;
             }
-            // Drop the dominated: another candidate of no higher cost in every part and
-            // at least as accurate (strictly better somewhere).
+            // Drop the dominated: another candidate at least as accurate (strictly better
+            // somewhere) whose cost is no higher in any part even when this one pays
+            // nothing for its method's whole-screen kernels and the other pays them in full
+            // and composes into other families' maps: a frame pays a method's kernels once
+            // for all its objects (the exact tracer on every object, where another method
+            // beats it on one object counting its kernels as shared, is that frame).
             // A candidate that renders views of the scene (`GpuSpec::views`) costs what the
             // other objects' methods cost in them: it dominates nothing by its own parts.
             let renders_views = |d: &Candidate| d.method.gpu.is_some_and(|g| (g.views)(&variant_q) > 0);
             let le = |d: &Candidate, c: &Candidate| {
-                !renders_views(d) && d.fixed <= c.fixed && d.screen <= c.screen && d.shared <= c.shared && d.psnr >= c.psnr
+                !renders_views(d)
+                    && d.fixed <= c.fixed
+                    && d.screen <= c.screen
+                    && d.fixed + d.compose_fixed + d.screen + d.shared <= c.fixed + c.screen
+                    && d.psnr >= c.psnr
             };
             let keep: Vec<Candidate> = list
                 .iter()

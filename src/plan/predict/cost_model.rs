@@ -2,7 +2,8 @@
 //! unit costs times its workload (`features`), split as the frame spends them: map passes
 //! (a constant per object, cube-map rasterisation per texel × scene triangle, per texel),
 //! camera work (per covered pixel; per pixel × hierarchy depth, more for dielectrics, whose
-//! rays bounce) and whole-screen kernels (per screen pixel, and × hierarchy depth), and the
+//! rays bounce) and whole-screen kernels (per frame, per scene triangle, per screen pixel,
+//! and × hierarchy depth), and the
 //! frame's base (per frame, per screen pixel, per light, per light × scene triangle). The
 //! unit costs are fitted
 //! (non-negative least squares) on a calibration run on the device itself
@@ -21,8 +22,9 @@ use crate::error::{Error, Result};
 
 /// The first line of every cost file's `format` field.
 /// (2: anti-aliasing's samples, multisampled and supersampled, as workload terms of their
-/// own.)
-pub const FORMAT: &str = "specula-costs 2";
+/// own; 3: a method's whole-screen kernels gain a constant per frame and one per scene
+/// triangle.)
+pub const FORMAT: &str = "specula-costs 3";
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
 /// `SCREEN_FEATURES` (per object, its camera work) and `SHARED_FEATURES` (per frame, the

@@ -1,7 +1,9 @@
 //! Error models: per method, PSNR on an object's pixels (against the exact tracer) as a
 //! linear function of the object's error features (`features::ERROR_FEATURES`), fitted by
-//! ridge regression on the corpus. Generalisation is measured by leaving each scene out in
-//! turn ([`leave_one_scene_out`]): the fit never sees the scene it predicts.
+//! ridge regression on the corpus's frames of [`BASE_SCREEN`] pixels; the part of the error
+//! that is aliasing falls with the frame's size by an exponent per method, measured on the
+//! corpus's objects at a second size. Generalisation is measured by leaving each scene out
+//! in turn ([`leave_one_scene_out`]): the fit never sees the scene it predicts.
 
 use std::collections::BTreeMap;
 
@@ -16,15 +18,24 @@ pub const RIDGE: f64 = 0.03;
 /// Predictions are clamped here (a method's error cannot fall below the exact tracer's,
 /// and no object is predicted below a blank image's typical PSNR).
 pub const PSNR_FLOOR: f64 = 5.0;
+/// The frame size (pixels) the error features are fitted at: the corpus's 128².
+pub const BASE_SCREEN: f64 = 128.0 * 128.0;
+/// The largest size exponent a fit may give (a method measured on few objects).
+pub const MAX_SIZE_EXPONENT: f64 = 3.0;
 
 /// Per method its coefficients over `ERROR_FEATURES`, and how many samples fitted it
-/// (fitted on frames without anti-aliasing); per method and `aa` value the factor by which
-/// anti-aliasing scales the part of an object's error that is aliasing ([`ErrorModel::predict`]).
+/// (fitted on frames of [`BASE_SCREEN`] pixels without anti-aliasing); per method and `aa`
+/// value the factor by which anti-aliasing scales the part of an object's error that is
+/// aliasing; per method the exponent by which the frame's size does ([`ErrorModel::predict`]).
 #[derive(Clone, Debug, Default)]
 pub struct ErrorModel {
     pub methods: BTreeMap<String, (Vec<f64>, usize)>,
     /// (model key, `aa` value) → (aliasing factor, samples).
     pub aa: BTreeMap<(String, String), (f64, usize)>,
+    /// Model key → (k, samples): a frame N pixels across scales the aliasing part of the
+    /// error at [`BASE_SCREEN`] by (N / 128)^−k (edge aliasing in theory: k = 1; a map
+    /// method's error is its map's, which the frame's size does not change: k = 0).
+    pub size: BTreeMap<String, (f64, usize)>,
 }
 
 /// The frame's anti-aliasing as a sample's knobs or a quality name it (`off` when unset).
@@ -99,6 +110,8 @@ impl ErrorModel {
         for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) == "off") {
             by.entry(model_key(&candidate(&s.method, &s.knobs)).to_string()).or_default().push(s);
         }
+        by.values_mut().for_each(|ss| ss.retain(|s| at_base(s)));
+        by.retain(|_, ss| !ss.is_empty());
         let methods = by
             .into_iter()
             .map(|(m, ss)| {
@@ -116,19 +129,33 @@ impl ErrorModel {
                 (m, (beta, ss.len()))
             })
             .collect();
-        ErrorModel { methods, aa: fit_aa(samples, keep) }
+        ErrorModel { methods, aa: fit_aa(samples, keep), size: fit_size(samples, keep) }
     }
 
-    /// Predicted PSNR of `method` on an object with these features in a frame anti-aliased
-    /// by `aa` (a value of the `aa` knob) resolving `aa_samples` samples per pixel; `None`
-    /// for a method the corpus never measured.
-    pub fn predict(&self, method: &str, features: &[f64], aa: &str, aa_samples: f64) -> Option<f64> {
+    /// Predicted PSNR of `method` on an object with these features in a frame of `screen`
+    /// pixels anti-aliased by `aa` (a value of the `aa` knob) resolving `aa_samples` samples
+    /// per pixel; `None` for a method the corpus never measured.
+    pub fn predict(&self, method: &str, features: &[f64], aa: &str, aa_samples: f64, screen: f64) -> Option<f64> {
         let own = self.predict_off(method, features)?;
-        if aa == "off" {
+        let aa_factor = if aa == "off" { 1.0 } else { self.aa_factor(method, aa, aa_samples) };
+        let factor = aa_factor * self.size_factor(method, screen);
+        if factor == 1.0 {
             return Some(own);
         }
         let exact = self.predict_off(EXACT, features).unwrap_or(PSNR_CAP);
-        Some(psnr(with_aa(mse(own), mse(exact), self.aa_factor(method, aa, aa_samples))))
+        Some(psnr(with_aa(mse(own), mse(exact), factor)))
+    }
+
+    /// The factor by which a frame of `screen` pixels scales `method`'s aliasing at
+    /// [`BASE_SCREEN`]: its own measured exponent, else (a `METHOD+hybrid` candidate) its
+    /// method's, else the exact tracers'.
+    pub fn size_factor(&self, method: &str, screen: f64) -> f64 {
+        if screen <= 0.0 || (screen - BASE_SCREEN).abs() < 0.5 {
+            return 1.0;
+        }
+        let at = |m: &str| self.size.get(m).filter(|(_, n)| *n >= 4).map(|(k, _)| *k);
+        let k = at(model_key(method)).or_else(|| at(model_key(candidate_method(method)))).or_else(|| at(EXACT)).unwrap_or(0.0);
+        (screen / BASE_SCREEN).sqrt().powf(-k)
     }
 
     /// The aliasing factor of `method` under `aa`: measured on the corpus where it has at
@@ -145,38 +172,79 @@ impl ErrorModel {
     }
 }
 
+/// Whether a sample's frame has the size the error features are fitted at.
+fn at_base(s: &Sample) -> bool {
+    (s.work.screen - BASE_SCREEN).abs() < 0.5
+}
+
+/// A sample's (scene, object, model key, frame pixels).
+type SampleKey<'a> = (usize, &'a str, String, u64);
+
+fn sample_key(s: &Sample) -> SampleKey<'_> {
+    (s.scene, s.object.as_str(), model_key(&candidate(&s.method, &s.knobs)).to_string(), s.work.screen as u64)
+}
+
+/// The PSNR of every sample measured with the default knobs, by [`sample_key`].
+fn default_psnr<'a>(samples: &'a [Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<SampleKey<'a>, f64> {
+    let mut off = BTreeMap::new();
+    for s in samples.iter().filter(|s| keep(s) && s.knobs == "default") {
+        off.entry(sample_key(s)).or_insert(s.psnr_db);
+    }
+    off
+}
+
+/// The factor [`with_aa`] needs to turn an object's error `own` (its method's, without the
+/// change) into `changed`, with `exact` the exact tracer's (all of it aliasing); `None`
+/// where the exact error sits at the cap (it tells nothing).
+fn aliasing_factor(own: f64, exact: f64, changed: f64) -> Option<f64> {
+    if exact >= PSNR_CAP - 1.0 {
+        return None;
+    }
+    let (mo, me, ma) = (mse(own), mse(exact), mse(changed));
+    let alias = mo.min(me);
+    Some(((ma - (mo - alias)) / alias).clamp(1e-3, 10.0))
+}
+
+/// The median (in logarithm) of each key's values.
+fn log_medians<K>(logs: BTreeMap<K, Vec<f64>>) -> impl Iterator<Item = (K, (f64, usize))> {
+    logs.into_iter().map(|(k, mut v)| {
+        v.sort_by(f64::total_cmp);
+        (k, (v[v.len() / 2], v.len()))
+    })
+}
+
+/// Per method its size exponent: over the objects measured with the default knobs both at
+/// [`BASE_SCREEN`] and at another size (and by the exact tracer at the base size), the
+/// median of the exponent k for which (N / 128)^−k is the factor [`with_aa`] needs to turn
+/// the error at the base size into the error at the other; clamped to 0–[`MAX_SIZE_EXPONENT`].
+fn fit_size(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<String, (f64, usize)> {
+    let off = default_psnr(samples, keep);
+    let mut ks: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for s in samples.iter().filter(|s| keep(s) && s.knobs == "default" && !at_base(s) && s.work.screen > 0.0) {
+        let (sc, o, m, _) = sample_key(s);
+        let base = BASE_SCREEN as u64;
+        let (Some(&own), Some(&exact)) = (off.get(&(sc, o, m.clone(), base)), off.get(&(sc, o, EXACT.to_string(), base))) else { continue };
+        let Some(factor) = aliasing_factor(own, exact, s.psnr_db.min(PSNR_CAP)) else { continue };
+        let ratio = (s.work.screen / BASE_SCREEN).sqrt();
+        ks.entry(m).or_default().push(-factor.ln() / ratio.ln());
+    }
+    log_medians(ks).map(|(m, (k, n))| (m, (k.clamp(0.0, MAX_SIZE_EXPONENT), n))).collect()
+}
+
 /// Per method and measured `aa` value its aliasing factor: over the objects measured both
 /// with it and without (and by the exact tracer without), the median (in logarithm) of the
 /// factor [`with_aa`] needs to turn the measured error without into the measured error with.
 /// Objects whose exact error sits at the cap tell nothing and are left out.
 fn fit_aa(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool) -> BTreeMap<(String, String), (f64, usize)> {
-    type Key<'a> = (usize, &'a str, String, u64);
-    fn key(s: &Sample) -> Key<'_> {
-        (s.scene, s.object.as_str(), model_key(&candidate(&s.method, &s.knobs)).to_string(), s.work.screen as u64)
-    }
-    let mut off: BTreeMap<Key, f64> = BTreeMap::new();
-    for s in samples.iter().filter(|s| keep(s) && s.knobs == "default") {
-        off.entry(key(s)).or_insert(s.psnr_db);
-    }
+    let off = default_psnr(samples, keep);
     let mut logs: BTreeMap<(String, String), Vec<f64>> = BTreeMap::new();
     for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) != "off") {
-        let (sc, o, m, px) = key(s);
+        let (sc, o, m, px) = sample_key(s);
         let (Some(&own), Some(&exact)) = (off.get(&(sc, o, m.clone(), px)), off.get(&(sc, o, EXACT.to_string(), px))) else { continue };
-        if exact >= PSNR_CAP - 1.0 {
-            continue;
-        }
-        let (mo, me, ma) = (mse(own), mse(exact), mse(s.psnr_db));
-        let alias = mo.min(me);
-        let factor = ((ma - (mo - alias)) / alias).clamp(1e-3, 10.0);
+        let Some(factor) = aliasing_factor(own, exact, s.psnr_db) else { continue };
         logs.entry((m, aa_of(&s.knobs).to_string())).or_default().push(factor.ln());
     }
-    logs.into_iter()
-        .map(|(k, mut v)| {
-            v.sort_by(f64::total_cmp);
-            let median = v[v.len() / 2];
-            (k, (median.exp(), v.len()))
-        })
-        .collect()
+    log_medians(logs).map(|(k, (median, n))| (k, (median.exp(), n))).collect()
 }
 
 /// One held-out prediction.
@@ -186,6 +254,8 @@ pub struct Held {
     pub object: String,
     pub method: String,
     pub knobs: String,
+    /// The frame's pixels.
+    pub screen: f64,
     pub predicted_db: f64,
     pub measured_db: f64,
 }
@@ -198,23 +268,38 @@ pub fn leave_one_scene_out(samples: &[Sample]) -> Vec<Held> {
 
 /// [`leave_one_scene_out`] with another ridge penalty.
 pub fn leave_one_scene_out_with(samples: &[Sample], ridge: f64) -> Vec<Held> {
+    held_out(samples, ridge, true)
+}
+
+/// [`leave_one_scene_out`] with the frame's size ignored (every size predicted as the
+/// base size): what the size exponents gain.
+pub fn leave_one_scene_out_unsized(samples: &[Sample]) -> Vec<Held> {
+    held_out(samples, RIDGE, false)
+}
+
+fn held_out(samples: &[Sample], ridge: f64, sized: bool) -> Vec<Held> {
     let mut scenes: Vec<usize> = samples.iter().map(|s| s.scene).collect();
     scenes.sort();
     scenes.dedup();
     let mut out = Vec::new();
     for sc in scenes {
-        let model = ErrorModel::fit_with(samples, &|s| s.scene != sc, ridge);
+        let mut model = ErrorModel::fit_with(samples, &|s| s.scene != sc, ridge);
+        if !sized {
+            model.size.clear();
+        }
         for s in samples.iter().filter(|s| s.scene == sc) {
             let aa = aa_of(&s.knobs);
             let n = crate::plan::budget::variant_quality(&crate::quality::Quality::default(), &s.knobs)
                 .map_or(1.0, |q| super::features::aa_samples(&q).1);
             let name = candidate(&s.method, &s.knobs);
-            if let Some(p) = model.predict(&name, &s.features, aa, n) {
+            let screen = if sized { s.work.screen } else { BASE_SCREEN };
+            if let Some(p) = model.predict(&name, &s.features, aa, n, screen) {
                 out.push(Held {
                     scene: sc,
                     object: s.object.clone(),
                     method: name.clone(),
                     knobs: s.knobs.clone(),
+                    screen: s.work.screen,
                     predicted_db: p,
                     measured_db: s.psnr_db.min(PSNR_CAP),
                 });

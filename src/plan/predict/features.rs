@@ -156,15 +156,18 @@ pub fn screen_features(w: &Workload) -> Vec<f64> {
 }
 
 /// Names of the whole-screen features, in the order [`shared_features`] returns them.
-pub const SHARED_FEATURES: [&str; 4] = ["screen", "screen_extra_msaa_samples", "screen_extra_ssaa_samples", "screen_rays"];
+pub const SHARED_FEATURES: [&str; 6] =
+    ["frame", "frame_triangles", "screen", "screen_extra_msaa_samples", "screen_extra_ssaa_samples", "screen_rays"];
 
-/// What a method's whole-screen kernels scale with: the frame's pixels (1e4), its samples
-/// beyond one per pixel, and its samples times the hierarchy depth (every sample's primary
-/// ray).
+/// What a method's whole-screen kernels scale with: a constant per frame (its dispatches,
+/// barriers and resets: a ray tracer's frame at 64² is mostly that), the scene's triangles
+/// (1e4: the structures it rebuilds when objects move), the frame's pixels (1e4), its
+/// samples beyond one per pixel, and its samples times the hierarchy depth (every sample's
+/// primary ray).
 pub fn shared_features(w: &Workload) -> Vec<f64> {
     let px = w.screen / 1e4;
     let [msaa, ssaa] = extra(w);
-    vec![px, px * msaa, px * ssaa, px * w.samples * depth(w)]
+    vec![1.0, w.scene_triangles / 1e4, px, px * msaa, px * ssaa, px * w.samples * depth(w)]
 }
 
 /// Samples beyond one per pixel, multisampled and supersampled.

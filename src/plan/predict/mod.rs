@@ -114,7 +114,7 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
                 let key = error_model::candidate(m.name, v);
                 let (Some(psnr), Some((fixed, screen, shared))) =
-                    (errors.predict(&key, &feats, &aa, aa_n), target.costs.predict(&key, &work))
+                    (errors.predict(&key, &feats, &aa, aa_n, work.screen), target.costs.predict(&key, &work))
                 else {
                     continue;
                 };
