@@ -107,11 +107,9 @@ impl ErrorModel {
     /// [`ErrorModel::fit`] with another ridge penalty.
     pub fn fit_with(samples: &[Sample], keep: &dyn Fn(&Sample) -> bool, ridge: f64) -> ErrorModel {
         let mut by: BTreeMap<String, Vec<&Sample>> = BTreeMap::new();
-        for s in samples.iter().filter(|s| keep(s) && aa_of(&s.knobs) == "off") {
+        for s in samples.iter().filter(|s| keep(s) && at_base(s) && aa_of(&s.knobs) == "off") {
             by.entry(model_key(&candidate(&s.method, &s.knobs)).to_string()).or_default().push(s);
         }
-        by.values_mut().for_each(|ss| ss.retain(|s| at_base(s)));
-        by.retain(|_, ss| !ss.is_empty());
         let methods = by
             .into_iter()
             .map(|(m, ss)| {
@@ -205,7 +203,7 @@ fn aliasing_factor(own: f64, exact: f64, changed: f64) -> Option<f64> {
     Some(((ma - (mo - alias)) / alias).clamp(1e-3, 10.0))
 }
 
-/// The median (in logarithm) of each key's values.
+/// The median of each key's values (logarithms of factors, or exponents).
 fn log_medians<K>(logs: BTreeMap<K, Vec<f64>>) -> impl Iterator<Item = (K, (f64, usize))> {
     logs.into_iter().map(|(k, mut v)| {
         v.sort_by(f64::total_cmp);
