@@ -18,6 +18,10 @@ use crate::vk::Context;
 /// near and far rooms, an occluder, a light, two objects, and tessellations from 600 to 10⁴
 /// triangles.
 pub const SCENES: [usize; 6] = [0, 3, 6, 7, 14, 22];
+/// The scenes on which the knob variants are timed at the larger size too (a glass blob
+/// with a mirror sphere and a light; a thin pane, a glass sphere and a glass blob behind an
+/// occluder in a far room): solid, thin and mirror objects, 2·10³ to 10⁴ triangles.
+pub const VARIANT_SCENES: [usize; 2] = [3, 22];
 /// Its two frame sizes, 9× apart in pixels (screen-proportional costs are told from the
 /// per-frame ones by the pair).
 pub const SIZES: [(u32, u32); 2] = [(64, 64), (192, 192)];
@@ -36,6 +40,7 @@ pub fn plan() -> Measure {
         // The software ray engine and ray hierarchy take 50–100× bvh's time on lavapipe:
         // two scenes give their unit costs.
         sparse: vec![(RAY_ENGINE, 7), (RAY_HIERARCHY, 7)],
+        variant_scenes: Some(VARIANT_SCENES.to_vec()),
         warmup: 1,
         frames: 2,
         errors: false,

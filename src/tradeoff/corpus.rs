@@ -28,6 +28,11 @@ pub struct Measure {
     /// Methods measured on every n-th scene only (the slow exact schemes: their cost per
     /// ray is what the calibration needs, not their error, which is the exact tracer's).
     pub sparse: Vec<(Method, usize)>,
+    /// The scenes on which a variant other than `default` is measured at the sizes after
+    /// the first (`None`: every scene). A calibration times the knobs' per-sample and
+    /// per-texel costs at both sizes on a few scenes and each method's own on all: the
+    /// variants at the larger size were most of its time.
+    pub variant_scenes: Option<Vec<usize>>,
     pub warmup: u32,
     pub frames: u32,
     pub base: Quality,
@@ -70,6 +75,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
             let mut object_pixels = vec![0usize; scene.meshes.len() + 1];
             ids.iter().for_each(|&id| object_pixels[(id as usize).min(scene.meshes.len())] += 1);
             for v in &cfg.variants {
+                let larger = cfg.sizes.first().is_some_and(|&s| s != size);
+                if v != "default" && larger && cfg.variant_scenes.as_ref().is_some_and(|s| !s.contains(&i)) {
+                    continue;
+                }
                 let q = crate::plan::budget::variant_quality(&cfg.base, v)?;
                 let set: Vec<&str> =
                     if v == "default" { Vec::new() } else { v.split_whitespace().filter_map(|p| p.split('=').next()).collect() };

@@ -60,6 +60,7 @@ pub fn run_corpus(
             methods.iter().map(|m| specula::Method::parse(m)).collect::<specula::Result<Vec<_>>>()?
         },
         sparse: vec![(specula::methods::RAY_ENGINE, 12), (specula::methods::RAY_HIERARCHY, 12)],
+        variant_scenes: None,
         warmup: 1,
         frames: 1,
         base: specula::Quality::default(),
