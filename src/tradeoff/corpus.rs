@@ -75,8 +75,8 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
             let mut object_pixels = vec![0usize; scene.meshes.len() + 1];
             ids.iter().for_each(|&id| object_pixels[(id as usize).min(scene.meshes.len())] += 1);
             for v in &cfg.variants {
-                let larger = cfg.sizes.first().is_some_and(|&s| s != size);
-                if v != "default" && larger && cfg.variant_scenes.as_ref().is_some_and(|s| !s.contains(&i)) {
+                let later_size = cfg.sizes.first().is_some_and(|&s| s != size);
+                if v != "default" && later_size && cfg.variant_scenes.as_ref().is_some_and(|s| !s.contains(&i)) {
                     continue;
                 }
                 let q = crate::plan::budget::variant_quality(&cfg.base, v)?;
