@@ -54,15 +54,16 @@ fn fresh(ctx: &specula::vk::Context, scene: &Scene, m: Method, q: &Quality) -> V
 /// maps twice; 3 for the schemes that share bvh's update path and differ only in the
 /// structure they rebuild: kd-tree, grid, octree, bih); each incrementally updated frame
 /// equals a fresh render of the same scene. (`ten_frames_of_a_moving_mirror_sphere` moves
-/// the demo's sphere for ten.)
-#[test]
-fn incremental_equals_fresh_for_every_gpu_method() {
+/// the demo's sphere for ten.) The registry's methods alternate between two tests, `half`
+/// 0 and 1, so that the suite's two test threads share them (one test took 52 s alone).
+fn incremental_equals_fresh(half: usize) {
     let ctx = common::gpu();
     let base = common::mirror_and_glass(24);
     let i = mirror_index(&base);
     let centre = base.meshes[i].bounds().center();
     let q = quality();
-    for &m in specula::Method::ALL.iter().filter(|m| m.is_gpu()) {
+    let methods: Vec<Method> = specula::Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect();
+    for &m in methods.iter().skip(half).step_by(2) {
         let frames = match m.name() {
             "kd-tree" | "grid" | "octree" | "bih" => 3,
             _ => 4,
@@ -80,6 +81,16 @@ fn incremental_equals_fresh_for_every_gpu_method() {
         r.destroy(&ctx);
     }
     common::assert_clean(&ctx);
+}
+
+#[test]
+fn incremental_equals_fresh_for_every_gpu_method_first_half() {
+    incremental_equals_fresh(0);
+}
+
+#[test]
+fn incremental_equals_fresh_for_every_gpu_method_second_half() {
+    incremental_equals_fresh(1);
 }
 
 /// Ten frames of the demo's mirror sphere on a path (distance maps, shadow maps, the

@@ -40,14 +40,16 @@ fn cases() -> Vec<(String, Method, Vec<&'static str>, u32)> {
     v
 }
 
-#[test]
-fn every_method_renders_the_recorded_bits() {
+/// The recorded lines of one half of the cases (alternating, over both scenes): the two
+/// halves are two tests, so that the suite's two test threads share them (one test took 44 s
+/// alone).
+fn renders_the_recorded_bits(half: usize) {
     let ctx = common::gpu();
     let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     let scenes = [("demo", demo), ("mirror_and_glass", common::mirror_and_glass(32))];
     let mut lines = Vec::new();
     for (scene_name, scene) in &scenes {
-        for (label, method, knobs, frames) in cases() {
+        for (label, method, knobs, frames) in cases().into_iter().skip(half).step_by(2) {
             let mut q = {
                 let mut knobs = Quality::default();
                 knobs.cube.cube_size = 32;
@@ -65,10 +67,8 @@ fn every_method_renders_the_recorded_bits() {
     }
     common::assert_clean(&ctx);
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/golden/images.txt");
-    let got = lines.join("\n") + "\n";
     if std::env::var_os("SPECULA_UPDATE_GOLDEN").is_some() {
-        std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
-        std::fs::write(path, &got).unwrap();
+        update(path, half, &lines);
     }
     let want = std::fs::read_to_string(path).unwrap_or_default();
     let want: std::collections::HashMap<&str, &str> = want.lines().filter_map(|l| l.rsplit_once(' ')).collect();
@@ -80,4 +80,35 @@ fn every_method_renders_the_recorded_bits() {
         }
     }
     assert!(bad.is_empty(), "images differ from the recorded bits:\n{}", bad.join("\n"));
+}
+
+/// Writes the table once both halves have rendered, in the order of one full pass (scene,
+/// then case), whichever half finishes last.
+fn update(path: &str, half: usize, lines: &[String]) {
+    static HALVES: std::sync::Mutex<[Option<Vec<String>>; 2]> = std::sync::Mutex::new([None, None]);
+    let mut h = HALVES.lock().unwrap_or_else(|e| e.into_inner());
+    h[half] = Some(lines.to_vec());
+    if let [Some(a), Some(b)] = &*h {
+        let per_scene = cases().len();
+        let (a_n, b_n) = (per_scene.div_ceil(2), per_scene / 2);
+        let mut all = Vec::new();
+        for s in 0..2 {
+            let (mut x, mut y) = (a[s * a_n..(s + 1) * a_n].iter(), b[s * b_n..(s + 1) * b_n].iter());
+            for k in 0..per_scene {
+                all.push(if k % 2 == 0 { x.next() } else { y.next() }.unwrap().clone());
+            }
+        }
+        std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
+        std::fs::write(path, all.join("\n") + "\n").unwrap();
+    }
+}
+
+#[test]
+fn every_method_renders_the_recorded_bits_first_half() {
+    renders_the_recorded_bits(0);
+}
+
+#[test]
+fn every_method_renders_the_recorded_bits_second_half() {
+    renders_the_recorded_bits(1);
 }
