@@ -45,12 +45,12 @@ for b in "${binaries[@]}"; do
   if printf '%s\n' "${alone[@]}" | grep -qx "$n"; then serial+=("$b")
   elif ! printf '%s\n' "${first[@]}" | grep -qx "$n"; then ordered+=("$b"); fi
 done
-logs=target/test-logs
-rm -rf "$logs" && mkdir -p "$logs"
+export TEST_LOGS=target/test-logs
+rm -rf "$TEST_LOGS" && mkdir -p "$TEST_LOGS"
 # One binary: its output to a log, a line when it ends, the whole log if it failed.
 run_one() {
   local b=$1 log start
-  log=target/test-logs/$(basename "$b").log
+  log=$TEST_LOGS/$(basename "$b").log
   start=$(date +%s)
   if "$b" >"$log" 2>&1; then
     echo "ok     $(basename "$b") ($(($(date +%s) - start)) s): $(grep -h '^test result' "$log" | tail -1)"

@@ -89,15 +89,13 @@ fn update(path: &str, half: usize, lines: &[String]) {
     let mut h = HALVES.lock().unwrap_or_else(|e| e.into_inner());
     h[half] = Some(lines.to_vec());
     if let [Some(a), Some(b)] = &*h {
-        let per_scene = cases().len();
-        let (a_n, b_n) = (per_scene.div_ceil(2), per_scene / 2);
-        let mut all = Vec::new();
-        for s in 0..2 {
-            let (mut x, mut y) = (a[s * a_n..(s + 1) * a_n].iter(), b[s * b_n..(s + 1) * b_n].iter());
-            for k in 0..per_scene {
-                all.push(if k % 2 == 0 { x.next() } else { y.next() }.unwrap().clone());
-            }
-        }
+        let by_key: std::collections::HashMap<&str, &String> =
+            a.iter().chain(b).filter_map(|l| l.rsplit_once(' ').map(|(key, _)| (key, l))).collect();
+        let all: Vec<&str> = ["demo", "mirror_and_glass"]
+            .iter()
+            .flat_map(|scene| cases().into_iter().map(move |(label, ..)| format!("{scene} {label}")))
+            .map(|key| by_key[key.as_str()].as_str())
+            .collect();
         std::fs::create_dir_all(std::path::Path::new(path).parent().unwrap()).unwrap();
         std::fs::write(path, all.join("\n") + "\n").unwrap();
     }
