@@ -45,9 +45,10 @@ fn libs() -> &'static Path {
     })
 }
 
-/// A directory of this process for one test (the tests run in parallel; each removes its own).
+/// A directory of this process for one test, under Cargo's target/tmp (the tests run in
+/// parallel; each removes its own when it passes).
 fn scratch(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("specula-c-abi-{}-{test}", std::process::id()));
+    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-c-abi-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -225,6 +226,7 @@ fn updates_from_c_move_objects_and_rebuild_only_what_changed() {
     assert!(out.contains("\n0 failure(s)"), "{out}");
     // Every check the program makes passed (measured 59): none skipped.
     assert_eq!(ok, 59, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
 }
 
 #[test]
@@ -240,4 +242,5 @@ fn misuse_from_c_returns_codes_and_survives() {
     // Every check the program makes passed (measured 137, 19 of them the budgeted
     // planner's, 8 the material's absorption, dispersion and sizes): none skipped.
     assert_eq!(ok, 137, "{out}");
+    std::fs::remove_dir_all(&dir).ok();
 }

@@ -83,7 +83,7 @@ fn mutate(seed: &[u8], rng: &mut Rng) -> Vec<u8> {
 
 /// Keeps a failing input for reproduction (and for the corpus once fixed).
 fn keep(seed: &Path, case: usize, input: &[u8]) -> PathBuf {
-    let dir = std::env::temp_dir().join("specula-fuzz-findings");
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("specula-fuzz-findings");
     let _ = std::fs::create_dir_all(&dir);
     let path = dir.join(format!("{}-{case}", seed.file_name().unwrap().to_string_lossy()));
     let _ = std::fs::write(&path, input);
@@ -184,7 +184,7 @@ fn gltf_and_glb_importer_survive_mutations() {
 
 #[test]
 fn environment_loaders_survive_mutations() {
-    let dir = std::env::temp_dir().join(format!("specula-fuzz-env-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-fuzz-env-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let mut findings = Vec::new();
     for (path, seed) in seeds("env") {

@@ -37,7 +37,7 @@ fn python() -> PathBuf {
 }
 
 fn dir() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("specula-mitsuba-{}", std::process::id()));
+    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-mitsuba-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
 }

@@ -6,7 +6,7 @@ mod shaderc;
 
 #[test]
 fn broken_shader_reports_file_and_line() {
-    let root = std::env::temp_dir().join(format!("specula-shaderc-{}", std::process::id()));
+    let root = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-shaderc-{}", std::process::id()));
     let glsl = root.join("glsl");
     std::fs::create_dir_all(glsl.join("common")).unwrap();
     std::fs::write(glsl.join("common/h.glsl"), "float helper() { return 1.0; }\n").unwrap();

@@ -30,7 +30,7 @@ fn every_embedded_module_validates() {
     embedded.sort();
     assert_eq!(embedded, expected, "embedded modules vs glsl/ sources");
     assert!(embedded.len() > 40, "{} modules", embedded.len());
-    let dir = std::env::temp_dir().join(format!("specula-spirv-{}", std::process::id()));
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-spirv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     for (name, bytes) in specula::shaders::ALL {
         assert_eq!(&bytes[..4], &0x0723_0203u32.to_le_bytes(), "{name}: SPIR-V magic");

@@ -24,7 +24,7 @@ fn run(args: &[&str]) -> String {
 }
 
 fn temp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("specula-{name}-{}", std::process::id()));
+    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
 }
