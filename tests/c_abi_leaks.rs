@@ -15,9 +15,12 @@
 //!   never freed, 60 B of it allocated under vkSetDebugUtilsObjectNameEXT, the rest freed at
 //!   exit), and its transient allocations move single samples by up to 1.5 KiB. Measured
 //!   over ten runs: the least-squares slope 460–507 B per cycle (standard deviation 15 B),
-//!   the median step 464 B every time. The bounds: the slope at most 560 B (the largest
-//!   measured plus 3.5 standard deviations) and the median step at most 528 B (measured
-//!   plus one 64-byte block), so that a leak of about 100 B every cycle shows. The
+//!   the median step 464 B every time (Mesa 22.3.6). The bounds: the slope at most 560 B
+//!   (the largest measured plus 3.5 standard deviations) and the median step at most 528 B
+//!   (measured plus one 64-byte block), so that a leak of about 100 B every cycle shows on
+//!   that driver. On Mesa 25.0.7 (scripts/setup.sh) the driver keeps less: slope 28–95 B,
+//!   median step 0 B in three runs, so there the bounds let a leak of about 450 B a cycle
+//!   through (not tightened: three runs do not give a spread to bound by). The
 //!   33 KiB per cycle the hardening issue measured is the layer's synchronization
 //!   validation (Vulkan-ValidationLayers 1.3.239 keeps about 31 KiB per device it
 //!   tracks): this test turns it off (`SPECULA_SYNC_VALIDATION=0`) so that it measures the
@@ -296,7 +299,7 @@ fn contexts_leak_nothing() {
         );
         // Measured 0 B (see the top).
         assert!(growth.abs() < CYCLES, "library heap grew by {growth} bytes over {CYCLES} create/render/destroy cycles");
-        // Measured 460–507 B and 464 B (see the top).
+        // Measured 460–507 B and 464 B on Mesa 22, 28–95 B and 0 B on Mesa 25 (see the top).
         assert!(slope <= 560.0, "the process's C heap grew by {slope:.1} bytes per create/render/destroy cycle");
         assert!(median <= 528.0, "the process's C heap grew by a median {median} bytes per create/render/destroy cycle");
     }
