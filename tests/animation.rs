@@ -102,7 +102,7 @@ fn close(a: Vec3, b: Vec3) -> bool {
 
 #[test]
 fn every_interpolation_mode_matches_the_closed_form() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-anim-{}", std::process::id()));
+    let dir = common::scratch_dir("anim");
     let mut s = specula::scene::load(&write_animated(&dir, &[0.0, 1.0])).unwrap();
     assert_eq!(s.meshes.len(), 3);
     assert_eq!(s.animation.as_ref().unwrap().duration, 2.0);
@@ -140,7 +140,7 @@ fn every_interpolation_mode_matches_the_closed_form() {
 
 #[test]
 fn malformed_samplers_name_their_field() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-anim-bad-{}", std::process::id()));
+    let dir = common::scratch_dir("anim-bad");
     let e = specula::scene::load(&write_animated(&dir, &[1.0, 1.0])).unwrap_err().to_string();
     assert!(e.contains("animations[0].channels[1].sampler.input") && e.contains("must increase"), "{e}");
     let e = specula::scene::load(&write_animated(&dir, &[0.0, f32::NAN])).unwrap_err().to_string();
@@ -152,7 +152,7 @@ fn malformed_samplers_name_their_field() {
 /// fresh render of the scene posed at that time.
 #[test]
 fn animated_frames_render_like_fresh_ones() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-anim-render-{}", std::process::id()));
+    let dir = common::scratch_dir("anim-render");
     let mut scene = specula::scene::load(&write_animated(&dir, &[0.0, 1.0])).unwrap();
     scene.camera = Some(specula::scene::Camera::look_at(Vec3::new(1.0, 2.0, 9.0), Vec3::new(1.0, 1.0, 0.0), 1.0));
     let light = specula::scene::Light {
@@ -202,7 +202,7 @@ fn animated_frames_render_like_fresh_ones() {
 /// hidden and appears when the animation gives it a scale.
 #[test]
 fn a_node_scaled_up_from_zero_appears() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-anim-pop-{}", std::process::id()));
+    let dir = common::scratch_dir("anim-pop");
     let mut s = specula::scene::load(&write_animated_with(&dir, &[0.0, 1.0], r#","scale":[0,0,0]"#)).unwrap();
     assert_eq!(s.meshes.len(), 3, "the zero-scale node's mesh is imported: {:?}", s.skipped);
     assert!(s.meshes[2].hidden && !s.meshes[0].hidden);

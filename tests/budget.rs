@@ -77,7 +77,7 @@ fn models_cover_objects_keep_forced_ones_and_bad_files_are_named() {
 fn the_cli_calibrates_predicts_and_reports_what_the_frame_measured() {
     // Its GPU work would share the cores with the other tests' timings.
     let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-budget-cli-{}", std::process::id()));
+    let dir = common::scratch_dir("budget-cli");
     std::fs::create_dir_all(&dir).unwrap();
     let models = dir.join("demo-models.json");
     let run = |args: &[&str]| {

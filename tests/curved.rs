@@ -395,7 +395,7 @@ fn curved_reflector_wins_in_a_deep_finely_tessellated_environment_and_auto_is_no
 /// per geometry-image size and tessellation, the search timed apart, one row each.
 #[test]
 fn tradeoff_sweeps_the_geometry_image_and_the_tessellation() {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-curved-tradeoff-{}", std::process::id()));
+    let out = common::scratch_dir("curved-tradeoff");
     let cfg = specula::tradeoff::Config {
         scene: sphere_scene(),
         scene_name: "sphere".into(),

@@ -184,7 +184,7 @@ fn gltf_and_glb_importer_survive_mutations() {
 
 #[test]
 fn environment_loaders_survive_mutations() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-fuzz-env-{}", std::process::id()));
+    let dir = common::scratch_dir("fuzz-env");
     std::fs::create_dir_all(&dir).unwrap();
     let mut findings = Vec::new();
     for (path, seed) in seeds("env") {

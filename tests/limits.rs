@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use specula::scene::{load_environment, load_environment_with, LoadLimits};
 
 fn dir() -> PathBuf {
-    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-limits-{}", std::process::id()));
+    let d = common::scratch_dir("limits");
     std::fs::create_dir_all(&d).unwrap();
     d
 }

@@ -99,7 +99,7 @@ fn errors_split_by_object() {
 fn compare_reports_errors_per_object() {
     let bin = env!("CARGO_BIN_EXE_specula");
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-masks-{}", std::process::id()));
+    let dir = common::scratch_dir("masks");
     std::fs::create_dir_all(&dir).unwrap();
     let run = |args: &[&str]| std::process::Command::new(bin).args(args).output().unwrap();
     let (r, e, err) = (dir.join("r.exr"), dir.join("e.exr"), dir.join("err.png"));

@@ -37,7 +37,7 @@ fn python() -> PathBuf {
 }
 
 fn dir() -> PathBuf {
-    let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-mitsuba-{}", std::process::id()));
+    let d = common::scratch_dir("mitsuba");
     std::fs::create_dir_all(&d).unwrap();
     d
 }

@@ -424,7 +424,7 @@ fn a_corrupt_cost_cache_is_named_and_replaced() {
     use specula::plan::predict::cost_model::{store, CostModel, DeviceKey, FORMAT};
     let ctx = common::gpu();
     let key = specula::plan::predict::device::DeviceKey::of(&ctx);
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-cost-cache-{}", std::process::id()));
+    let dir = common::scratch_dir("cost-cache");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     // Another device's costs, cached beside.

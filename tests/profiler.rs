@@ -51,7 +51,7 @@ fn specula() -> Command {
 
 #[test]
 fn cli_render_writes_image_profile_and_table() {
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-cli-{}", std::process::id()));
+    let dir = common::scratch_dir("cli");
     std::fs::create_dir_all(&dir).unwrap();
     let (png, exr, trace) = (dir.join("a.png"), dir.join("a.exr"), dir.join("trace.json"));
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
@@ -161,7 +161,7 @@ fn cli_info_lists_classification() {
 #[test]
 fn cli_failed_writes_exit_1_naming_the_path() {
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
-    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-writes-{}", std::process::id()));
+    let dir = common::scratch_dir("writes");
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("a-file");
     std::fs::write(&file, b"x").unwrap();

@@ -225,7 +225,7 @@ fn concave_occluder_fools_one_distance_map_not_layered_maps() {
 /// the ball's panel beside the whole image's.
 #[test]
 fn tradeoff_each_on_a_builtin_scene() {
-    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-showcase-each-{}", std::process::id()));
+    let out = common::scratch_dir("showcase-each");
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_specula"))
         .args(["tradeoff", "builtin:corner-mirror", "--size", "32x32", "--warmup", "1", "--frames", "1", "--validate"])
         .args([

@@ -55,6 +55,11 @@ pub fn emissive_room(scene: &mut Scene, center: Vec3, half: f32) {
     specula::scenes::emissive_room(scene, center, half).unwrap()
 }
 
+/// A scratch directory of this test process, under Cargo's target/tmp (not created).
+pub fn scratch_dir(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("specula-{name}-{}", std::process::id()))
+}
+
 /// A mirror material of reflectance `f0` at normal incidence (κ = 0, ν from eq. 2).
 pub fn mirror(f0: f32) -> Material {
     let s = f0.sqrt();
