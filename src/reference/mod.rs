@@ -153,7 +153,7 @@ pub fn sample_offset(x: u32, y: u32, s: u32, spp: u32) -> (f64, f64) {
 }
 
 /// A 32-bit integer hash (lowbias32 by Chris Wellons) of the pixel and sample.
-fn hash(x: u32, y: u32, s: u32) -> u32 {
+pub(crate) fn hash(x: u32, y: u32, s: u32) -> u32 {
     let mut h = x.wrapping_mul(0x9E37_79B9) ^ y.wrapping_mul(0x85EB_CA6B) ^ s.wrapping_mul(0xC2B2_AE35);
     h ^= h >> 16;
     h = h.wrapping_mul(0x7feb_352d);
@@ -209,6 +209,16 @@ impl<'a> Tracer<'a> {
     /// o + t d, t > t_min, sees, with `bounces` specular bounces left.
     pub fn radiance(&self, o: DVec3, d: DVec3, t_min: f64, bounces: u32) -> DVec3 {
         self.trace(Ray { o, d, t_min, skip: None }, bounces, DVec3::ONE, None)
+    }
+
+    /// The mesh the ray o + t d, t > t_min, meets first (`None`: the sky).
+    pub fn first_mesh(&self, o: DVec3, d: DVec3, t_min: f64) -> Option<u32> {
+        self.bvh.intersect(o, d, t_min, f64::INFINITY, None).map(|h| self.bvh.triangles[h.triangle as usize].mesh)
+    }
+
+    /// The specular bounces a path may take (the `depth` knob).
+    pub fn depth(&self) -> u32 {
+        self.depth
     }
 
     /// `radiance`, recording the path's diffuse hits in `sink` for progressive photon

@@ -193,6 +193,29 @@ pub fn run_evaluate(path: &Path, figure: &Path) -> specula::Result<()> {
         };
         println!("{size:<10} sized: n, median, 90th pct, bias {}   ignored: {}", stats(&held), stats(&ignored));
     }
+    let probes = specula::plan::predict::aliasing::probe_corpus(&c.samples, &|_| true)?;
+    let probed = error_model::leave_one_scene_out_probed(&c.samples, &probes);
+    println!(
+        "\nwith the exact tracer's error measured on each held-out object (plan::predict::aliasing; {} objects and sizes):",
+        probes.len()
+    );
+    println!(
+        "{:<24} {:>6} {:>14} {:>12} {:>10}   without: {:>8} {:>8} {:>8}",
+        "method", "n", "median |err|", "90th pct", "bias", "median", "90th", "bias"
+    );
+    let stats = |hs: &[error_model::Held]| {
+        let (med, p90) = error_model::abs_error_quantiles(hs);
+        (med, p90, hs.iter().map(|h| h.predicted_db - h.measured_db).sum::<f64>() / hs.len().max(1) as f64)
+    };
+    let mut pairs: Vec<(String, Vec<error_model::Held>, Vec<error_model::Held>)> = grouped(&probed, |h| &h.method)
+        .into_iter()
+        .map(|(m, hs)| (m.to_string(), hs, held.iter().filter(|h| h.method == m).cloned().collect()))
+        .collect();
+    pairs.push(("all".to_string(), probed.clone(), held.clone()));
+    for (m, with, without) in pairs {
+        let (a, b) = (stats(&with), stats(&without));
+        println!("{m:<24} {:>6} {:>14.2} {:>12.2} {:>10.2}   without: {:>8.2} {:>8.2} {:>8.2}", with.len(), a.0, a.1, a.2, b.0, b.1, b.2);
+    }
     let model = error_model::ErrorModel::fit(&c.samples, &|_| true);
     println!("\nanti-aliasing's factor on the aliasing part of the error (per method; measured samples):");
     for ((m, aa), (f, n)) in &model.aa {

@@ -5,7 +5,10 @@
 //!   over the planner's facts and the knobs (`features`, `error_model`), fitted on a corpus
 //!   of scenes generated in code (`scenes::corpus`, measured by `specula corpus` against the exact
 //!   tracer into `assets/models/corpus.json`); held-out scenes measure how well it
-//!   generalises (`error_model::leave_one_scene_out`).
+//!   generalises (`error_model::leave_one_scene_out`). The part every method shares, the
+//!   exact tracer's own error (aliasing, at this frame's size and anti-aliasing), is not
+//!   predicted but measured on the scene: the CPU reference traces a sample of each
+//!   object's pixels (`aliasing`), and the models' aliasing parts are anchored on it.
 //! * **Cost** is measured on the device: unit costs per method and workload term
 //!   (`cost_model`), fitted on a calibration run of a few corpus scenes (`specula calibrate`,
 //!   or automatically the first time a device is seen), cached per device; the stored
@@ -17,6 +20,7 @@
 //!   exact tracer (`bvh`) is predicted to cost, and within that takes the fastest choice
 //!   within [`TOLERANCE_DB`] of the most accurate one.
 
+pub mod aliasing;
 pub mod cost_model;
 pub mod device;
 pub use cost_model::Target;
@@ -100,10 +104,11 @@ fn coverage(scene: &Scene, size: (u32, u32)) -> Vec<f64> {
 pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, variants: &[String]) -> Result<Models> {
     let errors = error_model();
     let px = coverage(scene, target.size);
+    let measured = aliasing::measure(scene, quality, target.size);
     let mut out = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
-        let (aa, aa_n) = (q.get("aa"), features::aa_samples(&q).1);
+        let (aa, aa_n, per_sample) = (q.get("aa"), features::aa_samples(&q).1, q.frame.msaa_per_sample);
         let mut objects = Vec::new();
         let mut base = 0.0;
         for f in &facts.objects {
@@ -113,9 +118,10 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             let feats = error_features(f, scene, &q);
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
                 let key = error_model::candidate(m.name, v);
-                let (Some(psnr), Some((fixed, screen, shared))) =
-                    (errors.predict(&key, &feats, &aa, aa_n, work.screen), target.costs.predict(&key, &work))
-                else {
+                let (Some(psnr), Some((fixed, screen, shared))) = (
+                    errors.predict(&key, &feats, (&aa, aa_n, per_sample), work.screen, measured[f.mesh].as_ref()),
+                    target.costs.predict(&key, &work),
+                ) else {
                     continue;
                 };
                 let cycles = target.costs.methods.get(&key).map_or(1, |c| c.cycles);
