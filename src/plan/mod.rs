@@ -398,19 +398,26 @@ fn auto_plan(
     }
 }
 
-fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, target: Option<&predict::Target>) -> Result<Plan> {
-    check_names(scene, choices)?;
+/// The radius of proxy-sphere's proxy: the `proxy_radius` knob, else the scene's mean
+/// half extent.
+pub fn proxy_radius(scene: &Scene, quality: &Quality) -> f32 {
     let bounds = scene.bounds();
-    let diag = bounds.diagonal();
-    let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
-    let proxy_radius = quality.envmap.proxy_radius.unwrap_or_else(|| {
+    quality.envmap.proxy_radius.unwrap_or_else(|| {
         let half = (bounds.max - bounds.min) * 0.5;
         if bounds.is_empty() {
             1.0
         } else {
             ((half.x + half.y + half.z) / 3.0).max(1e-6)
         }
-    });
+    })
+}
+
+fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, target: Option<&predict::Target>) -> Result<Plan> {
+    check_names(scene, choices)?;
+    let bounds = scene.bounds();
+    let diag = bounds.diagonal();
+    let cube_near = if diag > 0.0 { diag * 1e-5 } else { 1e-4 };
+    let proxy_radius = proxy_radius(scene, quality);
     // Deep facts (convexity, mutual visibility) for the planner and for mixed choices,
     // whose composition depends on who sees whom; a whole-scene method needs none.
     let whole_scene = matches!(choices.method, Choice::Method(_)) && choices.objects.is_empty();

@@ -221,6 +221,55 @@ impl<'a> Tracer<'a> {
         self.depth
     }
 
+    /// Where the ray o + t d, t > t_min, first meets a mirror: its mesh, the point, the
+    /// reflected direction and the Fresnel weight; `None` where it meets anything else.
+    pub fn mirror_hit(&self, o: DVec3, d: DVec3, t_min: f64) -> Option<MirrorHit> {
+        let hit = self.bvh.intersect(o, d, t_min, f64::INFINITY, None)?;
+        let surface = self.surface(&hit);
+        let m = &self.scene.materials[surface.material];
+        if !matches!(m.kind, SurfaceKind::Mirror { .. }) {
+            return None;
+        }
+        let split = shade::specular_split(m, self.fresnel, d, surface.normal);
+        let mesh = self.bvh.triangles[hit.triangle as usize].mesh;
+        Some(MirrorHit { mesh, position: surface.position, reflected: split.r.normalize(), fresnel: split.fr, triangle: hit.triangle })
+    }
+
+    /// What the reflected ray of `hit` brings back, with one bounce fewer than the camera's.
+    pub fn reflected_radiance(&self, hit: &MirrorHit) -> DVec3 {
+        let ray = Ray { o: hit.position, d: hit.reflected, t_min: self.epsilon, skip: Some(hit.triangle) };
+        self.trace(ray, self.depth.saturating_sub(1), DVec3::ONE, None)
+    }
+
+    /// From `c` in direction `d` (unit), past every surface of mesh `exclude` (what a map of
+    /// that mesh's environment holds): the first other surface's distance (`None`: the sky).
+    pub fn distance_without(&self, c: DVec3, d: DVec3, exclude: u32) -> Option<f64> {
+        self.past(c, d, exclude).map(|(t, _)| t)
+    }
+
+    /// What [`Tracer::distance_without`]'s surface shows (the sky where there is none), with
+    /// one bounce fewer than the camera's.
+    pub fn seen_without(&self, c: DVec3, d: DVec3, exclude: u32) -> DVec3 {
+        match self.past(c, d, exclude) {
+            Some((_, t_min)) => self.trace(Ray { o: c, d, t_min, skip: None }, self.depth.saturating_sub(1), DVec3::ONE, None),
+            None => self.sky.radiance(d),
+        }
+    }
+
+    /// The first hit from `c` along `d` on a mesh other than `exclude`: its distance and the
+    /// ray parameter just past `exclude`'s surfaces before it.
+    fn past(&self, c: DVec3, d: DVec3, exclude: u32) -> Option<(f64, f64)> {
+        let mut t_min = 0.0;
+        for _ in 0..64 {
+            let h = self.bvh.intersect(c, d, t_min, f64::INFINITY, None)?;
+            if self.bvh.triangles[h.triangle as usize].mesh != exclude {
+                return Some((h.t, t_min));
+            }
+            t_min = h.t;
+        }
+        None
+    }
+
     /// `radiance`, recording the path's diffuse hits in `sink` for progressive photon
     /// mapping instead of adding a photon map's estimate there.
     fn trace(&self, ray: Ray, bounces: u32, weight: DVec3, mut sink: Option<&mut HitSink>) -> DVec3 {
@@ -309,6 +358,17 @@ impl<'a> Tracer<'a> {
         }
         shade::emission(m, &self.textures, s.uv) + albedo / std::f64::consts::PI * sum
     }
+}
+
+/// A camera ray's first hit on a mirror ([`Tracer::mirror_hit`]).
+#[derive(Clone, Copy, Debug)]
+pub struct MirrorHit {
+    pub mesh: u32,
+    pub position: DVec3,
+    /// The reflected direction (unit).
+    pub reflected: DVec3,
+    pub fresnel: DVec3,
+    triangle: u32,
 }
 
 /// A ray o + t d, t > t_min, that does not hit triangle `skip` (the one it leaves).

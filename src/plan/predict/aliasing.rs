@@ -36,15 +36,23 @@ const MSAA4: [(f64, f64); 4] = [(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), 
 /// The 2×2 supersampling grid, resolved by averaging.
 const SSAA2: [(f64, f64); 4] = [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)];
 
-/// The exact tracer's mean squared error (per channel, linear radiance, as PSNR measures it)
-/// on an object's pixels against the reference, without anti-aliasing and under the
-/// variants the planner chooses among; from `pixels` traced pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The environment-map methods whose error the probe measures on mirrors: each answers a
+/// reflected ray by one lookup of a cube map around the object's reference point.
+pub const LOOKUP_METHODS: [&str; 5] = ["envmap", "proxy-sphere", "proxy-box", "distance", "distance-multi"];
+
+/// What the probe measures on an object (mean squared errors per channel, linear radiance,
+/// as PSNR measures them, against the reference, over `pixels` traced pixels): the exact
+/// tracer's without anti-aliasing and under the variants the planner chooses among, and on
+/// a mirror the error of each cube-map lookup ([`LOOKUP_METHODS`]) at each cube size.
+#[derive(Clone, Debug, PartialEq)]
 pub struct Aliasing {
     pub pixels: usize,
     pub off: f64,
     pub msaa4: f64,
     pub ssaa2: f64,
+    /// (method, cube size, the lookup's error beyond the exact reflection at the pixel
+    /// centres).
+    pub lookups: Vec<(&'static str, u32, f64)>,
 }
 
 impl Aliasing {
@@ -58,13 +66,25 @@ impl Aliasing {
             _ => None,
         }
     }
+
+    /// The lookup error of `method` with cube maps of `cube_size`, where measured.
+    pub fn lookup(&self, method: &str, cube_size: u32) -> Option<f64> {
+        self.lookups.iter().find(|(m, n, _)| *m == method && *n == cube_size).map(|l| l.2)
+    }
 }
 
-/// Per mesh of `scene` (indexed as `scene.meshes`), the exact tracer's error on its
-/// pixels at `size` with `quality`'s bounces and Fresnel; `None` for meshes that are not
+/// What to measure besides aliasing: per mirror mesh its reference point (the maps'
+/// centre), the cube sizes the lookups run at, and the search's and proxies' knobs.
+pub struct Lookups<'a> {
+    pub mirrors: &'a [(usize, glam::Vec3)],
+    pub cube_sizes: &'a [u32],
+}
+
+/// Per mesh of `scene` (indexed as `scene.meshes`), what the probe measures on its pixels at
+/// `size` with `quality`'s bounces, Fresnel and search knobs; `None` for meshes that are not
 /// specular or that no lattice pixel shows, and for every mesh when the reference cannot
 /// trace the scene.
-pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32)) -> Vec<Option<Aliasing>> {
+pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Lookups) -> Vec<Option<Aliasing>> {
     let none = vec![None; scene.meshes.len()];
     let (w, h) = size;
     if w == 0 || h == 0 || scene.specular_meshes().next().is_none() {
@@ -106,31 +126,164 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32)) -> Vec<Option
         tracer.radiance(o, d, t, depth)
     };
     let mean = |x: u32, y: u32, offsets: &[(f64, f64)]| offsets.iter().map(|&s| at(x, y, s)).sum::<DVec3>() / offsets.len() as f64;
+    let env = Environment { scene, quality, tracer: &tracer, cube_sizes: lookups.cube_sizes };
     by_mesh
         .into_iter()
-        .map(|pixels| {
+        .enumerate()
+        .map(|(mesh, pixels)| {
             if pixels.is_empty() {
                 return None;
             }
             let n = pixels.len().min(PIXELS);
             let chosen: Vec<(u32, u32)> = (0..n).map(|k| pixels[k * pixels.len() / n]).collect();
+            let centre = lookups.mirrors.iter().find(|(m, _)| *m == mesh).map(|(_, c)| c.as_dvec3());
             let sq = |a: DVec3, b: DVec3| (a - b).length_squared() / 3.0;
-            let sums = chosen
+            let per_pixel: Vec<Vec<f64>> = chosen
                 .par_iter()
                 .map(|&(x, y)| {
                     let reference: Vec<(f64, f64)> = (0..spp).map(|s| sample_offset(x, y, s, spp)).collect();
                     let r = mean(x, y, &reference);
-                    let e = [sq(at(x, y, (0.5, 0.5)), r), sq(mean(x, y, &MSAA4), r), sq(mean(x, y, &SSAA2), r)];
-                    if e.iter().all(|v| v.is_finite()) {
-                        (e, 1usize)
-                    } else {
-                        ([0.0; 3], 0)
+                    let mut e = vec![sq(at(x, y, (0.5, 0.5)), r), sq(mean(x, y, &MSAA4), r), sq(mean(x, y, &SSAA2), r)];
+                    if let Some(c) = centre {
+                        let (o, d, t) = rays.ray(x as f64 + 0.5, y as f64 + 0.5);
+                        e.extend(env.lookup_errors(mesh as u32, c, tracer.mirror_hit(o, d, t)));
                     }
+                    e
                 })
-                .reduce(|| ([0.0; 3], 0), |a, b| ([a.0[0] + b.0[0], a.0[1] + b.0[1], a.0[2] + b.0[2]], a.1 + b.1));
-            let (e, k) = sums;
-            (k > 0).then(|| Aliasing { pixels: k, off: e[0] / k as f64, msaa4: e[1] / k as f64, ssaa2: e[2] / k as f64 })
+                .filter(|e| e.iter().all(|v| v.is_finite()))
+                .collect();
+            let k = per_pixel.len();
+            if k == 0 {
+                return None;
+            }
+            let sum = |i: usize| per_pixel.iter().map(|e| e[i]).sum::<f64>() / k as f64;
+            let lookups = match centre {
+                Some(_) => env.keys().enumerate().map(|(i, (m, n))| (m, n, sum(3 + i))).collect(),
+                None => Vec::new(),
+            };
+            Some(Aliasing { pixels: k, off: sum(0), msaa4: sum(1), ssaa2: sum(2), lookups })
         })
+        .collect()
+}
+
+/// The cube-map lookups of [`LOOKUP_METHODS`], simulated with the reference: a map texel
+/// holds what its centre's direction shows from the reference point with the object left
+/// out (as the GPU's maps are rendered), bilinearly filtered as the shaders sample it.
+struct Environment<'a> {
+    scene: &'a Scene,
+    quality: &'a Quality,
+    tracer: &'a Tracer<'a>,
+    cube_sizes: &'a [u32],
+}
+
+impl Environment<'_> {
+    /// (method, cube size) in the order [`Environment::lookup_errors`] returns them.
+    fn keys(&self) -> impl Iterator<Item = (&'static str, u32)> + '_ {
+        LOOKUP_METHODS.into_iter().flat_map(move |m| self.cube_sizes.iter().map(move |&n| (m, n)))
+    }
+
+    /// Per key, the squared error (per channel) of the lookup's reflection at a pixel whose
+    /// centre ray meets mirror `mesh` at `hit` (zeros where it meets something else: the
+    /// silhouette's pixels, whose error the aliasing part holds).
+    fn lookup_errors(&self, mesh: u32, c: DVec3, hit: Option<crate::reference::MirrorHit>) -> Vec<f64> {
+        let keys: Vec<(&str, u32)> = self.keys().collect();
+        let Some(hit) = hit.filter(|h| h.mesh == mesh) else { return vec![0.0; keys.len()] };
+        let exact = self.tracer.reflected_radiance(&hit);
+        let (x, r) = (hit.position, hit.reflected);
+        let bounds = self.scene.bounds();
+        let radius = crate::plan::proxy_radius(self.scene, self.quality) as f64;
+        let s = &self.quality.search;
+        let map = |dir: DVec3| {
+            let len = dir.length();
+            if len <= 0.0 {
+                return 0.0;
+            }
+            self.tracer.distance_without(c, dir / len, mesh).unwrap_or(2.0 * crate::search::SEARCH_SKY)
+        };
+        let searched =
+            crate::search::linear_search(&map, x - c, r, s.linear_steps, s.binary_steps, s.secant_steps, s.search_tolerance as f64);
+        let towards = |m: &str| -> DVec3 {
+            match m {
+                "envmap" => r,
+                "proxy-sphere" => sphere_exit(x - c, r, radius),
+                "proxy-box" => box_exit(bounds.min.as_dvec3(), bounds.max.as_dvec3(), x, r).map_or(r, |p| p - c),
+                _ => searched.dir,
+            }
+        };
+        keys.iter()
+            .map(|&(m, n)| {
+                let seen = bilinear(towards(m), n, &|d| self.tracer.seen_without(c, d, mesh));
+                (hit.fresnel * (seen - exact)).length_squared() / 3.0
+            })
+            .collect()
+    }
+}
+
+/// proxy.frag's sphere: the direction from the centre to where x + t r leaves the sphere of
+/// `radius` around it (x relative to the centre); r itself where it misses.
+fn sphere_exit(x: DVec3, r: DVec3, radius: f64) -> DVec3 {
+    let b = x.dot(r);
+    let disc = b * b - (x.length_squared() - radius * radius);
+    if disc < 0.0 {
+        return r;
+    }
+    let t = -b + disc.sqrt();
+    if t > 0.0 {
+        x + r * t
+    } else {
+        r
+    }
+}
+
+/// proxy.frag's box: where x + t r leaves the box (`None` where it does not, ahead).
+fn box_exit(min: DVec3, max: DVec3, x: DVec3, r: DVec3) -> Option<DVec3> {
+    let inv = r.recip();
+    let (t0, t1) = ((min - x) * inv, (max - x) * inv);
+    let t = t0.max(t1).min_element();
+    (t > 0.0).then(|| x + r * t)
+}
+
+/// A cube map of `n`² texels a face, sampled bilinearly in direction `dir` (within its
+/// face, clamped at the face's edge): `texel(d)` is what the texel whose centre lies in
+/// direction d holds.
+fn bilinear(dir: DVec3, n: u32, texel: &dyn Fn(DVec3) -> DVec3) -> DVec3 {
+    let a = dir.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+    let major = dir[axis];
+    if major == 0.0 || !major.is_finite() {
+        return texel(dir);
+    }
+    let n = n.max(1) as f64;
+    let coord = |k: usize| ((dir[k] / major.abs() + 1.0) * 0.5 * n - 0.5).clamp(0.0, n - 1.0);
+    let (su, sv) = (coord(u), coord(v));
+    let (iu, iv) = (su.floor(), sv.floor());
+    let (fu, fv) = (su - iu, sv - iv);
+    let centre = |i: f64, j: f64| {
+        let mut d = DVec3::ZERO;
+        d[axis] = major.signum();
+        d[u] = ((i + 0.5) / n) * 2.0 - 1.0;
+        d[v] = ((j + 0.5) / n) * 2.0 - 1.0;
+        texel(d.normalize())
+    };
+    let (i1, j1) = ((iu + 1.0).min(n - 1.0), (iv + 1.0).min(n - 1.0));
+    let weights = [((1.0 - fu) * (1.0 - fv), iu, iv), (fu * (1.0 - fv), i1, iv), ((1.0 - fu) * fv, iu, j1), (fu * fv, i1, j1)];
+    weights.iter().filter(|(w, _, _)| *w > 0.0).map(|&(w, i, j)| centre(i, j) * w).sum()
+}
+
+/// Each mirror's mesh and reference point, from the planner's facts.
+pub fn mirrors(scene: &Scene, facts: &crate::plan::facts::SceneFacts) -> Vec<(usize, glam::Vec3)> {
+    facts
+        .objects
+        .iter()
+        .filter(|o| matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Mirror { .. }))
+        .map(|o| (o.mesh, o.reference_point))
         .collect()
 }
 
@@ -150,7 +303,9 @@ pub fn probe_corpus(samples: &[Sample], keep: &dyn Fn(usize) -> bool) -> Result<
     for (scene, screen) in keys {
         let s = crate::scenes::corpus::scene(scene)?;
         let side = (screen as f64).sqrt().round() as u32;
-        for (m, a) in measure(&s, &q, (side, side)).into_iter().enumerate() {
+        let mirrors = mirrors(&s, &crate::plan::facts::SceneFacts::new(&s, &q, false));
+        let lookups = Lookups { mirrors: &mirrors, cube_sizes: &[128, 256, 512] };
+        for (m, a) in measure(&s, &q, (side, side), &lookups).into_iter().enumerate() {
             if let Some(a) = a {
                 probes.insert((scene, s.meshes[m].name.clone(), screen), a);
             }
@@ -172,16 +327,62 @@ mod tests {
     fn sampling_more_finely_aliases_less() {
         let mut room = Scene::new();
         crate::scenes::checker_room(&mut room, Vec3::ZERO, 2.0).unwrap();
-        assert!(measure(&room, &Quality::default(), (32, 32)).iter().all(Option::is_none));
+        assert!(measure(&room, &Quality::default(), (32, 32), &Lookups { mirrors: &[], cube_sizes: &[] }).iter().all(Option::is_none));
         let s = crate::scenes::corpus::scene(0).unwrap();
         let ball = s.specular_meshes().next().unwrap().0;
         let q = Quality::default();
-        let small = measure(&s, &q, (48, 48))[ball].expect("the ball is in view");
-        let large = measure(&s, &q, (192, 192))[ball].unwrap();
+        let none = Lookups { mirrors: &[], cube_sizes: &[] };
+        let small = measure(&s, &q, (48, 48), &none)[ball].clone().expect("the ball is in view");
+        let large = measure(&s, &q, (192, 192), &none)[ball].clone().unwrap();
         assert!(small.pixels >= 64 && large.pixels == PIXELS, "{small:?} {large:?}");
         assert!(small.off > 0.0 && small.msaa4 < small.off && small.ssaa2 < small.off, "{small:?}");
         assert!(large.off < small.off, "{small:?} {large:?}");
-        assert_eq!(measure(&s, &q, (48, 48))[ball], Some(small));
+        assert_eq!(measure(&s, &q, (48, 48), &none)[ball], Some(small.clone()));
         assert_eq!(small.mse("msaa4", false), None, "multisamples shaded once per pixel are not traced");
+        assert!(small.lookups.is_empty(), "no lookups asked for");
+    }
+
+    /// A mirror ball at the centre of a box room, its maps centred on it: the box proxy is
+    /// the room itself and the distance map holds it, so both look up what the reflected
+    /// rays see, up to the texels' filtering (less with larger maps); a lookup at infinity
+    /// (envmap) and a sphere proxy miss the parallax.
+    #[test]
+    fn lookups_in_a_box_room_rank_as_its_geometry_says() {
+        let mut s = Scene::new();
+        crate::scenes::checker_room(&mut s, Vec3::ZERO, 2.0).unwrap();
+        let m = s
+            .add_material(crate::scene::Material {
+                name: "m".into(),
+                kind: crate::scene::SurfaceKind::Mirror { nu: Vec3::splat(3.0), kappa: Vec3::ZERO },
+                ..Default::default()
+            })
+            .unwrap();
+        let ball = s.add_mesh(crate::scene::shapes::uv_sphere("ball", Vec3::ZERO, 0.5, 32, 16, m)).unwrap();
+        s.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.3, 0.4, 1.8), Vec3::ZERO, 0.9));
+        let lookups = Lookups { mirrors: &[(ball, Vec3::ZERO)], cube_sizes: &[64, 256] };
+        let a = measure(&s, &Quality::default(), (64, 64), &lookups)[ball].clone().expect("the ball is in view");
+        let at = |m: &str, n: u32| a.lookup(m, n).unwrap();
+        for n in [64, 256] {
+            assert!(at("proxy-box", n) < 0.2 * at("envmap", n) && at("distance", n) < 0.2 * at("envmap", n), "{:?}", a.lookups);
+            assert!(at("proxy-sphere", n) > at("proxy-box", n), "{:?}", a.lookups);
+        }
+        assert!(at("proxy-box", 256) < at("proxy-box", 64), "finer texels: {:?}", a.lookups);
+    }
+
+    #[test]
+    fn proxies_and_filtering_follow_the_shaders() {
+        // From the centre of a unit sphere every ray leaves at distance 1 along itself.
+        let r = DVec3::new(0.0, 0.6, 0.8);
+        assert!((sphere_exit(DVec3::ZERO, r, 1.0) - r).length() < 1e-12);
+        // A point outside a sphere it misses keeps the direction alone.
+        assert_eq!(sphere_exit(DVec3::new(5.0, 0.0, 0.0), DVec3::Y, 1.0), DVec3::Y);
+        let exit = box_exit(DVec3::splat(-1.0), DVec3::splat(1.0), DVec3::ZERO, DVec3::X).unwrap();
+        assert!((exit - DVec3::X).length() < 1e-12);
+        assert_eq!(box_exit(DVec3::splat(-1.0), DVec3::splat(1.0), DVec3::splat(3.0), DVec3::X), None);
+        // Bilinear filtering reproduces what every texel holds alike, and weights 4 texels.
+        let c = bilinear(DVec3::new(0.3, 1.0, -0.2), 16, &|_| DVec3::splat(2.0));
+        assert!((c - DVec3::splat(2.0)).length() < 1e-12);
+        let x = bilinear(DVec3::new(1.0, 0.01, 0.02), 8, &|d| d);
+        assert!(x.x > 0.95 && x.y.abs() < 0.2 && x.z.abs() < 0.2, "{x:?}");
     }
 }

@@ -140,18 +140,24 @@ impl ErrorModel {
 
     /// Predicted PSNR of `method` on an object with these features in a frame of `screen`
     /// pixels anti-aliased by `aa` (a value of the `aa` knob) resolving `aa_samples` samples
-    /// per pixel; `None` for a method the corpus never measured. `measured`: the exact
-    /// tracer's error on the object at this size, measured ([`super::aliasing`]) — the
-    /// anchor of every method's aliasing part (with the error under `aa` where it was
-    /// measured).
+    /// per pixel with cube maps of `cube_size`; `None` for a method the corpus never
+    /// measured. `measured`: what the probe measured on the object at this size
+    /// ([`super::aliasing`]): the exact tracer's error, the anchor of every method's
+    /// aliasing part (with the error under `aa` where it was measured), and on a mirror the
+    /// error of the cube-map lookups, which with that aliasing is their prediction.
     pub fn predict(
         &self,
         method: &str,
         features: &[f64],
-        (aa, aa_samples, per_sample): (&str, f64, bool),
+        (aa, aa_samples, per_sample, cube_size): (&str, f64, bool, u32),
         screen: f64,
         measured: Option<&Aliasing>,
     ) -> Option<f64> {
+        if let Some(m) = measured {
+            if let Some(lookup) = m.lookup(method, cube_size) {
+                return Some(psnr(lookup + m.mse(aa, per_sample).unwrap_or(m.off)));
+            }
+        }
         let own = self.predict_off(method, features)?;
         let aa_factor = if aa == "off" { 1.0 } else { self.aa_factor(method, aa, aa_samples) };
         let size = self.size_factor(method, screen);
@@ -355,7 +361,9 @@ fn held_out(samples: &[Sample], ridge: f64, sized: bool, probes: Option<&Probes>
             let name = candidate(&s.method, &s.knobs);
             let screen = if sized { s.work.screen } else { BASE_SCREEN };
             let probe = probes.and_then(|p| p.get(&(sc, s.object.clone(), s.work.screen.round() as u64)));
-            if let Some(p) = model.predict(&name, &s.features, (aa, n, true), screen, probe) {
+            let cube =
+                crate::plan::budget::variant_quality(&crate::quality::Quality::default(), &s.knobs).map_or(256, |q| q.cube.cube_size);
+            if let Some(p) = model.predict(&name, &s.features, (aa, n, true, cube), screen, probe) {
                 out.push(Held {
                     scene: sc,
                     object: s.object.clone(),

@@ -104,7 +104,12 @@ fn coverage(scene: &Scene, size: (u32, u32)) -> Vec<f64> {
 pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, variants: &[String]) -> Result<Models> {
     let errors = error_model();
     let px = coverage(scene, target.size);
-    let measured = aliasing::measure(scene, quality, target.size);
+    let mut cube_sizes: Vec<u32> =
+        variants.iter().filter_map(|v| budget::variant_quality(quality, v).ok()).map(|q| q.cube.cube_size).collect();
+    cube_sizes.sort();
+    cube_sizes.dedup();
+    let mirrors = aliasing::mirrors(scene, facts);
+    let measured = aliasing::measure(scene, quality, target.size, &aliasing::Lookups { mirrors: &mirrors, cube_sizes: &cube_sizes });
     let mut out = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
@@ -119,7 +124,7 @@ pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, targ
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {
                 let key = error_model::candidate(m.name, v);
                 let (Some(psnr), Some((fixed, screen, shared))) = (
-                    errors.predict(&key, &feats, (&aa, aa_n, per_sample), work.screen, measured[f.mesh].as_ref()),
+                    errors.predict(&key, &feats, (&aa, aa_n, per_sample, q.cube.cube_size), work.screen, measured[f.mesh].as_ref()),
                     target.costs.predict(&key, &work),
                 ) else {
                     continue;
