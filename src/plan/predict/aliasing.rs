@@ -29,7 +29,9 @@ use crate::scene::Scene;
 pub const LATTICE: u32 = 16384;
 /// Pixels traced per object (evenly spread over its lattice pixels).
 pub const PIXELS: usize = 128;
-/// The reference's samples per pixel when the quality's `spp` is not a perfect square.
+/// Samples per pixel of the image errors are measured against: the converged pixel, as 16
+/// stratified samples estimate it (as `specula tradeoff`'s reference and the corpus's 4×4
+/// supersampling do), whatever `spp` the caller's own reference renders take.
 const REFERENCE_SPP: u32 = 16;
 /// Vulkan's standard sample locations for 4 samples.
 const MSAA4: [(f64, f64); 4] = [(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), (0.625, 0.875)];
@@ -98,10 +100,7 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
         return none;
     }
     let rays = CameraRays::new(&camera, w, h);
-    let spp = match quality.reference.spp {
-        s if s > 0 && s.isqrt().pow(2) == s => s,
-        _ => REFERENCE_SPP,
-    };
+    let spp = REFERENCE_SPP;
     let step = ((w as f64 * h as f64 / LATTICE as f64).sqrt().ceil() as u32).max(1);
     let specular: Vec<bool> = (0..scene.meshes.len()).map(|m| scene.specular_meshes().any(|(i, _)| i == m)).collect();
     // One pixel per lattice cell (placed in the cell by a hash), grouped by what it shows.

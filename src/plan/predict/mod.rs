@@ -16,9 +16,12 @@
 //!   `assets/models/costs.json`.
 //! * **The choice** is the budgeted planner's search (`plan::budget`) over per-object
 //!   candidates built from these predictions: shared passes paid once, composition cycles
-//!   counted, dominated candidates dropped. Without a budget, `auto` spends at most what the
-//!   exact tracer (`bvh`) is predicted to cost, and within that takes the fastest choice
-//!   within [`TOLERANCE_DB`] of the most accurate one.
+//!   counted, dominated candidates dropped. Without a budget, `auto` spends at most what
+//!   `bvh` or the device's exact tracer ([`device_exact`]: ray queries where it has them) is
+//!   predicted to cost, and within that takes the fastest choice within [`TOLERANCE_DB`] of
+//!   the most accurate one; objects it ray traces get the device's own scheme unless another
+//!   is predicted more than [`SCHEME_MARGIN`] faster (the schemes render one image, and the
+//!   unit costs do not rank them reliably).
 
 pub mod aliasing;
 pub mod cost_model;
@@ -38,9 +41,9 @@ use samples::Corpus;
 
 use super::budget::{self, Budget, Cost, Models, ObjectModel, Prediction, VariantModel};
 use super::facts::SceneFacts;
-use super::{Choices, Method};
+use super::{Choice, Choices, Method};
 use crate::error::{Error, Result};
-use crate::methods::BVH;
+use crate::methods::{BVH, RAY_QUERY};
 use crate::quality::Quality;
 use crate::scene::Scene;
 
@@ -241,6 +244,9 @@ pub struct AutoPlan {
     pub quality: Quality,
     pub prediction: Prediction,
     pub models: Models,
+    /// Why the exact objects got the device's own exact scheme over the one predicted
+    /// fastest (`SCHEME_MARGIN`), where they did.
+    pub note: Option<String>,
 }
 
 impl AutoPlan {
@@ -260,11 +266,16 @@ impl AutoPlan {
             format!("; runner-up {} ({:.1} dB, {:.1} ms)", r.method, r.psnr_db, ms)
         });
         let knobs = if self.prediction.knobs == "default" { String::new() } else { format!(" with {}", self.prediction.knobs) };
-        format!("auto: predicted {:.1} dB, {:.1} ms{knobs}{runner}; budget {}", o.psnr_db, o.ms, b.describe())
+        let note = match &self.note {
+            Some(n) if error_model::model_key(method.name) == error_model::EXACT => format!("; {n}"),
+            _ => String::new(),
+        };
+        format!("auto: predicted {:.1} dB, {:.1} ms{knobs}{runner}; budget {}{note}", o.psnr_db, o.ms, b.describe())
     }
 }
 
-/// `auto` without a budget: the exact tracer's predicted frame (at the asked knobs) is the
+/// `auto` without a budget: the exact tracers' predicted frame (bvh's or the device's own
+/// scheme's, the larger; at the asked knobs) is the
 /// budget; within it, over the methods and [`auto_variants`], the fastest choice within the
 /// tolerance of the most accurate. `None` when some object has no prediction.
 pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Quality, target: &Target) -> Result<Option<AutoPlan>> {
@@ -277,28 +288,86 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
     let exact_src = [(&asked, source(target))];
     let src = [(&models, source(target))];
     let run = |c: &Choices, b: Budget| budget::choose_with(scene, facts, c, quality, b, target.size, &src);
-    // The exact tracer for every object the caller left to auto.
-    let mut exact = choices.clone();
-    for f in &facts.objects {
-        if !choices.objects.iter().any(|(n, _)| super::names_object(scene, f.mesh, n)) {
-            exact.objects.push((scene.meshes[f.mesh].name.clone(), BVH));
+    // An exact tracer for every object the caller left to auto: bvh, and the device's own
+    // scheme; the budget is the larger of their predicted frames.
+    let mut max_ms = f64::NEG_INFINITY;
+    for scheme in [BVH, device_exact(target)] {
+        let mut exact = choices.clone();
+        for f in &facts.objects {
+            if !choices.objects.iter().any(|(n, _)| super::names_object(scene, f.mesh, n)) {
+                exact.objects.push((scene.meshes[f.mesh].name.clone(), scheme));
+            }
         }
+        let Some((_, _, e)) = budget::choose_with(scene, facts, &exact, quality, Budget::MaxMs(f64::INFINITY), target.size, &exact_src)?
+        else {
+            return Ok(None);
+        };
+        max_ms = max_ms.max(e.frame_ms);
     }
-    let Some((_, _, exact)) = budget::choose_with(scene, facts, &exact, quality, Budget::MaxMs(f64::INFINITY), target.size, &exact_src)?
-    else {
-        return Ok(None);
-    };
-    let max_ms = exact.frame_ms;
     let Some((_, _, best)) = run(choices, Budget::MaxMs(max_ms))? else { return Ok(None) };
     let tolerance = if quality.plan.planner.speed() { SPEED_TOLERANCE_DB } else { TOLERANCE_DB };
     let floor_db = best.specular_psnr_db - tolerance;
-    Ok(run(choices, Budget::Near { max_ms, floor_db })?.map(|(choices, quality, prediction)| AutoPlan {
-        choices,
-        quality,
-        prediction,
-        models,
-    }))
+    let Some((mut chosen, quality_chosen, mut prediction)) = run(choices, Budget::Near { max_ms, floor_db })? else { return Ok(None) };
+    // Among the exact schemes, which render the same image, the device's own (ray queries
+    // where it has them, else bvh) unless another is predicted faster by more than the
+    // models can rank them (SCHEME_MARGIN).
+    let preferred = device_exact(target);
+    let exact = |m: Method| error_model::model_key(m.name) == error_model::EXACT;
+    let methods: Vec<(String, Method)> = prediction.objects.iter().map(|o| (o.name.clone(), o.method)).collect();
+    let swapped = Choices {
+        method: Choice::Auto,
+        objects: methods.iter().map(|(n, m)| (n.clone(), if exact(*m) && !choices_fix(choices, n) { preferred } else { *m })).collect(),
+    };
+    let mut note = None;
+    if swapped.objects != methods {
+        let same_knobs =
+            Models { variants: models.variants.iter().filter(|v| v.knobs == prediction.knobs).cloned().collect(), ..models.clone() };
+        let src = [(&same_knobs, source(target))];
+        if let Some((c, _, p)) =
+            budget::choose_with(scene, facts, &swapped, &quality_chosen, Budget::MaxMs(f64::INFINITY), target.size, &src)?
+        {
+            if p.frame_ms <= prediction.frame_ms * (1.0 + SCHEME_MARGIN) {
+                let mut names: Vec<String> =
+                    methods.iter().zip(&swapped.objects).filter(|(a, b)| a.1 != b.1).map(|(a, _)| a.1.name.to_string()).collect();
+                names.sort();
+                names.dedup();
+                note = Some(format!(
+                    "{preferred} rather than {}: the exact schemes render one image, and its frame, predicted at {:.1} ms against {:.1}, is within the {:.1}× by which the unit costs misrank them",
+                    names.join(", "),
+                    p.frame_ms,
+                    prediction.frame_ms,
+                    1.0 + SCHEME_MARGIN
+                ));
+                chosen = c;
+                prediction = Prediction { budget: prediction.budget, knobs: prediction.knobs, ..p };
+            }
+        }
+    }
+    Ok(Some(AutoPlan { choices: chosen, quality: quality_chosen, prediction, models, note }))
 }
+
+/// The device's own exact tracer: ray queries where its unit costs measured them (the
+/// device has them), else bvh. `auto`'s default budget is its predicted frame.
+pub fn device_exact(target: &Target) -> Method {
+    if target.costs.methods.contains_key(RAY_QUERY.name) {
+        RAY_QUERY
+    } else {
+        BVH
+    }
+}
+
+/// Whether the caller fixed object `name`'s method (auto may not change it).
+fn choices_fix(choices: &Choices, name: &str) -> bool {
+    choices.objects.iter().any(|(n, _)| n == name)
+}
+
+/// How much faster than the device's own exact scheme another exact scheme must be predicted
+/// for auto to take it (1.0: twice as fast). The schemes render the same image, and the unit
+/// costs, fitted at 64² and 192², rank their traversal at 512² wrong by up to 2.3× on this
+/// machine (concave mirror: bih predicted 0.63× ray-query's frame, measured 1.47×); measured
+/// in one run per scene on six scenes at 512², ray queries were the fastest scheme on three
+/// and within 1.37× of the fastest on the others, bih 1.3–1.9× bvh's (BENCHMARKS.md).
+pub const SCHEME_MARGIN: f64 = 1.0;
 
 /// Hysteresis: switching from `current` to `next` (per-object methods, every object named)
 /// must gain more than this PSNR (within the default budget) ...
@@ -326,13 +395,17 @@ pub fn switch(
         let src = [(models, source(target))];
         Ok(budget::choose_with(scene, facts, c, q, Budget::MaxMs(f64::INFINITY), target.size, &src)?.map(|r| r.2))
     };
-    let exact = Choices { method: current.0.method, objects: current.0.objects.iter().map(|(n, _)| (n.clone(), BVH)).collect() };
-    let (a, b, e) =
-        (eval(current.0, current.1, &now)?, eval(next.0, next.1, then.as_ref().unwrap_or(&now))?, eval(&exact, current.1, &now)?);
-    let (Some(a), Some(b), Some(e)) = (a, b, e) else {
+    let exact = |m: Method| Choices { method: current.0.method, objects: current.0.objects.iter().map(|(n, _)| (n.clone(), m)).collect() };
+    let (a, b, e, d) = (
+        eval(current.0, current.1, &now)?,
+        eval(next.0, next.1, then.as_ref().unwrap_or(&now))?,
+        eval(&exact(BVH), current.1, &now)?,
+        eval(&exact(device_exact(target)), current.1, &now)?,
+    );
+    let (Some(a), Some(b), Some(e), Some(d)) = (a, b, e, d) else {
         return Ok(None);
     };
-    let max_ms = e.frame_ms;
+    let max_ms = e.frame_ms.max(d.frame_ms);
     let better = b.specular_psnr_db > a.specular_psnr_db + SWITCH_DB && b.frame_ms <= max_ms;
     let cheaper = b.frame_ms < a.frame_ms * (1.0 - SWITCH_SAVING) && b.specular_psnr_db >= a.specular_psnr_db - TOLERANCE_DB;
     let back = a.frame_ms > max_ms * 1.1 && b.frame_ms <= max_ms;
