@@ -12,6 +12,14 @@
 //! the error is measured against), and the mean squared differences are the exact tracer's
 //! error under each. [`super::error_model::ErrorModel::predict`] anchors every method's
 //! aliasing on it.
+//!
+//! On a mirror the same pixels also measure the cube-map methods' lookups ([`LOOKUP_METHODS`]),
+//! the other part the features describe coarsely (proxy-box on a mirror ball in a room's
+//! corner: 22.1 dB predicted by the model, 39.1 measured): each texel holds what its centre's
+//! direction shows from the reference point with the object left out, filtered bilinearly, the
+//! proxies intersected as `proxy.frag` does and the distance map searched by `search.rs`, the
+//! CPU twin of the GLSL search. The lookup's error with the measured aliasing is the method's
+//! prediction.
 
 use std::collections::BTreeMap;
 
@@ -20,7 +28,6 @@ use rayon::prelude::*;
 
 use super::samples::Sample;
 use crate::error::Result;
-
 use crate::quality::{Caustics, Quality};
 use crate::reference::{sample_offset, CameraRays, Tracer};
 use crate::scene::Scene;
@@ -76,7 +83,8 @@ impl Aliasing {
 }
 
 /// What to measure besides aliasing: per mirror mesh its reference point (the maps'
-/// centre), the cube sizes the lookups run at, and the search's and proxies' knobs.
+/// centre), and the cube sizes the lookups run at (the search's and proxies' knobs are the
+/// quality's).
 pub struct Lookups<'a> {
     pub mirrors: &'a [(usize, glam::Vec3)],
     pub cube_sizes: &'a [u32],
