@@ -105,14 +105,32 @@ fn coverage(scene: &Scene, size: (u32, u32)) -> Vec<f64> {
 /// Per object and method, the predicted cost and error at `target`, in the budgeted
 /// planner's format (one variant per entry of `variants`).
 pub fn predict_models(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, variants: &[String]) -> Result<Models> {
+    let cube_sizes: Vec<u32> = variants.iter().filter_map(|v| budget::variant_quality(quality, v).ok()).map(|q| q.cube.cube_size).collect();
+    let measured = probe(scene, facts, quality, target, &cube_sizes);
+    models_measured(scene, facts, quality, target, variants, &measured)
+}
+
+/// What [`aliasing::measure`] measures on each object at `target`'s size, the lookups at
+/// each of `cube_sizes`.
+fn probe(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, cube_sizes: &[u32]) -> Vec<Option<aliasing::Aliasing>> {
+    let mut sizes = cube_sizes.to_vec();
+    sizes.sort();
+    sizes.dedup();
+    let mirrors = aliasing::mirrors(scene, facts);
+    aliasing::measure(scene, quality, target.size, &aliasing::Lookups { mirrors: &mirrors, cube_sizes: &sizes })
+}
+
+/// [`predict_models`] with the probe's measurements given.
+fn models_measured(
+    scene: &Scene,
+    facts: &SceneFacts,
+    quality: &Quality,
+    target: &Target,
+    variants: &[String],
+    measured: &[Option<aliasing::Aliasing>],
+) -> Result<Models> {
     let errors = error_model();
     let px = coverage(scene, target.size);
-    let mut cube_sizes: Vec<u32> =
-        variants.iter().filter_map(|v| budget::variant_quality(quality, v).ok()).map(|q| q.cube.cube_size).collect();
-    cube_sizes.sort();
-    cube_sizes.dedup();
-    let mirrors = aliasing::mirrors(scene, facts);
-    let measured = aliasing::measure(scene, quality, target.size, &aliasing::Lookups { mirrors: &mirrors, cube_sizes: &cube_sizes });
     let mut out = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
@@ -388,9 +406,20 @@ pub fn switch(
     next: (&Choices, &Quality),
     target: &Target,
 ) -> Result<Option<String>> {
-    // Predicted once per distinct set of knobs.
-    let now = predict_models(scene, facts, current.1, target, &["default".to_string()])?;
-    let then = if next.1 == current.1 { None } else { Some(predict_models(scene, facts, next.1, target, &["default".to_string()])?) };
+    // Predicted once per distinct set of knobs; measured once where the two differ only in
+    // knobs the probe reads per variant (anti-aliasing, cube size).
+    let default = ["default".to_string()];
+    let same_probe = |a: &Quality, b: &Quality| {
+        (a.frame.depth, a.frame.fresnel, a.frame.msaa_per_sample, &a.search, a.envmap.proxy_radius)
+            == (b.frame.depth, b.frame.fresnel, b.frame.msaa_per_sample, &b.search, b.envmap.proxy_radius)
+    };
+    let measured = probe(scene, facts, current.1, target, &[current.1.cube.cube_size, next.1.cube.cube_size]);
+    let now = models_measured(scene, facts, current.1, target, &default, &measured)?;
+    let then = match next.1 == current.1 {
+        true => None,
+        false if same_probe(current.1, next.1) => Some(models_measured(scene, facts, next.1, target, &default, &measured)?),
+        false => Some(predict_models(scene, facts, next.1, target, &default)?),
+    };
     let eval = |c: &Choices, q: &Quality, models: &Models| -> Result<Option<Prediction>> {
         let src = [(models, source(target))];
         Ok(budget::choose_with(scene, facts, c, q, Budget::MaxMs(f64::INFINITY), target.size, &src)?.map(|r| r.2))
