@@ -285,13 +285,8 @@ fn bilinear(dir: DVec3, n: u32, texel: &dyn Fn(DVec3) -> DVec3) -> DVec3 {
 }
 
 /// Each mirror's mesh and reference point, from the planner's facts.
-pub fn mirrors(scene: &Scene, facts: &crate::plan::facts::SceneFacts) -> Vec<(usize, glam::Vec3)> {
-    facts
-        .objects
-        .iter()
-        .filter(|o| matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Mirror { .. }))
-        .map(|o| (o.mesh, o.reference_point))
-        .collect()
+pub fn mirrors(facts: &crate::plan::facts::SceneFacts) -> Vec<(usize, glam::Vec3)> {
+    facts.objects.iter().filter(|o| o.class == crate::plan::ObjectClass::Mirror).map(|o| (o.mesh, o.reference_point)).collect()
 }
 
 /// The exact tracer's error measured on the corpus's objects, by (scene, object, frame
@@ -310,7 +305,7 @@ pub fn probe_corpus(samples: &[Sample], keep: &dyn Fn(usize) -> bool) -> Result<
     for (scene, screen) in keys {
         let s = crate::scenes::corpus::scene(scene)?;
         let side = (screen as f64).sqrt().round() as u32;
-        let mirrors = mirrors(&s, &crate::plan::facts::SceneFacts::new(&s, &q, false));
+        let mirrors = mirrors(&crate::plan::facts::SceneFacts::new(&s, &q, false));
         let lookups = Lookups { mirrors: &mirrors, cube_sizes: &[128, 256, 512] };
         for (m, a) in measure(&s, &q, (side, side), &lookups).into_iter().enumerate() {
             if let Some(a) = a {

@@ -116,7 +116,7 @@ fn probe(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, 
     let mut sizes = cube_sizes.to_vec();
     sizes.sort();
     sizes.dedup();
-    let mirrors = aliasing::mirrors(scene, facts);
+    let mirrors = aliasing::mirrors(facts);
     aliasing::measure(scene, quality, target.size, &aliasing::Lookups { mirrors: &mirrors, cube_sizes: &sizes })
 }
 
@@ -309,7 +309,8 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
     // An exact tracer for every object the caller left to auto: bvh, and the device's own
     // scheme; the budget is the larger of their predicted frames.
     let mut max_ms = f64::NEG_INFINITY;
-    for scheme in [BVH, device_exact(target)] {
+    let schemes = if device_exact(target) == BVH { vec![BVH] } else { vec![BVH, device_exact(target)] };
+    for scheme in schemes {
         let mut exact = choices.clone();
         for f in &facts.objects {
             if !choices.objects.iter().any(|(n, _)| super::names_object(scene, f.mesh, n)) {
@@ -331,10 +332,15 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
     // models can rank them (SCHEME_MARGIN).
     let preferred = device_exact(target);
     let exact = |m: Method| error_model::model_key(m.name) == error_model::EXACT;
+    let fixed = |mesh: usize| choices.objects.iter().any(|(n, _)| super::names_object(scene, mesh, n));
     let methods: Vec<(String, Method)> = prediction.objects.iter().map(|o| (o.name.clone(), o.method)).collect();
     let swapped = Choices {
         method: Choice::Auto,
-        objects: methods.iter().map(|(n, m)| (n.clone(), if exact(*m) && !choices_fix(choices, n) { preferred } else { *m })).collect(),
+        objects: prediction
+            .objects
+            .iter()
+            .map(|o| (o.name.clone(), if exact(o.method) && !fixed(o.mesh) { preferred } else { o.method }))
+            .collect(),
     };
     let mut note = None;
     if swapped.objects != methods {
@@ -372,11 +378,6 @@ pub fn device_exact(target: &Target) -> Method {
     } else {
         BVH
     }
-}
-
-/// Whether the caller fixed object `name`'s method (auto may not change it).
-fn choices_fix(choices: &Choices, name: &str) -> bool {
-    choices.objects.iter().any(|(n, _)| n == name)
 }
 
 /// How much faster than the device's own exact scheme another exact scheme must be predicted
