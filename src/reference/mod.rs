@@ -221,24 +221,40 @@ impl<'a> Tracer<'a> {
         self.depth
     }
 
-    /// Where the ray o + t d, t > t_min, first meets a mirror: its mesh, the point, the
-    /// reflected direction and the Fresnel weight; `None` where it meets anything else.
-    pub fn mirror_hit(&self, o: DVec3, d: DVec3, t_min: f64) -> Option<MirrorHit> {
+    /// Where the ray o + t d, t > t_min, first meets a specular surface: its mesh, the
+    /// point, the shading normal, the material and how it splits the ray (reflected and
+    /// refracted directions, Fresnel weights); `None` where it meets a diffuse one or the sky.
+    pub fn specular_hit(&self, o: DVec3, d: DVec3, t_min: f64) -> Option<SpecularHit> {
         let hit = self.bvh.intersect(o, d, t_min, f64::INFINITY, None)?;
         let surface = self.surface(&hit);
         let m = &self.scene.materials[surface.material];
-        if !matches!(m.kind, SurfaceKind::Mirror { .. }) {
+        if m.kind == SurfaceKind::Diffuse {
             return None;
         }
         let split = shade::specular_split(m, self.fresnel, d, surface.normal);
         let mesh = self.bvh.triangles[hit.triangle as usize].mesh;
-        Some(MirrorHit { mesh, position: surface.position, reflected: split.r.normalize(), fresnel: split.fr, triangle: hit.triangle })
+        Some(SpecularHit { mesh, position: surface.position, material: surface.material, split })
     }
 
-    /// What the reflected ray of `hit` brings back, with one bounce fewer than the camera's.
-    pub fn reflected_radiance(&self, hit: &MirrorHit) -> DVec3 {
-        let ray = Ray { o: hit.position, d: hit.reflected, t_min: self.epsilon, skip: Some(hit.triangle) };
-        self.trace(ray, self.depth.saturating_sub(1), DVec3::ONE, None)
+    /// How material `m` splits the ray of direction `d` (unit) meeting a surface of shading
+    /// normal `n`, with this tracer's Fresnel.
+    pub fn split(&self, m: &crate::scene::Material, d: DVec3, n: DVec3) -> shade::SpecularSplit {
+        shade::specular_split(m, self.fresnel, d, n)
+    }
+
+    /// From `c` in direction `d` (unit), the first surface of mesh `only`, every other mesh
+    /// passed through (what that mesh's refractor map holds: the mesh alone): its distance
+    /// and interpolated unit normal; `None` where the ray misses the mesh.
+    pub fn surface_of(&self, c: DVec3, d: DVec3, only: u32) -> Option<(f64, DVec3)> {
+        let mut t_min = 0.0;
+        for _ in 0..64 {
+            let h = self.bvh.intersect(c, d, t_min, f64::INFINITY, None)?;
+            if self.bvh.triangles[h.triangle as usize].mesh == only {
+                return Some((h.t, self.surface(&h).normal));
+            }
+            t_min = h.t;
+        }
+        None
     }
 
     /// From `c` in direction `d` (unit), past every surface of mesh `exclude` (what a map of
@@ -360,15 +376,14 @@ impl<'a> Tracer<'a> {
     }
 }
 
-/// A camera ray's first hit on a mirror ([`Tracer::mirror_hit`]).
+/// A ray's first hit on a specular surface ([`Tracer::specular_hit`]).
 #[derive(Clone, Copy, Debug)]
-pub struct MirrorHit {
+pub struct SpecularHit {
     pub mesh: u32,
     pub position: DVec3,
-    /// The reflected direction (unit).
-    pub reflected: DVec3,
-    pub fresnel: DVec3,
-    triangle: u32,
+    /// The surface's material (an index of the scene's materials).
+    pub material: usize,
+    pub split: shade::SpecularSplit,
 }
 
 /// A ray o + t d, t > t_min, that does not hit triangle `skip` (the one it leaves).

@@ -196,6 +196,7 @@ pub fn material_fresnel(m: &Material, mode: FresnelMode, cos_i: f64, eta: f64) -
 /// with their weights (survey eq. 1). `t` is meaningful where `ft` is non-zero; under
 /// dispersion `tc[k]` is channel k's refraction, `fr[k]` and `ft[k]` its weights (`t` the
 /// d line's, green), without it all three are `t`.
+#[derive(Clone, Copy, Debug)]
 pub struct SpecularSplit {
     pub r: DVec3,
     pub t: DVec3,

@@ -116,8 +116,8 @@ fn probe(scene: &Scene, facts: &SceneFacts, quality: &Quality, target: &Target, 
     let mut sizes = cube_sizes.to_vec();
     sizes.sort();
     sizes.dedup();
-    let mirrors = aliasing::mirrors(facts);
-    aliasing::measure(scene, quality, target.size, &aliasing::Lookups { mirrors: &mirrors, cube_sizes: &sizes })
+    let objects = aliasing::references(facts);
+    aliasing::measure(scene, quality, target.size, &aliasing::Lookups { objects: &objects, cube_sizes: &sizes })
 }
 
 /// [`predict_models`] with the probe's measurements given.
