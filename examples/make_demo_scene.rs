@@ -13,6 +13,13 @@
 //! scene `assets/mirrors/mirrors.gltf` instead (survey §5's showcase): the same room with
 //! two facing mirror panels on the left and right walls (the corridor of images), the
 //! mirror sphere between them, the box and the light, no animation.
+//!
+//! `cargo run --example make_demo_scene -- --bunny BUNNY_JS [OUTPUT_DIR]` writes the glass
+//! bunny scene `assets/bunny/bunny.gltf` (issue 31's first scene): the same room and light
+//! with the Stanford bunny (Stanford 3D Scanning Repository; the closed 1839-vertex,
+//! 3674-triangle mesh of npm's public-domain `bunny` package, whose `index.js` is BUNNY_JS)
+//! in solid glass of ν 1.5, 0.7 m tall on the floor, and the box: a non-convex refractor
+//! whose refracted rays meet it several times.
 
 use std::path::PathBuf;
 
@@ -234,13 +241,58 @@ fn kappa_for(f0: f32, nu: f32) -> f32 {
     ((f0 * (nu + 1.0).powi(2) - (nu - 1.0).powi(2)) / (1.0 - f0)).max(0.0).sqrt()
 }
 
+/// The bunny of npm's `bunny` package (`exports.positions=[[x,y,z],…];exports.cells=[[a,b,c],…]`)
+/// scaled to `height` (m), standing at `base` (the centre of its foot print), with
+/// area-weighted vertex normals.
+fn bunny(source: &str, height: f32, base: Vec3) -> Geometry {
+    let array = |key: &str| -> Value {
+        let start = source.find(key).unwrap_or_else(|| panic!("{key} not in the bunny source")) + key.len();
+        let end = start + source[start..].find("]]").expect("a closed array") + 2;
+        serde_json::from_str(&source[start..end]).expect("the bunny's arrays are JSON")
+    };
+    let positions: Vec<Vec3> = array("exports.positions=")
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| Vec3::new(p[0].as_f64().unwrap() as f32, p[1].as_f64().unwrap() as f32, p[2].as_f64().unwrap() as f32))
+        .collect();
+    let (min, max) = positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(a, b), &p| (a.min(p), b.max(p)));
+    let scale = height / (max.y - min.y);
+    let foot = Vec3::new(0.5 * (min.x + max.x), min.y, 0.5 * (min.z + max.z));
+    let mut g = Geometry::new();
+    g.positions = positions.iter().map(|&p| base + (p - foot) * scale).collect();
+    g.uvs = vec![Vec2::ZERO; g.positions.len()];
+    let mut normals = vec![Vec3::ZERO; g.positions.len()];
+    for t in array("exports.cells=").as_array().unwrap() {
+        let [a, b, c] = [0, 1, 2].map(|k| t[k].as_u64().unwrap() as u32);
+        let [pa, pb, pc] = [a, b, c].map(|i| g.positions[i as usize]);
+        let n = (pb - pa).cross(pc - pa);
+        [a, b, c].iter().for_each(|&i| normals[i as usize] += n);
+        g.indices.extend([a, b, c]);
+    }
+    g.normals = normals.iter().map(|n| n.normalize_or_zero()).collect();
+    g
+}
+
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
     let mirrors_scene = args.first().is_some_and(|a| a == "--mirrors");
     if mirrors_scene {
         args.remove(0);
     }
-    let (default_dir, stem) = if mirrors_scene { ("assets/mirrors", "mirrors") } else { ("assets/demo", "demo") };
+    let bunny_source = if args.first().is_some_and(|a| a == "--bunny") {
+        args.remove(0);
+        let path = args.remove(0);
+        Some(std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("reading the bunny source {path}: {e}")))
+    } else {
+        None
+    };
+    let bunny_scene = bunny_source.is_some();
+    let (default_dir, stem) = match (mirrors_scene, bunny_scene) {
+        (true, _) => ("assets/mirrors", "mirrors"),
+        (_, true) => ("assets/bunny", "bunny"),
+        _ => ("assets/demo", "demo"),
+    };
     let out = args.first().map(PathBuf::from).unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(default_dir));
     std::fs::create_dir_all(&out).expect("create output directory");
 
@@ -281,22 +333,43 @@ fn main() {
     nodes.push(json!({ "name": "room", "children": wall_nodes }));
     let room = nodes.len() - 1;
 
-    // Mirror sphere: silver-like ν with κ chosen so that F0 equals the base colour.
-    let f0 = [0.95f32, 0.93, 0.88];
-    let nu = [0.155f32, 0.117, 0.138];
-    let kappa: Vec<f32> = (0..3).map(|c| kappa_for(f0[c], nu[c])).collect();
-    materials.push(json!({
-        "name": "mirror",
-        "pbrMetallicRoughness": {
-            "baseColorFactor": [f0[0], f0[1], f0[2], 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.0
-        },
-        "extras": { "specula": { "nu": nu, "kappa": kappa } }
-    }));
-    let prim = bin.primitive(&sphere(0.5, 64, 32), materials.len() - 1);
-    meshes.push(json!({ "name": "mirror_sphere", "primitives": [prim] }));
-    let sphere_at = if mirrors_scene { [-0.3, 0.5, -0.9] } else { [-1.2, 0.5, -1.1] };
-    nodes.push(json!({ "name": "mirror_sphere", "mesh": meshes.len() - 1, "translation": sphere_at }));
-    let mirror = nodes.len() - 1;
+    // Mirror sphere (not in the bunny scene): silver-like ν with κ chosen so that F0 equals
+    // the base colour.
+    let mirror = (!bunny_scene).then(|| {
+        let f0 = [0.95f32, 0.93, 0.88];
+        let nu = [0.155f32, 0.117, 0.138];
+        let kappa: Vec<f32> = (0..3).map(|c| kappa_for(f0[c], nu[c])).collect();
+        materials.push(json!({
+            "name": "mirror",
+            "pbrMetallicRoughness": {
+                "baseColorFactor": [f0[0], f0[1], f0[2], 1.0], "metallicFactor": 1.0, "roughnessFactor": 0.0
+            },
+            "extras": { "specula": { "nu": nu, "kappa": kappa } }
+        }));
+        let prim = bin.primitive(&sphere(0.5, 64, 32), materials.len() - 1);
+        meshes.push(json!({ "name": "mirror_sphere", "primitives": [prim] }));
+        let sphere_at = if mirrors_scene { [-0.3, 0.5, -0.9] } else { [-1.2, 0.5, -1.1] };
+        nodes.push(json!({ "name": "mirror_sphere", "mesh": meshes.len() - 1, "translation": sphere_at }));
+        nodes.len() - 1
+    });
+
+    // The glass bunny scene: the bunny alone in the room.
+    let mut bunny_node = Vec::new();
+    if let Some(source) = &bunny_source {
+        materials.push(json!({
+            "name": "glass",
+            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+            "extensions": {
+                "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+                "KHR_materials_ior": { "ior": 1.5 },
+                "KHR_materials_volume": { "thicknessFactor": 0.3 }
+            }
+        }));
+        let prim = bin.primitive(&bunny(source, 0.7, Vec3::new(0.0, 0.0, -0.3)), materials.len() - 1);
+        meshes.push(json!({ "name": "bunny", "primitives": [prim] }));
+        nodes.push(json!({ "name": "bunny", "mesh": meshes.len() - 1 }));
+        bunny_node.push(nodes.len() - 1);
+    }
 
     // The planar-mirror scene: two facing panels 2 cm off the left and right walls, a plain
     // (κ = 0) mirror of F0 0.9.
@@ -319,7 +392,7 @@ fn main() {
     // Solid glass sphere (the demo only: the mirror scene shows planar mirrors, spheres
     // and the box).
     let mut glass = Vec::new();
-    if !mirrors_scene {
+    if !mirrors_scene && !bunny_scene {
         materials.push(json!({
             "name": "glass",
             "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
@@ -354,6 +427,8 @@ fn main() {
 
     let (eye, target) = if mirrors_scene {
         (Vec3::new(1.2, 1.7, 1.9), Vec3::new(-1.98, 1.2, -0.4))
+    } else if bunny_scene {
+        (Vec3::new(0.55, 0.62, 0.5), Vec3::new(0.0, 0.3, -0.3))
     } else {
         (Vec3::new(1.6, 1.6, 1.9), Vec3::new(-0.3, 0.8, -0.6))
     };
@@ -370,12 +445,14 @@ fn main() {
     let output = bin.animation_accessor(&path.iter().flat_map(|p| p.to_array()).collect::<Vec<f32>>(), 3);
     let animations = json!([{
         "name": "mirror_path",
-        "channels": [{ "sampler": 0, "target": { "node": mirror, "path": "translation" } }],
+        "channels": [{ "sampler": 0, "target": { "node": mirror.unwrap_or(0), "path": "translation" } }],
         "samplers": [{ "input": input, "output": output, "interpolation": "LINEAR" }],
     }]);
 
     let bin_name = format!("{stem}.bin");
-    let mut scene_nodes = vec![room, mirror];
+    let mut scene_nodes = vec![room];
+    scene_nodes.extend(mirror);
+    scene_nodes.extend(bunny_node);
     scene_nodes.extend(glass);
     scene_nodes.extend(panels);
     scene_nodes.extend([occluder, light, camera]);
@@ -407,7 +484,7 @@ fn main() {
         "accessors": bin.accessors,
     });
     let mut doc = doc;
-    if !mirrors_scene {
+    if !mirrors_scene && !bunny_scene {
         doc["animations"] = animations;
     }
     std::fs::write(out.join(&bin_name), &bin.data).expect("write the .bin");
@@ -422,6 +499,10 @@ fn main() {
     let solids = count(&|k| matches!(k, SurfaceKind::Dielectric { thin: false, .. }));
     if mirrors_scene {
         assert_eq!((diffuse, mirrors, solids), (7, 2, 0), "mirror scene classification");
+        assert!(scene.animation.is_none());
+    } else if bunny_scene {
+        let specular: Vec<String> = scene.specular_meshes().map(|(_, m)| m.name.clone()).collect();
+        assert_eq!((diffuse, solids, specular), (7, 1, vec!["bunny/0".to_string()]), "bunny scene classification");
         assert!(scene.animation.is_none());
     } else {
         assert_eq!((diffuse, mirrors, solids, scene.materials.len()), (7, 1, 1, 9), "demo classification");
