@@ -307,26 +307,28 @@ fn the_map_models_only_the_layers_the_scene_needs() {
     common::assert_clean(&ctx);
 }
 
-/// What the rule-based planner knew, the measuring planner's error models learned from the
-/// corpus: an object that sees itself (a bowl facing its reference point, a torus) is
-/// predicted more accurate with layered maps than with a single distance map.
+/// What the rule-based planner knew, the measuring planner predicts: a mirror bowl that
+/// faces its reference point sees itself, and is predicted more accurate with layered maps
+/// than with a single distance map, which leaves it out. (The glass torus, whose rule said
+/// the same, is not: at 128² against the converged reference its pixels measure 23.39 dB
+/// with distance and 21.59 with layered maps, and the probe's simulated distance lookups
+/// predict 23.2.)
 #[test]
 fn error_models_prefer_layered_maps_for_objects_that_see_themselves() {
     let q = quality(&[]);
     let target = specula::plan::predict::Target::nominal().unwrap();
-    for (name, scene) in [("bowl", bowl_scene()), ("torus", torus_scene())] {
-        let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
-        let models = specula::plan::predict::predict_models(&scene, &facts, &q, &target, &["default".into()]).unwrap();
-        let f = &facts.objects[0];
-        let object = &scene.meshes[f.mesh].name;
-        let db = |m: &str| models.variants[0].objects.iter().find(|o| &o.object == object && o.method == m).map(|o| o.psnr_db).unwrap();
-        let (layered, distance) = (db("layered"), db("distance"));
-        println!(
-            "{name}: self-facing {:.2}, visible {:.2}; predicted layered {layered:.1} dB, distance {distance:.1} dB",
-            f.self_facing, f.visible_fraction
-        );
-        assert!(layered > distance, "{name}: layered {layered:.1} dB, distance {distance:.1} dB");
-    }
+    let scene = bowl_scene();
+    let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
+    let models = specula::plan::predict::predict_models(&scene, &facts, &q, &target, &["default".into()]).unwrap();
+    let f = &facts.objects[0];
+    let object = &scene.meshes[f.mesh].name;
+    let db = |m: &str| models.variants[0].objects.iter().find(|o| &o.object == object && o.method == m).map(|o| o.psnr_db).unwrap();
+    let (layered, distance) = (db("layered"), db("distance"));
+    println!(
+        "bowl: self-facing {:.2}, visible {:.2}; predicted layered {layered:.1} dB, distance {distance:.1} dB",
+        f.self_facing, f.visible_fraction
+    );
+    assert!(layered > distance, "bowl: layered {layered:.1} dB, distance {distance:.1} dB");
 }
 
 #[test]

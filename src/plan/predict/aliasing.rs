@@ -22,10 +22,11 @@
 //! point with the object left out, a refractor map's the object's own nearest surface —
 //! filtered bilinearly, the proxies intersected as `proxy.frag` does, the maps searched by
 //! `search.rs`, the CPU twin of the GLSL search, and the refracted ray followed through the
-//! solid as `glsl/distance/refractor/trace.glsl` does. A method's prediction is the
-//! aliasing under its `aa` plus its squared error at the pixel centres less the exact
-//! tracer's there (the two are correlated: on the glass ball the simulated refractor-map
-//! measures 38.4 dB against the reference, the GPU's image 38.1).
+//! solid as `glsl/distance/refractor/trace.glsl` does. Without anti-aliasing a method's
+//! prediction is its simulated pixel centres against the converged pixels, measured rather
+//! than summed from the maps' error and the aliasing, which are correlated (on the glass ball
+//! the simulated refractor-map measures 38.4 dB, the GPU's image 38.1, the sum 36.6); with
+//! anti-aliasing, the maps' error (against the exact centres) plus the aliasing `aa` leaves.
 
 use std::collections::BTreeMap;
 
@@ -41,7 +42,7 @@ use crate::scene::Scene;
 /// Pixel centres tested for the object they show (a lattice over the frame).
 pub const LATTICE: u32 = 16384;
 /// Pixels traced per object (evenly spread over its lattice pixels).
-pub const PIXELS: usize = 128;
+pub const PIXELS: usize = 256;
 /// Samples per pixel of the image errors are measured against: the converged pixel, as 16
 /// stratified samples estimate it (as `specula tradeoff`'s reference and the corpus's 4×4
 /// supersampling do), whatever `spp` the caller's own reference renders take.
@@ -67,10 +68,8 @@ pub struct Aliasing {
     pub off: f64,
     pub msaa4: f64,
     pub ssaa2: f64,
-    /// (method, cube size, the method's squared error at the pixel centres less the exact
-    /// tracer's there, [`Aliasing::off`]: negative where the maps' blur happens to lie
-    /// nearer the converged pixel than the exact centre does).
-    pub lookups: Vec<(&'static str, u32, f64)>,
+    /// Per simulated method and cube size, its error.
+    pub lookups: Vec<Lookup>,
 }
 
 impl Aliasing {
@@ -85,9 +84,42 @@ impl Aliasing {
         }
     }
 
-    /// The lookup error of `method` with cube maps of `cube_size`, where measured.
-    pub fn lookup(&self, method: &str, cube_size: u32) -> Option<f64> {
-        self.lookups.iter().find(|(m, n, _)| *m == method && *n == cube_size).map(|l| l.2)
+    /// The simulated error of `method` with cube maps of `cube_size`, where measured.
+    pub fn lookup(&self, method: &str, cube_size: u32) -> Option<&Lookup> {
+        self.lookups.iter().find(|l| l.method == method && l.cube_size == cube_size)
+    }
+}
+
+/// A method's simulated error on an object's traced pixels (mean squared errors per channel).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Lookup {
+    pub method: &'static str,
+    pub cube_size: u32,
+    /// Shading each pixel at its centre, against the converged pixel: the method's error
+    /// without anti-aliasing. The maps' error and the aliasing are correlated (a lookup's
+    /// blur partly offsets the centre's aliasing), so this is measured, not summed.
+    pub off: f64,
+    /// Against the exact tracer at the pixel centres: the maps' error alone.
+    pub maps: f64,
+    /// Shaded at the four multisample positions (per sample) and on the 2×2 grid, averaged,
+    /// against the converged pixel: measured at the quality's cube size (the variants that
+    /// vary `aa` keep it), `None` at the others.
+    pub msaa4: Option<f64>,
+    pub ssaa2: Option<f64>,
+}
+
+impl Lookup {
+    /// The method's error under `aa` (`per_sample`: multisamples shaded per sample), where
+    /// the exact tracer's under it is `aliasing` (`None`: not traced): as measured, else the
+    /// maps' error on top of that aliasing, at most the error without.
+    pub fn under(&self, aa: &str, per_sample: bool, aliasing: Option<f64>) -> f64 {
+        let measured = match aa {
+            "off" => Some(self.off),
+            "msaa4" if per_sample => self.msaa4,
+            "ssaa2" => self.ssaa2,
+            _ => None,
+        };
+        measured.unwrap_or_else(|| aliasing.map_or(self.off, |a| (self.maps + a).min(self.off)))
     }
 }
 
@@ -143,6 +175,7 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
     };
     let mean = |x: u32, y: u32, offsets: &[(f64, f64)]| offsets.iter().map(|&s| at(x, y, s)).sum::<DVec3>() / offsets.len() as f64;
     let env = Environment { scene, quality, tracer: &tracer, cube_sizes: lookups.cube_sizes };
+    let aa_size: Vec<u32> = lookups.cube_sizes.iter().copied().filter(|&n| n == quality.cube.cube_size).collect();
     by_mesh
         .into_iter()
         .enumerate()
@@ -162,9 +195,22 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
                     let exact = at(x, y, (0.5, 0.5));
                     let mut e = vec![sq(exact, r), sq(mean(x, y, &MSAA4), r), sq(mean(x, y, &SSAA2), r)];
                     if let Some(c) = centre {
-                        let shades = env.shades(mesh as u32, c, rays.ray(x as f64 + 0.5, y as f64 + 0.5), exact);
-                        let off = e[0];
-                        e.extend(shades.into_iter().map(|v| sq(v, r) - off));
+                        let shades = env.shades(mesh as u32, c, rays.ray(x as f64 + 0.5, y as f64 + 0.5), exact, env.cube_sizes);
+                        e.extend(shades.into_iter().flat_map(|v| [sq(v, r), sq(v, exact)]));
+                        // The maps sampled as anti-aliasing samples them, at the asked cube size
+                        // (the variants that vary `aa` keep it).
+                        let sampled = |offsets: &[(f64, f64)]| {
+                            let mut sum = vec![DVec3::ZERO; env.keys(mesh, &aa_size).len()];
+                            for &(dx, dy) in offsets {
+                                let ray = rays.ray(x as f64 + dx, y as f64 + dy);
+                                for (s, v) in sum.iter_mut().zip(env.shades(mesh as u32, c, ray, at(x, y, (dx, dy)), &aa_size)) {
+                                    *s += v / offsets.len() as f64;
+                                }
+                            }
+                            sum
+                        };
+                        let (m4, s2) = (sampled(&MSAA4), sampled(&SSAA2));
+                        e.extend(m4.into_iter().zip(s2).flat_map(|(a, b)| [sq(a, r), sq(b, r)]));
                     }
                     e
                 })
@@ -176,7 +222,25 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
             }
             let sum = |i: usize| per_pixel.iter().map(|e| e[i]).sum::<f64>() / k as f64;
             let lookups = match centre {
-                Some(_) => env.keys(mesh).into_iter().enumerate().map(|(i, (m, n))| (m, n, sum(3 + i))).collect(),
+                Some(_) => {
+                    let keys = env.keys(mesh, env.cube_sizes);
+                    let sampled = env.keys(mesh, &aa_size);
+                    let at_aa = |method: &str, cube_size: u32, k: usize| {
+                        let i = sampled.iter().position(|&(m, n)| m == method && n == cube_size)?;
+                        Some(sum(3 + 2 * keys.len() + 2 * i + k))
+                    };
+                    keys.iter()
+                        .enumerate()
+                        .map(|(i, &(method, cube_size))| Lookup {
+                            method,
+                            cube_size,
+                            off: sum(3 + 2 * i),
+                            maps: sum(4 + 2 * i),
+                            msaa4: at_aa(method, cube_size, 0),
+                            ssaa2: at_aa(method, cube_size, 1),
+                        })
+                        .collect()
+                }
                 None => Vec::new(),
             };
             Some(Aliasing { pixels: k, off: sum(0), msaa4: sum(1), ssaa2: sum(2), lookups })
@@ -198,12 +262,12 @@ struct Environment<'a> {
 }
 
 impl Environment<'_> {
-    /// (method, cube size) in the order [`Environment::shades`] returns them for
-    /// `mesh`: every lookup method on a mirror or a dielectric that neither disperses nor
+    /// (method, cube size) for each of `sizes`, in the order [`Environment::shades`] returns
+    /// them for `mesh`: every lookup method on a mirror or a dielectric that neither disperses nor
     /// absorbs (the shaders' single-refraction lookups weight absorption by a bounding
     /// chord, which the probe does not model), and self refraction on a solid that does
     /// not disperse; none on other objects.
-    fn keys(&self, mesh: usize) -> Vec<(&'static str, u32)> {
+    fn keys(&self, mesh: usize, sizes: &[u32]) -> Vec<(&'static str, u32)> {
         let m = &self.scene.materials[self.scene.meshes[mesh].material];
         let lookups = match m.kind {
             crate::scene::SurfaceKind::Mirror { .. } => true,
@@ -212,7 +276,7 @@ impl Environment<'_> {
         };
         let solid = matches!(m.kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. }) && !m.disperses();
         let methods = LOOKUP_METHODS.iter().filter(|_| lookups).chain(std::iter::once(&REFRACTOR_METHOD).filter(|_| solid));
-        methods.flat_map(|&m| self.cube_sizes.iter().map(move |&n| (m, n))).collect()
+        methods.flat_map(|&m| sizes.iter().map(move |&n| (m, n))).collect()
     }
 
     /// A ray of direction `r` from `x`, searched in the distance map of reference point `c`
@@ -226,12 +290,12 @@ impl Environment<'_> {
         crate::search::linear_search(map, x, r, s.linear_steps, s.binary_steps, s.secant_steps, s.search_tolerance as f64)
     }
 
-    /// Per key of [`Environment::keys`], what the method shades at a pixel whose centre ray
+    /// Per key of [`Environment::keys`] at `sizes`, what the method shades where the ray
     /// o + t d meets `mesh` (whose maps are centred on `c`); `exact` (the exact tracer's
     /// radiance at the pixel centre) where it meets something else (the silhouette's pixels,
     /// whose error the aliasing part holds) or the simulation is not finite.
-    fn shades(&self, mesh: u32, c: DVec3, (o, d, t): (DVec3, DVec3, f64), exact: DVec3) -> Vec<DVec3> {
-        let keys = self.keys(mesh as usize);
+    fn shades(&self, mesh: u32, c: DVec3, (o, d, t): (DVec3, DVec3, f64), exact: DVec3, sizes: &[u32]) -> Vec<DVec3> {
+        let keys = self.keys(mesh as usize, sizes);
         let Some(hit) = self.tracer.specular_hit(o, d, t).filter(|h| h.mesh == mesh) else { return vec![exact; keys.len()] };
         let x = hit.position;
         let bounds = self.scene.bounds();
@@ -458,7 +522,7 @@ mod tests {
         s.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.3, 0.4, 1.8), Vec3::ZERO, 0.9));
         let lookups = Lookups { objects: &[(ball, Vec3::ZERO)], cube_sizes: &[64, 256] };
         let a = measure(&s, &Quality::default(), (64, 64), &lookups)[ball].clone().expect("the ball is in view");
-        let at = |m: &str, n: u32| a.lookup(m, n).unwrap();
+        let at = |m: &str, n: u32| a.lookup(m, n).unwrap().maps;
         for n in [64, 256] {
             assert!(at("proxy-box", n) < 0.2 * at("envmap", n) && at("distance", n) < 0.2 * at("envmap", n), "{:?}", a.lookups);
             assert!(at("proxy-sphere", n) > at("proxy-box", n), "{:?}", a.lookups);
@@ -489,7 +553,7 @@ mod tests {
         s.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.2, 0.3, 1.9), Vec3::ZERO, 0.8));
         let lookups = Lookups { objects: &[(ball, Vec3::ZERO)], cube_sizes: &[64, 512] };
         let a = measure(&s, &Quality::default(), (48, 48), &lookups)[ball].clone().expect("the ball is in view");
-        let at = |m: &str, n: u32| a.lookup(m, n).unwrap();
+        let at = |m: &str, n: u32| a.lookup(m, n).unwrap().maps;
         assert!(
             at("refractor-map", 512) < 0.05 * at("envmap", 512) && at("refractor-map", 512) < 0.05 * at("distance", 512),
             "{:?}",

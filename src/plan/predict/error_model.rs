@@ -154,12 +154,8 @@ impl ErrorModel {
         measured: Option<&Aliasing>,
     ) -> Option<f64> {
         if let Some(m) = measured {
-            if let Some(excess) = m.lookup(method, cube_size) {
-                // The excess over the exact tracer at the pixel centres, on top of the
-                // aliasing `aa` leaves; a negative excess (the maps' blur nearer the
-                // converged pixel) is trusted down to a quarter of that aliasing (+6 dB).
-                let aliasing = m.mse(aa, per_sample).unwrap_or(m.off);
-                return Some(psnr((aliasing + excess).max(0.25 * aliasing)));
+            if let Some(lookup) = m.lookup(method, cube_size) {
+                return Some(psnr(lookup.under(aa, per_sample, m.mse(aa, per_sample))));
             }
         }
         let own = self.predict_off(method, features)?;
