@@ -459,6 +459,22 @@ fn auto_keeps_its_choice_within_the_hysteresis_and_says_why_it_switches() {
     let mut kept = p.clone();
     kept.refresh_geometry(&moved).unwrap();
     assert_eq!(methods(&kept), methods(&p));
+    // ... without predicting again: within REPLAN_MOTION of where auto last predicted, the
+    // anchor stays there. A move beyond it predicts again: the anchor follows, or auto
+    // switches (with its reason).
+    assert!(kept.anchor.motion(&moved) > 0.0 && kept.anchor.motion(&scene) == 0.0);
+    let mut far = scene.clone();
+    let mut cam = far.camera_or_default();
+    let target = scene.meshes[p.objects[0].mesh].positions[0];
+    cam.position += (target - cam.position) * 2.0 * specula::plan::REPLAN_MOTION;
+    far.camera = Some(cam);
+    assert!(p.anchor.motion(&far) >= specula::plan::REPLAN_MOTION, "{}", p.anchor.motion(&far));
+    let mut again = p.clone();
+    match again.refresh_geometry(&far) {
+        Ok(()) => assert_eq!(again.anchor.motion(&far), 0.0),
+        Err(specula::Error::PlanChanged(w)) => assert!(w.starts_with("auto: "), "{w}"),
+        Err(e) => panic!("{e}"),
+    }
 
     let facts = specula::plan::facts::SceneFacts::new(&scene, &q, true);
     let on = |m: Method| Choices { method: Choice::Auto, objects: p.objects.iter().map(|o| (o.name.clone(), m)).collect() };
@@ -469,8 +485,10 @@ fn auto_keeps_its_choice_within_the_hysteresis_and_says_why_it_switches() {
             predict::switch(&scene, &facts, (&envmap, &q), (&auto, &q), &t).unwrap().expect("auto's choice is far better than envmap");
         assert!(why.contains("envmap →"), "{why}");
         assert_eq!(predict::switch(&scene, &facts, (&auto, &q), (&envmap, &q), &t).unwrap(), None, "and not back");
+        // (A plan whose anchor is unknown predicts again at its first move.)
         let mut poor = p.clone();
         poor.objects.iter_mut().for_each(|o| o.method = specula::methods::ENVMAP);
+        poor.anchor = Default::default();
         match poor.refresh_geometry(&scene) {
             Err(specula::Error::PlanChanged(w)) => assert!(w.starts_with("auto: "), "{w}"),
             other => panic!("expected a plan change, got {other:?}"),

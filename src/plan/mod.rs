@@ -74,8 +74,17 @@ impl Plan {
         // predicts the new choice better by more than its hysteresis (then a new renderer).
         let asked = Choices { method: self.choice, objects: self.overrides.clone() };
         let kept = Choices { method: self.choice, objects: self.objects.iter().map(|o| (o.name.clone(), o.method)).collect() };
-        let mut fresh = plan_inner(scene, &asked, &self.asked_quality, true, self.target.as_ref())?;
-        if methods(&fresh) != methods(self) || fresh.quality != self.quality {
+        // Under `auto` with its hysteresis, the choice is predicted again only once the view
+        // has moved by REPLAN_MOTION since it was last predicted: a prediction measures the
+        // scene on the CPU (0.1–0.6 s in a release build), and an engine moves objects
+        // every frame.
+        let settled = self.choice == Choice::Auto && self.quality.plan.plan_hysteresis && self.anchor.motion(scene) < REPLAN_MOTION;
+        let mut fresh = if settled {
+            plan_inner(scene, &kept, &self.quality, true, self.target.as_ref())?
+        } else {
+            plan_inner(scene, &asked, &self.asked_quality, true, self.target.as_ref())?
+        };
+        if !settled && (methods(&fresh) != methods(self) || fresh.quality != self.quality) {
             if self.choice == Choice::Auto && !self.quality.plan.plan_hysteresis {
                 let changed: Vec<String> = fresh
                     .objects
@@ -134,6 +143,9 @@ impl Plan {
         self.cube_near = fresh.cube_near;
         self.proxy_radius = fresh.proxy_radius;
         self.proxy_box = fresh.proxy_box;
+        if !settled {
+            self.anchor = Anchor::of(scene);
+        }
         Ok(())
     }
 
@@ -217,6 +229,13 @@ impl Default for Choices {
 /// The pass `reference` reports: one CPU pass, no maps.
 pub const REFERENCE_PASS: &str = "reference.trace";
 
+/// How far the view must move from where `auto` last predicted its choice (a fraction of
+/// the distance from the camera to a specular object, of the camera's field of view, or of
+/// an object's size: `Anchor::motion`) before a move predicts again. A choice depends on
+/// what each object covers and sees; at a tenth of the view those change by about a fifth
+/// (coverage goes with the distance squared), within the hysteresis' margins.
+pub const REPLAN_MOTION: f32 = 0.1;
+
 /// The plan of one method for the whole scene (objects it cannot serve get its fallback),
 /// or of the planner (`Choice::Auto`, honouring the scene file's `extras.specula.method`
 /// where it can; `plan_with` reports a hint that cannot serve its object as an error).
@@ -258,6 +277,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         map_mirrors: Vec::new(),
         mirror_layers: 0,
         caustics: None,
+        anchor: Anchor::default(),
     }
 }
 
@@ -469,6 +489,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         map_mirrors: Vec::new(),
         mirror_layers: 0,
         caustics: None,
+        anchor: Anchor::of(scene),
     };
     if !p.is_gpu() {
         p.stages.clear();

@@ -242,6 +242,65 @@ pub struct Plan {
     pub map_mirrors: Vec<usize>,
     /// Caustics (§6): the generators and their lights, when the scene has caustics.
     pub caustics: Option<CausticsPlan>,
+    /// Where the camera and the specular objects stood when the plan was chosen (under
+    /// `auto`: when its choice was last predicted).
+    #[serde(skip)]
+    pub anchor: Anchor,
+}
+
+/// The camera (position, viewing direction) and each specular object's bounding sphere
+/// (mesh, centre, radius) at a moment: how far a frame's view has moved from it.
+/// Equal to every other anchor, so that two plans compare by what they render.
+#[derive(Clone, Debug, Default)]
+pub struct Anchor {
+    camera: Option<(Vec3, Vec3)>,
+    objects: Vec<(usize, Vec3, f32)>,
+}
+
+impl PartialEq for Anchor {
+    fn eq(&self, _: &Anchor) -> bool {
+        true
+    }
+}
+
+impl Anchor {
+    pub fn of(scene: &crate::scene::Scene) -> Anchor {
+        let cam = scene.camera_or_default();
+        let forward = cam.world_from_camera.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let objects = scene
+            .specular_meshes()
+            .map(|(i, m)| {
+                let (lo, hi) = m.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(a, b), &p| (a.min(p), b.max(p)));
+                let centre = 0.5 * (lo + hi);
+                (i, centre, 0.5 * (hi - lo).length())
+            })
+            .collect();
+        Anchor { camera: Some((cam.position, forward)), objects }
+    }
+
+    /// How far `scene`'s view has moved from this anchor, as a fraction of the view: the
+    /// largest over the specular objects of the camera's and the object's displacement over
+    /// the object's distance from the camera, the change of its size over its size, and the
+    /// camera's turn over its field of view; infinite when the objects are not the same.
+    pub fn motion(&self, scene: &crate::scene::Scene) -> f32 {
+        let now = Anchor::of(scene);
+        let (Some((c0, f0)), Some((c1, f1))) = (self.camera, now.camera) else { return f32::INFINITY };
+        if self.objects.len() != now.objects.len() || self.objects.iter().zip(&now.objects).any(|(a, b)| a.0 != b.0) {
+            return f32::INFINITY;
+        }
+        let fov = scene.camera_or_default().yfov.max(1e-3);
+        let turn = f0.dot(f1).clamp(-1.0, 1.0).acos() / fov;
+        let moved = self.objects.iter().zip(&now.objects).map(|(&(_, p0, r0), &(_, p1, r1))| {
+            let d = (p1 - c1).length().max(r1).max(f32::MIN_POSITIVE);
+            ((c1 - c0).length() / d).max((p1 - p0).length() / d).max((r1 - r0).abs() / r0.max(f32::MIN_POSITIVE))
+        });
+        let m = moved.fold(turn, f32::max);
+        if m.is_nan() {
+            f32::INFINITY
+        } else {
+            m
+        }
+    }
 }
 
 /// One light's views of a generator: layers `first_layer ..` of the photon images.
