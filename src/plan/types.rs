@@ -254,7 +254,7 @@ pub struct Plan {
 #[derive(Clone, Debug, Default)]
 pub struct Anchor {
     camera: Option<(Vec3, Vec3)>,
-    objects: Vec<(usize, Vec3, f32)>,
+    objects: Vec<(usize, Vec3, f32, glam::Quat)>,
 }
 
 impl PartialEq for Anchor {
@@ -272,7 +272,8 @@ impl Anchor {
             .map(|(i, m)| {
                 let (lo, hi) = m.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(a, b), &p| (a.min(p), b.max(p)));
                 let centre = 0.5 * (lo + hi);
-                (i, centre, 0.5 * (hi - lo).length())
+                let (_, turn, _) = m.world.to_scale_rotation_translation();
+                (i, centre, 0.5 * (hi - lo).length(), turn.normalize())
             })
             .collect();
         Anchor { camera: Some((cam.position, forward)), objects }
@@ -280,8 +281,9 @@ impl Anchor {
 
     /// How far `scene`'s view has moved from this anchor, as a fraction of the view: the
     /// largest over the specular objects of the camera's and the object's displacement over
-    /// the object's distance from the camera, the change of its size over its size, and the
-    /// camera's turn over its field of view; infinite when the objects are not the same.
+    /// the object's distance from the camera, the change of its size over its size, its
+    /// turn in radians, and the camera's turn over its field of view; infinite when the
+    /// objects are not the same.
     pub fn motion(&self, scene: &crate::scene::Scene) -> f32 {
         let now = Anchor::of(scene);
         let (Some((c0, f0)), Some((c1, f1))) = (self.camera, now.camera) else { return f32::INFINITY };
@@ -290,9 +292,10 @@ impl Anchor {
         }
         let fov = scene.camera_or_default().yfov.max(1e-3);
         let turn = f0.dot(f1).clamp(-1.0, 1.0).acos() / fov;
-        let moved = self.objects.iter().zip(&now.objects).map(|(&(_, p0, r0), &(_, p1, r1))| {
+        let moved = self.objects.iter().zip(&now.objects).map(|(&(_, p0, r0, q0), &(_, p1, r1, q1))| {
             let d = (p1 - c1).length().max(r1).max(f32::MIN_POSITIVE);
-            ((c1 - c0).length() / d).max((p1 - p0).length() / d).max((r1 - r0).abs() / r0.max(f32::MIN_POSITIVE))
+            let shift = ((c1 - c0).length() / d).max((p1 - p0).length() / d);
+            shift.max((r1 - r0).abs() / r0.max(f32::MIN_POSITIVE)).max(q0.angle_between(q1))
         });
         let m = moved.fold(turn, f32::max);
         if m.is_nan() {
@@ -417,5 +420,43 @@ impl PlanStages {
         });
         self.maps[k].objects.push(object.mesh);
         object.passes.push(info.name);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Mat4, Quat};
+
+    /// The view's motion from an anchor: a camera step as a fraction of the distance to the
+    /// object, an object's turn in radians, its move over its distance; infinite when the
+    /// objects change.
+    #[test]
+    fn an_anchor_measures_how_far_the_view_moved() {
+        let mut s = crate::scene::Scene::new();
+        let m = s
+            .add_material(crate::scene::Material {
+                name: "m".into(),
+                kind: crate::scene::SurfaceKind::Mirror { nu: Vec3::splat(3.0), kappa: Vec3::ZERO },
+                ..Default::default()
+            })
+            .unwrap();
+        let ball = s.add_mesh(crate::scene::shapes::uv_sphere("ball", Vec3::ZERO, 0.5, 16, 8, m)).unwrap();
+        s.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 0.8));
+        let a = Anchor::of(&s);
+        assert_eq!(a.motion(&s), 0.0);
+        let mut step = s.clone();
+        step.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.0, 0.0, 3.8), Vec3::ZERO, 0.8));
+        assert!((a.motion(&step) - 0.2 / 3.8).abs() < 1e-3, "{}", a.motion(&step));
+        let mut turned = s.clone();
+        turned.set_object_transform(ball, Mat4::from_quat(Quat::from_rotation_y(0.3))).unwrap();
+        assert!((a.motion(&turned) - 0.3).abs() < 1e-3, "{}", a.motion(&turned));
+        let mut moved = s.clone();
+        moved.set_object_transform(ball, Mat4::from_translation(Vec3::new(0.4, 0.0, 0.0))).unwrap();
+        assert!(a.motion(&moved) > 0.09, "{}", a.motion(&moved));
+        let mut more = s.clone();
+        more.add_mesh(crate::scene::shapes::uv_sphere("two", Vec3::X, 0.5, 16, 8, m)).unwrap();
+        assert_eq!(a.motion(&more), f32::INFINITY);
+        assert_eq!(Anchor::default().motion(&s), f32::INFINITY);
     }
 }
