@@ -49,6 +49,9 @@ pub const PIXELS: usize = 256;
 /// spheres, mirrors and glass, at 512²: 1.09 s in a release build on 2 cores).
 pub const PIXELS_PER_FRAME: usize = 1024;
 pub const MIN_PIXELS: usize = 32;
+/// Pixels of an object the probe's pilot looks at (four samples each) to draw its pixels
+/// from.
+pub const PILOT: usize = 1024;
 /// Samples per pixel of the image errors are measured against: the converged pixel, as 16
 /// stratified samples estimate it (as `specula tradeoff`'s reference and the corpus's 4×4
 /// supersampling do), whatever `spp` the caller's own reference renders take.
@@ -191,13 +194,35 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
             if pixels.is_empty() {
                 return None;
             }
-            let n = pixels.len().min(per_object);
-            let chosen: Vec<(u32, u32)> = (0..n).map(|k| pixels[k * pixels.len() / n]).collect();
-            let centre = lookups.objects.iter().find(|(m, _)| *m == mesh).map(|(_, c)| c.as_dvec3());
             let sq = |a: DVec3, b: DVec3| (a - b).length_squared() / 3.0;
-            let per_pixel: Vec<Vec<f64>> = chosen
+            // Pixels drawn with probability proportional to how much their 2×2 grid samples
+            // vary (plus a floor), each weighing the inverse: an aliasing error is
+            // heavy-tailed (a few edge pixels carry most of it), and an even sample of it
+            // misses the tail (8 unseen scenes at 512²: `aa` variants predicted 2–8 dB too
+            // high). The pilot looks at up to PILOT pixels spread evenly over the object's.
+            let pilot: Vec<(u32, u32)> = {
+                let m = pixels.len().min(PILOT);
+                (0..m).map(|k| pixels[k * pixels.len() / m]).collect()
+            };
+            let spread: Vec<f64> = pilot
                 .par_iter()
                 .map(|&(x, y)| {
+                    let v: Vec<DVec3> = SSAA2.iter().map(|&s| at(x, y, s)).collect();
+                    let m = v.iter().sum::<DVec3>() / v.len() as f64;
+                    let e = v.iter().map(|&c| sq(c, m)).sum::<f64>() / v.len() as f64;
+                    if e.is_finite() {
+                        e
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let (chosen, weights) = importance_sample(&pilot, &spread, per_object);
+            let centre = lookups.objects.iter().find(|(m, _)| *m == mesh).map(|(_, c)| c.as_dvec3());
+            let per_pixel: Vec<(f64, Vec<f64>)> = chosen
+                .par_iter()
+                .zip(&weights)
+                .map(|(&(x, y), &weight)| {
                     let reference: Vec<(f64, f64)> = (0..spp).map(|s| sample_offset(x, y, s, spp)).collect();
                     let r = mean(x, y, &reference);
                     let exact = at(x, y, (0.5, 0.5));
@@ -220,15 +245,16 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
                         let (m4, s2) = (sampled(&MSAA4), sampled(&SSAA2));
                         e.extend(m4.into_iter().zip(s2).flat_map(|(a, b)| [sq(a, r), sq(b, r)]));
                     }
-                    e
+                    (weight, e)
                 })
-                .filter(|e| e.iter().all(|v| v.is_finite()))
+                .filter(|(_, e)| e.iter().all(|v| v.is_finite()))
                 .collect();
             let k = per_pixel.len();
-            if k == 0 {
+            let total: f64 = per_pixel.iter().map(|(w, _)| w).sum();
+            if k == 0 || !(total > 0.0) {
                 return None;
             }
-            let sum = |i: usize| per_pixel.iter().map(|e| e[i]).sum::<f64>() / k as f64;
+            let sum = |i: usize| per_pixel.iter().map(|(w, e)| w * e[i]).sum::<f64>() / total;
             let lookups = match centre {
                 Some(_) => {
                     let keys = env.keys(mesh, env.cube_sizes);
@@ -254,6 +280,52 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
             Some(Aliasing { pixels: k, off: sum(0), msaa4: sum(1), ssaa2: sum(2), lookups })
         })
         .collect()
+}
+
+/// `n` of `pixels` drawn with probability proportional to `spread` (each pixel's) plus a
+/// floor of the mean spread (half the draw even: the lookups' errors lie where the grid
+/// samples agree too; with a tenth of it proxy-box's held-out median rose 0.35 → 0.87 dB), by systematic sampling over
+/// the cumulative weights (deterministic, each pixel at most once), and each drawn pixel's
+/// weight, the inverse of its probability: weighted means of the drawn pixels estimate the
+/// mean over `pixels`. All of them, weighing alike, where `n` covers them.
+fn importance_sample(pixels: &[(u32, u32)], spread: &[f64], n: usize) -> (Vec<(u32, u32)>, Vec<f64>) {
+    if pixels.len() <= n {
+        return (pixels.to_vec(), vec![1.0; pixels.len()]);
+    }
+    let mean = spread.iter().sum::<f64>() / spread.len().max(1) as f64;
+    let floor = if mean > 0.0 { mean } else { 1.0 };
+    let p: Vec<f64> = spread.iter().map(|&v| v.max(0.0) + floor).collect();
+    let sum: f64 = p.iter().sum();
+    // Probabilities of inclusion n·p/Σp, capped at 1: a pixel at the cap is taken for sure
+    // and the rest share what is left.
+    let mut inclusion: Vec<f64> = p.iter().map(|&v| n as f64 * v / sum).collect();
+    for _ in 0..8 {
+        let capped: f64 = inclusion.iter().filter(|&&v| v >= 1.0).count() as f64;
+        let rest: f64 = p.iter().zip(&inclusion).filter(|(_, &v)| v < 1.0).map(|(&w, _)| w).sum();
+        if rest <= 0.0 {
+            break;
+        }
+        let share = (n as f64 - capped).max(0.0) / rest;
+        let next: Vec<f64> = p.iter().zip(&inclusion).map(|(&w, &v)| if v >= 1.0 { 1.0 } else { (w * share).min(1.0) }).collect();
+        if next == inclusion {
+            break;
+        }
+        inclusion = next;
+    }
+    let (mut chosen, mut weights) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut acc = 0.0;
+    let mut next = 0.5;
+    for (i, &v) in inclusion.iter().enumerate() {
+        acc += v;
+        if acc > next {
+            chosen.push(pixels[i]);
+            weights.push(1.0 / v);
+            while next < acc {
+                next += 1.0;
+            }
+        }
+    }
+    (chosen, weights)
 }
 
 /// The cube-map lookups of [`LOOKUP_METHODS`] and [`REFRACTOR_METHOD`]'s searches,
