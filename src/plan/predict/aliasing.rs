@@ -251,7 +251,7 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
                 .collect();
             let k = per_pixel.len();
             let total: f64 = per_pixel.iter().map(|(w, _)| w).sum();
-            if k == 0 || !(total > 0.0) {
+            if k == 0 || total.is_nan() || total <= 0.0 {
                 return None;
             }
             let sum = |i: usize| per_pixel.iter().map(|(w, e)| w * e[i]).sum::<f64>() / total;
