@@ -241,6 +241,19 @@ fn kappa_for(f0: f32, nu: f32) -> f32 {
     ((f0 * (nu + 1.0).powi(2) - (nu - 1.0).powi(2)) / (1.0 - f0)).max(0.0).sqrt()
 }
 
+/// Solid clear glass of ν 1.5 (KHR_materials_transmission, _ior, _volume with `thickness`).
+fn glass_material(thickness: f64) -> Value {
+    json!({
+        "name": "glass",
+        "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+        "extensions": {
+            "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+            "KHR_materials_ior": { "ior": 1.5 },
+            "KHR_materials_volume": { "thicknessFactor": thickness }
+        }
+    })
+}
+
 /// The bunny of npm's `bunny` package (`exports.positions=[[x,y,z],…];exports.cells=[[a,b,c],…]`)
 /// scaled to `height` (m), standing at `base` (the centre of its foot print), with
 /// area-weighted vertex normals.
@@ -356,15 +369,7 @@ fn main() {
     // The glass bunny scene: the bunny alone in the room.
     let mut bunny_node = Vec::new();
     if let Some(source) = &bunny_source {
-        materials.push(json!({
-            "name": "glass",
-            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
-            "extensions": {
-                "KHR_materials_transmission": { "transmissionFactor": 1.0 },
-                "KHR_materials_ior": { "ior": 1.5 },
-                "KHR_materials_volume": { "thicknessFactor": 0.3 }
-            }
-        }));
+        materials.push(glass_material(0.3));
         let prim = bin.primitive(&bunny(source, 0.7, Vec3::new(0.0, 0.0, -0.3)), materials.len() - 1);
         meshes.push(json!({ "name": "bunny", "primitives": [prim] }));
         nodes.push(json!({ "name": "bunny", "mesh": meshes.len() - 1 }));
@@ -393,15 +398,7 @@ fn main() {
     // and the box).
     let mut glass = Vec::new();
     if !mirrors_scene && !bunny_scene {
-        materials.push(json!({
-            "name": "glass",
-            "pbrMetallicRoughness": { "baseColorFactor": [1.0, 1.0, 1.0, 1.0], "metallicFactor": 0.0, "roughnessFactor": 0.0 },
-            "extensions": {
-                "KHR_materials_transmission": { "transmissionFactor": 1.0 },
-                "KHR_materials_ior": { "ior": 1.5 },
-                "KHR_materials_volume": { "thicknessFactor": 0.6 }
-            }
-        }));
+        materials.push(glass_material(0.6));
         let prim = bin.primitive(&sphere(0.45, 64, 32), materials.len() - 1);
         meshes.push(json!({ "name": "glass_sphere", "primitives": [prim] }));
         nodes.push(json!({ "name": "glass_sphere", "mesh": meshes.len() - 1, "translation": [0.9, 0.45, -0.3] }));

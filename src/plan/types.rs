@@ -434,13 +434,7 @@ mod tests {
     #[test]
     fn an_anchor_measures_how_far_the_view_moved() {
         let mut s = crate::scene::Scene::new();
-        let m = s
-            .add_material(crate::scene::Material {
-                name: "m".into(),
-                kind: crate::scene::SurfaceKind::Mirror { nu: Vec3::splat(3.0), kappa: Vec3::ZERO },
-                ..Default::default()
-            })
-            .unwrap();
+        let m = s.add_material(crate::scenes::mirror_material("m", 0.9)).unwrap();
         let ball = s.add_mesh(crate::scene::shapes::uv_sphere("ball", Vec3::ZERO, 0.5, 16, 8, m)).unwrap();
         s.camera = Some(crate::scene::Camera::look_at(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, 0.8));
         let a = Anchor::of(&s);

@@ -139,7 +139,7 @@ pub fn checker_room(scene: &mut Scene, center: Vec3, half: f32) -> Result<()> {
 }
 
 /// A mirror material of reflectance `f0` at normal incidence (κ = 0, ν from survey eq. 2).
-fn mirror_material(name: &str, f0: f32) -> Material {
+pub(crate) fn mirror_material(name: &str, f0: f32) -> Material {
     let s = f0.sqrt();
     let nu = (1.0 + s) / (1.0 - s);
     Material { name: name.into(), kind: SurfaceKind::Mirror { nu: Vec3::splat(nu), kappa: Vec3::ZERO }, ..Default::default() }

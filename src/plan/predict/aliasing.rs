@@ -226,23 +226,28 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
                     let reference: Vec<(f64, f64)> = (0..spp).map(|s| sample_offset(x, y, s, spp)).collect();
                     let r = mean(x, y, &reference);
                     let exact = at(x, y, (0.5, 0.5));
-                    let mut e = vec![sq(exact, r), sq(mean(x, y, &MSAA4), r), sq(mean(x, y, &SSAA2), r)];
+                    // The exact tracer at the anti-aliasing samples, traced once for its own
+                    // error and for the maps' simulation there.
+                    let (m4_exact, s2_exact): (Vec<DVec3>, Vec<DVec3>) =
+                        (MSAA4.iter().map(|&o| at(x, y, o)).collect(), SSAA2.iter().map(|&o| at(x, y, o)).collect());
+                    let avg = |v: &[DVec3]| v.iter().sum::<DVec3>() / v.len() as f64;
+                    let mut e = vec![sq(exact, r), sq(avg(&m4_exact), r), sq(avg(&s2_exact), r)];
                     if let Some(c) = centre {
                         let shades = env.shades(mesh as u32, c, rays.ray(x as f64 + 0.5, y as f64 + 0.5), exact, env.cube_sizes);
                         e.extend(shades.into_iter().flat_map(|v| [sq(v, r), sq(v, exact)]));
                         // The maps sampled as anti-aliasing samples them, at the asked cube size
                         // (the variants that vary `aa` keep it).
-                        let sampled = |offsets: &[(f64, f64)]| {
+                        let sampled = |offsets: &[(f64, f64)], exact: &[DVec3]| {
                             let mut sum = vec![DVec3::ZERO; env.keys(mesh, &aa_size).len()];
-                            for &(dx, dy) in offsets {
+                            for (&(dx, dy), &ex) in offsets.iter().zip(exact) {
                                 let ray = rays.ray(x as f64 + dx, y as f64 + dy);
-                                for (s, v) in sum.iter_mut().zip(env.shades(mesh as u32, c, ray, at(x, y, (dx, dy)), &aa_size)) {
+                                for (s, v) in sum.iter_mut().zip(env.shades(mesh as u32, c, ray, ex, &aa_size)) {
                                     *s += v / offsets.len() as f64;
                                 }
                             }
                             sum
                         };
-                        let (m4, s2) = (sampled(&MSAA4), sampled(&SSAA2));
+                        let (m4, s2) = (sampled(&MSAA4, &m4_exact), sampled(&SSAA2, &s2_exact));
                         e.extend(m4.into_iter().zip(s2).flat_map(|(a, b)| [sq(a, r), sq(b, r)]));
                     }
                     (weight, e)
