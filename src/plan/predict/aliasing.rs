@@ -289,8 +289,9 @@ pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Loo
 
 /// `n` of `pixels` drawn with probability proportional to `spread` (each pixel's) plus a
 /// floor of the mean spread (half the draw even: the lookups' errors lie where the grid
-/// samples agree too; with a tenth of it proxy-box's held-out median rose 0.35 → 0.87 dB), by systematic sampling over
-/// the cumulative weights (deterministic, each pixel at most once), and each drawn pixel's
+/// samples agree too; with a tenth of it proxy-box's held-out median rose 0.35 → 0.87 dB),
+/// by systematic sampling over the cumulative weights (deterministic, each pixel at most
+/// once; a pattern periodic in the pixels' order can alias with it), and each drawn pixel's
 /// weight, the inverse of its probability: weighted means of the drawn pixels estimate the
 /// mean over `pixels`. All of them, weighing alike, where `n` covers them.
 fn importance_sample(pixels: &[(u32, u32)], spread: &[f64], n: usize) -> (Vec<(u32, u32)>, Vec<f64>) {
@@ -613,6 +614,35 @@ mod tests {
             assert!(at("proxy-sphere", n) > at("proxy-box", n), "{:?}", a.lookups);
         }
         assert!(at("proxy-box", 256) < at("proxy-box", 64), "finer texels: {:?}", a.lookups);
+        // The maps sampled as anti-aliasing samples them, at the asked cube size only (256,
+        // the default): supersampling averages their error down.
+        let l = a.lookup("proxy-box", 256).unwrap();
+        assert!(l.ssaa2.is_some_and(|e| e < l.off) && l.msaa4.is_some(), "{l:?}");
+        assert_eq!((a.lookup("proxy-box", 64).unwrap().ssaa2, a.lookup("proxy-box", 64).unwrap().msaa4), (None, None));
+    }
+
+    /// The pixels drawn by importance estimate a heavy-tailed mean better than as many drawn
+    /// evenly: 1000 pixels, about one in 50 (placed by a hash) carrying 100× the others'
+    /// error, 40 drawn; the mean relative error over 20 placements.
+    #[test]
+    fn importance_sampling_finds_the_tail() {
+        let pixels: Vec<(u32, u32)> = (0..1000).map(|i| (i, 0)).collect();
+        let (mut importance, mut even) = (0.0, 0.0);
+        for seed in 0..20 {
+            let error = |&(i, _): &(u32, u32)| if crate::reference::hash(i, seed, 7) % 50 == 7 { 100.0 } else { 1.0 };
+            let truth = pixels.iter().map(error).sum::<f64>() / 1000.0;
+            let spread: Vec<f64> = pixels.iter().map(error).collect();
+            let (chosen, weights) = importance_sample(&pixels, &spread, 40);
+            assert_eq!(chosen.len(), 40);
+            let weighted = chosen.iter().zip(&weights).map(|(p, w)| w * error(p)).sum::<f64>() / weights.iter().sum::<f64>();
+            let drawn = (0..40).map(|k| error(&pixels[k * 1000 / 40])).sum::<f64>() / 40.0;
+            importance += (weighted - truth).abs() / truth / 20.0;
+            even += (drawn - truth).abs() / truth / 20.0;
+        }
+        assert!(importance < 0.5 * even && importance < 0.2, "importance {importance:.3}, even {even:.3} (mean relative errors)");
+        // Where the draw covers every pixel, all of them weigh alike.
+        let (all, w) = importance_sample(&pixels[..10], &[1.0; 10], 40);
+        assert_eq!((all.len(), w), (10, vec![1.0; 10]));
     }
 
     /// A solid glass ball at the centre of a box room, its maps centred on it: searching the
