@@ -9,8 +9,9 @@ use std::path::{Path, PathBuf};
 
 use specula::scene::{load_environment, load_environment_with, LoadLimits};
 
-fn dir() -> PathBuf {
-    let d = common::scratch_dir("limits");
+/// A scratch directory per test: the tests run in parallel and each removes its own.
+fn dir(test: &str) -> PathBuf {
+    let d = common::scratch_dir(&format!("limits-{test}"));
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -44,7 +45,7 @@ fn huge_hdr(d: &Path) -> PathBuf {
 
 #[test]
 fn declared_sizes_are_checked_before_allocation() {
-    let d = dir();
+    let d = dir("loader");
     for path in [huge_exr(&d), huge_png(&d), huge_hdr(&d)] {
         let e = load_environment(&path).unwrap_err().to_string();
         eprintln!("{e}");
@@ -64,8 +65,7 @@ fn declared_sizes_are_checked_before_allocation() {
 
 #[test]
 fn the_cli_exits_1_on_huge_declared_images() {
-    let d = dir().join("cli");
-    std::fs::create_dir_all(&d).unwrap();
+    let d = dir("cli");
     let exe = env!("CARGO_BIN_EXE_specula");
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf");
     let exr = huge_exr(&d);
