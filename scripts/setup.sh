@@ -2,10 +2,12 @@
 # Installs what specula needs on Debian 12 (as root): lavapipe (Mesa's CPU Vulkan
 # driver, Mesa 25 from bookworm-backports), the Vulkan loader, the Khronos validation layer, glslangValidator for the
 # shader build, spirv-val for the shader tests, a C/C++ compiler and the Vulkan headers
-# (the C host examples), and Rust (rustup) when
+# (the C host examples), an X server without a screen with the X libraries winit loads
+# (`specula view`: xvfb-run runs it headless in the tests), and Rust (rustup) when
 # no cargo is on the PATH. Only installs what is missing, so reruns are quick.
 set -euo pipefail
-packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers glslang-tools spirv-tools build-essential pkg-config ca-certificates curl)
+packages=(mesa-vulkan-drivers libvulkan1 libvulkan-dev vulkan-validationlayers glslang-tools spirv-tools build-essential pkg-config ca-certificates curl
+  xvfb xauth libx11-xcb1 libxcursor1 libxrandr2 libxi6 libxkbcommon-x11-0)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

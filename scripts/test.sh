@@ -19,6 +19,8 @@ if ! "$venv/bin/python" -c "import mitsuba" >/dev/null 2>&1; then
   "$venv/bin/pip" install -q "mitsuba==3.9.1"
 fi
 export SPECULA_DEVICE="${SPECULA_DEVICE:-llvmpipe}"
+# setup.sh installed Xvfb: the viewer's test must run here, not skip.
+export SPECULA_REQUIRE_VIEWER="${SPECULA_REQUIRE_VIEWER:-1}"
 # Not incremental: a fresh clone compiles everything once, and the incremental cache only
 # costs time then (the library: 137 s instead of 153 on 2 cores).
 export CARGO_INCREMENTAL="${CARGO_INCREMENTAL:-0}"

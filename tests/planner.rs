@@ -367,7 +367,7 @@ fn measured_exact_error_predicts_held_out_objects() {
         abs_error_quantiles, leave_one_scene_out, leave_one_scene_out_probed, ErrorModel, Held, EXACT,
     };
     let c = predict::stored_corpus().unwrap();
-    let third = |scene: usize| scene % 3 == 0;
+    let third = |scene: usize| scene.is_multiple_of(3);
     let probes = probe_corpus(&c.samples, &third).unwrap();
     assert!(probes.len() >= 20, "{} objects probed", probes.len());
     let held: Vec<Held> = leave_one_scene_out(&c.samples).into_iter().filter(|h| third(h.scene)).collect();

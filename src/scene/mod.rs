@@ -644,7 +644,7 @@ pub(crate) fn validate_mesh(mesh: &mut Mesh, material_count: usize, what: &str) 
     if mesh.positions.is_empty() || mesh.indices.is_empty() {
         return Err(Error::invalid(format!("{what}: indices"), "mesh has no vertices or no triangles"));
     }
-    if mesh.indices.len() % 3 != 0 {
+    if !mesh.indices.len().is_multiple_of(3) {
         return Err(Error::invalid(
             format!("{what}: indices"),
             format!("{} indices is not a whole number of triangles", mesh.indices.len()),

@@ -35,6 +35,12 @@ pub struct DeviceOptions {
     /// `SPECULA_RAY_QUERY=off`): `ray-query` then falls back to `bvh`, as on a device
     /// without them.
     pub hide_ray_query: bool,
+    /// Instance extensions to enable besides the library's own: a window's surface
+    /// extensions (`specula view`). Each must be available, or creation fails naming it.
+    pub instance_extensions: Vec<std::ffi::CString>,
+    /// Device extensions to enable besides the library's own (`VK_KHR_swapchain` for a
+    /// window). Each must be available on the chosen device, or creation fails naming it.
+    pub device_extensions: Vec<std::ffi::CString>,
 }
 
 /// What a host engine hands over in host-device mode.
@@ -301,6 +307,15 @@ impl Context {
         if sync {
             exts.push(ash::ext::validation_features::NAME.as_ptr());
         }
+        for e in &opts.instance_extensions {
+            if !exts_avail.iter().any(|a| a.extension_name_as_c_str().is_ok_and(|x| x == e.as_c_str())) {
+                return Err(Error::Unsupported(format!(
+                    "the Vulkan instance lacks the extension {} that was asked for",
+                    e.to_string_lossy()
+                )));
+            }
+            exts.push(e.as_ptr());
+        }
         let enabled_features = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
         let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enabled_features);
         let validation = Arc::new(ValidationLog::default());
@@ -350,6 +365,14 @@ impl Context {
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
         let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
         let mut ext_names: Vec<*const i8> = REQUIRED_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
+        let device_exts =
+            unsafe { instance_ref.enumerate_device_extension_properties(physical) }.call("vkEnumerateDeviceExtensionProperties")?;
+        for e in &opts.device_extensions {
+            if !device_exts.iter().any(|a| a.extension_name_as_c_str().is_ok_and(|x| x == e.as_c_str())) {
+                return Err(Error::Unsupported(format!("the device lacks the extension {} that was asked for", e.to_string_lossy())));
+            }
+            ext_names.push(e.as_ptr());
+        }
         // Vulkan's ray-tracing API where the device has it, unless hidden.
         let ray_query = if opts.hide_ray_query || ray_query_hidden_by_env() {
             Err("ray queries are hidden (SPECULA_RAY_QUERY=off or DeviceOptions::hide_ray_query)".to_string())

@@ -1,4 +1,4 @@
-//! The specula command line: render, info, plan, knobs, demo, bench, compare, tradeoff.
+//! The specula command line: render, view, info, plan, knobs, demo, bench, compare, tradeoff.
 //! One file per subcommand; `args` holds what they share (argument structs, parsers, the
 //! scene-and-knobs preparation, image output, the timed CPU reference).
 
@@ -15,6 +15,8 @@ mod plan;
 mod raytrace;
 mod render;
 mod tradeoff;
+#[cfg(feature = "viewer")]
+mod view;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -216,6 +218,13 @@ enum Command {
         #[arg(long, default_value = "animation")]
         out: PathBuf,
     },
+    /// Look at a scene in a window: fly or orbit, switch methods and knobs, per-pass timings
+    /// live, F12 for a screenshot (PNG + EXR + the `specula render` command that repeats it).
+    #[cfg(feature = "viewer")]
+    View {
+        #[command(flatten)]
+        args: view::ViewArgs,
+    },
     /// Render the bundled demo scene with every method into OUTDIR, with a timing table.
     Demo {
         #[arg(default_value = "out")]
@@ -317,6 +326,8 @@ fn run(cmd: Command) -> specula::Result<()> {
         Command::Calibrate { out, samples, refit, validate, device } => {
             corpus::run_calibrate(out.as_deref(), samples.as_deref(), refit.as_deref(), validate, &device)
         }
+        #[cfg(feature = "viewer")]
+        Command::View { args } => view::run(&args),
         Command::Bench { args, sweep } => bench::run(&args, sweep.as_deref()),
         Command::Compare { test, reference, error_image, scene, mask } => {
             compare::run(&test, &reference, error_image.as_deref(), scene.as_deref(), mask.as_deref())

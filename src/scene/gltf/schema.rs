@@ -160,7 +160,7 @@ pub fn check(file: &str, json: &Value) -> Result<()> {
     let views = json.get("bufferViews").and_then(Value::as_array).cloned().unwrap_or_default();
     for (i, view) in views.iter().enumerate() {
         let Some(s) = c.number(view, "byteStride", &format!("bufferViews[{i}]"))? else { continue };
-        if !(4.0..=252.0).contains(&s) || s.fract() != 0.0 || (s as u64) % 4 != 0 {
+        if !(4.0..=252.0).contains(&s) || s.fract() != 0.0 || !(s as u64).is_multiple_of(4) {
             return Err(c.err(format!("bufferViews[{i}].byteStride"), format!("must be a multiple of 4 in 4..=252, got {s}")));
         }
     }
