@@ -81,6 +81,12 @@
 #define SPECULA_METHOD_REFERENCE 99
 
 
+// sizeof(SpeculaContextDesc) before `vulkan_allocator`: still accepted.
+#define SPECULA_CONTEXT_DESC_SIZE_V1 24
+
+// sizeof(SpeculaHostDesc) before `vulkan_allocator`: still accepted.
+#define SPECULA_HOST_DESC_SIZE_V1 56
+
 // The size of SpeculaRenderDesc before the budget fields (type, size, method, width,
 // height): still accepted, as no budget.
 #define SPECULA_RENDER_DESC_SIZE_V1 20
@@ -147,6 +153,11 @@ typedef struct {
   const char *device_name;
   // Non-zero: enable the Khronos validation layer; validation errors fail the frame.
   uint32_t enable_validation;
+  // A `const VkAllocationCallbacks*`, or NULL (zero where the caller's struct ends
+  // before this field): copied at the call, and passed to every Vulkan object the context
+  // creates and destroys, its instance and device included. Device memory blocks come
+  // from gpu-allocator, whose vkAllocateMemory calls pass none.
+  const void *vulkan_allocator;
 } SpeculaContextDesc;
 
 // `PFN_vkVoidFunction`.
@@ -182,7 +193,29 @@ typedef struct {
   // `ray_query`, `buffer_device_address`): the `ray-query` method then traces through
   // them; else its objects get `bvh`, and the plan's reason says why.
   uint32_t ray_query_enabled;
+  // A `const VkAllocationCallbacks*`, or NULL (zero where the caller's struct ends
+  // before this field): copied at the call, and passed to every Vulkan object the library
+  // creates and destroys on the host's device (device memory blocks excepted, as in
+  // SpeculaContextDesc).
+  const void *vulkan_allocator;
 } SpeculaHostDesc;
+
+// The host's allocator for the library's CPU memory (specula_set_host_allocator). The
+// callbacks may be called from any thread, at any time until the process ends (blocks made
+// through them are freed through them, even after another allocator was set).
+typedef struct {
+  // SPECULA_STRUCT_HOST_ALLOCATOR
+  SpeculaStructType type;
+  // sizeof(SpeculaHostAllocator)
+  uint32_t size;
+  // Handed to both callbacks.
+  void *user;
+  // Returns `size` bytes aligned to `alignment` (a power of two, at least 16), or NULL
+  // when out of memory.
+  void *(*allocate)(void *user, size_t size, size_t alignment);
+  // Frees a block `allocate` returned, given the size and alignment it was asked for.
+  void (*free)(void *user, void *memory, size_t size, size_t alignment);
+} SpeculaHostAllocator;
 
 typedef uint32_t SpeculaLogLevel;
 
@@ -441,6 +474,8 @@ typedef struct {
 
 #define SPECULA_STRUCT_REQUIREMENTS 9
 
+#define SPECULA_STRUCT_HOST_ALLOCATOR 10
+
 // Emission + Lambertian direct light.
 #define SPECULA_SURFACE_DIFFUSE 0
 
@@ -478,9 +513,9 @@ uint32_t specula_live_context_count(void);
 // The library version as VK_MAKE_API_VERSION(0, major, minor, patch). Thread-safe.
 uint32_t specula_version(void);
 
-// The message of the last failed specula_context_create* or specula_get_requirements on
-// this thread ("" if none). The pointer stays valid for the thread's lifetime; its text
-// changes with the next failure. Thread-safe.
+// The message of the last failed specula_context_create*, specula_get_requirements or
+// specula_set_host_allocator on this thread ("" if none). The pointer stays valid for the
+// thread's lifetime; its text changes with the next failure. Thread-safe.
 const char *specula_creation_error(void);
 
 // Fills `out` with what a host must enable (host-device mode). Thread-safe.
@@ -494,6 +529,14 @@ SpeculaResult specula_context_create(const SpeculaContextDesc *desc, SpeculaCont
 // SpeculaHostDesc). The library never submits and never destroys the host's objects.
 // Thread-safe.
 SpeculaResult specula_context_create_host(const SpeculaHostDesc *desc, SpeculaContext **out);
+
+// Routes the library's CPU allocations (every context's, and the calls' own) through the
+// host's allocator from now on; NULL returns to the system allocator. Process-wide: Rust
+// allocates through one allocator per program. Blocks already made are freed by the
+// allocator that made them, so this may be called at any time; the callbacks must stay
+// callable until the process ends. SPECULA_ERROR_UNSUPPORTED where the library was built
+// without its `host-allocator` feature. Thread-safe.
+SpeculaResult specula_set_host_allocator(const SpeculaHostAllocator *allocator);
 
 // Destroys a context and everything it created. Needs an idle GPU in host-device mode
 // (no submitted frame of this context may still run). Passing NULL does nothing; a

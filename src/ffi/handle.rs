@@ -18,7 +18,7 @@ use crate::methods::{Choice, Method};
 use crate::quality::Quality;
 use crate::renderer::Renderer;
 use crate::scene::Scene;
-use crate::vk::{Context, DeviceOptions, HostHandles};
+use crate::vk::{Context, DeviceOptions, HostHandles, VulkanAllocator};
 
 // ------------------------------------------------------------------ the context
 
@@ -360,9 +360,9 @@ pub extern "C" fn specula_version() -> u32 {
     vk::make_api_version(0, v(env!("CARGO_PKG_VERSION_MAJOR")), v(env!("CARGO_PKG_VERSION_MINOR")), v(env!("CARGO_PKG_VERSION_PATCH")))
 }
 
-/// The message of the last failed specula_context_create* or specula_get_requirements on
-/// this thread ("" if none). The pointer stays valid for the thread's lifetime; its text
-/// changes with the next failure. Thread-safe.
+/// The message of the last failed specula_context_create*, specula_get_requirements or
+/// specula_set_host_allocator on this thread ("" if none). The pointer stays valid for the
+/// thread's lifetime; its text changes with the next failure. Thread-safe.
 #[no_mangle]
 pub extern "C" fn specula_creation_error() -> *const c_char {
     CREATION_ERROR.with(|e| e.borrow().as_ptr() as *const c_char)
@@ -415,9 +415,14 @@ pub unsafe extern "C" fn specula_get_requirements(out: *mut SpeculaRequirements)
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_create(desc: *const SpeculaContextDesc, out: *mut *mut SpeculaContext) -> SpeculaResult {
     create(out, || {
-        let d = header(desc, SPECULA_STRUCT_CONTEXT_DESC, "desc")?;
+        let (d, _) = header_grown(desc, SPECULA_STRUCT_CONTEXT_DESC, "desc", SPECULA_CONTEXT_DESC_SIZE_V1 as usize)?;
         let filter = if d.device_name.is_null() { None } else { Some(cstr(d.device_name, "desc.device_name")?.to_string()) };
-        Ok(Context::new(&DeviceOptions { validation: d.enable_validation != 0, device_filter: filter, ..Default::default() })?)
+        Ok(Context::new(&DeviceOptions {
+            validation: d.enable_validation != 0,
+            device_filter: filter,
+            allocation_callbacks: vulkan_allocator(d.vulkan_allocator)?,
+            ..Default::default()
+        })?)
     })
 }
 
@@ -427,7 +432,7 @@ pub unsafe extern "C" fn specula_context_create(desc: *const SpeculaContextDesc,
 #[no_mangle]
 pub unsafe extern "C" fn specula_context_create_host(desc: *const SpeculaHostDesc, out: *mut *mut SpeculaContext) -> SpeculaResult {
     create(out, || {
-        let d = header(desc, SPECULA_STRUCT_HOST_DESC, "desc")?;
+        let (d, _) = header_grown(desc, SPECULA_STRUCT_HOST_DESC, "desc", SPECULA_HOST_DESC_SIZE_V1 as usize)?;
         let Some(gipa) = d.get_instance_proc_addr else { return fail(SPECULA_ERROR_NULL_POINTER, "desc.get_instance_proc_addr is NULL") };
         if d.instance.is_null() || d.physical_device.is_null() || d.device.is_null() {
             return fail(SPECULA_ERROR_NULL_POINTER, "desc.instance, physical_device and device must not be NULL");
@@ -444,8 +449,57 @@ pub unsafe extern "C" fn specula_context_create_host(desc: *const SpeculaHostDes
             queue_family: d.queue_family,
             debug_utils: d.debug_utils_enabled != 0,
             ray_query: d.ray_query_enabled != 0,
+            allocation_callbacks: vulkan_allocator(d.vulkan_allocator)?,
         };
         Ok(Context::from_host(&host)?)
+    })
+}
+
+/// A host's `VkAllocationCallbacks`, copied; NULL is none. Vulkan requires the allocation,
+/// reallocation and free functions.
+unsafe fn vulkan_allocator(p: *const c_void) -> FfiResult<Option<VulkanAllocator>> {
+    if p.is_null() {
+        return Ok(None);
+    }
+    let c = *(p as *const vk::AllocationCallbacks<'static>);
+    for (missing, name) in [
+        (c.pfn_allocation.is_none(), "pfnAllocation"),
+        (c.pfn_reallocation.is_none(), "pfnReallocation"),
+        (c.pfn_free.is_none(), "pfnFree"),
+    ] {
+        if missing {
+            return fail(SPECULA_ERROR_NULL_POINTER, format!("desc.vulkan_allocator->{name} is NULL"));
+        }
+    }
+    Ok(Some(VulkanAllocator(c)))
+}
+
+/// Routes the library's CPU allocations (every context's, and the calls' own) through the
+/// host's allocator from now on; NULL returns to the system allocator. Process-wide: Rust
+/// allocates through one allocator per program. Blocks already made are freed by the
+/// allocator that made them, so this may be called at any time; the callbacks must stay
+/// callable until the process ends. SPECULA_ERROR_UNSUPPORTED where the library was built
+/// without its `host-allocator` feature. Thread-safe.
+#[no_mangle]
+pub unsafe extern "C" fn specula_set_host_allocator(allocator: *const SpeculaHostAllocator) -> SpeculaResult {
+    let r = boundary(|| {
+        let hooks = if allocator.is_null() {
+            None
+        } else {
+            let (a, _) = header_grown(allocator, SPECULA_STRUCT_HOST_ALLOCATOR, "allocator", std::mem::size_of::<SpeculaHostAllocator>())?;
+            let (Some(allocate), Some(free)) = (a.allocate, a.free) else {
+                return fail(SPECULA_ERROR_NULL_POINTER, "allocator.allocate and allocator.free must not be NULL");
+            };
+            Some(super::allocator::Hooks { user: a.user, allocate, free })
+        };
+        if !super::allocator::set(hooks) {
+            return fail(SPECULA_ERROR_UNSUPPORTED, "the library was built without its host-allocator feature");
+        }
+        Ok(SPECULA_SUCCESS)
+    });
+    r.unwrap_or_else(|f| {
+        set_creation_error(&f);
+        f.0
     })
 }
 

@@ -29,6 +29,8 @@ mod objects;
 
 mod updates;
 
+mod allocator;
+
 pub use frames::*;
 pub use handle::*;
 pub use objects::*;

@@ -56,6 +56,7 @@ pub const SPECULA_STRUCT_CAMERA_DESC: SpeculaStructType = 6;
 pub const SPECULA_STRUCT_RENDER_DESC: SpeculaStructType = 7;
 pub const SPECULA_STRUCT_HOST_IMAGE: SpeculaStructType = 8;
 pub const SPECULA_STRUCT_REQUIREMENTS: SpeculaStructType = 9;
+pub const SPECULA_STRUCT_HOST_ALLOCATOR: SpeculaStructType = 10;
 
 /// Rendering methods: SPECULA_METHOD_* (defined near the top of this header, generated from
 /// the method registry), the same names as the CLI's `--method`; SPECULA_METHOD_AUTO lets
@@ -99,6 +100,7 @@ pub type SpeculaGetInstanceProcAddr = Option<unsafe extern "C" fn(instance: *mut
 
 /// Standalone mode: the library creates its own headless instance and device.
 #[repr(C)]
+#[derive(Clone, Copy)]
 pub struct SpeculaContextDesc {
     /// SPECULA_STRUCT_CONTEXT_DESC
     pub r#type: SpeculaStructType,
@@ -109,12 +111,21 @@ pub struct SpeculaContextDesc {
     pub device_name: *const c_char,
     /// Non-zero: enable the Khronos validation layer; validation errors fail the frame.
     pub enable_validation: u32,
+    /// A `const VkAllocationCallbacks*`, or NULL (zero where the caller's struct ends
+    /// before this field): copied at the call, and passed to every Vulkan object the context
+    /// creates and destroys, its instance and device included. Device memory blocks come
+    /// from gpu-allocator, whose vkAllocateMemory calls pass none.
+    pub vulkan_allocator: *const c_void,
 }
+
+/// sizeof(SpeculaContextDesc) before `vulkan_allocator`: still accepted.
+pub const SPECULA_CONTEXT_DESC_SIZE_V1: u32 = 24;
 
 /// Host-device mode (the FSR2/XeSS model): the host's Vulkan objects, created with
 /// everything `specula_get_requirements` lists. The library loads Vulkan through
 /// `get_instance_proc_addr`, never submits, and never destroys these objects.
 #[repr(C)]
+#[derive(Clone, Copy)]
 pub struct SpeculaHostDesc {
     /// SPECULA_STRUCT_HOST_DESC
     pub r#type: SpeculaStructType,
@@ -139,6 +150,33 @@ pub struct SpeculaHostDesc {
     /// `ray_query`, `buffer_device_address`): the `ray-query` method then traces through
     /// them; else its objects get `bvh`, and the plan's reason says why.
     pub ray_query_enabled: u32,
+    /// A `const VkAllocationCallbacks*`, or NULL (zero where the caller's struct ends
+    /// before this field): copied at the call, and passed to every Vulkan object the library
+    /// creates and destroys on the host's device (device memory blocks excepted, as in
+    /// SpeculaContextDesc).
+    pub vulkan_allocator: *const c_void,
+}
+
+/// sizeof(SpeculaHostDesc) before `vulkan_allocator`: still accepted.
+pub const SPECULA_HOST_DESC_SIZE_V1: u32 = 56;
+
+/// The host's allocator for the library's CPU memory (specula_set_host_allocator). The
+/// callbacks may be called from any thread, at any time until the process ends (blocks made
+/// through them are freed through them, even after another allocator was set).
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct SpeculaHostAllocator {
+    /// SPECULA_STRUCT_HOST_ALLOCATOR
+    pub r#type: SpeculaStructType,
+    /// sizeof(SpeculaHostAllocator)
+    pub size: u32,
+    /// Handed to both callbacks.
+    pub user: *mut c_void,
+    /// Returns `size` bytes aligned to `alignment` (a power of two, at least 16), or NULL
+    /// when out of memory.
+    pub allocate: Option<unsafe extern "C" fn(user: *mut c_void, size: usize, alignment: usize) -> *mut c_void>,
+    /// Frees a block `allocate` returned, given the size and alignment it was asked for.
+    pub free: Option<unsafe extern "C" fn(user: *mut c_void, memory: *mut c_void, size: usize, alignment: usize)>,
 }
 
 /// What a host must enable before it creates its device (host-device mode).

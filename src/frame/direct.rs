@@ -70,7 +70,7 @@ pub fn sky_and_direct(
     match direct {
         Ok(d) => Ok((sky, d)),
         Err(e) => {
-            unsafe { ctx.device.destroy_pipeline(sky, None) };
+            unsafe { ctx.device.destroy_pipeline(sky, ctx.alloc()) };
             Err(e)
         }
     }

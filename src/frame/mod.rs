@@ -222,7 +222,7 @@ pub fn view_mask(mode: CubeMode) -> u32 {
 pub fn destroy_pipelines(ctx: &Context, pipelines: &mut [vk::Pipeline]) {
     for p in pipelines.iter_mut() {
         if *p != vk::Pipeline::null() {
-            unsafe { ctx.device.destroy_pipeline(*p, None) };
+            unsafe { ctx.device.destroy_pipeline(*p, ctx.alloc()) };
             *p = vk::Pipeline::null();
         }
     }

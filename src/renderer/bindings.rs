@@ -119,23 +119,23 @@ impl Bindings {
         unsafe {
             let d = &ctx.device;
             if self.layout != vk::PipelineLayout::null() {
-                d.destroy_pipeline_layout(self.layout, None);
+                d.destroy_pipeline_layout(self.layout, ctx.alloc());
             }
             if self.pool != vk::DescriptorPool::null() {
-                d.destroy_descriptor_pool(self.pool, None);
+                d.destroy_descriptor_pool(self.pool, ctx.alloc());
             }
             if self.set_layout != vk::DescriptorSetLayout::null() {
-                d.destroy_descriptor_set_layout(self.set_layout, None);
+                d.destroy_descriptor_set_layout(self.set_layout, ctx.alloc());
             }
             for s in self.owned_sets.drain(..) {
-                d.destroy_descriptor_pool(s.pool, None);
+                d.destroy_descriptor_pool(s.pool, ctx.alloc());
             }
             if self.maps_layout != vk::DescriptorSetLayout::null() {
-                d.destroy_descriptor_set_layout(self.maps_layout, None);
+                d.destroy_descriptor_set_layout(self.maps_layout, ctx.alloc());
             }
             for s in [self.linear_repeat, self.nearest_clamp] {
                 if s != vk::Sampler::null() {
-                    d.destroy_sampler(s, None);
+                    d.destroy_sampler(s, ctx.alloc());
                 }
             }
         }

@@ -41,6 +41,27 @@ pub struct DeviceOptions {
     /// Device extensions to enable besides the library's own (`VK_KHR_swapchain` for a
     /// window). Each must be available on the chosen device, or creation fails naming it.
     pub device_extensions: Vec<std::ffi::CString>,
+    /// The host's Vulkan allocation callbacks, passed to every Vulkan object the context
+    /// creates and destroys (its instance and device included).
+    pub allocation_callbacks: Option<VulkanAllocator>,
+}
+
+/// A host's `VkAllocationCallbacks`, copied: the library passes them to every
+/// `vkCreate*`/`vkDestroy*` it calls. Device memory comes from gpu-allocator, whose
+/// `vkAllocateMemory` calls pass none (the driver's own host allocations for those few
+/// large blocks).
+#[derive(Clone, Copy)]
+pub struct VulkanAllocator(pub vk::AllocationCallbacks<'static>);
+
+// SAFETY: the callbacks are the host's, which promises (Vulkan's rules for
+// VkAllocationCallbacks) that they may be called from any thread the context is used on.
+unsafe impl Send for VulkanAllocator {}
+unsafe impl Sync for VulkanAllocator {}
+
+impl std::fmt::Debug for VulkanAllocator {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "VulkanAllocator(user data {:p})", self.0.p_user_data)
+    }
 }
 
 /// What a host engine hands over in host-device mode.
@@ -56,6 +77,8 @@ pub struct HostHandles {
     /// The host enabled [`RAY_QUERY_DEVICE_EXTENSIONS`] and the features
     /// [`ray_query_supported`] checks: `ray-query` traces through them.
     pub ray_query: bool,
+    /// The host's Vulkan allocation callbacks for every object the library creates.
+    pub allocation_callbacks: Option<VulkanAllocator>,
 }
 
 /// Messages the validation layer reported; tests fail on any error.
@@ -160,6 +183,8 @@ pub struct Context {
     /// Vulkan's ray-tracing API (acceleration structures and ray queries), where the device
     /// has it and it was enabled; else why not (the `ray-query` method's fallback reason).
     pub ray_query: std::result::Result<RayQueryDevice, String>,
+    /// The host's allocation callbacks for every object the library creates and destroys.
+    callbacks: Option<VulkanAllocator>,
 }
 
 /// What the `ray-query` method needs of a device that traces through Vulkan's ray-tracing
@@ -335,14 +360,16 @@ impl Context {
         if sync {
             ci = ci.push_next(&mut features);
         }
-        let instance = unsafe { entry.create_instance(&ci, None) }.call("vkCreateInstance")?;
-        let mut ctx_guard = InstanceGuard { instance: Some(instance), debug: None, messenger: vk::DebugUtilsMessengerEXT::null() };
+        let alloc = opts.allocation_callbacks;
+        let callbacks = alloc.as_ref().map(|c| &c.0);
+        let instance = unsafe { entry.create_instance(&ci, callbacks) }.call("vkCreateInstance")?;
+        let mut ctx_guard = InstanceGuard { instance: Some(instance), debug: None, messenger: vk::DebugUtilsMessengerEXT::null(), alloc };
         let instance_ref = ctx_guard.instance.as_ref().unwrap();
         if has_debug_utils {
             let di = ash::ext::debug_utils::Instance::new(&entry, instance_ref);
             if opts.validation {
                 ctx_guard.messenger =
-                    unsafe { di.create_debug_utils_messenger(&messenger_info, None) }.call("vkCreateDebugUtilsMessengerEXT")?;
+                    unsafe { di.create_debug_utils_messenger(&messenger_info, callbacks) }.call("vkCreateDebugUtilsMessengerEXT")?;
             }
             ctx_guard.debug = Some(di);
         }
@@ -397,7 +424,7 @@ impl Context {
         if on {
             dci = dci.push_next(&mut accel).push_next(&mut rq);
         }
-        let device = unsafe { instance_ref.create_device(physical, &dci, None) }.call("vkCreateDevice")?;
+        let device = unsafe { instance_ref.create_device(physical, &dci, callbacks) }.call("vkCreateDevice")?;
         let queue = unsafe { device.get_device_queue(queue_family, 0) };
         let (instance, debug_instance, messenger) = ctx_guard.release();
         let mut ctx = Context::assemble(
@@ -415,6 +442,7 @@ impl Context {
         )?;
         ctx.owned = true;
         ctx.sample_rate_shading = sample_rate_shading;
+        ctx.callbacks = alloc;
         Ok(ctx)
     }
 
@@ -449,7 +477,7 @@ impl Context {
         } else {
             ray_query_supported(&instance, host.physical_device)
         };
-        Context::assemble(
+        let mut ctx = Context::assemble(
             entry,
             instance,
             host.physical_device,
@@ -461,7 +489,9 @@ impl Context {
             Arc::new(ValidationLog::default()),
             false,
             ray_query,
-        )
+        )?;
+        ctx.callbacks = host.allocation_callbacks;
+        Ok(ctx)
     }
 
     /// Whether the library created (and will destroy) the instance and device.
@@ -532,6 +562,7 @@ impl Context {
             owned,
             sample_rate_shading: false,
             ray_query,
+            callbacks: None,
         })
     }
 
@@ -574,8 +605,9 @@ impl Context {
     pub fn one_shot<R>(&self, f: impl FnOnce(vk::CommandBuffer) -> Result<R>) -> Result<R> {
         let queue = self.queue.ok_or_else(|| Error::invalid("one_shot", "this context has no queue of its own (host-device mode)"))?;
         let d = &self.device;
-        let pool = unsafe { d.create_command_pool(&vk::CommandPoolCreateInfo::default().queue_family_index(self.queue_family), None) }
-            .call("vkCreateCommandPool")?;
+        let pool =
+            unsafe { d.create_command_pool(&vk::CommandPoolCreateInfo::default().queue_family_index(self.queue_family), self.alloc()) }
+                .call("vkCreateCommandPool")?;
         let result = (|| {
             let cmd =
                 unsafe { d.allocate_command_buffers(&vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1)) }
@@ -586,17 +618,22 @@ impl Context {
             .call("vkBeginCommandBuffer")?;
             let r = f(cmd)?;
             unsafe { d.end_command_buffer(cmd) }.call("vkEndCommandBuffer")?;
-            let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), None) }.call("vkCreateFence")?;
+            let fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default(), self.alloc()) }.call("vkCreateFence")?;
             let cmds = [cmd];
             let submit = [vk::SubmitInfo::default().command_buffers(&cmds)];
             let waited = unsafe { d.queue_submit(queue, &submit, fence) }
                 .call("vkQueueSubmit")
                 .and_then(|_| unsafe { d.wait_for_fences(&[fence], true, u64::MAX) }.call("vkWaitForFences"));
-            unsafe { d.destroy_fence(fence, None) };
+            unsafe { d.destroy_fence(fence, self.alloc()) };
             waited.map(|_| r)
         })();
-        unsafe { d.destroy_command_pool(pool, None) };
+        unsafe { d.destroy_command_pool(pool, self.alloc()) };
         result
+    }
+
+    /// What every `vkCreate*` and `vkDestroy*` of this context passes as `pAllocator`.
+    pub fn alloc(&self) -> Option<&vk::AllocationCallbacks<'static>> {
+        self.callbacks.as_ref().map(|c| &c.0)
     }
 
     pub fn wait_idle(&self) -> Result<()> {
@@ -613,13 +650,14 @@ impl Drop for Context {
                 a.take();
             }
             if self.owned {
-                self.device.destroy_device(None);
+                let alloc = self.callbacks.as_ref().map(|c| &c.0);
+                self.device.destroy_device(alloc);
                 if let Some(di) = &self.debug_instance {
                     if self.messenger != vk::DebugUtilsMessengerEXT::null() {
-                        di.destroy_debug_utils_messenger(self.messenger, None);
+                        di.destroy_debug_utils_messenger(self.messenger, alloc);
                     }
                 }
-                self.instance.destroy_instance(None);
+                self.instance.destroy_instance(alloc);
             }
         }
     }
@@ -630,6 +668,7 @@ struct InstanceGuard {
     instance: Option<ash::Instance>,
     debug: Option<ash::ext::debug_utils::Instance>,
     messenger: vk::DebugUtilsMessengerEXT,
+    alloc: Option<VulkanAllocator>,
 }
 
 impl InstanceGuard {
@@ -642,13 +681,14 @@ impl InstanceGuard {
 impl Drop for InstanceGuard {
     fn drop(&mut self) {
         if let Some(i) = self.instance.take() {
+            let alloc = self.alloc.as_ref().map(|c| &c.0);
             unsafe {
                 if let Some(d) = &self.debug {
                     if self.messenger != vk::DebugUtilsMessengerEXT::null() {
-                        d.destroy_debug_utils_messenger(self.messenger, None);
+                        d.destroy_debug_utils_messenger(self.messenger, alloc);
                     }
                 }
-                i.destroy_instance(None);
+                i.destroy_instance(alloc);
             }
         }
     }

@@ -10,7 +10,7 @@ mod resource;
 
 pub use context::{
     process_validation_errors, ray_query_supported, required_features_supported, Context, DeviceOptions, HostHandles, MemoryRegistry,
-    RayQueryDevice, ValidationLog, RAY_QUERY_DEVICE_EXTENSIONS, REQUIRED_DEVICE_EXTENSIONS,
+    RayQueryDevice, ValidationLog, VulkanAllocator, RAY_QUERY_DEVICE_EXTENSIONS, REQUIRED_DEVICE_EXTENSIONS,
 };
 pub use readback::{decode, read_image, record_copy_to_buffer};
 // ImageData moved to crate::image; the old path keeps working.

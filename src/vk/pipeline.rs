@@ -8,7 +8,7 @@ use crate::error::{Error, Result, VkCall};
 pub fn shader_module(ctx: &Context, name: &str) -> Result<vk::ShaderModule> {
     let bytes = crate::shaders::get(name).ok_or_else(|| Error::invalid("shader", format!("no embedded shader '{name}'")))?;
     let words = ash::util::read_spv(&mut std::io::Cursor::new(bytes)).map_err(|e| Error::invalid(name, format!("bad SPIR-V: {e}")))?;
-    let m = unsafe { ctx.device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None) }
+    let m = unsafe { ctx.device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), ctx.alloc()) }
         .call("vkCreateShaderModule")?;
     ctx.name(m, name);
     Ok(m)
@@ -31,7 +31,7 @@ pub fn descriptor_set_layout(
         })
         .collect();
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&b);
-    let l = unsafe { ctx.device.create_descriptor_set_layout(&info, None) }.call("vkCreateDescriptorSetLayout")?;
+    let l = unsafe { ctx.device.create_descriptor_set_layout(&info, ctx.alloc()) }.call("vkCreateDescriptorSetLayout")?;
     ctx.name(l, name);
     Ok(l)
 }
@@ -44,15 +44,16 @@ pub fn allocate_set(
     bindings: &[Binding],
 ) -> Result<(vk::DescriptorPool, vk::DescriptorSet)> {
     let sizes: Vec<_> = bindings.iter().map(|&(_, ty, count)| vk::DescriptorPoolSize { ty, descriptor_count: count }).collect();
-    let pool = unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None) }
-        .call("vkCreateDescriptorPool")?;
+    let pool =
+        unsafe { ctx.device.create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), ctx.alloc()) }
+            .call("vkCreateDescriptorPool")?;
     let layouts = [layout];
     let set = match unsafe {
         ctx.device.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
     } {
         Ok(s) => s[0],
         Err(e) => {
-            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            unsafe { ctx.device.destroy_descriptor_pool(pool, ctx.alloc()) };
             return Err(e).call("vkAllocateDescriptorSets");
         }
     };
@@ -69,10 +70,10 @@ pub fn destroy_layouts(
     set_layouts: &mut [vk::DescriptorSetLayout],
 ) {
     unsafe {
-        ctx.device.destroy_pipeline_layout(*layout, None);
-        ctx.device.destroy_descriptor_pool(*pool, None);
+        ctx.device.destroy_pipeline_layout(*layout, ctx.alloc());
+        ctx.device.destroy_descriptor_pool(*pool, ctx.alloc());
         for l in set_layouts.iter() {
-            ctx.device.destroy_descriptor_set_layout(*l, None);
+            ctx.device.destroy_descriptor_set_layout(*l, ctx.alloc());
         }
     }
     *layout = vk::PipelineLayout::null();
@@ -121,7 +122,7 @@ pub fn pipeline_layout(
     if push_bytes > 0 {
         info = info.push_constant_ranges(&ranges);
     }
-    let l = unsafe { ctx.device.create_pipeline_layout(&info, None) }.call("vkCreatePipelineLayout")?;
+    let l = unsafe { ctx.device.create_pipeline_layout(&info, ctx.alloc()) }.call("vkCreatePipelineLayout")?;
     ctx.name(l, name);
     Ok(l)
 }
@@ -218,7 +219,7 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
     let fs = match shader_module(ctx, desc.fragment) {
         Ok(f) => f,
         Err(e) => {
-            unsafe { ctx.device.destroy_shader_module(vs, None) };
+            unsafe { ctx.device.destroy_shader_module(vs, ctx.alloc()) };
             return Err(e);
         }
     };
@@ -309,10 +310,10 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
         .dynamic_state(&dy)
         .layout(layout)
         .push_next(&mut rendering);
-    let r = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+    let r = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], ctx.alloc()) };
     unsafe {
-        ctx.device.destroy_shader_module(vs, None);
-        ctx.device.destroy_shader_module(fs, None);
+        ctx.device.destroy_shader_module(vs, ctx.alloc());
+        ctx.device.destroy_shader_module(fs, ctx.alloc());
     }
     let p = r.map_err(|(_, e)| e).call("vkCreateGraphicsPipelines")?[0];
     ctx.name(p, desc.name);
@@ -323,8 +324,8 @@ pub fn compute_pipeline(ctx: &Context, layout: vk::PipelineLayout, shader: &str)
     let cs = shader_module(ctx, shader)?;
     let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(cs).name(c"main");
     let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);
-    let r = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], None) };
-    unsafe { ctx.device.destroy_shader_module(cs, None) };
+    let r = unsafe { ctx.device.create_compute_pipelines(vk::PipelineCache::null(), &[info], ctx.alloc()) };
+    unsafe { ctx.device.destroy_shader_module(cs, ctx.alloc()) };
     let p = r.map_err(|(_, e)| e).call("vkCreateComputePipelines")?[0];
     ctx.name(p, shader);
     Ok(p)
@@ -339,7 +340,7 @@ pub fn sampler(ctx: &Context, name: &str, filter: vk::Filter, address: vk::Sampl
         .address_mode_v(address)
         .address_mode_w(address)
         .max_lod(0.0);
-    let s = unsafe { ctx.device.create_sampler(&info, None) }.call("vkCreateSampler")?;
+    let s = unsafe { ctx.device.create_sampler(&info, ctx.alloc()) }.call("vkCreateSampler")?;
     ctx.name(s, name);
     Ok(s)
 }

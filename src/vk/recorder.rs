@@ -34,7 +34,7 @@ pub struct Profiler {
 impl Profiler {
     pub fn new(ctx: &Context, max_passes: u32) -> Result<Profiler> {
         let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2 * max_passes);
-        let pool = unsafe { ctx.device.create_query_pool(&info, None) }.call("vkCreateQueryPool")?;
+        let pool = unsafe { ctx.device.create_query_pool(&info, ctx.alloc()) }.call("vkCreateQueryPool")?;
         ctx.name(pool, "profiler.timestamps");
         Ok(Profiler { pool, capacity: max_passes, names: Vec::new(), cpu_ms: Vec::new(), untimed: 0 })
     }
@@ -90,7 +90,7 @@ impl Profiler {
 
     pub fn destroy(&mut self, ctx: &Context) {
         if self.pool != vk::QueryPool::null() {
-            unsafe { ctx.device.destroy_query_pool(self.pool, None) };
+            unsafe { ctx.device.destroy_query_pool(self.pool, ctx.alloc()) };
             self.pool = vk::QueryPool::null();
         }
     }

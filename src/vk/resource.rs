@@ -44,17 +44,18 @@ impl Buffer {
             return Err(Error::invalid(name, "zero-size buffer"));
         }
         let d = &ctx.device;
-        let raw = unsafe { d.create_buffer(&vk::BufferCreateInfo::default().size(size).usage(usage), None) }.call("vkCreateBuffer")?;
+        let raw =
+            unsafe { d.create_buffer(&vk::BufferCreateInfo::default().size(size).usage(usage), ctx.alloc()) }.call("vkCreateBuffer")?;
         let req = unsafe { d.get_buffer_memory_requirements(raw) };
         let allocation = match allocate(ctx, name, req, location, true) {
             Ok(a) => a,
             Err(e) => {
-                unsafe { d.destroy_buffer(raw, None) };
+                unsafe { d.destroy_buffer(raw, ctx.alloc()) };
                 return Err(e);
             }
         };
         if let Err(e) = unsafe { d.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.call("vkBindBufferMemory") {
-            unsafe { d.destroy_buffer(raw, None) };
+            unsafe { d.destroy_buffer(raw, ctx.alloc()) };
             let _ = ctx.allocator().as_mut().map(|a| a.free(allocation));
             return Err(e);
         }
@@ -114,7 +115,7 @@ impl Buffer {
 
     pub fn destroy(&mut self, ctx: &Context) {
         if let Some(a) = self.allocation.take() {
-            unsafe { ctx.device.destroy_buffer(self.raw, None) };
+            unsafe { ctx.device.destroy_buffer(self.raw, ctx.alloc()) };
             if let Some(al) = ctx.allocator().as_mut() {
                 let _ = al.free(a);
             }
@@ -265,12 +266,12 @@ impl Image {
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(desc.usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
-        let raw = unsafe { d.create_image(&info, None) }.call("vkCreateImage")?;
+        let raw = unsafe { d.create_image(&info, ctx.alloc()) }.call("vkCreateImage")?;
         let req = unsafe { d.get_image_memory_requirements(raw) };
         let allocation = match allocate(ctx, desc.name, req, MemoryLocation::GpuOnly, false) {
             Ok(a) => a,
             Err(e) => {
-                unsafe { d.destroy_image(raw, None) };
+                unsafe { d.destroy_image(raw, ctx.alloc()) };
                 return Err(e);
             }
         };
@@ -401,7 +402,7 @@ impl Image {
             layer_count: count,
         };
         let info = vk::ImageViewCreateInfo::default().image(self.raw).view_type(ty).format(self.format).subresource_range(range);
-        let v = unsafe { ctx.device.create_image_view(&info, None) }.call("vkCreateImageView")?;
+        let v = unsafe { ctx.device.create_image_view(&info, ctx.alloc()) }.call("vkCreateImageView")?;
         ctx.name(v, &format!("{}{suffix}", self.name));
         Ok(v)
     }
@@ -466,14 +467,14 @@ impl Image {
         let d = &ctx.device;
         unsafe {
             for v in self.layer_views.drain(..).chain(self.group_views.drain(..)) {
-                d.destroy_image_view(v, None);
+                d.destroy_image_view(v, ctx.alloc());
             }
             if self.view != vk::ImageView::null() {
-                d.destroy_image_view(self.view, None);
+                d.destroy_image_view(self.view, ctx.alloc());
             }
             self.view = vk::ImageView::null();
             if let Some(a) = self.allocation.take() {
-                d.destroy_image(self.raw, None);
+                d.destroy_image(self.raw, ctx.alloc());
                 if let Some(al) = ctx.allocator().as_mut() {
                     let _ = al.free(a);
                 }

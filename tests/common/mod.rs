@@ -153,6 +153,7 @@ pub fn c_context() -> *mut specula::ffi::SpeculaContext {
         size: std::mem::size_of::<SpeculaContextDesc>() as u32,
         device_name: std::ptr::null(),
         enable_validation: 1,
+        vulkan_allocator: std::ptr::null(),
     };
     let mut ctx = std::ptr::null_mut();
     unsafe { assert_eq!(specula_context_create(&desc, &mut ctx), SPECULA_SUCCESS) };
@@ -178,6 +179,7 @@ pub fn host_desc(own: &Context, ray_query_enabled: u32) -> specula::ffi::Specula
         queue_family: own.queue_family,
         debug_utils_enabled: 0,
         ray_query_enabled,
+        vulkan_allocator: std::ptr::null(),
     }
 }
 

@@ -664,18 +664,18 @@ impl Stage for CurvedReflectors {
         unsafe {
             let d = &ctx.device;
             if self.layout != vk::PipelineLayout::null() {
-                d.destroy_pipeline_layout(self.layout, None);
+                d.destroy_pipeline_layout(self.layout, ctx.alloc());
             }
             if self.pool != vk::DescriptorPool::null() {
-                d.destroy_descriptor_pool(self.pool, None);
+                d.destroy_descriptor_pool(self.pool, ctx.alloc());
             }
             for l in [self.set_layout, self.empty_layout] {
                 if l != vk::DescriptorSetLayout::null() {
-                    d.destroy_descriptor_set_layout(l, None);
+                    d.destroy_descriptor_set_layout(l, ctx.alloc());
                 }
             }
             if self.nearest != vk::Sampler::null() {
-                d.destroy_sampler(self.nearest, None);
+                d.destroy_sampler(self.nearest, ctx.alloc());
             }
         }
         self.layout = vk::PipelineLayout::null();

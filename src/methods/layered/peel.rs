@@ -254,7 +254,7 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
     })();
     destroy_pipelines(ctx, &mut [pipeline]);
     if layout != vk::PipelineLayout::null() {
-        unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+        unsafe { ctx.device.destroy_pipeline_layout(layout, ctx.alloc()) };
     }
     target.destroy(ctx);
     result
@@ -391,10 +391,10 @@ impl Stage for LayeredMaps {
         }
         self.depth.clear();
         for (pool, _) in self.sets.drain(..) {
-            unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
+            unsafe { ctx.device.destroy_descriptor_pool(pool, ctx.alloc()) };
         }
         if self.nearest != vk::Sampler::null() {
-            unsafe { ctx.device.destroy_sampler(self.nearest, None) };
+            unsafe { ctx.device.destroy_sampler(self.nearest, ctx.alloc()) };
             self.nearest = vk::Sampler::null();
         }
     }

@@ -231,8 +231,8 @@ impl Intersector {
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, None);
-            ctx.device.destroy_descriptor_pool(self.rq_pool, None);
+            ctx.device.destroy_pipeline(self.pipeline, ctx.alloc());
+            ctx.device.destroy_descriptor_pool(self.rq_pool, ctx.alloc());
         }
         self.pipeline = vk::Pipeline::null();
         self.rq_pool = vk::DescriptorPool::null();

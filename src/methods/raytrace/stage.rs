@@ -495,7 +495,7 @@ impl RayTrace {
         sizes[0].descriptor_count += count(RAY_QUERY_BINDINGS, vk::DescriptorType::STORAGE_BUFFER, rq_sets);
         let sizes = &sizes[..2 + rq_sets];
         let info = vk::DescriptorPoolCreateInfo::default().max_sets((ray_sets + trace_sets + rq_sets) as u32).pool_sizes(sizes);
-        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, None) }.call("vkCreateDescriptorPool")?;
+        self.pool = unsafe { ctx.device.create_descriptor_pool(&info, ctx.alloc()) }.call("vkCreateDescriptorPool")?;
         let mut layouts = vec![self.set_layouts[0]; ray_sets];
         layouts.extend(std::iter::repeat_n(self.set_layouts[1], trace_sets));
         layouts.extend(std::iter::repeat_n(self.set_layouts[3], rq_sets));

@@ -133,7 +133,7 @@ impl Structure {
         let usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_STORAGE_KHR | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let mut buffer = Buffer::new(ctx, name, size.max(256), usage, MemoryLocation::GpuOnly)?;
         let info = vk::AccelerationStructureCreateInfoKHR::default().buffer(buffer.raw).size(size.max(256)).ty(ty);
-        let raw = match unsafe { rq.accel.create_acceleration_structure(&info, None) }.call("vkCreateAccelerationStructureKHR") {
+        let raw = match unsafe { rq.accel.create_acceleration_structure(&info, ctx.alloc()) }.call("vkCreateAccelerationStructureKHR") {
             Ok(r) => r,
             Err(e) => {
                 buffer.destroy(ctx);
@@ -151,7 +151,7 @@ impl Structure {
 
     fn destroy(&mut self, ctx: &Context, rq: &RayQueryDevice) {
         if self.raw != vk::AccelerationStructureKHR::null() {
-            unsafe { rq.accel.destroy_acceleration_structure(self.raw, None) };
+            unsafe { rq.accel.destroy_acceleration_structure(self.raw, ctx.alloc()) };
             self.raw = vk::AccelerationStructureKHR::null();
         }
         self.buffer.destroy(ctx);
@@ -513,7 +513,7 @@ impl AccelStructures {
             .call("vkGetQueryPoolResults")?;
             self.compact(ctx, rq, &built, &sizes)
         })();
-        unsafe { ctx.device.destroy_query_pool(queries, None) };
+        unsafe { ctx.device.destroy_query_pool(queries, ctx.alloc()) };
         for &k in &built {
             self.free_inputs(ctx, k);
         }
