@@ -17,6 +17,7 @@ use std::ffi::c_void;
 
 /// What the host registered, kept for the process's life (blocks point at it).
 #[derive(Clone, Copy)]
+#[cfg_attr(not(feature = "host-allocator"), allow(dead_code))]
 pub(crate) struct Hooks {
     pub user: *mut c_void,
     pub allocate: unsafe extern "C" fn(user: *mut c_void, size: usize, alignment: usize) -> *mut c_void,

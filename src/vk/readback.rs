@@ -24,7 +24,8 @@ pub fn record_copy_to_buffer(ctx: &Context, cmd: vk::CommandBuffer, image: &Imag
     unsafe { ctx.device.cmd_copy_image_to_buffer(cmd, image.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer.raw, &[region]) };
 }
 
-/// Decodes the bytes of a copied image into f32 texels.
+/// Decodes the bytes of a copied image into f32 texels (8-bit formats: the stored code / 255,
+/// sRGB codes not decoded).
 pub fn decode(format: vk::Format, width: u32, height: u32, layers: u32, bytes: &[u8]) -> Result<ImageData> {
     let n = (width * height * layers) as usize;
     let (channels, data): (u32, Vec<f32>) = match format {
@@ -34,6 +35,10 @@ pub fn decode(format: vk::Format, width: u32, height: u32, layers: u32, bytes: &
             (4, bytes[..n * 8].chunks_exact(2).map(|h| half::f16::from_le_bytes([h[0], h[1]]).to_f32()).collect())
         }
         vk::Format::R8G8B8A8_UNORM | vk::Format::R8G8B8A8_SRGB => (4, bytes[..n * 4].iter().map(|&b| b as f32 / 255.0).collect()),
+        // Stored B, G, R, A: returned as R, G, B, A.
+        vk::Format::B8G8R8A8_UNORM | vk::Format::B8G8R8A8_SRGB => {
+            (4, bytes[..n * 4].chunks_exact(4).flat_map(|p| [p[2], p[1], p[0], p[3]]).map(|b| b as f32 / 255.0).collect())
+        }
         f => return Err(Error::invalid("readback", format!("unsupported format {f:?}"))),
     };
     Ok(ImageData { width, height, layers, channels, data })
