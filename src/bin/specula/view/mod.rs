@@ -103,7 +103,7 @@ pub fn run(a: &ViewArgs) -> specula::Result<()> {
     }
     let script = a.script.as_deref().map(Script::load).transpose()?;
     let event_loop = EventLoop::new().map_err(|e| {
-        specula::Error::Unsupported(format!("cannot open a window ({e}): the viewer needs an X11 display (DISPLAY), e.g. under xvfb-run"))
+        specula::Error::invalid("window", format!("cannot open one ({e}): the viewer needs an X11 display (DISPLAY), e.g. under xvfb-run"))
     })?;
     event_loop.set_control_flow(ControlFlow::Poll);
     let mut scene = job.scene.clone();
@@ -134,7 +134,7 @@ pub fn run(a: &ViewArgs) -> specula::Result<()> {
     let validation =
         app.gpu.as_ref().map(|g| (g.ctx.validation.error_count(), g.ctx.validation.warning_count(), g.ctx.validation.error_messages()));
     app.shutdown();
-    run.map_err(|e| specula::Error::Unsupported(format!("the window's event loop: {e}")))?;
+    run.map_err(|e| specula::Error::invalid("window", format!("its event loop: {e}")))?;
     if let Some(e) = app.error.take() {
         return Err(e);
     }
@@ -142,7 +142,10 @@ pub fn run(a: &ViewArgs) -> specula::Result<()> {
     if let (true, Some((errors, warnings, messages))) = (a.validate, validation) {
         println!("validation: {errors} error(s), {warnings} warning(s)");
         if errors > 0 {
-            return Err(specula::Error::Unsupported(format!("the validation layer reported {errors} error(s): {}", messages.join(" | "))));
+            for m in messages {
+                eprintln!("specula view: {m}");
+            }
+            return Err(specula::Error::Validation(errors));
         }
     }
     Ok(())
@@ -292,9 +295,9 @@ impl App {
         let (w, h) = (self.job.width, self.job.height);
         let title = format!("specula — {}", self.args.scene.display());
         let attrs = Window::default_attributes().with_title(title).with_inner_size(winit::dpi::PhysicalSize::new(w, h));
-        let window = el.create_window(attrs).map_err(|e| specula::Error::Unsupported(format!("cannot create a window: {e}")))?;
-        let display = window.display_handle().map_err(|e| specula::Error::Unsupported(format!("the window's display: {e}")))?.as_raw();
-        let handle = window.window_handle().map_err(|e| specula::Error::Unsupported(format!("the window's handle: {e}")))?.as_raw();
+        let window = el.create_window(attrs).map_err(|e| specula::Error::invalid("window", format!("cannot create one: {e}")))?;
+        let display = window.display_handle().map_err(|e| specula::Error::invalid("window", format!("its display: {e}")))?.as_raw();
+        let handle = window.window_handle().map_err(|e| specula::Error::invalid("window", format!("its handle: {e}")))?.as_raw();
         let instance_extensions = ash_window::enumerate_required_extensions(display)
             .map_err(|e| specula::Error::Unsupported(format!("no Vulkan surface for this window system: {e}")))?
             .iter()
@@ -311,7 +314,7 @@ impl App {
         // SAFETY: the handles are the live window's; the surface is destroyed (Presenter::
         // destroy) before the window and the instance.
         let surface = unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
-            .map_err(|e| specula::Error::Unsupported(format!("vkCreate*SurfaceKHR: {e}")))?;
+            .map_err(|result| specula::Error::Vulkan { call: "vkCreate*SurfaceKHR", result })?;
         let size = window.inner_size();
         let present = present::Presenter::new(&ctx, surface, (size.width.max(1), size.height.max(1)))?;
         let egui_ctx = egui::Context::default();
@@ -324,7 +327,7 @@ impl App {
             egui_ash_renderer::DynamicRendering { color_attachment_format: present.format, depth_attachment_format: None },
             egui_ash_renderer::Options { in_flight_frames: 1, enable_depth_test: false, enable_depth_write: false, srgb_framebuffer: true },
         )
-        .map_err(|e| specula::Error::Unsupported(format!("the overlay's renderer: {e}")))?;
+        .map_err(|e| specula::Error::invalid("overlay", e.to_string()))?;
         let target = specula::target_for(&ctx, (w, h));
         println!("viewing {} on {} ({})", self.args.scene.display(), ctx.device_name, ctx.driver_info);
         self.gpu = Some(Gpu {
@@ -477,7 +480,7 @@ impl App {
             gpu.present.wait(&gpu.ctx)?;
             let frees = std::mem::take(&mut gpu.free_later);
             if let Some(er) = gpu.egui_renderer.as_mut() {
-                er.free_textures(&frees).map_err(|e| specula::Error::Unsupported(format!("the overlay: {e}")))?;
+                er.free_textures(&frees).map_err(|e| specula::Error::invalid("overlay", e.to_string()))?;
             }
             if gpu.present.out_of_date {
                 let s = gpu.window.inner_size();
@@ -538,10 +541,10 @@ impl App {
         self.pending.extend(asked);
         gpu.egui_state.handle_platform_output(&gpu.window, out.platform_output);
         let primitives = gpu.egui_ctx.tessellate(out.shapes, out.pixels_per_point);
-        let queue = gpu.ctx.queue.ok_or_else(|| specula::Error::Unsupported("the viewer's context has no queue".into()))?;
+        let queue = gpu.ctx.queue.ok_or_else(|| specula::Error::invalid("window", "the viewer's context has no queue"))?;
         let er = gpu.egui_renderer.as_mut().expect("the overlay renderer lives until shutdown");
         er.set_textures(queue, gpu.present.pool(), &out.textures_delta.set)
-            .map_err(|e| specula::Error::Unsupported(format!("the overlay's textures: {e}")))?;
+            .map_err(|e| specula::Error::invalid("overlay", e.to_string()))?;
         gpu.free_later = out.textures_delta.free;
 
         let cmd = gpu.present.begin(&gpu.ctx)?;
@@ -563,8 +566,7 @@ impl App {
             .layer_count(1)
             .color_attachments(&attachment);
         unsafe { gpu.ctx.device.cmd_begin_rendering(cmd, &rendering) };
-        er.cmd_draw(cmd, extent, out.pixels_per_point, &primitives)
-            .map_err(|e| specula::Error::Unsupported(format!("the overlay: {e}")))?;
+        er.cmd_draw(cmd, extent, out.pixels_per_point, &primitives).map_err(|e| specula::Error::invalid("overlay", e.to_string()))?;
         unsafe { gpu.ctx.device.cmd_end_rendering(cmd) };
         gpu.present.submit_and_present(&gpu.ctx, &target)?;
         self.frame += 1;

@@ -35,8 +35,8 @@ pub struct Target {
     pub view: vk::ImageView,
 }
 
-fn vkerr(what: &str, e: vk::Result) -> specula::Error {
-    specula::Error::Unsupported(format!("{what}: {e}"))
+fn vkerr(call: &'static str, result: vk::Result) -> specula::Error {
+    specula::Error::Vulkan { call, result }
 }
 
 impl Presenter {
@@ -47,10 +47,10 @@ impl Presenter {
             .map_err(|e| vkerr("vkGetPhysicalDeviceSurfaceSupportKHR", e))?;
         if !supported {
             unsafe { surface_fn.destroy_surface(surface, None) };
-            return Err(specula::Error::Unsupported(format!(
-                "{}'s graphics queue family {} cannot present to this window",
-                ctx.device_name, ctx.queue_family
-            )));
+            return Err(specula::Error::invalid(
+                "window",
+                format!("{}'s graphics queue family {} cannot present to this window", ctx.device_name, ctx.queue_family),
+            ));
         }
         let d = &ctx.device;
         let pool = unsafe {
@@ -122,17 +122,17 @@ impl Presenter {
             .copied()
             .ok_or_else(|| {
                 let offered: Vec<String> = formats.iter().map(|f| format!("{:?}", f.format)).collect();
-                specula::Error::Unsupported(format!(
-                    "the window offers no 8-bit sRGB swapchain format the renderer can blit into (offered: {})",
-                    offered.join(", ")
-                ))
+                specula::Error::invalid(
+                    "window",
+                    format!("it offers no 8-bit sRGB swapchain format the renderer can blit into (offered: {})", offered.join(", ")),
+                )
             })?;
         let need = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_DST;
         if !caps.supported_usage_flags.contains(need) {
-            return Err(specula::Error::Unsupported(format!(
-                "the window's swapchain images cannot be transfer destinations and colour attachments ({:?})",
-                caps.supported_usage_flags
-            )));
+            return Err(specula::Error::invalid(
+                "window",
+                format!("its swapchain images cannot be transfer destinations and colour attachments ({:?})", caps.supported_usage_flags),
+            ));
         }
         let extent = if caps.current_extent.width != u32::MAX {
             caps.current_extent
@@ -243,7 +243,7 @@ impl Presenter {
     /// Leaves the target presentable, submits the frame and presents it.
     pub fn submit_and_present(&mut self, ctx: &Context, target: &Target) -> specula::Result<()> {
         let d = &ctx.device;
-        let queue = ctx.queue.ok_or_else(|| specula::Error::Unsupported("the viewer's context has no queue".into()))?;
+        let queue = ctx.queue.ok_or_else(|| specula::Error::invalid("window", "the viewer's context has no queue"))?;
         let to_present = [vk::ImageMemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT)
             .src_access_mask(vk::AccessFlags2::COLOR_ATTACHMENT_WRITE)
