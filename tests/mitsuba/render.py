@@ -23,7 +23,10 @@ The conventions mapping, written down once (the Rust side writes the JSON in the
   two differ on purpose inside the ramp (Mitsuba's own curve against glTF's squared ramp
   in cos θ, which specula follows): the test compares outside it.
 - integrator: path tracing to `max_depth` (specula's `depth` + 1: Mitsuba counts the camera
-  segment), no Russian roulette before that depth.
+  segment), no Russian roulette before that depth; or, with `"integrator": "ptracer"`,
+  Mitsuba's particle tracer (light paths from the emitters, every diffuse vertex connected to
+  the camera: it samples point-light caustics, L S+ D E, which a path tracer cannot), with
+  `spp` × width × height particles; specular surfaces seen directly stay black in it.
 """
 import json
 import sys
@@ -57,7 +60,7 @@ def main():
     cam = desc["camera"]
     scene = {
         "type": "scene",
-        "integrator": {"type": "path", "max_depth": int(desc["max_depth"]), "rr_depth": int(desc["max_depth"]) + 1},
+        "integrator": {"type": desc.get("integrator", "path"), "max_depth": int(desc["max_depth"]), "rr_depth": int(desc["max_depth"]) + 1},
         "sensor": {
             "type": "perspective",
             "fov_axis": "y",
