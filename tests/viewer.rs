@@ -1,5 +1,5 @@
 //! `specula view` headless under `xvfb-run`: scripted input moves the camera, orbits,
-//! switches methods and knobs (one refused), pauses the animation; every screenshot is
+//! switches methods and knobs (one refused), resizes the window, pauses the animation; every screenshot is
 //! rendered again by `specula render` from the command line the viewer wrote beside it and
 //! must match bit for bit, with the validation layer clean over the whole session.
 //!
@@ -65,23 +65,24 @@ fn rerender(shots: &Path, name: &str) -> (Vec<u32>, Vec<u32>, String) {
 }
 
 #[test]
-fn scripted_input_moves_orbits_and_switches_and_each_screenshot_renders_again_bit_for_bit() {
+fn scripted_input_moves_orbits_switches_and_resizes_and_each_screenshot_renders_again_bit_for_bit() {
     let dir = common::scratch_dir("viewer-input");
     let shots = dir.join("shots");
     let script = "0 screenshot start\n\
          0 key w down\n4 key w up\n5 look 30 10\n6 screenshot fly\n\
          7 orbit\n8 look 40 0\n9 wheel 1\n10 screenshot orbit\n\
          11 method * envmap\n12 knob cube_size=64\n13 screenshot envmap\n\
-         14 method mirror_ball planar-mirror\n15 knob cube_size=3\n16 screenshot refused\n17 quit\n";
+         14 method mirror_ball planar-mirror\n15 knob cube_size=3\n16 screenshot refused\n\
+         17 resize 80 40\n21 screenshot resized\n22 quit\n";
     let Some(o) = view_scripted(&dir, "builtin:corner-mirror", "64x48", &[], script) else { return };
     let (out, err) = (String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     assert!(o.status.success(), "{out}\n{err}");
-    assert!(out.contains("viewed 18 frames") && out.contains("validation: 0 error(s)"), "{out}");
+    assert!(out.contains("viewed 23 frames") && out.contains("validation: 0 error(s)"), "{out}");
     // The refused method (a sphere is not planar) and knob (outside its range) changed nothing.
     assert!(err.contains("planar-mirror for mirror_ball refused, nothing changed"), "{err}");
     assert!(err.contains("knob cube_size=3 refused, nothing changed"), "{err}");
     let mut images = Vec::new();
-    for name in ["start", "fly", "orbit", "envmap", "refused"] {
+    for name in ["start", "fly", "orbit", "envmap", "refused", "resized"] {
         let (shot, again, command) = rerender(&shots, name);
         assert!(shot == again, "{name}: the screenshot differs from `{command}`");
         images.push((name, shot, command));
@@ -93,6 +94,9 @@ fn scripted_input_moves_orbits_and_switches_and_each_screenshot_renders_again_bi
     }
     assert!(images[3].2.contains("--method envmap -q cube_size=64"), "{}", images[3].2);
     assert!(images[4].1 == images[3].1 && images[4].2 == images[3].2, "a refused change changed the view");
+    // The window's new size: a new swapchain and a renderer at that size.
+    assert!(images[5].2.contains("--size 80x40") && images[5].1.len() == 80 * 40 * 4, "{}", images[5].2);
+    assert!(err.contains("new renderer: new size 80x40"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
 

@@ -383,6 +383,16 @@ impl App {
             Action::Orbit => self.ctl.toggle_mode(),
             Action::Wheel(s) => self.ctl.wheel(s),
             Action::Pause => self.paused = !self.paused,
+            Action::Resize(w, h) => {
+                // The window system answers with a Resized event (or not at all, where a
+                // window manager keeps the size); the swapchain and the renderer follow it.
+                let gpu = self.gpu.as_mut().expect("the device exists while frames are drawn");
+                if let Some(now) = gpu.window.request_inner_size(winit::dpi::PhysicalSize::new(w, h)) {
+                    if (now.width, now.height) == (w, h) {
+                        gpu.present.out_of_date = true;
+                    }
+                }
+            }
             Action::Method(object, name) => {
                 let mut choices = self.job.choices.clone();
                 let what = object.clone().unwrap_or_else(|| "the scene".into());

@@ -11,6 +11,7 @@
 //! 24 method glass refractor-map   # an object's method (`method * M` for the whole scene)
 //! 25 knob cube_size=128
 //! 26 pause             # pause / resume the glTF animations
+//! 26 resize 320 200    # ask the window system for this inner size (the frame follows it)
 //! 27 screenshot near   # DIR/near.png + .exr + .txt (the `specula render` camera arguments)
 //! 30 quit
 //! ```
@@ -31,6 +32,7 @@ pub enum Action {
     Method(Option<String>, String),
     Knob(String),
     Pause,
+    Resize(u32, u32),
     Screenshot(String),
     Quit,
 }
@@ -122,6 +124,17 @@ impl Script {
                     want(0)?;
                     Action::Pause
                 }
+                "resize" => {
+                    want(2)?;
+                    let side = |k: usize| {
+                        args[k]
+                            .parse::<u32>()
+                            .ok()
+                            .filter(|v| (1..=16384).contains(v))
+                            .ok_or_else(|| bad(format!("'{}' is not a size in 1..=16384", args[k])))
+                    };
+                    Action::Resize(side(1)?, side(2)?)
+                }
                 "screenshot" => {
                     want(1)?;
                     let name = args[1];
@@ -135,7 +148,9 @@ impl Script {
                     Action::Quit
                 }
                 other => {
-                    return Err(bad(format!("unknown action '{other}' (key, look, orbit, wheel, method, knob, pause, screenshot, quit)")))
+                    return Err(bad(format!(
+                        "unknown action '{other}' (key, look, orbit, wheel, method, knob, pause, resize, screenshot, quit)"
+                    )))
                 }
             };
             steps.push((frame, action));
@@ -173,6 +188,7 @@ mod tests {
             ("0 look 1", 1, "'look' takes 2 argument(s), got 1"),
             ("0 jump", 1, "unknown action 'jump'"),
             ("0 screenshot ../x", 1, "may hold only"),
+            ("0 resize 0 10", 1, "'0' is not a size"),
         ] {
             let (l, m) = Script::parse(text).err().unwrap();
             assert_eq!(l, line, "{text}: {m}");
