@@ -166,8 +166,10 @@ struct Gpu {
     egui_state: egui_winit::State,
     egui_renderer: Option<egui_ash_renderer::Renderer>,
     renderer: Option<Renderer>,
-    /// What `auto` predicts with: this device's unit costs.
-    target: Option<specula::plan::predict::Target>,
+    /// What `auto` predicts with: this device's unit costs, found the first time `auto` is
+    /// asked for (a fixed method needs none, and a first calibration takes minutes on a CPU
+    /// device).
+    target: std::sync::OnceLock<Option<specula::plan::predict::Target>>,
     /// Overlay textures to free once the frame that last drew with them has completed.
     free_later: Vec<egui::TextureId>,
     timings: Vec<PassTiming>,
@@ -328,7 +330,6 @@ impl App {
             egui_ash_renderer::Options { in_flight_frames: 1, enable_depth_test: false, enable_depth_write: false, srgb_framebuffer: true },
         )
         .map_err(|e| specula::Error::invalid("overlay", e.to_string()))?;
-        let target = specula::target_for(&ctx, (w, h));
         println!("viewing {} on {} ({})", self.args.scene.display(), ctx.device_name, ctx.driver_info);
         self.gpu = Some(Gpu {
             window,
@@ -338,7 +339,7 @@ impl App {
             egui_state,
             egui_renderer: Some(egui_renderer),
             renderer: None,
-            target,
+            target: std::sync::OnceLock::new(),
             free_later: Vec::new(),
             timings: Vec::new(),
         });
@@ -351,8 +352,18 @@ impl App {
     fn make_renderer(&self, choices: &specula::plan::Choices, quality: &Quality) -> specula::Result<Renderer> {
         let gpu = self.gpu.as_ref().expect("the device exists while frames are drawn");
         let size = (gpu.present.extent.width, gpu.present.extent.height);
-        let target =
-            gpu.target.clone().or_else(specula::plan::predict::Target::nominal).map(|t| specula::plan::predict::Target { size, ..t });
+        let target = if choices.method == Choice::Auto {
+            let found = gpu.target.get_or_init(|| {
+                eprintln!(
+                    "specula view: auto predicts with this device's unit costs: read from the cache, or measured now once \
+                     (seconds on a GPU, about three minutes on lavapipe)"
+                );
+                specula::target_for(&gpu.ctx, size)
+            });
+            found.clone().or_else(specula::plan::predict::Target::nominal).map(|t| specula::plan::predict::Target { size, ..t })
+        } else {
+            None
+        };
         let plan = specula::plan::plan_for(&self.scene, choices, quality, target.as_ref())?;
         Renderer::new(&gpu.ctx, &self.scene, plan, size.0, size.1)
     }
