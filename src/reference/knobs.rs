@@ -10,7 +10,8 @@ knobs! {
         /// CPU reference: photons traced from each punctual light into each caustic generator's bounding cone for its caustics
         reference_photons: u32 = 1000000, count(1000..=100000000, "photons");
         /// CPU reference: radius of the caustics' density estimate on the receivers (Epanechnikov kernel); auto: 0.5 % of the
-        /// scene's bounding-box diagonal
+        /// scene's bounding-box diagonal (caustic_estimate=progressive: each hit point's first radius holds 16 of the first
+        /// pass's photons, at most that)
         caustic_radius: Option<f32> = auto, auto_metres();
         /// CPU reference: the caustics' density estimate: one photon map with the fixed caustic_radius kernel, or progressive photon mapping (Hachisuka et al. 2008: reference_photons split into ppm_passes passes, each camera hit point's radius shrinking from caustic_radius as photons arrive, α 0.7), which converges to the sharp caustic
         caustic_estimate: CausticEstimate = "kernel", one_of()["kernel" => CausticEstimate::Kernel, "progressive" => CausticEstimate::Progressive];
