@@ -498,6 +498,8 @@ fn caustics_agree_with_mitsubas_particle_tracer() {
     assert!(caustic.len() >= 100, "the caustics cover {} floor pixels: the scene does not show them", caustic.len());
     assert!((p.0 - 1.0).abs() <= 0.04, "Mitsuba's caustic energy is {:.4} of the reference's", p.0);
     assert!(p.1 <= 0.3, "the caustics' RMSE is {:.4} of their mean", p.1);
-    assert!(p.2 >= 33.0, "the floor: {:.2} dB against Mitsuba", p.2);
+    // Measured (the adaptive start): energy 1.0259, RMSE 0.2659 of the mean, the floor
+    // 33.74 dB; the kernel 0.9935, 0.4573, 29.06 dB.
+    assert!(p.2 >= 32.74, "the floor: {:.2} dB against Mitsuba", p.2);
     assert!(p.1 < 0.7 * k.1, "the progressive estimate ({:.4}) is not clearly nearer Mitsuba than the kernel's ({:.4})", p.1, k.1);
 }
