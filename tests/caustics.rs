@@ -283,7 +283,7 @@ fn absorbing_glass_dims_its_caustic() {
     // photons besides).
     let mut fine = scene.clone();
     fine.meshes[1] = shapes::uv_sphere("glass", C, R, 256, 128, glass);
-    let mut q = quality(&["caustics=splat", "reference_photons=200000"]);
+    let mut q = quality(&["caustics=splat", "caustic_estimate=kernel", "reference_photons=200000"]);
     q.frame.depth = 2;
     let tracer = specula::reference::Tracer::new(&fine, &q).unwrap();
     let photons = tracer.photon_map().unwrap().photons();
@@ -370,7 +370,7 @@ fn exact_photons_match_the_closed_forms_and_the_light_tracer() {
     let glass = s.meshes[1].material;
     s.meshes[1] = glass_box(C, 0.35, std::f32::consts::FRAC_PI_4, glass);
     s.meshes[0].positions.iter_mut().for_each(|p| *p *= 8.0);
-    let mut q = quality(&["caustics=splat", "reference_photons=400000"]);
+    let mut q = quality(&["caustics=splat", "caustic_estimate=kernel", "reference_photons=400000"]);
     q.frame.depth = 16;
     let tracer = specula::reference::Tracer::new(&s, &q).unwrap();
     let truth: f64 = tracer.photon_map().unwrap().photons().iter().map(|p| p.power.x).sum();
@@ -988,7 +988,7 @@ fn total_internal_reflection_paths_reach_the_floor() {
     let power =
         |bounces: &str| caustic_power(&ctx, &s, &quality(&["caustics=splat", "photons=128", &format!("internal_bounces={bounces}")])).0;
     let (none, some) = (power("0"), power("4"));
-    let mut q = quality(&["caustics=splat", "reference_photons=400000"]);
+    let mut q = quality(&["caustics=splat", "caustic_estimate=kernel", "reference_photons=400000"]);
     q.frame.depth = 16;
     let tracer = specula::reference::Tracer::new(&s, &q).unwrap();
     let exact: f64 = tracer.photon_map().unwrap().photons().iter().map(|p| p.power.x).sum();

@@ -324,6 +324,8 @@ mod tests {
         {
             let mut knobs = Quality::default();
             knobs.caustics.caustics = Caustics::Splat;
+            // These tests read the light tracer's photon map, which the kernel estimate builds.
+            knobs.reference.caustic_estimate = crate::reference::knobs::CausticEstimate::Kernel;
             knobs.reference.reference_photons = photons;
             knobs.reference.caustic_radius = Some(radius);
             knobs.frame.fresnel = FresnelMode::Exact;
