@@ -51,7 +51,7 @@ impl Error {
 }
 
 /// Attaches the failing call's name to a `vk::Result`.
-pub(crate) trait VkCall<T> {
+pub trait VkCall<T> {
     fn call(self, call: &'static str) -> Result<T>;
 }
 

@@ -394,12 +394,7 @@ impl Context {
         let mut ext_names: Vec<*const i8> = REQUIRED_DEVICE_EXTENSIONS.iter().map(|e| e.as_ptr()).collect();
         let device_exts =
             unsafe { instance_ref.enumerate_device_extension_properties(physical) }.call("vkEnumerateDeviceExtensionProperties")?;
-        for e in &opts.device_extensions {
-            if !device_exts.iter().any(|a| a.extension_name_as_c_str().is_ok_and(|x| x == e.as_c_str())) {
-                return Err(Error::Unsupported(format!("the device lacks the extension {} that was asked for", e.to_string_lossy())));
-            }
-            ext_names.push(e.as_ptr());
-        }
+        ext_names.extend(asked_extensions(&device_exts, &opts.device_extensions, "the device")?);
         // Vulkan's ray-tracing API where the device has it, unless hidden.
         let ray_query = if opts.hide_ray_query || ray_query_hidden_by_env() {
             Err("ray queries are hidden (SPECULA_RAY_QUERY=off or DeviceOptions::hide_ray_query)".to_string())
@@ -661,6 +656,21 @@ impl Drop for Context {
             }
         }
     }
+}
+
+/// The pointers of `asked` (`DeviceOptions`' extra extensions), each among `available`, or an
+/// error naming the first that `what` lacks.
+fn asked_extensions(available: &[vk::ExtensionProperties], asked: &[std::ffi::CString], what: &str) -> Result<Vec<*const i8>> {
+    asked
+        .iter()
+        .map(|e| {
+            if available.iter().any(|a| a.extension_name_as_c_str().is_ok_and(|x| x == e.as_c_str())) {
+                Ok(e.as_ptr())
+            } else {
+                Err(Error::Unsupported(format!("{what} lacks the extension {} that was asked for", e.to_string_lossy())))
+            }
+        })
+        .collect()
 }
 
 /// Destroys a half-built instance when device creation fails part-way.

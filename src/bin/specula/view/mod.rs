@@ -18,6 +18,7 @@ use std::time::Instant;
 
 use ash::vk;
 use raw_window_handle::{HasDisplayHandle, HasWindowHandle};
+use specula::error::VkCall;
 use specula::plan::{Choice, Method};
 use specula::quality::{Quality, KNOBS};
 use specula::scene::Scene;
@@ -315,8 +316,8 @@ impl App {
         })?;
         // SAFETY: the handles are the live window's; the surface is destroyed (Presenter::
         // destroy) before the window and the instance.
-        let surface = unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
-            .map_err(|result| specula::Error::Vulkan { call: "vkCreate*SurfaceKHR", result })?;
+        let surface =
+            unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }.call("vkCreate*SurfaceKHR")?;
         let size = window.inner_size();
         let present = present::Presenter::new(&ctx, surface, (size.width.max(1), size.height.max(1)))?;
         let egui_ctx = egui::Context::default();

@@ -4,6 +4,7 @@
 //! the same path a host engine takes), the overlay draws on top, and the image is presented.
 
 use ash::vk;
+use specula::error::VkCall;
 use specula::vk::{Context, Image};
 
 /// Formats the swapchain may take, best first: 8-bit sRGB, so the linear radiance the
@@ -35,16 +36,12 @@ pub struct Target {
     pub view: vk::ImageView,
 }
 
-fn vkerr(call: &'static str, result: vk::Result) -> specula::Error {
-    specula::Error::Vulkan { call, result }
-}
-
 impl Presenter {
     /// The swapchain for `surface` at `size` (the surface's own extent where it fixes one).
     pub fn new(ctx: &Context, surface: vk::SurfaceKHR, size: (u32, u32)) -> specula::Result<Presenter> {
         let surface_fn = ash::khr::surface::Instance::new(&ctx.entry, &ctx.instance);
         let supported = unsafe { surface_fn.get_physical_device_surface_support(ctx.physical, ctx.queue_family, surface) }
-            .map_err(|e| vkerr("vkGetPhysicalDeviceSurfaceSupportKHR", e))?;
+            .call("vkGetPhysicalDeviceSurfaceSupportKHR")?;
         if !supported {
             unsafe { surface_fn.destroy_surface(surface, None) };
             return Err(specula::Error::invalid(
@@ -61,7 +58,7 @@ impl Presenter {
                 None,
             )
         }
-        .map_err(|e| vkerr("vkCreateCommandPool", e))?;
+        .call("vkCreateCommandPool")?;
         let mut p = Presenter {
             surface_fn,
             swapchain_fn: ash::khr::swapchain::Device::new(&ctx.instance, d),
@@ -95,11 +92,10 @@ impl Presenter {
                     .command_buffer_count(1),
             )
         }
-        .map_err(|e| vkerr("vkAllocateCommandBuffers", e))?[0];
-        self.fence = unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }
-            .map_err(|e| vkerr("vkCreateFence", e))?;
-        self.acquired =
-            unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }.map_err(|e| vkerr("vkCreateSemaphore", e))?;
+        .call("vkAllocateCommandBuffers")?[0];
+        self.fence =
+            unsafe { d.create_fence(&vk::FenceCreateInfo::default().flags(vk::FenceCreateFlags::SIGNALED), None) }.call("vkCreateFence")?;
+        self.acquired = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }.call("vkCreateSemaphore")?;
         self.recreate(ctx, size)
     }
 
@@ -109,9 +105,9 @@ impl Presenter {
         let d = &ctx.device;
         ctx.wait_idle()?;
         let caps = unsafe { self.surface_fn.get_physical_device_surface_capabilities(ctx.physical, self.surface) }
-            .map_err(|e| vkerr("vkGetPhysicalDeviceSurfaceCapabilitiesKHR", e))?;
+            .call("vkGetPhysicalDeviceSurfaceCapabilitiesKHR")?;
         let formats = unsafe { self.surface_fn.get_physical_device_surface_formats(ctx.physical, self.surface) }
-            .map_err(|e| vkerr("vkGetPhysicalDeviceSurfaceFormatsKHR", e))?;
+            .call("vkGetPhysicalDeviceSurfaceFormatsKHR")?;
         let blit_dst = |f: vk::Format| {
             let p = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, f) };
             p.optimal_tiling_features.contains(vk::FormatFeatureFlags::BLIT_DST | vk::FormatFeatureFlags::COLOR_ATTACHMENT)
@@ -164,13 +160,13 @@ impl Presenter {
             self.extent = extent;
             return Ok(());
         }
-        self.swapchain = unsafe { self.swapchain_fn.create_swapchain(&info, None) }.map_err(|e| vkerr("vkCreateSwapchainKHR", e))?;
+        self.swapchain = unsafe { self.swapchain_fn.create_swapchain(&info, None) }.call("vkCreateSwapchainKHR")?;
         if old != vk::SwapchainKHR::null() {
             unsafe { self.swapchain_fn.destroy_swapchain(old, None) };
         }
         self.format = chosen.format;
         self.extent = extent;
-        self.images = unsafe { self.swapchain_fn.get_swapchain_images(self.swapchain) }.map_err(|e| vkerr("vkGetSwapchainImagesKHR", e))?;
+        self.images = unsafe { self.swapchain_fn.get_swapchain_images(self.swapchain) }.call("vkGetSwapchainImagesKHR")?;
         for (i, &image) in self.images.iter().enumerate() {
             ctx.name(image, &format!("swapchain[{i}]"));
             let view = unsafe {
@@ -183,9 +179,9 @@ impl Presenter {
                     None,
                 )
             }
-            .map_err(|e| vkerr("vkCreateImageView", e))?;
+            .call("vkCreateImageView")?;
             self.views.push(view);
-            let s = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }.map_err(|e| vkerr("vkCreateSemaphore", e))?;
+            let s = unsafe { d.create_semaphore(&vk::SemaphoreCreateInfo::default(), None) }.call("vkCreateSemaphore")?;
             self.rendered.push(s);
         }
         self.out_of_date = false;
@@ -208,7 +204,7 @@ impl Presenter {
     /// Waits for the frame in flight (one at a time: the renderer writes its view table from
     /// the host while recording).
     pub fn wait(&self, ctx: &Context) -> specula::Result<()> {
-        unsafe { ctx.device.wait_for_fences(&[self.fence], true, u64::MAX) }.map_err(|e| vkerr("vkWaitForFences", e))
+        unsafe { ctx.device.wait_for_fences(&[self.fence], true, u64::MAX) }.call("vkWaitForFences")
     }
 
     /// The next image to draw into; `None` when the swapchain must be recreated first.
@@ -225,7 +221,7 @@ impl Presenter {
                 self.out_of_date = true;
                 Ok(None)
             }
-            Err(e) => Err(vkerr("vkAcquireNextImageKHR", e)),
+            Err(e) => Err(e).call("vkAcquireNextImageKHR"),
         }
     }
 
@@ -233,9 +229,9 @@ impl Presenter {
     pub fn begin(&self, ctx: &Context) -> specula::Result<vk::CommandBuffer> {
         let d = &ctx.device;
         unsafe {
-            d.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty()).map_err(|e| vkerr("vkResetCommandBuffer", e))?;
+            d.reset_command_buffer(self.cmd, vk::CommandBufferResetFlags::empty()).call("vkResetCommandBuffer")?;
             d.begin_command_buffer(self.cmd, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT))
-                .map_err(|e| vkerr("vkBeginCommandBuffer", e))?;
+                .call("vkBeginCommandBuffer")?;
         }
         Ok(self.cmd)
     }
@@ -255,15 +251,15 @@ impl Presenter {
             .subresource_range(color_range())];
         unsafe {
             d.cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().image_memory_barriers(&to_present));
-            d.end_command_buffer(self.cmd).map_err(|e| vkerr("vkEndCommandBuffer", e))?;
-            d.reset_fences(&[self.fence]).map_err(|e| vkerr("vkResetFences", e))?;
+            d.end_command_buffer(self.cmd).call("vkEndCommandBuffer")?;
+            d.reset_fences(&[self.fence]).call("vkResetFences")?;
         }
         let rendered = self.rendered[target.index as usize];
         let wait = [vk::SemaphoreSubmitInfo::default().semaphore(self.acquired).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
         let signal = [vk::SemaphoreSubmitInfo::default().semaphore(rendered).stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)];
         let cmds = [vk::CommandBufferSubmitInfo::default().command_buffer(self.cmd)];
         let submit = [vk::SubmitInfo2::default().wait_semaphore_infos(&wait).command_buffer_infos(&cmds).signal_semaphore_infos(&signal)];
-        unsafe { d.queue_submit2(queue, &submit, self.fence) }.map_err(|e| vkerr("vkQueueSubmit2", e))?;
+        unsafe { d.queue_submit2(queue, &submit, self.fence) }.call("vkQueueSubmit2")?;
         let (swapchains, indices, waits) = ([self.swapchain], [target.index], [rendered]);
         let present = vk::PresentInfoKHR::default().wait_semaphores(&waits).swapchains(&swapchains).image_indices(&indices);
         match unsafe { self.swapchain_fn.queue_present(queue, &present) } {
@@ -272,7 +268,7 @@ impl Presenter {
                 self.out_of_date = true;
                 Ok(())
             }
-            Err(e) => Err(vkerr("vkQueuePresentKHR", e)),
+            Err(e) => Err(e).call("vkQueuePresentKHR"),
         }
     }
 
