@@ -14,7 +14,8 @@
 // hit, which is stored relative to its caustic cube's centre (the generator's reference point
 // in cube-map space, UPSK08; the light in light space, SP07) with the
 // photon's power: the light's intensity × the texel's solid angle (its area for a
-// directional light) × the Fresnel transmittances along the path.
+// directional light) × the Fresnel transmittances along the path, and (w) the direction it
+// arrives along (photon_direction_code, for the photon map's gather).
 //
 // EXACT_PATHS (caustic_paths=exact, survey §6.1.1): the photon is traced in the original
 // geometry through ray queries (set 5) instead: the light's visibility by a shadow ray; at
@@ -25,6 +26,7 @@
 // (mirrors reflect, dielectrics transmit, or reflect totally) up to EXACT_BOUNCES, to the
 // first diffuse hit.
 #include "distance/refractor/trace.glsl"
+#include "caustics/photon_map.glsl"
 
 // KHR_materials_dispersion: a photon refracts as one channel, the same all along its
 // path: chosen by its texel at the first dispersive surface it enters ((x + y) mod 3, so
@@ -160,7 +162,7 @@ void main() {
         skip = h.triangle;
         if (m2.kind == KIND_DIFFUSE) {
             out_hit = vec4(pos - centre, 1.0);
-            out_power = vec4(w * power, 0.0);
+            out_power = vec4(w * power, photon_direction_code(dir));
             return;
         }
         SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
@@ -217,6 +219,6 @@ void main() {
     SearchResult h = search_ray(x, dir);
     if (h.escaped) return;
     out_hit = vec4(x + dir * h.d, 1.0);
-    out_power = vec4(w * power, 0.0);
+    out_power = vec4(w * power, photon_direction_code(dir));
 #endif
 }

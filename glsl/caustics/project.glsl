@@ -5,14 +5,18 @@
 // distance test stops light leaks: the point takes the caustic only if it is the surface
 // the receiver distance map holds in that direction. Receivers facing away from the
 // generator (back faces) take none.
+//
+// caustics=photon-map gathers from the photon grid instead (caustics/photon_map.glsl).
 #ifndef CAUSTICS_PROJECT_GLSL
 #define CAUSTICS_PROJECT_GLSL
+#include "caustics/photon_map.glsl"
 
 // n: the receiver's normal on the side it is seen from.
 vec3 caustic_irradiance(vec3 p, vec3 n) {
     vec3 e = vec3(0.0);
     uint count = caustic.cube_count;
     if (count == 0u) return e;
+    if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return photon_map_irradiance(p, n);
     float texel = 2.0 / float(caustic.cube_size);
     for (uint g = 0u; g < count; ++g) {
         vec3 w = p - cubes[g].centre.xyz;

@@ -7,9 +7,10 @@ knobs! {
     pub struct CausticsKnobs {
         /// caustics (§6): photons from each punctual light traced through each caustic generator in its maps, stored as hits in
         /// cube-map space, then splatted (photon splatting) or meshed into caustic triangles (flux over area) into a light cube map
-        /// around the generator, filtered, and projected onto diffuse surfaces with a distance test; the CPU reference adds
-        /// light-traced caustics
-        caustics: Caustics = "triangles", one_of()["off" => Caustics::Off, "splat" => Caustics::Splat, "triangles" => Caustics::Triangles];
+        /// around the generator, filtered, and projected onto diffuse surfaces with a distance test; or (`photon-map`, §6.1.1,
+        /// PDC03) sorted into a hashed uniform grid on the GPU and gathered per shaded point from its photon_k nearest photons
+        /// within photon_radius; the CPU reference adds light-traced caustics
+        caustics: Caustics = "triangles", one_of()["off" => Caustics::Off, "splat" => Caustics::Splat, "triangles" => Caustics::Triangles, "photon-map" => Caustics::PhotonMap];
         /// caustics: edge of each photon hit location image (photons² per light and generator view); caustic triangles keep 64
         /// bytes per triangle in one storage buffer, within the device's maxStorageBufferRange (lavapipe's 128 MiB: 1024² photons
         /// for one photon layer, 592² for three)
@@ -17,6 +18,13 @@ knobs! {
         /// caustics=splat: radius of each photon's splat (an Epanechnikov kernel normalised to the photon's power) in light-cube
         /// texels
         splat_size: f32 = 2, real(0.5..=16, "texels");
+        /// caustics=photon-map: photons each shaded point gathers (its k nearest on its surface within photon_radius; the
+        /// irradiance is their power under an Epanechnikov kernel reaching the (k + 1)-th, or photon_radius where fewer lie
+        /// within it): more is smoother and blurs more
+        photon_k: u32 = 16, count(1..=64, "photons");
+        /// caustics=photon-map: the gather's largest radius and the grid's cell edge, as a fraction of the scene's bounding
+        /// diagonal (scale-free: the same at 1 mm and 1 km); photons further than it are never gathered
+        photon_radius: f32 = 0.01, real(0.0005..=0.25, "of the diagonal");
         /// caustics: radius of the box filter over each light cube face before projection (0: none)
         caustic_filter: u32 = 1, count(0..=8, "texels");
         /// caustics: a diffuse point takes the light cube map's irradiance only where its distance from the generator matches the
@@ -73,4 +81,7 @@ pub enum Caustics {
     Splat,
     /// Caustic triangles (§6.3.2).
     Triangles,
+    /// The photon map (§6.1.1, PDC03): photons in a uniform grid built on the GPU, gathered
+    /// per shaded point by their k nearest neighbours.
+    PhotonMap,
 }

@@ -36,7 +36,14 @@ gpu_structs! {
         /// caustic_paths=exact: rays leave a surface this far along (10⁻⁶ of the scene's
         /// diagonal, as the ray tracers' secondary rays)
         ray_offset: float,
-        pad: [uint; 3],
+        /// caustics=photon-map: photons gathered per shaded point (photon_k)
+        gather_k: uint,
+        /// caustics=photon-map: buckets of the hashed grid, a power of two (`photon_grid`
+        /// holds each bucket's first photon, then its count)
+        grid_cells: uint,
+        /// caustics=photon-map: the gather's largest radius and the grid's cell edge (world
+        /// units)
+        gather_radius: float,
     }
 }
 
@@ -49,6 +56,9 @@ gpu_consts! {
     CAUSTIC_DISTANCE_TEST: uint = 1;
     /// `CausticParams.flags`: the receiver-orientation factor cos α of the projection.
     CAUSTIC_ORIENTATION: uint = 2;
+    /// `CausticParams.flags`: caustics=photon-map: diffuse points gather from the photon grid
+    /// instead of projecting light cube maps.
+    CAUSTIC_PHOTON_MAP: uint = 4;
     /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_CUBE_SHIFT: uint = 8;
@@ -93,5 +103,12 @@ descriptor_sets! {
         /// Caustic triangles: per cube face f and triangle i, `caustic_faces[f · triangle_count
         /// + i]` is 1 when the face draws it (its frustum may hold it).
         CAUSTIC_FACES = 17: STORAGE_BUFFER => "buffer CausticFaces { uint caustic_faces[]; }";
+        /// caustics=photon-map: the hashed uniform grid, `grid_cells` buckets' first photon in
+        /// `photon_list` then their counts (caustics/grid.comp builds it every frame).
+        PHOTON_GRID = 18: STORAGE_BUFFER => "buffer PhotonGrid { uint photon_grid[]; }";
+        /// caustics=photon-map: the photons sorted by bucket, two vec4 each: the world position
+        /// with the power's r, then g, b, and the arrival direction (octahedral, 12 bits a
+        /// coordinate, `photon_direction`).
+        PHOTON_LIST = 19: STORAGE_BUFFER => "buffer PhotonList { vec4 photon_list[]; }";
     }
 }

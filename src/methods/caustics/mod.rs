@@ -13,7 +13,11 @@
 //!   traced through the generator in the sampled geometry to its terminal hit;
 //! - `caustics.splat` (photon splatting, §6.3.1) or `caustics.triangles` (§6.3.2): the
 //!   photons into the light cube map, radiant intensity seen from the reference point;
-//! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0).
+//! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0);
+//! - or, `caustics=photon-map` (§6.1.1, PDC03), `caustics.photon_map`: instead of light cube
+//!   maps, every photon sorted into a hashed uniform grid on the GPU (count, scan, scatter:
+//!   glsl/caustics/grid*.comp), from which each shaded point gathers its `photon_k`
+//!   nearest (glsl/caustics/photon_map.glsl).
 
 pub mod knobs;
 pub mod project;
@@ -48,11 +52,32 @@ impl CausticsPlan {
     /// The profiled passes it records, in order.
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
-        v.push(if self.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" });
-        if q.caustics.caustic_filter > 0 {
+        v.push(match self.filter {
+            Caustics::Splat => "caustics.splat",
+            Caustics::PhotonMap => "caustics.photon_map",
+            _ => "caustics.triangles",
+        });
+        if self.light_cubes() && q.caustics.caustic_filter > 0 {
             v.push("caustics.filter");
         }
         v
+    }
+
+    /// Whether it keeps light cube maps (splats and caustic triangles go there; the photon
+    /// map's gather reads the photons themselves).
+    pub fn light_cubes(&self) -> bool {
+        self.filter != Caustics::PhotonMap
+    }
+
+    /// caustics=photon-map: every photon of every layer (photons² a layer).
+    pub fn photon_count(&self, q: &Quality) -> u64 {
+        self.photon_layers as u64 * (q.caustics.photons as u64).pow(2)
+    }
+
+    /// caustics=photon-map: the photon grid's buckets, the power of two at or above the
+    /// photons' count (a load factor of at most 1).
+    pub fn grid_cells(&self, q: &Quality) -> u32 {
+        (self.photon_count(q).max(256).next_power_of_two()).min(1 << 30) as u32
     }
 }
 
@@ -271,29 +296,53 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
 }
 
 /// Device memory: per caustic cube a receiver distance cube (R32F) and a light cube map
-/// (RGBA32F, two with filtering), the photon images (two RGBA32F layers per view and a
-/// depth buffer), the receivers' depth buffer, and for caustic triangles their set-up
-/// buffers (64 bytes and six face flags per triangle).
+/// (RGBA32F, two with filtering; none for the photon map), the photon images (two RGBA32F
+/// layers per view and a depth buffer), the receivers' depth buffer, for caustic triangles
+/// their set-up buffers (64 bytes and six face flags per triangle), for the photon map its
+/// sorted photons and grid.
 pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
     let s = q.cube.cube_size as u64;
     let n = q.caustics.photons as u64;
     let g = p.cubes.len() as u64;
-    let light_cubes = if q.caustics.caustic_filter > 0 { 2 } else { 1 };
+    let light_cubes = match (p.light_cubes(), q.caustics.caustic_filter > 0) {
+        (false, _) => 0,
+        (true, true) => 2,
+        (true, false) => 1,
+    };
+    // The photon map: two vec4 a photon, and two words a bucket.
+    let photon_map = if p.filter == Caustics::PhotonMap { p.photon_count(q) * 32 + p.grid_cells(q) as u64 * 8 } else { 0 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
     let triangles = if p.filter == Caustics::Triangles { p.photon_layers as u64 * 2 * (n - 1) * (n - 1) * (64 + 24) } else { 0 };
-    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles
+    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles + photon_map
 }
 
 /// What `specula plan` says of it.
 pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
+    let store = if p.light_cubes() {
+        format!(
+            "{} light cube(s) 6×{}² RGBA32F{}",
+            p.cubes.len(),
+            q.cube.cube_size,
+            if q.caustics.caustic_filter > 0 { format!(", box filter radius {}", q.caustics.caustic_filter) } else { String::new() }
+        )
+    } else {
+        format!(
+            "{} photons in a grid of {} buckets, gathered by their {} nearest within {} of the diagonal",
+            p.photon_count(q),
+            p.grid_cells(q),
+            q.caustics.photon_k,
+            q.caustics.photon_radius
+        )
+    };
     let mut s = format!(
-        "caustics ({}, {} space): {} photons² per light view, {} light cube(s) 6×{}² RGBA32F{}, {:.2} MiB",
-        if p.filter == Caustics::Splat { format!("splat, splat_size {}", q.caustics.splat_size) } else { "triangles".into() },
+        "caustics ({}, {} space): {} photons² per light view, {store}, {:.2} MiB",
+        match p.filter {
+            Caustics::Splat => format!("splat, splat_size {}", q.caustics.splat_size),
+            Caustics::PhotonMap => "photon map".into(),
+            _ => "triangles".into(),
+        },
         if p.space == CausticSpace::Light { "light" } else { "cube-map" },
         q.caustics.photons,
-        p.cubes.len(),
-        q.cube.cube_size,
-        if q.caustics.caustic_filter > 0 { format!(", box filter radius {}", q.caustics.caustic_filter) } else { String::new() },
         p.bytes as f64 / (1 << 20) as f64
     );
     for g in &p.generators {

@@ -28,8 +28,23 @@ pub const CAUSTICS: Slot = Slot::buffer("caustics.generators", 0, binding::CAUST
 pub const CAUSTIC_TRIANGLES: Slot = Slot::buffer("caustics.triangles", 0, binding::CAUSTIC_TRIANGLES);
 pub const CAUSTIC_FACES: Slot = Slot::buffer("caustics.triangle_faces", 0, binding::CAUSTIC_FACES);
 
-pub const SLOTS: &[Slot] =
-    &[CAUSTIC_DISTANCES, CAUSTIC_MAPS, CAUSTIC_RAW, PHOTON_HITS, PHOTON_POWER, CAUSTICS, CAUSTIC_TRIANGLES, CAUSTIC_FACES];
+/// caustics=photon-map: the hashed grid and the photons sorted into it, read wherever diffuse
+/// surfaces are shaded.
+pub const PHOTON_GRID: Slot = Slot::buffer("caustics.photon_grid", 0, binding::PHOTON_GRID);
+pub const PHOTON_LIST: Slot = Slot::buffer("caustics.photon_list", 0, binding::PHOTON_LIST);
+
+pub const SLOTS: &[Slot] = &[
+    CAUSTIC_DISTANCES,
+    CAUSTIC_MAPS,
+    CAUSTIC_RAW,
+    PHOTON_HITS,
+    PHOTON_POWER,
+    CAUSTICS,
+    CAUSTIC_TRIANGLES,
+    CAUSTIC_FACES,
+    PHOTON_GRID,
+    PHOTON_LIST,
+];
 
 impl crate::frame::maps::Maps {
     /// Caustics: the photon hit location images (xyz hit relative to the reference point,

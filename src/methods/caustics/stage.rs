@@ -6,11 +6,16 @@
 
 use ash::vk;
 
-use super::slots::{CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_HITS, PHOTON_POWER};
+use super::slots::{
+    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_GRID, PHOTON_HITS, PHOTON_LIST,
+    PHOTON_POWER,
+};
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
-use crate::frame::layout::{CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION};
+use crate::frame::layout::{
+    CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_PHOTON_MAP,
+};
 use crate::frame::shadow::FAR;
 use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
@@ -38,6 +43,9 @@ pub struct CausticsStage {
     box_filter: vk::Pipeline,
     /// Caustic triangles: the set-up kernel (caustics/setup.comp).
     setup: vk::Pipeline,
+    /// The photon map: its grid's count, scan and scatter kernels (caustics/grid.comp,
+    /// caustics/grid_scan.comp).
+    grid: [vk::Pipeline; 3],
     layout: vk::PipelineLayout,
     /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
     exact: Option<SceneRays>,
@@ -46,7 +54,10 @@ pub struct CausticsStage {
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
 pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (GpuCausticParams, Vec<GpuCausticCube>) {
     let flags = if q.caustics.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 }
-        | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 };
+        | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 }
+        | if plan.light_cubes() { 0 } else { CAUSTIC_PHOTON_MAP };
+    let diag = scene.bounds().diagonal();
+    let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
     let params = GpuCausticParams {
         cube_count: plan.cubes.len() as u32,
         photon_size: q.caustics.photons,
@@ -56,15 +67,10 @@ pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (
         filter_radius: q.caustics.caustic_filter,
         triangle_count: plan.photon_layers * 2 * (q.caustics.photons - 1) * (q.caustics.photons - 1),
         layer_triangles: 2 * (q.caustics.photons - 1) * (q.caustics.photons - 1),
-        ray_offset: {
-            let diag = scene.bounds().diagonal();
-            if diag.is_finite() && diag > 0.0 {
-                diag * 1e-6
-            } else {
-                1e-6
-            }
-        },
-        pad: [0; 3],
+        ray_offset: diag * 1e-6,
+        gather_k: q.caustics.photon_k,
+        grid_cells: plan.grid_cells(q),
+        gather_radius: diag * q.caustics.photon_radius,
     };
     let cubes = plan
         .cubes
@@ -113,6 +119,7 @@ impl CausticsStage {
             accumulate: vk::Pipeline::null(),
             box_filter: vk::Pipeline::null(),
             setup: vk::Pipeline::null(),
+            grid: [vk::Pipeline::null(); 3],
             layout: init.layout,
             exact: None,
         };
@@ -128,9 +135,13 @@ impl CausticsStage {
             Image::new(ctx, &ImageDesc { name, format, width: s, height: s, kind: ImageKind::CubeArray { cubes }, usage: attach })
         };
         maps.set_image(&CAUSTIC_DISTANCES, cube("caustics.receivers", vk::Format::R32_SFLOAT)?);
-        maps.set_image(&CAUSTIC_MAPS, cube("caustics.light_cubes", LIGHT_FORMAT)?);
-        if self.filter > 0 {
-            maps.set_image(&CAUSTIC_RAW, cube("caustics.light_cubes.unfiltered", LIGHT_FORMAT)?);
+        if self.plan.light_cubes() {
+            maps.set_image(&CAUSTIC_MAPS, cube("caustics.light_cubes", LIGHT_FORMAT)?);
+            if self.filter > 0 {
+                maps.set_image(&CAUSTIC_RAW, cube("caustics.light_cubes.unfiltered", LIGHT_FORMAT)?);
+            }
+        } else {
+            self.filter = 0;
         }
         let layers = ImageKind::D2Array { layers: self.plan.photon_layers };
         let photon = |name| Image::new(ctx, &ImageDesc { name, format: HIT_FORMAT, width: n, height: n, kind: layers, usage: attach });
@@ -200,6 +211,9 @@ impl CausticsStage {
                 &desc("caustics.photons", "scene/mesh.vert", "caustics/photons.frag", VertexInput::Mesh, &hits, true, 0, Blend::Replace),
             )?
         };
+        if self.plan.filter == Caustics::PhotonMap {
+            return self.init_photon_map(init, maps);
+        }
         let (vs, fs) = match self.plan.filter {
             Caustics::Splat => ("caustics/splat.vert", "caustics/splat.frag"),
             _ => ("caustics/triangles.vert", "caustics/triangles.frag"),
@@ -212,18 +226,7 @@ impl CausticsStage {
             let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
             let gpu = crate::vk::MemoryLocation::GpuOnly;
             // One storage-buffer descriptor must reach every triangle.
-            let limit = ctx.properties.limits.max_storage_buffer_range as u64;
-            if count * 64 > limit {
-                return Err(crate::Error::invalid(
-                    "knob photons",
-                    format!(
-                        "{n}: caustic triangles for {} photon layers need {} bytes in one storage buffer, beyond {}'s {limit} (fewer photons, or caustics=splat)",
-                        self.plan.photon_layers,
-                        count * 64,
-                        ctx.device_name
-                    ),
-                ));
-            }
+            within_storage_range(ctx, "caustic triangles", count * 64, n, self.plan.photon_layers)?;
             maps.set_buffer(&CAUSTIC_TRIANGLES, Buffer::new(ctx, "caustics.triangles", count * 64, storage, gpu)?);
             maps.set_buffer(&CAUSTIC_FACES, Buffer::new(ctx, "caustics.triangle_faces", count * 6 * 4, storage, gpu)?);
             self.setup = crate::vk::pipeline::compute_pipeline(ctx, layout, "caustics/setup.comp")?;
@@ -236,6 +239,70 @@ impl CausticsStage {
             )?;
         }
         Ok(())
+    }
+
+    /// caustics=photon-map: the sorted photons and the grid (in the frame's set: every pass
+    /// that shades a diffuse surface gathers from them), and the kernels that build them.
+    fn init_photon_map(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let (ctx, q) = (init.ctx, &init.plan.quality);
+        let photons = self.plan.photon_count(q);
+        within_storage_range(ctx, "the photon map", photons * 32, q.caustics.photons, self.plan.photon_layers)?;
+        let gpu = crate::vk::MemoryLocation::GpuOnly;
+        let grid = self.plan.grid_cells(q) as u64 * 8;
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        maps.set_buffer(&PHOTON_GRID, Buffer::new(ctx, "caustics.photon_grid", grid, usage, gpu)?);
+        maps.set_buffer(&PHOTON_LIST, Buffer::new(ctx, "caustics.photon_list", photons * 32, vk::BufferUsageFlags::STORAGE_BUFFER, gpu)?);
+        let compute = |shader| crate::vk::pipeline::compute_pipeline(ctx, self.layout, shader);
+        self.grid = [compute("caustics/grid.comp")?, compute("caustics/grid_scan.comp")?, compute("caustics/grid.comp#SCATTER")?];
+        Ok(())
+    }
+
+    /// The photon map's grid (§6.1.1, PDC03), rebuilt from this frame's photon images: the
+    /// buckets' counts zeroed, every photon counted into its bucket, the counts scanned into
+    /// first places, every photon scattered into its place; then made visible to every
+    /// pass that shades. (The previous frame's reads are behind the pass's opening barrier.)
+    fn build_photon_grid(&self, rec: &mut Recorder, f: &FrameInputs, grid: vk::Buffer) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let barrier = |src: vk::PipelineStageFlags2, src_access, dst: vk::PipelineStageFlags2, dst_access| {
+            let b = [vk::MemoryBarrier2::default()
+                .src_stage_mask(src)
+                .src_access_mask(src_access)
+                .dst_stage_mask(dst)
+                .dst_access_mask(dst_access)];
+            unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
+        };
+        let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        unsafe { ctx.device.cmd_fill_buffer(cmd, grid, 0, vk::WHOLE_SIZE, 0) };
+        barrier(vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE, compute, storage);
+        let (x, y) = spread_groups((self.photons as u64 * self.photons as u64).div_ceil(64));
+        let per_layer = |pipeline: vk::Pipeline| {
+            unsafe {
+                ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, pipeline);
+                ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
+            }
+            for c in 0..self.plan.cubes.len() {
+                for layer in cube_layers(&self.plan, c) {
+                    f.push_flags(ctx, cmd, 0, layer, c as u32);
+                    unsafe { ctx.device.cmd_dispatch(cmd, x, y, 1) };
+                }
+            }
+        };
+        per_layer(self.grid[0]);
+        barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, compute, storage);
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.grid[1]);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
+            ctx.device.cmd_dispatch(cmd, 1, 1, 1);
+        }
+        barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, compute, storage);
+        per_layer(self.grid[2]);
+        barrier(
+            compute,
+            vk::AccessFlags2::SHADER_STORAGE_WRITE,
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::SHADER_STORAGE_READ,
+        );
     }
 
     /// Vertices of one photon layer's splat draw (a quad per photon).
@@ -324,6 +391,7 @@ impl Stage for CausticsStage {
         self.cube_depth.destroy(ctx);
         self.photon_depth.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
+        destroy_pipelines(ctx, &mut self.grid);
     }
 }
 
@@ -405,6 +473,19 @@ impl CausticsStage {
         }
         rec.end(open);
 
+        // The photon map: the photons sorted into its grid, gathered where surfaces are shaded.
+        if self.plan.filter == Caustics::PhotonMap {
+            let Some(grid) = maps.buffer(&PHOTON_GRID).map(|b| b.raw) else { return };
+            let open = rec
+                .pass("caustics.photon_map")
+                .reads(hits, Access::ComputeSampled)
+                .reads(power, Access::ComputeSampled)
+                .after_buffer_writes()
+                .begin();
+            self.build_photon_grid(rec, f, grid);
+            rec.end(open);
+            return;
+        }
         // Splats or triangles into the light cube maps (the unfiltered ones with a filter).
         let name = if self.plan.filter == Caustics::Splat { "caustics.splat" } else { "caustics.triangles" };
         let filtering = self.filter > 0;
@@ -449,6 +530,29 @@ impl CausticsStage {
             rec.end(open);
         }
     }
+}
+
+/// Refuses, naming the `photons` knob, a buffer of `bytes` that one storage-buffer descriptor
+/// cannot reach on this device (`what`: what it holds, for `layers` photon layers).
+fn within_storage_range(ctx: &Context, what: &str, bytes: u64, photons: u32, layers: u32) -> Result<()> {
+    let limit = ctx.properties.limits.max_storage_buffer_range as u64;
+    if bytes <= limit {
+        return Ok(());
+    }
+    Err(crate::Error::invalid(
+        "knob photons",
+        format!(
+            "{photons}: {what} for {layers} photon layers needs {bytes} bytes in one storage buffer, beyond {}'s {limit} (fewer photons, or caustics=splat)",
+            ctx.device_name
+        ),
+    ))
+}
+
+/// Workgroups (x, y) covering `groups`: at most 32768 along x (every device allows 65535 an
+/// axis), the rest along y (caustics/grid.comp's `invocation`; surplus invocations return).
+fn spread_groups(groups: u64) -> (u32, u32) {
+    let x = groups.clamp(1, 32768);
+    (x as u32, groups.div_ceil(x).max(1) as u32)
 }
 
 impl Owner for CausticsStage {
