@@ -38,11 +38,12 @@ gpu_structs! {
         ray_offset: float,
         /// caustics=photon-map: photons gathered per shaded point (photon_k)
         gather_k: uint,
-        /// caustics=photon-map: buckets of the hashed grid, a power of two (`photon_grid`
-        /// holds each bucket's first photon, then its count)
+        /// caustics=photon-map: buckets of the hashed grid's two levels, a power of two
+        /// (`photon_grid` holds each bucket's first place and count among the fine cells, then
+        /// among the coarse ones)
         grid_cells: uint,
-        /// caustics=photon-map: the gather's largest radius and the grid's cell edge (world
-        /// units)
+        /// caustics=photon-map: the gather's largest radius (world units): the grid's fine
+        /// cells are a quarter, its coarse cells twice as wide
         gather_radius: float,
     }
 }
@@ -103,12 +104,16 @@ descriptor_sets! {
         /// Caustic triangles: per cube face f and triangle i, `caustic_faces[f · triangle_count
         /// + i]` is 1 when the face draws it (its frustum may hold it).
         CAUSTIC_FACES = 17: STORAGE_BUFFER => "buffer CausticFaces { uint caustic_faces[]; }";
-        /// caustics=photon-map: the hashed uniform grid, `grid_cells` buckets' first photon in
-        /// `photon_list` then their counts (caustics/grid.comp builds it every frame).
+        /// caustics=photon-map: the hashed uniform grid, two levels of `grid_cells` buckets: the
+        /// fine cells' first places in `photon_list` and counts, then the coarse cells' first
+        /// places in `photon_coarse` and counts (caustics/grid.comp builds it every frame;
+        /// glsl/caustics/photon_map.glsl).
         PHOTON_GRID = 18: STORAGE_BUFFER => "buffer PhotonGrid { uint photon_grid[]; }";
         /// caustics=photon-map: the photons sorted by bucket, two vec4 each: the world position
         /// with the power's r, then g, b, and the arrival direction (octahedral, 12 bits a
         /// coordinate, `photon_direction`).
         PHOTON_LIST = 19: STORAGE_BUFFER => "buffer PhotonList { vec4 photon_list[]; }";
+        /// caustics=photon-map: the photons' places in `photon_list`, sorted by coarse bucket.
+        PHOTON_COARSE = 20: STORAGE_BUFFER => "buffer PhotonCoarse { uint photon_coarse[]; }";
     }
 }

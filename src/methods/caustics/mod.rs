@@ -309,8 +309,8 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
         (true, true) => 2,
         (true, false) => 1,
     };
-    // The photon map: two vec4 a photon, and two words a bucket.
-    let photon_map = if p.filter == Caustics::PhotonMap { p.photon_count(q) * 32 + p.grid_cells(q) as u64 * 8 } else { 0 };
+    // The photon map: two vec4 and a coarse place a photon, and four words a bucket.
+    let photon_map = if p.filter == Caustics::PhotonMap { p.photon_count(q) * 36 + p.grid_cells(q) as u64 * 16 } else { 0 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
     let triangles = if p.filter == Caustics::Triangles { p.photon_layers as u64 * 2 * (n - 1) * (n - 1) * (64 + 24) } else { 0 };
     g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles + photon_map

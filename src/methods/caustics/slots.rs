@@ -32,6 +32,7 @@ pub const CAUSTIC_FACES: Slot = Slot::buffer("caustics.triangle_faces", 0, bindi
 /// surfaces are shaded.
 pub const PHOTON_GRID: Slot = Slot::buffer("caustics.photon_grid", 0, binding::PHOTON_GRID);
 pub const PHOTON_LIST: Slot = Slot::buffer("caustics.photon_list", 0, binding::PHOTON_LIST);
+pub const PHOTON_COARSE: Slot = Slot::buffer("caustics.photon_coarse", 0, binding::PHOTON_COARSE);
 
 pub const SLOTS: &[Slot] = &[
     CAUSTIC_DISTANCES,
@@ -44,6 +45,7 @@ pub const SLOTS: &[Slot] = &[
     CAUSTIC_FACES,
     PHOTON_GRID,
     PHOTON_LIST,
+    PHOTON_COARSE,
 ];
 
 impl crate::frame::maps::Maps {

@@ -7,8 +7,8 @@
 use ash::vk;
 
 use super::slots::{
-    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_GRID, PHOTON_HITS, PHOTON_LIST,
-    PHOTON_POWER,
+    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID, PHOTON_HITS,
+    PHOTON_LIST, PHOTON_POWER,
 };
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
@@ -43,9 +43,11 @@ pub struct CausticsStage {
     box_filter: vk::Pipeline,
     /// Caustic triangles: the set-up kernel (caustics/setup.comp).
     setup: vk::Pipeline,
-    /// The photon map: its grid's count, scan and scatter kernels (caustics/grid.comp,
-    /// caustics/grid_scan.comp).
-    grid: [vk::Pipeline; 3],
+    /// The photon map: its grid's count, scan, scatter and coarse-scatter kernels
+    /// (caustics/grid.comp, caustics/grid_scan.comp).
+    grid: [vk::Pipeline; 4],
+    /// caustics=photon-map: places for every photon (photons² a layer, every layer).
+    photon_places: u64,
     layout: vk::PipelineLayout,
     /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
     exact: Option<SceneRays>,
@@ -119,7 +121,8 @@ impl CausticsStage {
             accumulate: vk::Pipeline::null(),
             box_filter: vk::Pipeline::null(),
             setup: vk::Pipeline::null(),
-            grid: [vk::Pipeline::null(); 3],
+            grid: [vk::Pipeline::null(); 4],
+            photon_places: 0,
             layout: init.layout,
             exact: None,
         };
@@ -248,19 +251,28 @@ impl CausticsStage {
         let photons = self.plan.photon_count(q);
         within_storage_range(ctx, "the photon map", photons * 32, q.caustics.photons, self.plan.photon_layers)?;
         let gpu = crate::vk::MemoryLocation::GpuOnly;
-        let grid = self.plan.grid_cells(q) as u64 * 8;
+        let grid = self.plan.grid_cells(q) as u64 * 16;
         let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
         maps.set_buffer(&PHOTON_GRID, Buffer::new(ctx, "caustics.photon_grid", grid, usage, gpu)?);
-        maps.set_buffer(&PHOTON_LIST, Buffer::new(ctx, "caustics.photon_list", photons * 32, vk::BufferUsageFlags::STORAGE_BUFFER, gpu)?);
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        maps.set_buffer(&PHOTON_LIST, Buffer::new(ctx, "caustics.photon_list", photons * 32, storage, gpu)?);
+        maps.set_buffer(&PHOTON_COARSE, Buffer::new(ctx, "caustics.photon_coarse", photons * 4, storage, gpu)?);
         let compute = |shader| crate::vk::pipeline::compute_pipeline(ctx, self.layout, shader);
-        self.grid = [compute("caustics/grid.comp")?, compute("caustics/grid_scan.comp")?, compute("caustics/grid.comp#SCATTER")?];
+        self.grid = [
+            compute("caustics/grid.comp")?,
+            compute("caustics/grid_scan.comp")?,
+            compute("caustics/grid.comp#SCATTER")?,
+            compute("caustics/grid.comp#COARSE")?,
+        ];
+        self.photon_places = photons;
         Ok(())
     }
 
     /// The photon map's grid (§6.1.1, PDC03), rebuilt from this frame's photon images: the
-    /// buckets' counts zeroed, every photon counted into its bucket, the counts scanned into
-    /// first places, every photon scattered into its place; then made visible to every
-    /// pass that shades. (The previous frame's reads are behind the pass's opening barrier.)
+    /// buckets' counts zeroed, every photon counted into its fine and coarse buckets, the
+    /// counts scanned into first places, every photon scattered into its fine place, then
+    /// its place into its coarse one; then made visible to every pass that shades. (The
+    /// previous frame's reads are behind the pass's opening barrier.)
     fn build_photon_grid(&self, rec: &mut Recorder, f: &FrameInputs, grid: vk::Buffer) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let barrier = |src: vk::PipelineStageFlags2, src_access, dst: vk::PipelineStageFlags2, dst_access| {
@@ -297,6 +309,13 @@ impl CausticsStage {
         }
         barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, compute, storage);
         per_layer(self.grid[2]);
+        // The coarse level: every place of the sorted photons (those past the photons placed return).
+        barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, compute, storage);
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.grid[3]);
+            let (x, y) = spread_groups(self.photon_places.div_ceil(64));
+            ctx.device.cmd_dispatch(cmd, x, y, 1);
+        }
         barrier(
             compute,
             vk::AccessFlags2::SHADER_STORAGE_WRITE,
