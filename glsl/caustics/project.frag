@@ -16,5 +16,9 @@ void main() {
     vec3 n = normalize(in_normal);
     vec3 v = views[in_view].eye.xyz - in_position;
     if (dot(n, v) < 0.0) n = -n;  // two-sided, as shade_diffuse
-    out_color = vec4(material_base_color(m, in_uv) / PI * caustic_irradiance(in_position, n), 0.0);
+    // Screen space: the camera's view (view 0) reads its pixel; a mirrored view gets none.
+    vec3 e = (caustic.flags & CAUSTIC_SCREEN_SPACE) == 0u ? caustic_irradiance(in_position, n)
+           : in_view == 0u                          ? caustic_screen_irradiance(ivec2(gl_FragCoord.xy), n, normalize(v))
+                                                    : vec3(0.0);
+    out_color = vec4(material_base_color(m, in_uv) / PI * e, 0.0);
 }

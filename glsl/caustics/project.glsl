@@ -17,6 +17,8 @@ vec3 caustic_irradiance(vec3 p, vec3 n) {
     uint count = caustic.cube_count;
     if (count == 0u) return e;
     if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return photon_map_irradiance(p, n);
+    // Screen space: only the camera's own surfaces (caustic_screen_irradiance) get caustics.
+    if ((caustic.flags & CAUSTIC_SCREEN_SPACE) != 0u) return e;
     float texel = 2.0 / float(caustic.cube_size);
     for (uint g = 0u; g < count; ++g) {
         vec3 w = p - cubes[g].centre.xyz;
@@ -35,5 +37,13 @@ vec3 caustic_irradiance(vec3 p, vec3 n) {
         e += j * cos_factor / (d * d);
     }
     return e;
+}
+
+// caustic_space=screen (LC04, WD06b): the caustic irradiance at the camera's pixel `pixel`
+// of a surface of normal n seen along v (towards the eye, unit): caustics.screen holds it per
+// unit area across the view, which a surface tilted by θ from the view spreads over 1/cos θ
+// as much area.
+vec3 caustic_screen_irradiance(ivec2 pixel, vec3 n, vec3 v) {
+    return texelFetch(caustic_screen, pixel, 0).rgb * abs(dot(n, v));
 }
 #endif

@@ -1,10 +1,18 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_multiview : require
+// variants: SCREEN
 // caustics.splat: photon splatting (survey §6.3.1). One quad per texel of the photon hit
 // location image (layer push.object), placed by this shader from the image: no readback.
 // Drawn into each face of the generator's light cube map (view push.view + gl_ViewIndex:
 // the face's view around the cube's centre), so a splat near an edge reaches both faces.
+//
+// SCREEN (caustic_space=screen, LC04/WD06b): into the camera's view (push.view; push.flags:
+// the layer's caustic cube, whose centre the hits are stored from), as irradiance per unit
+// area across the view at the photon's depth: the screen's pixel there spans px × py, so a
+// splat of r pixels spreads the power over r² px py. The quad lies nudged towards the camera
+// by two pixels' width, so that a photon on the surface the camera sees passes the depth
+// test of caustics/screen_depth.frag's depth, and one behind it does not.
 #include "common/scene.glsl"
 
 layout(location = 0) out vec2 out_offset;
@@ -22,6 +30,25 @@ void main() {
     vec4 c = v.view_proj * vec4(v.eye.xyz + hit.xyz, 1.0);
     vec2 corner = CORNERS[uint(gl_VertexIndex) % 6u];
     out_offset = corner;
+#ifdef SCREEN
+    vec3 p = cubes[push.flags].centre.xyz + hit.xyz;
+    vec4 clip = v.view_proj * vec4(p, 1.0);
+    if (hit.w == 0.0 || clip.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
+        out_scale = vec3(0.0);
+        gl_Position = vec4(0.0, 0.0, 0.0, -1.0);
+        return;
+    }
+    vec2 screen = vec2(float(caustic.screen_width), float(caustic.screen_height));
+    vec3 ndc = clip.xyz / clip.w;
+    vec4 a = v.inv_view_proj * vec4(ndc.xy + vec2(2.0 / screen.x, 0.0), ndc.z, 1.0);
+    vec4 b = v.inv_view_proj * vec4(ndc.xy + vec2(0.0, 2.0 / screen.y), ndc.z, 1.0);
+    float px = length(a.xyz / a.w - p);
+    float py = length(b.xyz / b.w - p);
+    float r = caustic.splat_size;
+    out_scale = power / (r * r * px * py);
+    vec4 near = v.view_proj * vec4(p + normalize(v.eye.xyz - p) * 2.0 * max(px, py), 1.0);
+    gl_Position = vec4((ndc.xy + corner * (2.0 * r / screen)) * near.w, near.z, near.w);
+#else
     if (hit.w == 0.0 || c.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
         out_scale = vec3(0.0);
         gl_Position = vec4(0.0, 0.0, 0.0, -1.0);  // outside every clip volume: no quad
@@ -37,4 +64,5 @@ void main() {
     float solid = (4.0 / (size * size)) * pow(major / length(hit.xyz), 3.0);
     out_scale = power / (r * r * solid);
     gl_Position = c + vec4(corner * (2.0 * r / size) * c.w, 0.0, 0.0);
+#endif
 }

@@ -34,8 +34,14 @@ void main() {
     vec3 n = dot(s.n, -d) < 0.0 ? -s.n : s.n;  // two-sided
     if (!count_only) {
         accumulate(pl.pixel, w * material_emission(m, s.uv));
-        // Caustics (§6.3.3): light through specular objects, from their light cube maps.
-        accumulate(pl.pixel, w * albedo / PI * caustic_irradiance(s.p, n));
+        // Caustics (§6.3.3): light through specular objects, from their light cube maps; in
+        // screen space only on the primary hits, from the camera's pixel.
+        vec3 e = caustic_irradiance(s.p, n);
+        if ((caustic.flags & CAUSTIC_SCREEN_SPACE) != 0u && trace.bounce == 0u) {
+            uint at = pl.pixel / trace.samples;
+            e = caustic_screen_irradiance(ivec2(at % trace.width, at / trace.width), n, -d);
+        }
+        accumulate(pl.pixel, w * albedo / PI * e);
     }
     for (uint k = 0u; k < push.light_count; ++k) {
         vec3 wi;

@@ -35,8 +35,10 @@ knobs! {
         caustic_orientation: bool = "on", one_of()["on" => true, "off" => false];
         /// caustics: photon hits stored and projected in cube-map space, one light cube map per generator around its reference
         /// point (UPSK08), or in light space, one per generator and point or spot light around the light (the shadow-map space of
-        /// SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md)
-        caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light];
+        /// SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md); or in screen
+        /// space (LC04, WD06b; caustics=splat): splatted straight onto the camera's image of the receivers, depth-tested against
+        /// it, so that caustics seen in mirrors or through glass are missing
+        caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light, "screen" => CausticSpace::Screen];
         /// caustics: a dielectric generator's photons follow both Fresnel branches, each its own photon image (the reflected one is
         /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way. `exact`: photons traced
         /// in the original geometry through Vulkan ray queries (§6.1.1): every specular bounce to the first diffuse hit, a
@@ -70,6 +72,9 @@ pub enum CausticSpace {
     /// Light space (the shadow-map space of SP07): one cube per generator and point or spot
     /// light, around the light; directional lights stay in cube-map space.
     Light,
+    /// Screen space (LC04, WD06b): photons splatted onto the camera's image of the
+    /// receivers; only what the camera sees directly gets them.
+    Screen,
 }
 
 /// How caustics are rendered (survey §6.3).

@@ -45,6 +45,10 @@ gpu_structs! {
         /// caustics=photon-map: the gather's largest radius (world units): the grid's fine
         /// cells are a quarter, its coarse cells twice as wide
         gather_radius: float,
+        /// caustic_space=screen: the camera target's size (pixels)
+        screen_width: uint,
+        screen_height: uint,
+        pad: [uint; 2],
     }
 }
 
@@ -60,6 +64,9 @@ gpu_consts! {
     /// `CausticParams.flags`: caustics=photon-map: diffuse points gather from the photon grid
     /// instead of projecting light cube maps.
     CAUSTIC_PHOTON_MAP: uint = 4;
+    /// `CausticParams.flags`: caustic_space=screen: the camera's own diffuse surfaces take the
+    /// caustic from `caustic_screen` at their pixel; every other view, none.
+    CAUSTIC_SCREEN_SPACE: uint = 8;
     /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_CUBE_SHIFT: uint = 8;
@@ -115,5 +122,8 @@ descriptor_sets! {
         PHOTON_LIST = 19: STORAGE_BUFFER => "buffer PhotonList { vec4 photon_list[]; }";
         /// caustics=photon-map: the photons' places in `photon_list`, sorted by coarse bucket.
         PHOTON_COARSE = 20: STORAGE_BUFFER => "buffer PhotonCoarse { uint photon_coarse[]; }";
+        /// caustic_space=screen: the caustic's irradiance per pixel of the camera target, per
+        /// unit area across the view (caustics.screen splats the photons there).
+        CAUSTIC_SCREEN = 21: COMBINED_IMAGE_SAMPLER => "uniform sampler2D caustic_screen";
     }
 }

@@ -53,6 +53,7 @@ impl CausticsPlan {
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
         v.push(match self.filter {
+            _ if self.space == CausticSpace::Screen => "caustics.screen",
             Caustics::Splat => "caustics.splat",
             Caustics::PhotonMap => "caustics.photon_map",
             _ => "caustics.triangles",
@@ -64,9 +65,9 @@ impl CausticsPlan {
     }
 
     /// Whether it keeps light cube maps (splats and caustic triangles go there; the photon
-    /// map's gather reads the photons themselves).
+    /// map's gather reads the photons themselves, screen space splats into the camera's view).
     pub fn light_cubes(&self) -> bool {
-        self.filter != Caustics::PhotonMap
+        self.filter != Caustics::PhotonMap && self.space != CausticSpace::Screen
     }
 
     /// caustics=photon-map: every photon of every layer (photons² a layer).
@@ -341,7 +342,11 @@ pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
             Caustics::PhotonMap => "photon map".into(),
             _ => "triangles".into(),
         },
-        if p.space == CausticSpace::Light { "light" } else { "cube-map" },
+        match p.space {
+            CausticSpace::Light => "light",
+            CausticSpace::Screen => "screen",
+            CausticSpace::Cube => "cube-map",
+        },
         q.caustics.photons,
         p.bytes as f64 / (1 << 20) as f64
     );

@@ -56,7 +56,7 @@ impl Stage for CausticsProject {
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let mut pass = rec.pass("caustics.project").writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
-        let maps = [&super::slots::CAUSTIC_DISTANCES, &super::slots::CAUSTIC_MAPS].map(|s| io.maps.image(s));
+        let maps = [&super::slots::CAUSTIC_DISTANCES, &super::slots::CAUSTIC_MAPS, &super::slots::CAUSTIC_SCREEN].map(|s| io.maps.image(s));
         for img in io.scene_images.iter().copied().chain(maps.into_iter().flatten()) {
             pass = pass.reads(img, Access::FragmentSampled);
         }

@@ -34,6 +34,10 @@ pub const PHOTON_GRID: Slot = Slot::buffer("caustics.photon_grid", 0, binding::P
 pub const PHOTON_LIST: Slot = Slot::buffer("caustics.photon_list", 0, binding::PHOTON_LIST);
 pub const PHOTON_COARSE: Slot = Slot::buffer("caustics.photon_coarse", 0, binding::PHOTON_COARSE);
 
+/// caustic_space=screen: the caustic's irradiance per camera pixel, read where the camera's
+/// diffuse surfaces are shaded.
+pub const CAUSTIC_SCREEN: Slot = Slot { shading: true, ..Slot::image("caustics.screen", 0, binding::CAUSTIC_SCREEN, Sampler::Nearest) };
+
 pub const SLOTS: &[Slot] = &[
     CAUSTIC_DISTANCES,
     CAUSTIC_MAPS,
@@ -46,6 +50,7 @@ pub const SLOTS: &[Slot] = &[
     PHOTON_GRID,
     PHOTON_LIST,
     PHOTON_COARSE,
+    CAUSTIC_SCREEN,
 ];
 
 impl crate::frame::maps::Maps {

@@ -7,21 +7,22 @@
 use ash::vk;
 
 use super::slots::{
-    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID, PHOTON_HITS,
-    PHOTON_LIST, PHOTON_POWER,
+    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_SCREEN, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID,
+    PHOTON_HITS, PHOTON_LIST, PHOTON_POWER,
 };
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{
     CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_PHOTON_MAP,
+    CAUSTIC_SCREEN_SPACE,
 };
 use crate::frame::shadow::FAR;
 use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
 use crate::frame::stage::{FrameIo, Maps, Stage, StageInit};
 use crate::frame::{cube_depth, destroy_pipelines, render_cube_faces, view_mask, FrameInputs};
 use crate::methods::raytrace::ray_query::scene::SceneRays;
-use crate::quality::{CausticPaths, Caustics, CubeMode, Quality};
+use crate::quality::{CausticPaths, CausticSpace, Caustics, CubeMode, Quality};
 use crate::vk::pipeline::{graphics_pipeline, Blend, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
 use crate::Result;
@@ -48,16 +49,27 @@ pub struct CausticsStage {
     grid: [vk::Pipeline; 4],
     /// caustics=photon-map: places for every photon (photons² a layer, every layer).
     photon_places: u64,
+    /// caustic_space=screen: the camera's depth of every surface, then the splats depth-tested
+    /// against it (caustics/screen_depth.frag, caustics/splat.vert#SCREEN), and that depth.
+    screen: [vk::Pipeline; 2],
+    screen_depth: Image,
     layout: vk::PipelineLayout,
     /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
     exact: Option<SceneRays>,
 }
 
-/// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene`.
-pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (GpuCausticParams, Vec<GpuCausticCube>) {
+/// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene` and a
+/// camera target of `(width, height)`.
+pub fn table(
+    plan: &CausticsPlan,
+    q: &Quality,
+    scene: &crate::scene::Scene,
+    (width, height): (u32, u32),
+) -> (GpuCausticParams, Vec<GpuCausticCube>) {
     let flags = if q.caustics.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 }
         | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 }
-        | if plan.light_cubes() { 0 } else { CAUSTIC_PHOTON_MAP };
+        | if plan.filter == Caustics::PhotonMap { CAUSTIC_PHOTON_MAP } else { 0 }
+        | if plan.space == CausticSpace::Screen { CAUSTIC_SCREEN_SPACE } else { 0 };
     let diag = scene.bounds().diagonal();
     let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
     let params = GpuCausticParams {
@@ -73,6 +85,9 @@ pub fn table(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> (
         gather_k: q.caustics.photon_k,
         grid_cells: plan.grid_cells(q),
         gather_radius: diag * q.caustics.photon_radius,
+        screen_width: width,
+        screen_height: height,
+        pad: [0; 2],
     };
     let cubes = plan
         .cubes
@@ -94,8 +109,8 @@ pub fn cube_layers(plan: &CausticsPlan, c: usize) -> impl Iterator<Item = u32> +
         .flat_map(|lv| lv.first_layer..lv.first_layer + lv.faces * lv.branches)
 }
 
-fn table_bytes(plan: &CausticsPlan, q: &Quality, scene: &crate::scene::Scene) -> Vec<u8> {
-    let (params, cubes) = table(plan, q, scene);
+fn table_bytes(plan: &CausticsPlan, q: &Quality, init: &StageInit) -> Vec<u8> {
+    let (params, cubes) = table(plan, q, init.scene, (init.width, init.height));
     let mut bytes = bytemuck::bytes_of(&params).to_vec();
     bytes.extend_from_slice(bytemuck::cast_slice(&cubes));
     bytes
@@ -123,6 +138,8 @@ impl CausticsStage {
             setup: vk::Pipeline::null(),
             grid: [vk::Pipeline::null(); 4],
             photon_places: 0,
+            screen: [vk::Pipeline::null(); 2],
+            screen_depth: Image::placeholder(),
             layout: init.layout,
             exact: None,
         };
@@ -131,6 +148,13 @@ impl CausticsStage {
 
     fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
         let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
+        if self.plan.space == CausticSpace::Screen && self.plan.filter != Caustics::Splat {
+            let filter = if self.plan.filter == Caustics::PhotonMap { "photon-map" } else { "triangles" };
+            return Err(crate::Error::invalid(
+                "knob caustic_space",
+                format!("screen: photons are splatted onto the camera's image (caustics=splat); caustics={filter} keeps them elsewhere (caustic_space=cube or light)"),
+            ));
+        }
         let (s, n) = (q.cube.cube_size, q.caustics.photons);
         let cubes = self.plan.cubes.len() as u32;
         let attach = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -150,7 +174,7 @@ impl CausticsStage {
         let photon = |name| Image::new(ctx, &ImageDesc { name, format: HIT_FORMAT, width: n, height: n, kind: layers, usage: attach });
         maps.set_image(&PHOTON_HITS, photon("caustics.photon_hits")?);
         maps.set_image(&PHOTON_POWER, photon("caustics.photon_power")?);
-        let bytes = table_bytes(&self.plan, q, init.scene);
+        let bytes = table_bytes(&self.plan, q, init);
         maps.set_buffer(&CAUSTICS, Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         self.cube_depth = cube_depth(ctx, "caustics.depth", s, self.mode)?;
         self.photon_depth = Image::new(
@@ -217,6 +241,9 @@ impl CausticsStage {
         if self.plan.filter == Caustics::PhotonMap {
             return self.init_photon_map(init, maps);
         }
+        if self.plan.space == CausticSpace::Screen {
+            return self.init_screen(init, maps);
+        }
         let (vs, fs) = match self.plan.filter {
             Caustics::Splat => ("caustics/splat.vert", "caustics/splat.frag"),
             _ => ("caustics/triangles.vert", "caustics/triangles.frag"),
@@ -241,6 +268,66 @@ impl CausticsStage {
                 &desc("caustics.filter", "scene/sky.vert", "caustics/filter.frag", VertexInput::None, &light, false, mask, Blend::Replace),
             )?;
         }
+        Ok(())
+    }
+
+    /// caustic_space=screen: the camera-sized irradiance image and depth buffer, and the two
+    /// pipelines that fill them.
+    fn init_screen(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let ctx = init.ctx;
+        let (width, height) = (init.width, init.height);
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
+        maps.set_image(
+            &CAUSTIC_SCREEN,
+            Image::new(ctx, &ImageDesc { name: "caustics.screen", format: LIGHT_FORMAT, width, height, kind: ImageKind::D2, usage })?,
+        );
+        self.screen_depth = Image::new(
+            ctx,
+            &ImageDesc {
+                name: "caustics.screen_depth",
+                format: DEPTH_FORMAT,
+                width,
+                height,
+                kind: ImageKind::D2,
+                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            },
+        )?;
+        let light = [LIGHT_FORMAT];
+        let desc = |name, vertex, fragment, vertex_input, depth_write, depth_op| GraphicsDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input,
+            color_formats: &light,
+            depth_format: Some(DEPTH_FORMAT),
+            depth_test: true,
+            depth_write,
+            view_mask: 0,
+            cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
+            blend: Blend::Add,
+            depth_op,
+        };
+        use crate::vk::pipeline::DepthOp;
+        self.screen = [
+            graphics_pipeline(
+                ctx,
+                self.layout,
+                &desc("caustics.screen_depth", "scene/mesh.vert", "caustics/screen_depth.frag", VertexInput::Mesh, true, DepthOp::Nearer),
+            )?,
+            graphics_pipeline(
+                ctx,
+                self.layout,
+                &desc(
+                    "caustics.screen",
+                    "caustics/splat.vert#SCREEN",
+                    "caustics/splat.frag",
+                    VertexInput::None,
+                    false,
+                    DepthOp::NearerOrEqual,
+                ),
+            )?,
+        ];
         Ok(())
     }
 
@@ -385,7 +472,7 @@ impl Stage for CausticsStage {
             }
         }
         if let Some(b) = maps.buffer_mut(&CAUSTICS) {
-            b.write(&table_bytes(&self.plan, &init.plan.quality, init.scene))?;
+            b.write(&table_bytes(&self.plan, &init.plan.quality, init))?;
         }
         Ok(())
     }
@@ -393,7 +480,7 @@ impl Stage for CausticsStage {
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         // Taken out of the frame's maps while recorded (several are written at once), put
         // back after.
-        let own = [&CAUSTIC_DISTANCES, &PHOTON_HITS, &PHOTON_POWER, &CAUSTIC_MAPS, &CAUSTIC_RAW];
+        let own = [&CAUSTIC_DISTANCES, &PHOTON_HITS, &PHOTON_POWER, &CAUSTIC_MAPS, &CAUSTIC_RAW, &CAUSTIC_SCREEN];
         let mut images = own.map(|s| io.maps.take_image(s));
         self.record_images(rec, f, io, &mut images);
         for (slot, image) in own.into_iter().zip(images) {
@@ -411,16 +498,19 @@ impl Stage for CausticsStage {
         self.photon_depth.destroy(ctx);
         destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
         destroy_pipelines(ctx, &mut self.grid);
+        destroy_pipelines(ctx, &mut self.screen);
+        self.screen_depth.destroy(ctx);
     }
 }
 
 impl CausticsStage {
     /// Records the passes into the caustics' own images: receiver distances, photon hits
-    /// and power, light cube maps and their unfiltered twins (`own` in `record`'s order).
-    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 5]) {
+    /// and power, light cube maps and their unfiltered twins, the screen's irradiance (`own` in
+    /// `record`'s order).
+    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 6]) {
         let ctx = rec.ctx;
         let maps = &*io.maps;
-        let [distances, hits, power, light_image, raw_image] = images;
+        let [distances, hits, power, light_image, raw_image, screen_image] = images;
         let (Some(distances), Some(hits), Some(power)) = (distances.as_mut(), hits.as_mut(), power.as_mut()) else {
             return;
         };
@@ -492,6 +582,43 @@ impl CausticsStage {
         }
         rec.end(open);
 
+        // Screen space (LC04, WD06b): the camera's depth of everything, then every photon's
+        // splat at its pixel, depth-tested against it, in one rendering.
+        if let Some(screen) = screen_image.as_mut() {
+            let open = rec
+                .pass("caustics.screen")
+                .writes(screen, Access::ColorAttachment)
+                .writes(&mut self.screen_depth, Access::DepthAttachment)
+                .reads(hits, Access::VertexSampled)
+                .reads(power, Access::VertexSampled)
+                .begin();
+            let colors = [screen.view];
+            let t = Target {
+                color: &colors,
+                depth: Some(self.screen_depth.view),
+                width: screen.width,
+                height: screen.height,
+                view_mask: 0,
+                layer_count: 1,
+                clear_color: [0.0; 4],
+                clear: true,
+            };
+            begin_rendering(ctx, cmd, &t);
+            f.bind(ctx, cmd, self.screen[0]);
+            for d in f.scene.draws.iter().filter(|d| d.index_count > 0) {
+                f.draw(ctx, cmd, io.views.camera, d);
+            }
+            f.bind(ctx, cmd, self.screen[1]);
+            for c in 0..self.plan.cubes.len() {
+                for layer in cube_layers(&self.plan, c) {
+                    f.push_flags(ctx, cmd, io.views.camera, layer, c as u32);
+                    unsafe { ctx.device.cmd_draw(cmd, self.vertices(), 1, 0, 0) };
+                }
+            }
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+            rec.end(open);
+            return;
+        }
         // The photon map: the photons sorted into its grid, gathered where surfaces are shaded.
         if self.plan.filter == Caustics::PhotonMap {
             let Some(grid) = maps.buffer(&PHOTON_GRID).map(|b| b.raw) else { return };
