@@ -227,6 +227,13 @@ pub struct Target<'a> {
     pub clear: bool,
 }
 
+impl<'a> Target<'a> {
+    /// One layer of `color` (and `depth`) of `width` × `height`, cleared to zero.
+    pub fn cleared(color: &'a [vk::ImageView], depth: Option<vk::ImageView>, width: u32, height: u32) -> Target<'a> {
+        Target { color, depth, width, height, view_mask: 0, layer_count: 1, clear_color: [0.0; 4], clear: true }
+    }
+}
+
 pub fn begin_rendering(ctx: &Context, cmd: vk::CommandBuffer, t: &Target) {
     let area = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: t.width, height: t.height } };
     begin_rendering_in(ctx, cmd, t, area);

@@ -551,17 +551,7 @@ impl CausticsStage {
                     let layer = lv.first_layer + branch * lv.faces + face;
                     rec.barrier(&mut self.photon_depth, Access::DepthAttachment);
                     let colors = [hits.layer_view(layer), power.layer_view(layer)];
-                    let t = Target {
-                        color: &colors,
-                        depth: Some(self.photon_depth.view),
-                        width: self.photons,
-                        height: self.photons,
-                        view_mask: 0,
-                        layer_count: 1,
-                        clear_color: [0.0; 4],
-                        clear: true,
-                    };
-                    begin_rendering(ctx, cmd, &t);
+                    begin_rendering(ctx, cmd, &Target::cleared(&colors, Some(self.photon_depth.view), self.photons, self.photons));
                     f.bind(ctx, cmd, self.photon);
                     f.bind_maps(ctx, cmd, io.sets.geometry);
                     if let Some(e) = &self.exact {
@@ -593,17 +583,7 @@ impl CausticsStage {
                 .reads(power, Access::VertexSampled)
                 .begin();
             let colors = [screen.view];
-            let t = Target {
-                color: &colors,
-                depth: Some(self.screen_depth.view),
-                width: screen.width,
-                height: screen.height,
-                view_mask: 0,
-                layer_count: 1,
-                clear_color: [0.0; 4],
-                clear: true,
-            };
-            begin_rendering(ctx, cmd, &t);
+            begin_rendering(ctx, cmd, &Target::cleared(&colors, Some(self.screen_depth.view), screen.width, screen.height));
             f.bind(ctx, cmd, self.screen[0]);
             for d in f.scene.draws.iter().filter(|d| d.index_count > 0) {
                 f.draw(ctx, cmd, io.views.camera, d);

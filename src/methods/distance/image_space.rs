@@ -132,17 +132,7 @@ impl Stage for Backfaces {
             rec.pass("image_space.backfaces").writes(map, Access::ColorAttachment).writes(&mut self.depth, Access::DepthAttachment).begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let colors = [map.view];
-        let t = Target {
-            color: &colors,
-            depth: Some(self.depth.view),
-            width: map.width,
-            height: map.height,
-            view_mask: 0,
-            layer_count: 1,
-            clear_color: [0.0; 4],
-            clear: true,
-        };
-        begin_rendering(ctx, cmd, &t);
+        begin_rendering(ctx, cmd, &Target::cleared(&colors, Some(self.depth.view), map.width, map.height));
         f.bind(ctx, cmd, self.pipeline);
         for d in f.scene.draws.iter().filter(|d| self.objects.contains(&(d.mesh as usize))) {
             f.draw(ctx, cmd, io.views.camera, d);
