@@ -503,3 +503,70 @@ fn caustics_agree_with_mitsubas_particle_tracer() {
     assert!(p.2 >= 32.74, "the floor: {:.2} dB against Mitsuba", p.2);
     assert!(p.1 < 0.7 * k.1, "the progressive estimate ({:.4}) is not clearly nearer Mitsuba than the kernel's ({:.4})", p.1, k.1);
 }
+
+/// Issue 34: on `caustic-ball` (a glass ball resting on the floor) the kernel and the
+/// progressive estimates disagree near the ball (BENCHMARKS.md); on the pixels whose whole
+/// footprint is floor, Mitsuba's particle tracer puts almost no caustic light, and neither
+/// reference nor any GPU filter may add enough there to move the floor's PSNR against it by
+/// half a dB below caustics off. Measured (48×36): the references 40.40 (progressive) and
+/// 41.96 dB (kernel) against 39.97 without caustics; the GPU (bvh) 38.56 off, 38.59 splat,
+/// 38.59 triangles, 38.75 photon map. Run by hand (`cargo test --test mitsuba -- --ignored`):
+/// 17 s beside the CI's budget.
+#[test]
+#[ignore]
+fn caustic_ball_against_mitsubas_particle_tracer() {
+    let s = specula::scenes::caustic_ball().unwrap();
+    let reference = |estimate: &str, caustics: &str| {
+        let mut q = Quality::default();
+        q.frame.depth = 8;
+        q.reference.spp = 64;
+        for pair in ["fresnel=exact", "reference_photons=4000000", "ppm_passes=32"] {
+            q.set_pair(pair).unwrap();
+        }
+        q.set("caustic_estimate", estimate).unwrap();
+        q.set("caustics", caustics).unwrap();
+        specula::reference::render_reference(&s, &q, SIZE).unwrap()
+    };
+    let (progressive, kernel, off) =
+        (reference("progressive", "triangles"), reference("kernel", "triangles"), reference("progressive", "off"));
+    let m = mitsuba_with(&s, "caustic-ball", 4096, 8, "ptracer");
+    let fine = specula::reference::object_ids(&s, (SIZE.0 * 4, SIZE.1 * 4)).unwrap();
+    let all_floor = |p: usize| {
+        let (x, y) = (p % SIZE.0 as usize, p / SIZE.0 as usize);
+        (0..16).all(|k| fine[(y * 4 + k / 4) * SIZE.0 as usize * 4 + x * 4 + k % 4] == 1)
+    };
+    let pixels: Vec<usize> = (0..(SIZE.0 * SIZE.1) as usize).filter(|&p| all_floor(p)).collect();
+    let lum = |img: &ImageData, p: usize| (0..3).map(|c| img.data[p * 4 + c] as f64).sum::<f64>() / 3.0;
+    let energy = |img: &ImageData| pixels.iter().map(|&p| lum(img, p) - lum(&off, p)).sum::<f64>();
+    let floor = |r: &ImageData| {
+        let se = |p: usize| (0..3).map(|c| ((r.data[p * 4 + c] - m.data[p * 4 + c]) as f64).powi(2)).sum::<f64>() / 3.0;
+        -10.0 * (pixels.iter().map(|&p| se(p)).sum::<f64>() / pixels.len() as f64).log10()
+    };
+    println!(
+        "caustic-ball, {} floor pixels: caustic energy on the visible floor: Mitsuba {:.3}, progressive {:.3}, kernel {:.3}; \
+         the floor against Mitsuba: progressive {:.2} dB, kernel {:.2} dB, caustics off {:.2} dB",
+        pixels.len(),
+        energy(&m),
+        energy(&progressive),
+        energy(&kernel),
+        floor(&progressive),
+        floor(&kernel),
+        floor(&off)
+    );
+    assert!(floor(&progressive) >= floor(&off) - 0.5 && floor(&kernel) >= floor(&off) - 0.5, "the references' caustics on the floor");
+    let ctx = common::gpu();
+    let mut gpu_off = f64::NAN;
+    for c in ["off", "splat", "triangles", "photon-map"] {
+        let mut q = Quality::default();
+        q.set_pair("fresnel=exact").unwrap();
+        q.set("caustics", c).unwrap();
+        let img = specula::render(&ctx, &s, specula::methods::BVH, &q, SIZE, (0, 1)).unwrap().image;
+        let f = floor(&img);
+        println!("GPU bvh caustics={c}: caustic energy on the visible floor {:.3}, the floor against Mitsuba {f:.2} dB", energy(&img));
+        if c == "off" {
+            gpu_off = f;
+        }
+        assert!(f >= gpu_off - 0.5, "caustics={c}: the floor {f:.2} dB against Mitsuba, {gpu_off:.2} without caustics");
+    }
+    common::assert_clean(&ctx);
+}
