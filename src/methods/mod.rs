@@ -16,15 +16,16 @@ pub mod envmap;
 pub mod geometry;
 pub mod layered;
 pub mod raytrace;
+pub mod reference;
 pub mod registry;
 
-pub use crate::reference::REFERENCE;
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
 pub use envmap::{ENVMAP, PROXY_BOX, PROXY_SPHERE};
 pub use geometry::{CURVED_REFLECTOR, PLANAR_MIRROR, PLANAR_REFRACTION};
 pub use layered::LAYERED;
 pub use raytrace::ray_query::RAY_QUERY;
 pub use raytrace::{BIH, BVH, GRID, KD_TREE, OCTREE, RAY_ENGINE, RAY_HIERARCHY};
+pub use reference::REFERENCE;
 pub use registry::{map_named, Choice, Method, MethodInfo, ObjectClass, EVERY_CLASS};
 
 use crate::error::{Error, Result};
@@ -40,7 +41,7 @@ pub const ALL: &[Method] = &registry::all_methods::<{ registry::method_count(FAM
 /// beyond maps and camera passes, called by the planner and the renderer in this order
 /// (their view blocks follow in the view table in this order too).
 pub const FAMILIES: &[registry::Family] =
-    &[envmap::FAMILY, distance::FAMILY, layered::FAMILY, raytrace::FAMILY, geometry::FAMILY, caustics::FAMILY, crate::reference::FAMILY];
+    &[envmap::FAMILY, distance::FAMILY, layered::FAMILY, raytrace::FAMILY, geometry::FAMILY, caustics::FAMILY, reference::FAMILY];
 
 /// Every slot of the frame's maps (`frame::maps`): the frame's own, then each family's
 /// (`registry::Family::slots`), the order the camera passes and diffuse shading list their

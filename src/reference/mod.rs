@@ -33,41 +33,10 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::image::ImageData;
 use crate::quality::{Caustics, FresnelMode, Quality};
-use crate::quality::{CausticsKnobs, FrameKnobs, ReferenceKnobs};
 use crate::scene::{Camera, Scene, SurfaceKind};
 use bvh::{Bvh, Hit};
 use caustics::PhotonMap;
 use shade::{ShadeLight, Sky, Textures};
-
-/// The reference as the registry's last family: one CPU method, no hooks.
-pub const FAMILY: crate::methods::registry::Family =
-    crate::methods::registry::Family { name: "reference", methods: &[REFERENCE_INFO], ..crate::methods::registry::Family::NONE };
-
-/// The exact CPU reference as a registered method: it has no GPU passes (`Renderer::new`
-/// refuses its plan); `reference::render_reference` renders it.
-pub const REFERENCE_INFO: &crate::methods::registry::MethodInfo = &crate::methods::registry::MethodInfo {
-    name: "reference",
-    abi: 99,
-    section: "§2, Table 1",
-    family: "reference",
-    summary: "the exact CPU reference (f64, SAH BVH, Möller–Trumbore): Whitted recursion through both the reflected and the refracted branch weighted by Fresnel, up to `depth` bounces, the GPU's non-specular shading with exact shadow rays, `spp` stratified samples per pixel, both cores (rayon). Ground truth for the tests and `specula tradeoff`",
-    serves: crate::methods::registry::EVERY_CLASS,
-    knobs: &[
-        FrameKnobs::depth,
-        ReferenceKnobs::spp,
-        FrameKnobs::fresnel,
-        CausticsKnobs::caustics,
-        ReferenceKnobs::reference_photons,
-        ReferenceKnobs::caustic_radius,
-        ReferenceKnobs::caustic_estimate,
-        ReferenceKnobs::ppm_passes,
-    ],
-    gpu: None,
-    fallback: None,
-    shape: crate::methods::registry::Shape::Any,
-    needs: crate::methods::registry::DeviceNeeds::Nothing,
-};
-pub const REFERENCE: crate::methods::registry::Method = crate::methods::registry::Method(REFERENCE_INFO.name);
 
 /// Path weights below this (every channel) are not traced further.
 pub const MIN_PATH_WEIGHT: f64 = 1e-6;
