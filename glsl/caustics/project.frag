@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: CAUSTICS_PHOTON_MAP
 // caustics.project (survey §6.3.3): the camera's diffuse surfaces again, at the depth
 // scene.direct left, adding the caustics' radiance albedo/π · E (blended additively). The
 // map-generation passes project inside their own shading (common/shading.glsl).

@@ -9,14 +9,23 @@
 // caustics=photon-map gathers from the photon grid instead (caustics/photon_map.glsl).
 #ifndef CAUSTICS_PROJECT_GLSL
 #define CAUSTICS_PROJECT_GLSL
+#ifdef CAUSTICS_PHOTON_MAP
+// Only the variants of the passes that gather (caustics/project.frag, raytrace/shade.comp):
+// the gather's k-nearest lists, in every diffuse shader, slowed other methods' frames on
+// lavapipe even where the branch was never taken (tests/planner.rs measured it).
 #include "caustics/photon_map.glsl"
+#endif
 
 // n: the receiver's normal on the side it is seen from.
 vec3 caustic_irradiance(vec3 p, vec3 n) {
     vec3 e = vec3(0.0);
     uint count = caustic.cube_count;
     if (count == 0u) return e;
+#ifdef CAUSTICS_PHOTON_MAP
     if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return photon_map_irradiance(p, n);
+#else
+    if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return e;  // gathered by the camera's passes only
+#endif
     // Screen space: only the camera's own surfaces (caustic_screen_irradiance) get caustics.
     if ((caustic.flags & CAUSTIC_SCREEN_SPACE) != 0u) return e;
     float texel = 2.0 / float(caustic.cube_size);

@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: CAUSTICS_PHOTON_MAP
 // Shading of one bounce's hits (survey §2.3.1): a ray that left the scene adds the
 // environment, a diffuse hit its emission and, per light, one shadow query carrying the
 // unshadowed Lambertian contribution (added by shadow.comp when nothing occludes it), all

@@ -9,7 +9,8 @@ knobs! {
         /// cube-map space, then splatted (photon splatting) or meshed into caustic triangles (flux over area) into a light cube map
         /// around the generator, filtered, and projected onto diffuse surfaces with a distance test; or (`photon-map`, §6.1.1,
         /// PDC03) sorted into a hashed uniform grid on the GPU and gathered per shaded point from its photon_k nearest photons
-        /// within photon_radius; the CPU reference adds light-traced caustics
+        /// within photon_radius (by the camera's diffuse surfaces and the ray tracers' diffuse hits; the map passes do not
+        /// gather, so it is missing in cube-map reflections and refractions); the CPU reference adds light-traced caustics
         caustics: Caustics = "triangles", one_of()["off" => Caustics::Off, "splat" => Caustics::Splat, "triangles" => Caustics::Triangles, "photon-map" => Caustics::PhotonMap];
         /// caustics: edge of each photon hit location image (photons² per light and generator view); caustic triangles keep 64
         /// bytes per triangle in one storage buffer, within the device's maxStorageBufferRange (lavapipe's 128 MiB: 1024² photons

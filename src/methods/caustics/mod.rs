@@ -16,8 +16,10 @@
 //! - `caustics.filter`: a box filter over the light cube map (`caustic_filter` > 0);
 //! - or, `caustics=photon-map` (§6.1.1, PDC03), `caustics.photon_map`: instead of light cube
 //!   maps, every photon sorted into a hashed uniform grid on the GPU (count, scan, scatter:
-//!   glsl/caustics/grid*.comp), from which each shaded point gathers its `photon_k`
-//!   nearest (glsl/caustics/photon_map.glsl);
+//!   glsl/caustics/grid*.comp), from which the camera's diffuse surfaces and the ray
+//!   tracers' diffuse hits gather their `photon_k` nearest (glsl/caustics/photon_map.glsl,
+//!   in the `CAUSTICS_PHOTON_MAP` variants of caustics/project.frag and raytrace/shade.comp
+//!   only: its lists in every diffuse shader slowed every method on lavapipe);
 //! - or, `caustic_space=screen` (§6.2, LC04/WD06b), `caustics.screen`: the splats drawn
 //!   straight into a camera-sized irradiance image, depth-tested against the camera's depth
 //!   of everything; only the camera's own diffuse surfaces read it (no light cube maps).

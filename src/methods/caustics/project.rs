@@ -27,7 +27,7 @@ impl CausticsProject {
             &GraphicsDesc {
                 name: "caustics.project",
                 vertex: "scene/mesh.vert",
-                fragment: "caustics/project.frag",
+                fragment: if photon_map(init) { "caustics/project.frag#CAUSTICS_PHOTON_MAP" } else { "caustics/project.frag" },
                 vertex_input: VertexInput::Mesh,
                 color_formats: &[TARGET_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
@@ -75,4 +75,10 @@ impl Stage for CausticsProject {
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
     }
+}
+
+/// Whether the plan's caustics are the photon map, whose gather only the passes' variants
+/// hold (glsl/caustics/project.glsl).
+pub fn photon_map(init: &crate::frame::stage::StageInit) -> bool {
+    init.plan.caustics.as_ref().is_some_and(|c| c.filter == crate::quality::Caustics::PhotonMap)
 }

@@ -402,14 +402,16 @@ impl RayTrace {
             layouts.extend([self.set_layouts[2], self.set_layouts[3]]);
         }
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
-        self.create_pipelines(ctx)?;
+        self.create_pipelines(ctx, crate::methods::caustics::project::photon_map(init))?;
         if tile > 0 {
             self.order = Some(RayOrder::new(ctx, self.layout, most, (self.width, self.height, self.samples, tile))?);
         }
         self.create_sets(ctx)
     }
 
-    fn create_pipelines(&mut self, ctx: &Context) -> Result<()> {
+    /// `photon_map`: the plan's caustics are the photon map (the shading kernel's variant that
+    /// gathers it).
+    fn create_pipelines(&mut self, ctx: &Context, photon_map: bool) -> Result<()> {
         let raster = |name, vertex, fragment, formats: &'static [vk::Format], depth: Option<vk::Format>| GraphicsDesc {
             name,
             vertex,
@@ -464,7 +466,8 @@ impl RayTrace {
             }
         }
         self.p.primary = compute_pipeline(ctx, self.layout, "raytrace/primary.comp")?;
-        self.p.shade = compute_pipeline(ctx, self.layout, "raytrace/shade.comp")?;
+        let shade = if photon_map { "raytrace/shade.comp#CAUSTICS_PHOTON_MAP" } else { "raytrace/shade.comp" };
+        self.p.shade = compute_pipeline(ctx, self.layout, shade)?;
         self.p.spawn = compute_pipeline(ctx, self.layout, "raytrace/spawn.comp")?;
         self.p.spawn_cutoff = compute_pipeline(ctx, self.layout, "raytrace/spawn_cutoff.comp")?;
         self.p.shadow = compute_pipeline(ctx, self.layout, "raytrace/shadow.comp")?;
