@@ -420,6 +420,20 @@ fn emissive_textured_wall_agrees_with_mitsuba() {
 /// from its centre, ends 0.1 m above the floor); the wall throws the light's mirror image onto
 /// the floor, bounded by the wall's outline. The progressive estimate (the reference's
 /// converging one) must agree; the fixed kernel (the default) is measured beside it.
+/// The CPU reference of the caustic cross-checks: depth 8, exact Fresnel, 4·10⁶ photons in
+/// 32 progressive passes, `spp` samples a pixel, the caustics and their estimate as given.
+fn caustic_reference(s: &Scene, spp: u32, estimate: &str, caustics: &str) -> ImageData {
+    let mut q = Quality::default();
+    q.frame.depth = 8;
+    q.reference.spp = spp;
+    for pair in ["fresnel=exact", "reference_photons=4000000", "ppm_passes=32"] {
+        q.set_pair(pair).unwrap();
+    }
+    q.set("caustic_estimate", estimate).unwrap();
+    q.set("caustics", caustics).unwrap();
+    specula::reference::render_reference(s, &q, SIZE).unwrap()
+}
+
 #[test]
 fn caustics_agree_with_mitsubas_particle_tracer() {
     let mut s = Scene::new();
@@ -445,17 +459,7 @@ fn caustics_agree_with_mitsubas_particle_tracer() {
     s.camera = Some(Camera::look_at(Vec3::new(-0.2, 2.6, 2.8), Vec3::new(0.0, 0.0, -0.4), 55f32.to_radians()));
     // 256 samples a pixel: a focused spot smaller than the spacing of 16 samples' floor
     // points is hit by one or two of them, which moved the spot's two pixels by 30 %.
-    let reference = |estimate: &str, caustics: &str| {
-        let mut q = Quality::default();
-        q.frame.depth = 8;
-        q.reference.spp = 256;
-        for pair in ["fresnel=exact", "reference_photons=4000000", "ppm_passes=32"] {
-            q.set_pair(pair).unwrap();
-        }
-        q.set("caustic_estimate", estimate).unwrap();
-        q.set("caustics", caustics).unwrap();
-        specula::reference::render_reference(&s, &q, SIZE).unwrap()
-    };
+    let reference = |estimate: &str, caustics: &str| caustic_reference(&s, 256, estimate, caustics);
     let (progressive, kernel, off) =
         (reference("progressive", "triangles"), reference("kernel", "triangles"), reference("progressive", "off"));
     let m = mitsuba_with(&s, "caustics", 4096, 8, "ptracer");
@@ -516,17 +520,7 @@ fn caustics_agree_with_mitsubas_particle_tracer() {
 #[ignore]
 fn caustic_ball_against_mitsubas_particle_tracer() {
     let s = specula::scenes::caustic_ball().unwrap();
-    let reference = |estimate: &str, caustics: &str| {
-        let mut q = Quality::default();
-        q.frame.depth = 8;
-        q.reference.spp = 64;
-        for pair in ["fresnel=exact", "reference_photons=4000000", "ppm_passes=32"] {
-            q.set_pair(pair).unwrap();
-        }
-        q.set("caustic_estimate", estimate).unwrap();
-        q.set("caustics", caustics).unwrap();
-        specula::reference::render_reference(&s, &q, SIZE).unwrap()
-    };
+    let reference = |estimate: &str, caustics: &str| caustic_reference(&s, 64, estimate, caustics);
     let (progressive, kernel, off) =
         (reference("progressive", "triangles"), reference("kernel", "triangles"), reference("progressive", "off"));
     let m = mitsuba_with(&s, "caustic-ball", 4096, 8, "ptracer");

@@ -192,6 +192,21 @@ pub fn begin_camera_rendering(ctx: &Context, cmd: vk::CommandBuffer, target: &Im
     crate::vk::begin_rendering_in(ctx, cmd, &t, area);
 }
 
+/// A 2D depth buffer of `width` × `height` (`DEPTH_FORMAT`) for a pass of its own.
+pub fn depth_2d(ctx: &Context, name: &str, width: u32, height: u32) -> crate::Result<Image> {
+    Image::new(
+        ctx,
+        &crate::vk::ImageDesc {
+            name,
+            format: direct::DEPTH_FORMAT,
+            width,
+            height,
+            kind: crate::vk::ImageKind::D2,
+            usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+        },
+    )
+}
+
 /// The depth buffer cube rendering needs: six layers for multiview, one otherwise.
 pub fn cube_depth(ctx: &Context, name: &str, size: u32, mode: CubeMode) -> crate::Result<Image> {
     let kind = match mode {

@@ -281,17 +281,7 @@ impl CausticsStage {
             &CAUSTIC_SCREEN,
             Image::new(ctx, &ImageDesc { name: "caustics.screen", format: LIGHT_FORMAT, width, height, kind: ImageKind::D2, usage })?,
         );
-        self.screen_depth = Image::new(
-            ctx,
-            &ImageDesc {
-                name: "caustics.screen_depth",
-                format: DEPTH_FORMAT,
-                width,
-                height,
-                kind: ImageKind::D2,
-                usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            },
-        )?;
+        self.screen_depth = crate::frame::depth_2d(ctx, "caustics.screen_depth", width, height)?;
         let light = [LIGHT_FORMAT];
         let desc = |name, vertex, fragment, vertex_input, depth_write, depth_op| GraphicsDesc {
             name,

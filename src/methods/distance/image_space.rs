@@ -65,17 +65,7 @@ impl Backfaces {
             let format = vk::Format::R32G32B32A32_SFLOAT;
             let backfaces = ImageDesc { name: "image_space.backfaces", format, width, height, kind: ImageKind::D2, usage };
             maps.set_image(&BACKFACES, Image::new(ctx, &backfaces)?);
-            me.depth = Image::new(
-                ctx,
-                &ImageDesc {
-                    name: "image_space.backfaces.depth",
-                    format: DEPTH_FORMAT,
-                    width,
-                    height,
-                    kind: ImageKind::D2,
-                    usage: vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-                },
-            )?;
+            me.depth = crate::frame::depth_2d(ctx, "image_space.backfaces.depth", width, height)?;
             maps.set_buffer(
                 &THICKNESS,
                 Buffer::with_data(
