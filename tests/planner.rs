@@ -229,7 +229,17 @@ fn auto_and_budgets_on_unseen_scenes() {
             got.ms = got.ms.min(measure(&ctx, &scene, "max-ms", &choices, &qt, &target, &reference).ms);
         }
         let best = singles.iter().filter(|s| s.ms <= t).map(|s| s.psnr).fold(f64::NEG_INFINITY, f64::max);
-        assert!(got.ms <= NOISE * t, "{name}: --max-ms {t:.2} rendered in {:.2} ms (predicted {:.2}):{table}", got.ms, pred.frame_ms);
+        assert!(
+            got.ms <= NOISE * t,
+            "{name}: --max-ms {t:.2} rendered {choices:?} with {} in {:.2} ms (predicted {:.2}):{table}",
+            specula::quality::KNOBS
+                .iter()
+                .filter(|k| qt.get(k.name) != q.get(k.name))
+                .map(|k| format!("{}={} ", k.name, qt.get(k.name)))
+                .collect::<String>(),
+            got.ms,
+            pred.frame_ms
+        );
         assert!(got.psnr >= best - 1.0, "{name}: --max-ms {t:.2} gave {:.1} dB, the best within it {best:.1}:{table}", got.psnr);
 
         // --min-psnr P: 4 dB under the best single method's lowest object (reachable).

@@ -10,12 +10,14 @@
 pub mod animation;
 mod environment;
 pub mod faces;
+mod fingerprint;
 pub mod gltf;
 pub mod shapes;
 pub mod update;
 
 pub use self::gltf::load;
 pub use environment::*;
+pub use fingerprint::Fingerprint;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 
