@@ -40,6 +40,38 @@ impl Fingerprint {
     }
 }
 
+/// The last `N` values computed, by key (most recently used kept): for work that is a pure
+/// function of a fingerprint's inputs.
+pub struct Kept<V, const N: usize>(std::sync::Mutex<Vec<(u128, std::sync::Arc<V>)>>);
+
+impl<V, const N: usize> Default for Kept<V, N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<V, const N: usize> Kept<V, N> {
+    pub const fn new() -> Self {
+        Kept(std::sync::Mutex::new(Vec::new()))
+    }
+
+    /// The value kept under `key`, else `compute`'s (kept).
+    pub fn get(&self, key: u128, compute: impl FnOnce() -> V) -> std::sync::Arc<V> {
+        let lock = || self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let hit = {
+            let mut kept = lock();
+            kept.iter().position(|(k, _)| *k == key).map(|i| kept.remove(i).1)
+        };
+        let value = hit.unwrap_or_else(|| std::sync::Arc::new(compute()));
+        let mut kept = lock();
+        kept.push((key, value.clone()));
+        if kept.len() > N {
+            kept.remove(0);
+        }
+        value
+    }
+}
+
 impl Scene {
     /// Feeds every field a render reads into `h`. The structs are taken apart field by field
     /// without `..`, so that a field added to them must be added here (or named as unread).

@@ -17,7 +17,7 @@ pub mod update;
 
 pub use self::gltf::load;
 pub use environment::*;
-pub use fingerprint::Fingerprint;
+pub use fingerprint::{Fingerprint, Kept};
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
 

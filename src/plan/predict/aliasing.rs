@@ -152,29 +152,14 @@ pub struct Lookups<'a> {
 /// budgets, the C ABI's misuse checks) costs the fingerprint, not the tracing (on the demo
 /// 0.6 s of tracing against well under a millisecond).
 pub fn measure(scene: &Scene, quality: &Quality, size: (u32, u32), lookups: &Lookups) -> Vec<Option<Aliasing>> {
-    use std::sync::{Arc, Mutex};
-    type Kept = Vec<(u128, Arc<Vec<Option<Aliasing>>>)>;
-    static MEMO: Mutex<Kept> = Mutex::new(Vec::new());
+    static KEPT: crate::scene::Kept<Vec<Option<Aliasing>>, REMEMBERED> = crate::scene::Kept::new();
     let key = {
         let mut h = crate::scene::Fingerprint::new();
         scene.fingerprint(&mut h);
         h.text(&format!("{quality:?} {size:?} {:?} {:?}", lookups.objects, lookups.cube_sizes));
         h.finish()
     };
-    let memo = |f: &mut dyn FnMut(&mut Kept)| f(&mut MEMO.lock().unwrap_or_else(|e| e.into_inner()));
-    let mut hit = None;
-    memo(&mut |m| hit = m.iter().position(|(k, _)| *k == key).map(|i| m.remove(i)));
-    let values = match hit {
-        Some((_, values)) => values,
-        None => Arc::new(measure_once(scene, quality, size, lookups)),
-    };
-    memo(&mut |m| {
-        m.push((key, values.clone()));
-        if m.len() > REMEMBERED {
-            m.remove(0);
-        }
-    });
-    values.as_ref().clone()
+    KEPT.get(key, || measure_once(scene, quality, size, lookups)).as_ref().clone()
 }
 
 /// Measurements [`measure`] keeps (the most recently used).
