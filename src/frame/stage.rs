@@ -258,12 +258,16 @@ pub struct MapInfo {
     pub bytes: fn(&Plan, u32, (u32, u32)) -> u64,
     /// What one object's map is, for `specula plan` (e.g. "cube 6×256² RGBA16F").
     pub describe: fn(&Quality, (u32, u32)) -> String,
+    /// One map for all the objects that take it (a layered map of the whole scene): its
+    /// time does not grow with them, so the planner's cost model counts it once per frame,
+    /// as a method's whole-screen kernels, not shared out among its objects.
+    pub shared: bool,
 }
 
 impl MapInfo {
     /// What the plan keeps of it.
     pub fn kind(&self) -> MapKind {
-        MapKind { name: self.name, order: self.order, cube: self.cube, layer_field: self.layer_field }
+        MapKind { name: self.name, order: self.order, cube: self.cube, layer_field: self.layer_field, shared: self.shared }
     }
 }
 

@@ -72,6 +72,9 @@ pub struct MapPlan {
     pub order: u32,
     #[serde(skip)]
     pub cube: bool,
+    /// One map for all its objects (`MapInfo::shared`).
+    #[serde(skip)]
+    pub shared: bool,
     /// Meshes, in layer order.
     pub objects: Vec<usize>,
     pub bytes: u64,
@@ -371,6 +374,7 @@ pub struct MapKind {
     pub order: u32,
     pub cube: bool,
     pub layer_field: Option<LayerField>,
+    pub shared: bool,
 }
 
 /// What the plan needs of a frame effect (`frame::stage::EffectInfo`): its stage over
@@ -407,7 +411,14 @@ impl PlanStages {
         let k = match self.maps.iter().position(|m| m.name == info.name) {
             Some(k) => k,
             None => {
-                self.maps.push(MapPlan { name: info.name, order: info.order, cube: info.cube, objects: Vec::new(), bytes: 0 });
+                self.maps.push(MapPlan {
+                    name: info.name,
+                    order: info.order,
+                    cube: info.cube,
+                    shared: info.shared,
+                    objects: Vec::new(),
+                    bytes: 0,
+                });
                 self.maps.len() - 1
             }
         };

@@ -29,6 +29,7 @@ pub const DISTANCE_CUBES: MapInfo = MapInfo {
     create: create_distance,
     bytes: distance_bytes,
     describe: |q, _| describe_cube(q),
+    shared: false,
 };
 
 fn create_distance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
@@ -52,6 +53,7 @@ pub const REFRACTOR_CUBES: MapInfo = MapInfo {
         6 * s * s * cube_texel_bytes(&p.quality) * n as u64
     },
     describe: |q, _| describe_cube(q) + " (normal, distance)",
+    shared: false,
 };
 
 /// `image_space.backfaces`: the refractors' back faces from the camera.
@@ -63,6 +65,7 @@ pub const BACKFACES: MapInfo = MapInfo {
     create: image_space::create,
     bytes: |_, _, (w, h)| w as u64 * h as u64 * 16,
     describe: |_, _| "camera-sized RGBA32F back-face normals and depths + per-vertex thickness".into(),
+    shared: false,
 };
 
 const SEARCH_KNOB_LIST: [&str; 10] = [

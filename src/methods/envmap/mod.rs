@@ -23,6 +23,7 @@ pub const RADIANCE_CUBES: MapInfo = MapInfo {
     create: crate::methods::cube_maps::create_radiance,
     bytes: radiance_bytes,
     describe: |q, _| describe_cube(q),
+    shared: false,
 };
 
 fn radiance_bytes(p: &Plan, objects: u32, _: (u32, u32)) -> u64 {

@@ -39,6 +39,7 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
             .map_or(format!("auto (the depth complexity, at most {MAX_LAYERS}; memory counted at {MAX_LAYERS})"), |l| l.to_string());
         format!("one map of the whole scene, shared: layers {layers}, each {}", peel::describe_layer(q))
     },
+    shared: true,
 };
 
 /// The layers the plan budgets: the knob, or for `auto` the most there can be (the stage

@@ -71,7 +71,11 @@ pub fn attribute(p: &Plan, passes: &[(String, f64)]) -> (Vec<(usize, Cost, Cost)
             let draws = |s: &StageSpec, mesh: usize| matches!(s, StageSpec::Camera(c) if c.objects.iter().any(|(m, _)| *m == mesh));
             owners = (0..p.objects.len()).filter(|&i| stages.iter().any(|s| draws(s, p.objects[i].mesh))).collect();
         }
-        let shared = stages.iter().any(|s| matches!(s, StageSpec::Camera(c) if c.profiled.shared));
+        let shared = stages.iter().any(|s| match s {
+            StageSpec::Camera(c) => c.profiled.shared,
+            StageSpec::Map(m) => m.shared,
+            _ => false,
+        });
         if owners.is_empty() {
             base.add(part, 1.0);
         } else if shared {
@@ -153,5 +157,13 @@ mod tests {
         assert_eq!(base, Cost::default());
         assert_eq!(objects.len(), p.objects.len());
         objects.iter().for_each(|o| assert_eq!((o.1, o.2), (Cost::default(), screen(3.0))));
+
+        // The layered map of the whole scene (`MapInfo::shared`): each of its objects pays it
+        // whole, once per frame for the method, as fixed time.
+        let p = plan(&scene, crate::methods::LAYERED, &q);
+        assert!(p.objects.len() >= 2 && p.stages.iter().any(|s| matches!(s, StageSpec::Map(m) if m.shared)));
+        let (objects, base) = one(&p, "layered.peel", 5.0);
+        assert_eq!(base, Cost::default());
+        objects.iter().for_each(|o| assert_eq!((o.1, o.2), (Cost::default(), Cost { fixed_ms: 5.0, screen_ms: 0.0 })));
     }
 }
