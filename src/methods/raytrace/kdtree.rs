@@ -405,18 +405,26 @@ fn binned_split(refs: &[Ref], lo: DVec3, hi: DVec3, slack: f64) -> Option<Split>
 /// The bounds of the part of triangle `t` inside the box [lo, hi] (the triangle clipped
 /// to the box's six planes, Sutherland–Hodgman), or None when it misses the box.
 pub(super) fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3)> {
-    // Each plane adds at most one corner to a convex polygon: at most 3 + 6.
-    let mut poly = [DVec3::ZERO; 9];
-    let mut next = [DVec3::ZERO; 9];
-    poly[..3].copy_from_slice(t);
-    let mut n = 3;
+    // Each plane adds at most one corner to a convex polygon: at most 3 + 6. Two buffers,
+    // read from one and written to the other (no copy of the polygon between planes).
+    let mut buf = [[DVec3::ZERO; 9]; 2];
+    buf[0][..3].copy_from_slice(t);
+    let (mut cur, mut n) = (0, 3);
     for axis in 0..3 {
         // Keep the points p with side · (p[axis] − plane) ≤ 0.
         for (side, plane) in [(-1.0, lo[axis]), (1.0, hi[axis])] {
+            let d = |p: DVec3| side * (p[axis] - plane);
+            // A plane that every corner lies inside leaves the polygon as it is (the
+            // common case: a reference clipped where it crosses the split plane only).
+            if buf[cur][..n].iter().all(|&p| d(p) <= 0.0) {
+                continue;
+            }
+            let (a, b) = buf.split_at_mut(1);
+            let (poly, next) = if cur == 0 { (&a[0], &mut b[0]) } else { (&b[0], &mut a[0]) };
             let mut m = 0;
             for i in 0..n {
-                let (p, q) = (poly[i], poly[(i + 1) % n]);
-                let (dp, dq) = (side * (p[axis] - plane), side * (q[axis] - plane));
+                let (p, q) = (poly[i], poly[if i + 1 == n { 0 } else { i + 1 }]);
+                let (dp, dq) = (d(p), d(q));
                 if dp <= 0.0 {
                     next[m] = p;
                     m += 1;
@@ -431,11 +439,11 @@ pub(super) fn clip(t: &[DVec3; 3], lo: DVec3, hi: DVec3) -> Option<(DVec3, DVec3
             if m == 0 {
                 return None;
             }
-            std::mem::swap(&mut poly, &mut next);
+            cur = 1 - cur;
             n = m;
         }
     }
-    let (a, b) = poly[..n].iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
+    let (a, b) = buf[cur][..n].iter().fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| (a.min(p), b.max(p)));
     Some((a.max(lo), b.min(hi)))
 }
 
