@@ -1,10 +1,14 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: INTER_OBJECT
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
 // the reference point (not window-space z). Specular objects other than the map's owner
 // reflect the environment map, or, in inter-object mode (§4.3), are shaded by their own
 // method from their maps of the previous cycle: searched in their distance map, or self
-// refracted in their refractor map (§4.4).
+// refracted in their refractor map (§4.4). The inter-object paths are compiled only into
+// the INTER_OBJECT variant, which the frames that run inter-object cycles use: the other
+// maps see the environment map alone, and their pipeline compiles in a small part of the
+// time (the searches of every other object's maps are most of the shader).
 #include "distance/refractor/trace.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -23,6 +27,7 @@ void main() {
         c = shade_diffuse(m, in_position, n, eye, in_uv);
     } else {
         SpecularSplit s = specular_split(m, in_position, n, eye);
+#ifdef INTER_OBJECT
         bool inter = (push.flags & FLAG_INTER_OBJECT) != 0u && o.map_shading != MAP_SHADING_SKY;
         if (inter && (push.flags & FLAG_FIRST_CYCLE) != 0u) {
             c = vec3(0.0);
@@ -34,6 +39,12 @@ void main() {
             REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, n, dir) * (inter ? traced_radiance(o, in_position, dir) : sky_radiance(dir)));
             c += refracted;
         }
+#else
+        c = s.fr * sky_radiance(s.r);
+        vec3 refracted;
+        REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, n, dir) * sky_radiance(dir));
+        c += refracted;
+#endif
     }
     out_radiance_distance = vec4(c, length(in_position - eye));
 }

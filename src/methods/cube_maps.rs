@@ -138,6 +138,7 @@ impl CubeMaps {
         self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube.cube_size, q.cube.cube_mode)?;
         let (sky, surface) = match self.kind {
             MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
+            MapKind::Distance if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
             MapKind::Distance => ("distance/sky.frag", "distance/generate.frag"),
         };
         let formats = [format];
