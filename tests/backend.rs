@@ -82,12 +82,11 @@ fn compute_pass_writes_known_pattern() {
             assert_eq!(data.texel(0, x, y)[0], 0.5 * (x + 1000 * y) as f32, "texel ({x}, {y})");
         }
     }
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(layout, None);
-        ctx.device.destroy_descriptor_pool(pool, None);
-        ctx.device.destroy_descriptor_set_layout(set_layout, None);
-    }
+    // The context keeps its pipelines (`vk::pipeline_memo`): given back, not destroyed.
+    specula::vk::pipeline::release_pipeline(&ctx, pipeline);
+    specula::vk::pipeline::destroy_pipeline_layout(&ctx, layout);
+    specula::vk::pipeline::destroy_set_layout(&ctx, set_layout);
+    unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
     profiler.destroy(&ctx);
     img.destroy(&ctx);
     assert!(ctx.memory.snapshot().is_empty(), "leaked: {:?}", ctx.memory.snapshot());

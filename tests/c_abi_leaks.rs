@@ -20,8 +20,14 @@
 //!   (the largest measured plus 3.5 standard deviations) and the median step at most 528 B
 //!   (measured plus one 64-byte block), so that a leak of about 100 B every cycle shows on
 //!   that driver. On Mesa 25.0.7 (scripts/setup.sh) the driver keeps less: slope 28–95 B,
-//!   median step 0 B in three runs, so there the bounds let a leak of about 450 B a cycle
-//!   through (not tightened: three runs do not give a spread to bound by). (Those runs
+//!   median step 0 B in three runs. Since each context keeps its pipelines and layouts for
+//!   its renderers (`vk::pipeline_memo`), lavapipe keeps more per context: over 13 runs the
+//!   slope 53–1298 B (537–1298 but for one), the median step 0–1424 B, with the validation
+//!   layer; 460–530 B without it, against 28–130 B with the pipelines made per renderer
+//!   (296–534 B with the layer, the same day). Not found in the library (its heap stays
+//!   flat, every Vulkan object is destroyed before its device, an empty submission after the
+//!   pipelines' destruction changes nothing, and neither does keeping one layout per
+//!   definition). The bounds, 1800 B for both, let a leak of about 500 B a cycle through. (Those runs
 //!   counted 40 cycles after 10; the suite counts 24 after 6, 20 s less of CI: the slope's
 //!   spread grows by (40/24)^1.5, about 2.2, which on Mesa 25 leaves it far under the bound.) The
 //!   33 KiB per cycle the hardening issue measured is the layer's synchronization
@@ -314,9 +320,10 @@ fn contexts_leak_nothing() {
         );
         // Measured 0 B (see the top).
         assert!(growth.abs() < CYCLES, "library heap grew by {growth} bytes over {CYCLES} create/render/destroy cycles");
-        // Measured 460–507 B and 464 B on Mesa 22, 28–95 B and 0 B on Mesa 25 (see the top).
-        assert!(slope <= 560.0, "the process's C heap grew by {slope:.1} bytes per create/render/destroy cycle");
-        assert!(median <= 528.0, "the process's C heap grew by a median {median} bytes per create/render/destroy cycle");
+        // Measured 460–507 B and 464 B on Mesa 22, 28–95 B and 0 B on Mesa 25 (see the top);
+        // with the context's kept pipelines, 53–1298 B and 0–1424 B (see the top).
+        assert!(slope <= 1800.0, "the process's C heap grew by {slope:.1} bytes per create/render/destroy cycle");
+        assert!(median <= 1800.0, "the process's C heap grew by a median {median} bytes per create/render/destroy cycle");
     }
 }
 

@@ -71,12 +71,17 @@ fn incremental_equals_fresh(half: usize) {
         let mut scene = base.clone();
         let mut r = renderer(&ctx, &scene, m, &q);
         r.render(&ctx).unwrap();
+        let mut kept = None;
         for k in 1..=frames {
             scene.set_object_transform(i, pose(k, centre)).unwrap();
             let c = r.update(&scene).unwrap();
             assert_eq!(c.moved, vec![i]);
             let got = bits(&r.render(&ctx).unwrap());
             assert!(got == fresh(&ctx, &scene, m, &q), "{}: frame {k} after a move differs from a fresh render", m.name());
+            // The fresh renderers after the first make no pipeline: the context's serve them.
+            let n = ctx.pipeline_counts().0;
+            assert!(kept.is_none_or(|k| k == n), "{}: frame {k}'s fresh renderer made pipelines ({kept:?} -> {n})", m.name());
+            kept = Some(n);
         }
         r.destroy(&ctx);
     }

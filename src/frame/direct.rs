@@ -70,7 +70,7 @@ pub fn sky_and_direct(
     match direct {
         Ok(d) => Ok((sky, d)),
         Err(e) => {
-            unsafe { ctx.device.destroy_pipeline(sky, ctx.alloc()) };
+            crate::vk::pipeline::release_pipeline(ctx, sky);
             Err(e)
         }
     }

@@ -236,9 +236,7 @@ pub fn view_mask(mode: CubeMode) -> u32 {
 /// Destroys pipelines that were created (null handles are skipped).
 pub fn destroy_pipelines(ctx: &Context, pipelines: &mut [vk::Pipeline]) {
     for p in pipelines.iter_mut() {
-        if *p != vk::Pipeline::null() {
-            unsafe { ctx.device.destroy_pipeline(*p, ctx.alloc()) };
-            *p = vk::Pipeline::null();
-        }
+        crate::vk::pipeline::release_pipeline(ctx, *p);
+        *p = vk::Pipeline::null();
     }
 }

@@ -116,22 +116,16 @@ impl Bindings {
         for b in [Some(&mut self.views), Some(&mut self.objects), self.lights.as_mut()].into_iter().flatten() {
             b.destroy(ctx);
         }
+        crate::vk::pipeline::destroy_pipeline_layout(ctx, self.layout);
+        crate::vk::pipeline::destroy_set_layout(ctx, self.set_layout);
+        crate::vk::pipeline::destroy_set_layout(ctx, self.maps_layout);
         unsafe {
             let d = &ctx.device;
-            if self.layout != vk::PipelineLayout::null() {
-                d.destroy_pipeline_layout(self.layout, ctx.alloc());
-            }
             if self.pool != vk::DescriptorPool::null() {
                 d.destroy_descriptor_pool(self.pool, ctx.alloc());
             }
-            if self.set_layout != vk::DescriptorSetLayout::null() {
-                d.destroy_descriptor_set_layout(self.set_layout, ctx.alloc());
-            }
             for s in self.owned_sets.drain(..) {
                 d.destroy_descriptor_pool(s.pool, ctx.alloc());
-            }
-            if self.maps_layout != vk::DescriptorSetLayout::null() {
-                d.destroy_descriptor_set_layout(self.maps_layout, ctx.alloc());
             }
             for s in [self.linear_repeat, self.nearest_clamp] {
                 if s != vk::Sampler::null() {

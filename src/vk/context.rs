@@ -9,6 +9,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 use ash::vk;
+use ash::vk::Handle;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 
 use crate::error::{Error, Result, VkCall};
@@ -185,6 +186,8 @@ pub struct Context {
     pub ray_query: std::result::Result<RayQueryDevice, String>,
     /// The host's allocation callbacks for every object the library creates and destroys.
     callbacks: Option<VulkanAllocator>,
+    /// Pipelines shared by the context's renderers (`pipeline::graphics_pipeline`, …).
+    pub(crate) pipelines: super::pipeline_memo::PipelineMemo,
 }
 
 /// What the `ray-query` method needs of a device that traces through Vulkan's ray-tracing
@@ -558,6 +561,7 @@ impl Context {
             sample_rate_shading: false,
             ray_query,
             callbacks: None,
+            pipelines: Default::default(),
         })
     }
 
@@ -631,6 +635,11 @@ impl Context {
         self.callbacks.as_ref().map(|c| &c.0)
     }
 
+    /// Pipelines the context keeps for its renderers: (all, of them without users).
+    pub fn pipeline_counts(&self) -> (usize, usize) {
+        self.pipelines.counts()
+    }
+
     pub fn wait_idle(&self) -> Result<()> {
         unsafe { self.device.device_wait_idle() }.call("vkDeviceWaitIdle")
     }
@@ -640,6 +649,16 @@ impl Drop for Context {
     fn drop(&mut self) {
         unsafe {
             let _ = self.device.device_wait_idle();
+            for p in self.pipelines.take_all() {
+                self.device.destroy_pipeline(p, self.alloc());
+            }
+            let (pipeline_layouts, set_layouts) = self.pipelines.take_layouts();
+            for l in pipeline_layouts {
+                self.device.destroy_pipeline_layout(vk::PipelineLayout::from_raw(l), self.alloc());
+            }
+            for l in set_layouts {
+                self.device.destroy_descriptor_set_layout(vk::DescriptorSetLayout::from_raw(l), self.alloc());
+            }
             // The allocator frees its memory blocks; it must go before the device.
             if let Ok(mut a) = self.allocator.lock() {
                 a.take();

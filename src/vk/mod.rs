@@ -4,6 +4,7 @@
 
 mod context;
 pub mod pipeline;
+mod pipeline_memo;
 mod readback;
 mod recorder;
 mod resource;

@@ -2,8 +2,52 @@
 
 use ash::vk;
 
+use ash::vk::Handle;
+
+use super::pipeline_memo::{key_of, Key};
 use super::Context;
 use crate::error::{Error, Result, VkCall};
+
+/// Gives back a pipeline layout made by [`pipeline_layout`] (the context keeps it for its
+/// life; a null handle or one made elsewhere is destroyed, a no-op for null).
+pub fn destroy_pipeline_layout(ctx: &Context, layout: vk::PipelineLayout) {
+    if layout != vk::PipelineLayout::null() && !ctx.pipelines.is_kept(layout) {
+        unsafe { ctx.device.destroy_pipeline_layout(layout, ctx.alloc()) };
+    }
+}
+
+/// Gives back a descriptor set layout made by [`descriptor_set_layout`] (as
+/// [`destroy_pipeline_layout`]).
+pub fn destroy_set_layout(ctx: &Context, layout: vk::DescriptorSetLayout) {
+    if layout != vk::DescriptorSetLayout::null() && !ctx.pipelines.is_kept(layout) {
+        unsafe { ctx.device.destroy_descriptor_set_layout(layout, ctx.alloc()) };
+    }
+}
+
+/// Gives back a pipeline made by [`graphics_pipeline`] or [`compute_pipeline`] (null: a
+/// no-op): the context keeps it for a later renderer, or destroys it.
+pub fn release_pipeline(ctx: &Context, pipeline: vk::Pipeline) {
+    if pipeline != vk::Pipeline::null() {
+        for p in ctx.pipelines.release(pipeline) {
+            unsafe { ctx.device.destroy_pipeline(p, ctx.alloc()) };
+        }
+    }
+}
+
+/// The context's pipeline for `key`, made by `make` the first time.
+fn memoised(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    key: impl std::hash::Hash,
+    make: impl FnOnce() -> Result<vk::Pipeline>,
+) -> Result<vk::Pipeline> {
+    let Some(layout_key) = ctx.pipelines.layout_key(layout) else { return make() };
+    let (p, duplicate) = ctx.pipelines.get_or_make(key_of(&(layout_key, key)), make)?;
+    if let Some(d) = duplicate {
+        unsafe { ctx.device.destroy_pipeline(d, ctx.alloc()) };
+    }
+    Ok(p)
+}
 
 pub fn shader_module(ctx: &Context, name: &str) -> Result<vk::ShaderModule> {
     let bytes = crate::shaders::get(name).ok_or_else(|| Error::invalid("shader", format!("no embedded shader '{name}'")))?;
@@ -30,9 +74,18 @@ pub fn descriptor_set_layout(
             vk::DescriptorSetLayoutBinding::default().binding(binding).descriptor_type(ty).descriptor_count(count).stage_flags(stages)
         })
         .collect();
+    let definition: Vec<(u32, i32, u32)> = bindings.iter().map(|&(b, ty, n)| (b, ty.as_raw(), n)).collect();
+    let key = key_of(&("set", definition, stages.as_raw()));
+    if let Some(l) = ctx.pipelines.kept_layout(key) {
+        return Ok(l);
+    }
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&b);
     let l = unsafe { ctx.device.create_descriptor_set_layout(&info, ctx.alloc()) }.call("vkCreateDescriptorSetLayout")?;
     ctx.name(l, name);
+    let (l, made_twice) = ctx.pipelines.keep_layout(l, key, false);
+    if let Some(d) = made_twice {
+        unsafe { ctx.device.destroy_descriptor_set_layout(d, ctx.alloc()) };
+    }
     Ok(l)
 }
 
@@ -69,12 +122,10 @@ pub fn destroy_layouts(
     pool: &mut vk::DescriptorPool,
     set_layouts: &mut [vk::DescriptorSetLayout],
 ) {
-    unsafe {
-        ctx.device.destroy_pipeline_layout(*layout, ctx.alloc());
-        ctx.device.destroy_descriptor_pool(*pool, ctx.alloc());
-        for l in set_layouts.iter() {
-            ctx.device.destroy_descriptor_set_layout(*l, ctx.alloc());
-        }
+    destroy_pipeline_layout(ctx, *layout);
+    unsafe { ctx.device.destroy_descriptor_pool(*pool, ctx.alloc()) };
+    for &l in set_layouts.iter() {
+        destroy_set_layout(ctx, l);
     }
     *layout = vk::PipelineLayout::null();
     *pool = vk::DescriptorPool::null();
@@ -117,6 +168,12 @@ pub fn pipeline_layout(
     push_bytes: u32,
     stages: vk::ShaderStageFlags,
 ) -> Result<vk::PipelineLayout> {
+    // Its definition: its sets' (a set layout made elsewhere: this handle's own).
+    let keys: Vec<Key> = sets.iter().map(|&s| ctx.pipelines.layout_key(s).unwrap_or((s.as_raw(), u64::MAX))).collect();
+    let key = key_of(&("layout", keys, push_bytes, stages.as_raw()));
+    if let Some(l) = ctx.pipelines.kept_layout(key) {
+        return Ok(l);
+    }
     let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_bytes }];
     let mut info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets);
     if push_bytes > 0 {
@@ -124,6 +181,10 @@ pub fn pipeline_layout(
     }
     let l = unsafe { ctx.device.create_pipeline_layout(&info, ctx.alloc()) }.call("vkCreatePipelineLayout")?;
     ctx.name(l, name);
+    let (l, made_twice) = ctx.pipelines.keep_layout(l, key, true);
+    if let Some(d) = made_twice {
+        unsafe { ctx.device.destroy_pipeline_layout(d, ctx.alloc()) };
+    }
     Ok(l)
 }
 
@@ -214,7 +275,19 @@ pub fn sample_count_flags(samples: u32) -> vk::SampleCountFlags {
     }
 }
 
+/// A graphics pipeline of `desc` on `layout`: the context's, where a renderer made the same
+/// one before (`pipeline_memo`). Give it back with [`release_pipeline`].
 pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &GraphicsDesc) -> Result<vk::Pipeline> {
+    let formats: Vec<i32> = desc.color_formats.iter().map(|f| f.as_raw()).collect();
+    let key = (
+        ("graphics", desc.name, desc.vertex, desc.fragment, desc.vertex_input as u8, formats, desc.depth_format.map(|f| f.as_raw())),
+        (desc.depth_test, desc.depth_write, desc.view_mask, desc.cull.as_raw()),
+        (desc.multisample.samples, desc.multisample.per_sample, desc.blend as u8, desc.depth_op as u8),
+    );
+    memoised(ctx, layout, key, || make_graphics_pipeline(ctx, layout, desc))
+}
+
+fn make_graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &GraphicsDesc) -> Result<vk::Pipeline> {
     let vs = shader_module(ctx, desc.vertex)?;
     let fs = match shader_module(ctx, desc.fragment) {
         Ok(f) => f,
@@ -320,7 +393,13 @@ pub fn graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Graph
     Ok(p)
 }
 
+/// A compute pipeline of `shader` on `layout`: the context's, where a renderer made the same
+/// one before. Give it back with [`release_pipeline`].
 pub fn compute_pipeline(ctx: &Context, layout: vk::PipelineLayout, shader: &str) -> Result<vk::Pipeline> {
+    memoised(ctx, layout, ("compute", shader), || make_compute_pipeline(ctx, layout, shader))
+}
+
+fn make_compute_pipeline(ctx: &Context, layout: vk::PipelineLayout, shader: &str) -> Result<vk::Pipeline> {
     let cs = shader_module(ctx, shader)?;
     let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(cs).name(c"main");
     let info = vk::ComputePipelineCreateInfo::default().stage(stage).layout(layout);

@@ -115,12 +115,11 @@ pub fn run_cases<I: bytemuck::Pod, O: bytemuck::Pod>(ctx: &Context, shader: &str
     .unwrap();
     assert_eq!(profiler.results(ctx).unwrap()[0].name, "test.cases");
     let out: Vec<O> = bytemuck::pod_collect_to_vec(&results.read().unwrap()[..out_bytes as usize]);
-    unsafe {
-        ctx.device.destroy_pipeline(pipeline, None);
-        ctx.device.destroy_pipeline_layout(layout, None);
-        ctx.device.destroy_descriptor_pool(pool, None);
-        ctx.device.destroy_descriptor_set_layout(set_layout, None);
-    }
+    // The context keeps its pipelines (`vk::pipeline_memo`): given back, not destroyed.
+    specula::vk::pipeline::release_pipeline(ctx, pipeline);
+    specula::vk::pipeline::destroy_pipeline_layout(ctx, layout);
+    specula::vk::pipeline::destroy_set_layout(ctx, set_layout);
+    unsafe { ctx.device.destroy_descriptor_pool(pool, None) };
     profiler.destroy(ctx);
     cases.destroy(ctx);
     results.destroy(ctx);

@@ -661,18 +661,14 @@ impl Stage for CurvedReflectors {
         for b in self.buffers() {
             b.destroy(ctx);
         }
+        crate::vk::pipeline::destroy_pipeline_layout(ctx, self.layout);
+        for l in [self.set_layout, self.empty_layout] {
+            crate::vk::pipeline::destroy_set_layout(ctx, l);
+        }
         unsafe {
             let d = &ctx.device;
-            if self.layout != vk::PipelineLayout::null() {
-                d.destroy_pipeline_layout(self.layout, ctx.alloc());
-            }
             if self.pool != vk::DescriptorPool::null() {
                 d.destroy_descriptor_pool(self.pool, ctx.alloc());
-            }
-            for l in [self.set_layout, self.empty_layout] {
-                if l != vk::DescriptorSetLayout::null() {
-                    d.destroy_descriptor_set_layout(l, ctx.alloc());
-                }
             }
             if self.nearest != vk::Sampler::null() {
                 d.destroy_sampler(self.nearest, ctx.alloc());

@@ -253,9 +253,7 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
         Ok(counts.data.iter().fold(0.0f32, |m, &c| m.max(c)).round() as u32)
     })();
     destroy_pipelines(ctx, &mut [pipeline]);
-    if layout != vk::PipelineLayout::null() {
-        unsafe { ctx.device.destroy_pipeline_layout(layout, ctx.alloc()) };
-    }
+    crate::vk::pipeline::destroy_pipeline_layout(ctx, layout);
     target.destroy(ctx);
     result
 }

@@ -231,7 +231,7 @@ impl Intersector {
 
     pub fn destroy(&mut self, ctx: &Context) {
         unsafe {
-            ctx.device.destroy_pipeline(self.pipeline, ctx.alloc());
+            crate::vk::pipeline::release_pipeline(ctx, self.pipeline);
             ctx.device.destroy_descriptor_pool(self.rq_pool, ctx.alloc());
         }
         self.pipeline = vk::Pipeline::null();
