@@ -144,7 +144,7 @@ fn main() -> specula::Result<()> {
                 p.frame_ms,
                 t[0],
                 match b {
-                    Budget::MaxMs(ms) | Budget::Near { max_ms: ms, .. } => format!("{:.2}", t[0] / ms),
+                    Budget::MaxMs(ms) | Budget::Within(ms) | Budget::Near { max_ms: ms, .. } => format!("{:.2}", t[0] / ms),
                     Budget::MinPsnr(_) => "-".into(),
                 },
                 against.method,

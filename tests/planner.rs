@@ -440,8 +440,8 @@ fn the_search_within_the_exact_frame_is_at_least_as_accurate_as_the_exact_tracer
                 objects: facts.objects.iter().map(|f| (scene.meshes[f.mesh].name.clone(), specula::methods::BVH)).collect(),
             };
             let run = |c: &Choices, b: Budget| predict::choose(&scene, c, &q, b, &t, &predict::budget_variants()).unwrap().unwrap().2;
-            let e = run(&exact, Budget::MaxMs(f64::INFINITY));
-            let best = run(&Choices::all(Choice::Auto), Budget::MaxMs(e.frame_ms));
+            let e = run(&exact, Budget::Within(f64::INFINITY));
+            let best = run(&Choices::all(Choice::Auto), Budget::Within(e.frame_ms));
             assert!(
                 best.met && best.frame_ms <= e.frame_ms && best.specular_psnr_db >= e.specular_psnr_db - 1e-9,
                 "{} at {size:?}: best within bvh's {:.2} ms is {:.2} ms {:.2} dB, bvh {:.2} dB ({:?})",

@@ -25,6 +25,8 @@ pub(super) struct Candidate {
     /// (`registry::Family::composes`): the map cost of its cheapest candidate whose method
     /// shades it in maps (0 where the models have none).
     pub(super) compose_fixed: f64,
+    /// Its cost model's under-prediction margin (`ObjectModel::under`).
+    pub(super) under: f64,
 }
 
 /// One knob variant's candidates.
@@ -79,6 +81,7 @@ pub(super) fn candidates(
                     pixels: (mean(&|o| o.pixels as f64) * ratio).round() as usize,
                     model: model.clone(),
                     compose_fixed: 0.0,
+                    under: es.iter().map(|o| o.under).fold(1.0, f64::max),
                 }
             };
             let usable = |m: Method| m.is_gpu() && m.fits(f);

@@ -76,6 +76,7 @@ pub fn fit(scene: &Scene, scene_name: &str, device: &str, size: (u32, u32), rows
                     cycles: r.plan.cycles.max(1),
                     row,
                     psnr_db: region.psnr.min(PSNR_CAP),
+                    under: 1.0,
                 }),
             }
             *seen.entry(key).or_insert(0.0) += 1.0;

@@ -39,6 +39,14 @@ pub struct ObjectModel {
     pub row: String,
     /// PSNR on its own pixels, capped at [`PSNR_CAP`].
     pub psnr_db: f64,
+    /// How far its method's cost model under-predicts a frame (`MethodCost::under`; 1 for
+    /// a measured row): a frame-time budget counts its time times this.
+    #[serde(default = "unit")]
+    pub under: f64,
+}
+
+fn unit() -> f64 {
+    1.0
 }
 
 fn one() -> u32 {
@@ -196,6 +204,7 @@ mod tests {
             cycles: 1,
             row: "envmap".into(),
             psnr_db: 30.0,
+            under: 1.0,
         };
         let m = |size: u32, screen| Models {
             format: FORMAT.into(),

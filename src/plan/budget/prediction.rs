@@ -14,8 +14,15 @@ pub const MAX_PSNR_DB: f64 = 200.0;
 /// A frame budget.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum Budget {
-    /// At most this many GPU milliseconds per frame; the least error within it.
+    /// At most this many GPU milliseconds per frame; the least error within it. A choice's
+    /// frame counts as its prediction times the largest under-prediction margin of its
+    /// methods' cost models (`MethodCost::under`): the frame, not only its prediction,
+    /// should fit.
     MaxMs(f64),
+    /// A predicted frame of at most this many milliseconds, the least error within it:
+    /// predictions compared with predictions (`auto`'s default, within the exact tracer's
+    /// predicted frame), no margin.
+    Within(f64),
     /// Every specular object at least this PSNR (dB) on its pixels; the least time.
     MinPsnr(f64),
     /// `auto`'s default: at most `max_ms` (the exact tracer's predicted frame), and within
@@ -46,6 +53,7 @@ impl Budget {
         let short = |v: f64| format!("{:.3}", v).trim_end_matches('0').trim_end_matches('.').to_string();
         match self {
             Budget::MaxMs(ms) => format!("--max-ms {}", short(*ms)),
+            Budget::Within(ms) => format!("a predicted frame within {} ms", short(*ms)),
             Budget::MinPsnr(db) => format!("--min-psnr {}", short(*db)),
             Budget::Near { max_ms, floor_db } => {
                 format!("default (at most the exact tracer's {} ms, the fastest reaching {} dB)", short(*max_ms), short(*floor_db))

@@ -156,9 +156,12 @@ pub(super) fn rank(budget: Budget, ms: f64, picks: &[&Candidate]) -> (bool, f64,
                 (false, -1e9 - ms, psnr)
             }
         }
-        // Within the time: the most accurate, then the fastest; over it: the fastest.
-        Budget::MaxMs(t) => {
-            if ms <= t {
+        // Within the time: the most accurate, then the fastest; over it: the fastest. The
+        // time is the prediction times the largest under-prediction margin among the
+        // picks' methods (a budget the frame holds, not one its prediction does).
+        Budget::MaxMs(t) | Budget::Within(t) => {
+            let margin = if matches!(budget, Budget::MaxMs(_)) { picks.iter().map(|c| c.under).fold(1.0, f64::max) } else { 1.0 };
+            if ms * margin <= t {
                 (true, combined_psnr(picks), -ms)
             } else {
                 (false, -ms, combined_psnr(picks))
@@ -248,6 +251,7 @@ mod tests {
             pixels: 100,
             model: String::new(),
             compose_fixed: 0.0,
+            under: 1.0,
         }
     }
 

@@ -23,8 +23,13 @@ use crate::error::{Error, Result};
 /// The first line of every cost file's `format` field.
 /// (2: anti-aliasing's samples, multisampled and supersampled, as workload terms of their
 /// own; 3: a method's whole-screen kernels gain a constant per frame and one per scene
-/// triangle.)
+/// triangle. `MethodCost::under`, the under-prediction margin, came later without a new
+/// format: a file without it reads as margin 1.)
 pub const FORMAT: &str = "specula-costs 3";
+
+/// The quantile of a method's measured-over-predicted frame times that [`MethodCost::under`]
+/// keeps: a frame-time budget holds on this share of the calibration's frames.
+pub const UNDER_QUANTILE: f64 = 0.9;
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
 /// `SCREEN_FEATURES` (per object, its camera work) and `SHARED_FEATURES` (per frame, the
@@ -37,6 +42,24 @@ pub struct MethodCost {
     /// Inter-object cycles of the frames it was measured in (the map part covers that many).
     pub cycles: u32,
     pub samples: usize,
+    /// Its frames' measured time over the fit's prediction, at [`UNDER_QUANTILE`] over the
+    /// calibration's frames, at least 1: how far the fit under-predicts this method's
+    /// frames. A frame-time budget (`--max-ms`) counts the method's time times this.
+    #[serde(default = "unit")]
+    pub under: f64,
+}
+
+fn unit() -> f64 {
+    1.0
+}
+
+/// The `q` quantile of `v` (nearest rank); 1 for none.
+fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
+    if v.is_empty() {
+        return 1.0;
+    }
+    v.sort_by(f64::total_cmp);
+    v[((v.len() as f64 * q).ceil() as usize).clamp(1, v.len()) - 1]
 }
 
 /// One device's unit costs.
@@ -131,14 +154,32 @@ impl CostModel {
             }
         }
         let (x, y): (Vec<Vec<f64>>, Vec<f64>) = frames.into_iter().unzip();
-        let beta = fit_over(x, y, plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()));
+        let beta = fit_over(x.clone(), y.clone(), plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()));
         let n = SCREEN_FEATURES.len();
+        // Per frame: its objects' map shares and its camera work and kernels, measured over
+        // predicted.
+        let mut maps = vec![(0.0, 0.0); keys.len()];
+        for s in ss {
+            let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
+            if let Some(k) = keys.iter().position(|q| *q == key) {
+                maps[k].0 += s.fixed_ms;
+                maps[k].1 += linear::dot(&fixed, &map_features(&s.work));
+            }
+        }
+        let ratios: Vec<f64> = x
+            .iter()
+            .zip(&y)
+            .zip(&maps)
+            .map(|((x, y), (mm, mp))| (y + mm) / (linear::dot(&beta, x) + mp).max(1e-6))
+            .filter(|r| r.is_finite())
+            .collect();
         MethodCost {
             fixed,
             screen: beta[..n].to_vec(),
             shared: beta[n..].to_vec(),
             cycles: ss.iter().map(|s| s.cycles).max().unwrap_or(1).max(1),
             samples: ss.len(),
+            under: quantile(ratios, UNDER_QUANTILE).max(1.0),
         }
     }
 

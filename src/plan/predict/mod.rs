@@ -150,7 +150,7 @@ fn models_measured(
                 ) else {
                     continue;
                 };
-                let cycles = target.costs.methods.get(&key).map_or(1, |c| c.cycles);
+                let (cycles, under) = target.costs.methods.get(&key).map_or((1, 1.0), |c| (c.cycles, c.under));
                 objects.push(ObjectModel {
                     object: name.clone(),
                     class: f.class.label().to_string(),
@@ -161,6 +161,7 @@ fn models_measured(
                     cycles,
                     row: String::new(),
                     psnr_db: psnr,
+                    under,
                 });
             }
         }
@@ -317,13 +318,13 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
                 exact.objects.push((scene.meshes[f.mesh].name.clone(), scheme));
             }
         }
-        let Some((_, _, e)) = budget::choose_with(scene, facts, &exact, quality, Budget::MaxMs(f64::INFINITY), target.size, &exact_src)?
+        let Some((_, _, e)) = budget::choose_with(scene, facts, &exact, quality, Budget::Within(f64::INFINITY), target.size, &exact_src)?
         else {
             return Ok(None);
         };
         max_ms = max_ms.max(e.frame_ms);
     }
-    let Some((_, _, best)) = run(choices, Budget::MaxMs(max_ms))? else { return Ok(None) };
+    let Some((_, _, best)) = run(choices, Budget::Within(max_ms))? else { return Ok(None) };
     let tolerance = if quality.plan.planner.speed() { SPEED_TOLERANCE_DB } else { TOLERANCE_DB };
     let floor_db = best.specular_psnr_db - tolerance;
     let Some((mut chosen, quality_chosen, mut prediction)) = run(choices, Budget::Near { max_ms, floor_db })? else { return Ok(None) };
@@ -350,7 +351,7 @@ pub fn auto(scene: &Scene, facts: &SceneFacts, choices: &Choices, quality: &Qual
             Models { variants: models.variants.iter().filter(|v| v.knobs == prediction.knobs).cloned().collect(), ..models.clone() };
         let src = [(&same_knobs, source(target))];
         if let Some((c, _, p)) =
-            budget::choose_with(scene, facts, &swapped, &quality_chosen, Budget::MaxMs(f64::INFINITY), target.size, &src)?
+            budget::choose_with(scene, facts, &swapped, &quality_chosen, Budget::Within(f64::INFINITY), target.size, &src)?
         {
             if p.frame_ms <= prediction.frame_ms * (1.0 + SCHEME_MARGIN) {
                 let mut names: Vec<String> =
@@ -426,7 +427,7 @@ pub fn switch(
     };
     let eval = |c: &Choices, q: &Quality, models: &Models| -> Result<Option<Prediction>> {
         let src = [(models, source(target))];
-        Ok(budget::choose_with(scene, facts, c, q, Budget::MaxMs(f64::INFINITY), target.size, &src)?.map(|r| r.2))
+        Ok(budget::choose_with(scene, facts, c, q, Budget::Within(f64::INFINITY), target.size, &src)?.map(|r| r.2))
     };
     let exact = |m: Method| Choices { method: current.0.method, objects: current.0.objects.iter().map(|(n, _)| (n.clone(), m)).collect() };
     let (a, b, e, d) = (
