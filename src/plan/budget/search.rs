@@ -292,6 +292,19 @@ mod tests {
         assert_eq!(search(Budget::MaxMs(0.1), &time, &per), [0, 0, 0]);
     }
 
+    /// `--max-ms` counts a choice's time times its methods' largest margin; `Within` does not.
+    #[test]
+    fn a_time_budget_keeps_the_cost_models_margin() {
+        // One object: a 4 ms candidate at 40 dB whose model under-predicts by 1.5×, and a
+        // 5 ms one at 35 dB predicted exactly (base 1 ms).
+        let per = vec![vec![Candidate { under: 1.5, ..cand(4.0, 40.0) }, cand(5.0, 35.0)]];
+        // 6.5 ms: 5 × 1.5 = 7.5 over it, 6 within: the second. The prediction alone: the first.
+        assert_eq!(search(Budget::MaxMs(6.5), &time, &per), [1]);
+        assert_eq!(search(Budget::Within(6.5), &time, &per), [0]);
+        // 8 ms: both fit with the margin; the more accurate.
+        assert_eq!(search(Budget::MaxMs(8.0), &time, &per), [0]);
+    }
+
     #[test]
     fn combined_psnr_weights_by_pixels() {
         let a = Candidate { pixels: 300, ..cand(1.0, 20.0) };

@@ -307,6 +307,19 @@ mod tests {
         let w = Workload { pixels: 5e3, screen: 2e4, cube_texels: 1e5, ..Workload::default() };
         let (plain, hybrid) = (m.predict("distance", &w).unwrap(), m.predict("distance+hybrid", &w).unwrap());
         assert!(plain.1 > 0.0 && hybrid.0 >= plain.0 && hybrid.1 + hybrid.2 >= plain.1 + plain.2, "{plain:?} {hybrid:?}");
+        // Frames the linear model fits exactly: no margin.
+        assert!((m.methods["distance"].under - 1.0).abs() < 1e-6, "{}", m.methods["distance"].under);
+        // One frame of ten measured 2× the trend: the 90th percentile is a fitted frame, the
+        // second outlier lifts it.
+        let mut c = Corpus::new(key(1));
+        for k in 1..=10 {
+            let px = 1e3 * k as f64;
+            c.samples.push(sample("default", px, if k == 5 { 2.0 } else { 1.0 } * px / 1e3));
+        }
+        let one = CostModel::fit(&c, key(1), 0.0).methods["distance"].under;
+        c.samples.push(sample("default", 11e3, 2.0 * 11.0));
+        let two = CostModel::fit(&c, key(1), 0.0).methods["distance"].under;
+        assert!(one < 1.2 && two > 1.3, "margins {one} and {two}");
     }
 
     /// Two device keys side by side in one cache; a corrupt or truncated file is an error
