@@ -42,9 +42,10 @@ pub struct MethodCost {
     /// Inter-object cycles of the frames it was measured in (the map part covers that many).
     pub cycles: u32,
     pub samples: usize,
-    /// Its frames' measured time over the fit's prediction, at [`UNDER_QUANTILE`] over the
-    /// calibration's frames, at least 1: how far the fit under-predicts this method's
-    /// frames. A frame-time budget (`--max-ms`) counts the method's time times this.
+    /// Its frames' measured time over the fit's prediction, at [`UNDER_QUANTILE`] of the
+    /// calibration's measured time of the method (frames weighted by their time, so that a
+    /// frame of a tenth of a millisecond does not set it), at least 1: how far the fit
+    /// under-predicts this method's frames. A frame-time budget (`--max-ms`) counts the method's time times this.
     #[serde(default = "unit")]
     pub under: f64,
 }
@@ -53,13 +54,23 @@ fn unit() -> f64 {
     1.0
 }
 
-/// The `q` quantile of `v` (nearest rank); 1 for none.
-fn quantile(mut v: Vec<f64>, q: f64) -> f64 {
+/// The `q` quantile of values weighted by their weights (`(value, weight)`): the least value
+/// whose values at most it carry a `q` share of the weight; 1 for none.
+fn quantile(mut v: Vec<(f64, f64)>, q: f64) -> f64 {
+    v.retain(|(_, w)| *w > 0.0);
     if v.is_empty() {
         return 1.0;
     }
-    v.sort_by(f64::total_cmp);
-    v[((v.len() as f64 * q).ceil() as usize).clamp(1, v.len()) - 1]
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = v.iter().map(|(_, w)| w).sum();
+    let mut sum = 0.0;
+    for &(value, w) in &v {
+        sum += w;
+        if sum >= q * total * (1.0 - 1e-12) {
+            return value;
+        }
+    }
+    v[v.len() - 1].0
 }
 
 /// One device's unit costs.
@@ -166,12 +177,13 @@ impl CostModel {
                 maps[k].1 += linear::dot(&fixed, &map_features(&s.work));
             }
         }
-        let ratios: Vec<f64> = x
+        // (ratio, measured ms) per frame.
+        let ratios: Vec<(f64, f64)> = x
             .iter()
             .zip(&y)
             .zip(&maps)
-            .map(|((x, y), (mm, mp))| (y + mm) / (linear::dot(&beta, x) + mp).max(1e-6))
-            .filter(|r| r.is_finite())
+            .map(|((x, y), (mm, mp))| ((y + mm) / (linear::dot(&beta, x) + mp).max(1e-6), y + mm))
+            .filter(|(r, _)| r.is_finite())
             .collect();
         MethodCost {
             fixed,
@@ -309,16 +321,17 @@ mod tests {
         assert!(plain.1 > 0.0 && hybrid.0 >= plain.0 && hybrid.1 + hybrid.2 >= plain.1 + plain.2, "{plain:?} {hybrid:?}");
         // Frames the linear model fits exactly: no margin.
         assert!((m.methods["distance"].under - 1.0).abs() < 1e-6, "{}", m.methods["distance"].under);
-        // One frame of ten measured 2× the trend: the 90th percentile is a fitted frame, the
-        // second outlier lifts it.
-        let mut c = Corpus::new(key(1));
-        for k in 1..=10 {
-            let px = 1e3 * k as f64;
-            c.samples.push(sample("default", px, if k == 5 { 2.0 } else { 1.0 } * px / 1e3));
-        }
-        let one = CostModel::fit(&c, key(1), 0.0).methods["distance"].under;
-        c.samples.push(sample("default", 11e3, 2.0 * 11.0));
-        let two = CostModel::fit(&c, key(1), 0.0).methods["distance"].under;
+        // One frame of ten measured 2× the trend: the shortest, a few per cent of the
+        // measured time, does not set the margin (it is weighted by time); the longest does.
+        let margin = |outlier: usize| {
+            let mut c = Corpus::new(key(1));
+            for k in 1..=10 {
+                let px = 1e3 * k as f64;
+                c.samples.push(sample("default", px, if k == outlier { 2.0 } else { 1.0 } * px / 1e3));
+            }
+            CostModel::fit(&c, key(1), 0.0).methods["distance"].under
+        };
+        let (one, two) = (margin(1), margin(10));
         assert!(one < 1.2 && two > 1.3, "margins {one} and {two}");
     }
 
