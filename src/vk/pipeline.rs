@@ -1,7 +1,6 @@
 //! Graphics and compute pipelines from the embedded SPIR-V, and descriptor set layouts.
 
 use ash::vk;
-
 use ash::vk::Handle;
 
 use super::pipeline_memo::{key_of, Key};
@@ -68,17 +67,17 @@ pub fn descriptor_set_layout(
     bindings: &[Binding],
     stages: vk::ShaderStageFlags,
 ) -> Result<vk::DescriptorSetLayout> {
+    let definition: Vec<(u32, i32, u32)> = bindings.iter().map(|&(b, ty, n)| (b, ty.as_raw(), n)).collect();
+    let key = key_of(&("set", definition, stages.as_raw()));
+    if let Some(l) = ctx.pipelines.kept_layout(key) {
+        return Ok(l);
+    }
     let b: Vec<_> = bindings
         .iter()
         .map(|&(binding, ty, count)| {
             vk::DescriptorSetLayoutBinding::default().binding(binding).descriptor_type(ty).descriptor_count(count).stage_flags(stages)
         })
         .collect();
-    let definition: Vec<(u32, i32, u32)> = bindings.iter().map(|&(b, ty, n)| (b, ty.as_raw(), n)).collect();
-    let key = key_of(&("set", definition, stages.as_raw()));
-    if let Some(l) = ctx.pipelines.kept_layout(key) {
-        return Ok(l);
-    }
     let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&b);
     let l = unsafe { ctx.device.create_descriptor_set_layout(&info, ctx.alloc()) }.call("vkCreateDescriptorSetLayout")?;
     ctx.name(l, name);

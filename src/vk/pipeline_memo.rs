@@ -54,6 +54,19 @@ struct Inner {
     idle: VecDeque<Key>,
 }
 
+impl Inner {
+    /// The pipeline made from `key`, one user more (out of the idle ones if it had none).
+    fn take_user(&mut self, key: Key) -> Option<vk::Pipeline> {
+        let e = self.pipelines.get_mut(&key)?;
+        e.users += 1;
+        let p = e.pipeline;
+        if e.users == 1 {
+            self.idle.retain(|k| *k != key);
+        }
+        Some(p)
+    }
+}
+
 /// A context's shared pipelines.
 #[derive(Default)]
 pub struct PipelineMemo {
@@ -112,27 +125,14 @@ impl PipelineMemo {
         key: Key,
         make: impl FnOnce() -> crate::error::Result<vk::Pipeline>,
     ) -> crate::error::Result<(vk::Pipeline, Option<vk::Pipeline>)> {
-        {
-            let mut g = self.lock();
-            if let Some(e) = g.pipelines.get_mut(&key) {
-                e.users += 1;
-                let p = e.pipeline;
-                if e.users == 1 {
-                    g.idle.retain(|k| *k != key);
-                }
-                return Ok((p, None));
-            }
+        if let Some(p) = self.lock().take_user(key) {
+            return Ok((p, None));
         }
         // Made outside the lock: another thread's pipelines are not held up by this one.
         let p = make()?;
         let mut g = self.lock();
-        if let Some(e) = g.pipelines.get_mut(&key) {
+        if let Some(kept) = g.take_user(key) {
             // Another thread made the same one meanwhile: keep one.
-            e.users += 1;
-            let kept = e.pipeline;
-            if e.users == 1 {
-                g.idle.retain(|k| *k != key);
-            }
             return Ok((kept, Some(p)));
         }
         g.pipelines.insert(key, Entry { pipeline: p, users: 1 });

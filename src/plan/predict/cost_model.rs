@@ -28,7 +28,8 @@ use crate::error::{Error, Result};
 pub const FORMAT: &str = "specula-costs 3";
 
 /// The quantile of a method's measured-over-predicted frame times that [`MethodCost::under`]
-/// keeps: a frame-time budget holds on this share of the calibration's frames.
+/// keeps, frames weighted by their measured time: a frame-time budget holds on this share of
+/// the calibration's time.
 pub const UNDER_QUANTILE: f64 = 0.9;
 
 /// Unit costs of one method, over `features::MAP_FEATURES` (per object, its maps),
@@ -45,7 +46,8 @@ pub struct MethodCost {
     /// Its frames' measured time over the fit's prediction, at [`UNDER_QUANTILE`] of the
     /// calibration's measured time of the method (frames weighted by their time, so that a
     /// frame of a tenth of a millisecond does not set it), at least 1: how far the fit
-    /// under-predicts this method's frames. A frame-time budget (`--max-ms`) counts the method's time times this.
+    /// under-predicts this method's frames. A frame-time budget (`--max-ms`) counts the
+    /// method's time times this.
     #[serde(default = "unit")]
     pub under: f64,
 }
@@ -147,37 +149,33 @@ impl CostModel {
         // objects' and the screen's).
         let mut frames: Vec<(Vec<f64>, f64)> = Vec::new();
         let mut keys: Vec<(usize, &str, u64)> = Vec::new();
+        // Per frame, its objects' map shares: (measured, predicted), for the margin below.
+        let mut maps: Vec<(f64, f64)> = Vec::new();
         for s in ss {
             let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
             let per = screen_features(&s.work);
-            match keys.iter().position(|k| *k == key) {
-                Some(k) => {
-                    let (x, y) = &mut frames[k];
-                    per.iter().enumerate().for_each(|(j, v)| x[j] += v);
-                    *y += s.screen_ms;
-                }
-                None => {
-                    keys.push(key);
-                    let mut x = per;
-                    x.extend(shared_features(&s.work));
-                    frames.push((x, s.screen_ms + s.shared_ms));
-                }
+            let k = keys.iter().position(|k| *k == key).unwrap_or(keys.len());
+            if k == maps.len() {
+                maps.push((0.0, 0.0));
+            }
+            maps[k].0 += s.fixed_ms;
+            maps[k].1 += linear::dot(&fixed, &map_features(&s.work));
+            if k < keys.len() {
+                let (x, y) = &mut frames[k];
+                per.iter().enumerate().for_each(|(j, v)| x[j] += v);
+                *y += s.screen_ms;
+            } else {
+                keys.push(key);
+                let mut x = per;
+                x.extend(shared_features(&s.work));
+                frames.push((x, s.screen_ms + s.shared_ms));
             }
         }
         let (x, y): (Vec<Vec<f64>>, Vec<f64>) = frames.into_iter().unzip();
         let beta = fit_over(x.clone(), y.clone(), plain.map(|p| p.screen.iter().chain(&p.shared).copied().collect()));
         let n = SCREEN_FEATURES.len();
-        // Per frame: its objects' map shares and its camera work and kernels, measured over
-        // predicted.
-        let mut maps = vec![(0.0, 0.0); keys.len()];
-        for s in ss {
-            let key = (s.scene, s.knobs.as_str(), s.work.screen as u64);
-            if let Some(k) = keys.iter().position(|q| *q == key) {
-                maps[k].0 += s.fixed_ms;
-                maps[k].1 += linear::dot(&fixed, &map_features(&s.work));
-            }
-        }
-        // (ratio, measured ms) per frame.
+        // Per frame (its map shares, camera work and kernels): measured over predicted, and
+        // the measured ms.
         let ratios: Vec<(f64, f64)> = x
             .iter()
             .zip(&y)
