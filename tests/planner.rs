@@ -276,7 +276,10 @@ fn auto_ray_traces_with_bvh_unless_another_scheme_is_clearly_faster() {
     let p = plan_for(&scene, &Choices::all(Choice::Auto), &Quality::default(), Some(&t)).unwrap();
     let o = &p.objects[0];
     assert_eq!(o.method, specula::methods::BVH, "{}", o.reason);
-    assert!(o.reason.contains("bvh rather than bih"), "{}", o.reason);
+    // The scheme predicted fastest, named in the reason (bih, then kd-tree with the light
+    // terms' calibration: both predicted 1.5–1.7× faster than bvh here).
+    let rather = ["bih", "kd-tree", "grid", "octree", "ray-query"].iter().any(|s| o.reason.contains(&format!("bvh rather than {s}:")));
+    assert!(rather, "{}", o.reason);
     // Ray-tracing hardware: ray queries' unit costs a tenth of this machine's.
     let mut costs = (*t.costs).clone();
     let rq = costs.methods.get_mut("ray-query").expect("the nominal costs time ray queries");
@@ -312,8 +315,13 @@ fn anti_aliasing_removes_at_most_the_exact_tracers_aliasing_at_the_frames_size()
 /// The stored unit costs follow the frame's size: a ray tracer's frame has a constant part
 /// (dispatches, barriers, resets) and a part per pixel, so bvh on the concave mirror costs
 /// far less than 64× more at 512² than at 64² (measured on lavapipe: 11.8 ms at 64², 72–99 ms
-/// at 512²; a model without the constant predicted 449 ms), and every method's frame grows
-/// with its pixels.
+/// at 512² when this test was written; 19.5 ms at 64², 29 / 51 ms at 128² / 256² and 106–140
+/// ms at 512² on 2026-12-06, `specula bench builtin:concave-occluder --method bvh --size NxN
+/// -q map_updates=always`; a model without the constant predicted 449 ms), and every method's
+/// frame grows with its pixels. The calibration of 2026-12-06 (64² and 256²) predicts 19.5
+/// and 231 ms: 1.65–2.2× over at 512², where lavapipe's cost per pixel is lower than the
+/// calibration rooms' mirrors at 256² show (corpus-00 at 512²: 155 ms measured, 214
+/// predicted); the bound at 512² is twice the highest measured frame.
 #[test]
 fn unit_costs_follow_the_frame_size() {
     let frame = |size: (u32, u32)| {
@@ -327,7 +335,7 @@ fn unit_costs_follow_the_frame_size() {
     let (small, large) = (frame((64, 64)), frame((512, 512)));
     println!("predicted ms at 64² and 512²: {:?}", small.iter().map(|(m, v)| format!("{m} {v:.1} / {:.1}", large[m])).collect::<Vec<_>>());
     let bvh = (small["bvh"], large["bvh"]);
-    assert!((5.0..25.0).contains(&bvh.0) && (36.0..200.0).contains(&bvh.1), "bvh {bvh:?} ms");
+    assert!((5.0..25.0).contains(&bvh.0) && (36.0..280.0).contains(&bvh.1), "bvh {bvh:?} ms");
     assert!(bvh.1 / bvh.0 < 16.0, "bvh grows {:.1}× for 64× the pixels", bvh.1 / bvh.0);
     for (m, v) in &small {
         assert!(large[m] > *v, "{m}: {v:.2} ms at 64², {:.2} at 512²", large[m]);
@@ -703,5 +711,76 @@ fn a_calibration_measures_pixels_and_the_knobs_a_method_reads() {
         assert!(measured(scene, "default", 256.0) && measured(scene, variant, 1024.0), "scene {scene}");
     }
     assert!(measured(1, variant, 256.0) && !measured(0, variant, 256.0), "the variant at 16² on scene 1 only");
+
+    // The caustics' knobs are every method's where the scene has a light (scene 3), no
+    // method's where it has none (scene 0): `caustics=off` is measured on lit scenes only.
+    let cfg = specula::tradeoff::Measure {
+        scenes: vec![0, 3],
+        sizes: vec![(16, 16)],
+        variants: vec!["default".into(), "caustics=off".into()],
+        methods: vec![specula::methods::BVH],
+        variant_scenes: None,
+        ..cfg
+    };
+    let c = specula::tradeoff::measure(&ctx, &cfg, &mut |_| {}).unwrap();
+    let off = |scene: usize| c.samples.iter().filter(|s| s.scene == scene && s.knobs == "caustics=off").collect::<Vec<_>>();
+    assert!(off(0).is_empty(), "caustics=off measured on an unlit scene");
+    assert!(!off(3).is_empty() && off(3).iter().all(|s| s.work.caustic_photons == 0.0), "{:?}", off(3));
+    let lit = c.samples.iter().find(|s| s.scene == 3 && s.knobs == "default").unwrap();
+    assert!(lit.work.caustic_photons > 0.0 && lit.work.caustic_texels > 0.0, "{:?}", lit.work);
+    common::assert_clean(&ctx);
+}
+
+/// An unseen scene with a light: a glass blob beside a mirror sphere in a closed room lit by
+/// a point light (caustics from both, shadow maps; the calibration's lit scenes are 3 and 7).
+const LIT_SCENE: usize = 39;
+/// How far a lit frame's measured time may lie from its prediction, either way. The
+/// calibration's own frames fit within 1.6× (BENCHMARKS.md, "The light in the cost
+/// models"); before the light terms, envmap's lit frames were predicted up to 12× short.
+const LIT_SPREAD: f64 = 2.0;
+
+/// The cost models predict frames with a light and caustics on a scene they never measured:
+/// every calibrated method's whole frame (its maps, camera work, shadow maps, the caustics'
+/// photons, cubes and projection) within [`LIT_SPREAD`] of its measured time, either way.
+#[test]
+fn frames_with_a_light_and_caustics_are_predicted_on_an_unseen_scene() {
+    let _turn = turn();
+    let ctx = common::gpu();
+    let target = specula::target_for(&ctx, SIZE).expect("unit costs for this device");
+    let scene = corpus::scene(LIT_SCENE).unwrap();
+    assert!(LIT_SCENE >= corpus::SIZE && !specula::tradeoff::calibrate::SCENES.contains(&LIT_SCENE) && !scene.lights.is_empty());
+    let mut q = Quality::default();
+    q.frame.map_updates_always = true;
+    let mut rows = String::new();
+    let mut worst: Option<(f64, String)> = None;
+    let methods = Method::ALL.iter().filter(|m| {
+        m.is_gpu()
+            && target.costs.methods.contains_key(m.name)
+            && **m != specula::methods::RAY_ENGINE
+            && **m != specula::methods::RAY_HIERARCHY
+    });
+    let specular: Vec<String> =
+        scene.meshes.iter().filter(|x| scene.materials[x.material].kind.is_specular()).map(|x| x.name.clone()).collect();
+    for &m in methods {
+        // Every object forced to the method (none where it serves not all of them).
+        let all = Choices { method: Choice::Method(m), objects: specular.iter().map(|n| (n.clone(), m)).collect() };
+        let within = Budget::Within(specula::plan::budget::prediction::MAX_FRAME_MS);
+        let Some((choices, qm, pred)) = predict::choose(&scene, &all, &q, within, &target, &["default".into()]).unwrap() else {
+            continue;
+        };
+        let plan = plan_for(&scene, &choices, &qm, Some(&target)).unwrap();
+        assert!(plan.caustics.is_some(), "{}: no caustics planned", m.name);
+        let frame = specula::render_plan(&ctx, &scene, plan, SIZE, (1, 3)).unwrap();
+        let ms: f64 = frame.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum();
+        let ratio = ms / pred.frame_ms;
+        rows += &format!("\n  {:<24} predicted {:>8.2} ms, measured {:>8.2} ({ratio:.2}×)", m.name, pred.frame_ms, ms);
+        let off = ratio.max(1.0 / ratio);
+        if worst.as_ref().is_none_or(|(w, _)| off > *w) {
+            worst = Some((off, m.name.to_string()));
+        }
+    }
+    println!("{}: measured over predicted frame time at {}x{}:{rows}", corpus::name(LIT_SCENE), SIZE.0, SIZE.1);
+    let (off, name) = worst.expect("some method is calibrated");
+    assert!(off <= LIT_SPREAD, "{name}: {off:.2}× off its prediction:{rows}");
     common::assert_clean(&ctx);
 }

@@ -21,8 +21,8 @@ pub struct Measure {
     pub scenes: Vec<usize>,
     pub sizes: Vec<(u32, u32)>,
     /// `default` or `knob=value …` over the base knobs; a method is measured in a variant
-    /// only when it reads every knob the variant sets or the knob is frame-wide (`aa`),
-    /// else the variant is its default.
+    /// only when it reads every knob the variant sets or the knob is frame-wide (`aa`) or
+    /// the caustics' on a scene with a light, else the variant is its default.
     pub variants: Vec<String>,
     pub methods: Vec<Method>,
     /// Methods measured on every n-th scene only (the slow exact schemes: their cost per
@@ -56,6 +56,12 @@ fn frame_wide(k: &str) -> bool {
     crate::frame::knobs::FrameKnobs::KNOBS.iter().any(|f| f.name == k)
 }
 
+/// Whether knob `k` is the caustics' (an effect: every method's frame runs it where a light
+/// sees a specular object, none where the scene has no light).
+fn caustic_knob(k: &str) -> bool {
+    crate::methods::caustics::knobs::CausticsKnobs::KNOBS.iter().any(|f| f.name == k)
+}
+
 /// Every GPU method of the registry.
 pub fn gpu_methods() -> Vec<Method> {
     Method::ALL.iter().copied().filter(|m| m.is_gpu()).collect()
@@ -68,6 +74,7 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
         let scene = corpus::scene(i)?;
         let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();
         let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
+        let lit = !scene.lights.is_empty();
         for &size in &cfg.sizes {
             let ids = crate::reference::object_ids(&scene, size)?;
             // Each object's pixels, from the exact first hits (with or without errors: a
@@ -107,7 +114,7 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     // times the ray tracers' multisampling too (before, it skipped them, and
                     // their multisamples were predicted free; bvh with msaa4 at 512² measures 346
                     // ms against 99 without).
-                    let reads = |k: &&str| m.knobs.contains(k) || frame_wide(k);
+                    let reads = |k: &&str| m.knobs.contains(k) || frame_wide(k) || (lit && caustic_knob(k));
                     let measured = if cfg.errors { set.iter().all(reads) } else { set.is_empty() || set.iter().any(reads) };
                     if !measured || m.needs.missing_on(ctx).is_some() || unrunnable {
                         continue;
@@ -125,11 +132,14 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     let passes: Vec<(String, f64)> = frame.passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
                     let (costs, base) = crate::plan::budget::attribute(&plan, &passes);
                     let mut any = None;
+                    let meshes: Vec<usize> = plan.objects.iter().map(|o| o.mesh).collect();
+                    let covered = object_pixels[1..].iter().sum::<usize>() as f64;
+                    let frame = crate::plan::predict::features::FrameWork::new(&scene, &meshes, &q, covered);
                     for (o, (mesh, own, shared)) in plan.objects.iter().zip(costs) {
                         let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
                         let pixels = object_pixels[mesh + 1];
                         let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
-                        let work = workload(f, &scene, &q, size, pixels as f64);
+                        let work = workload(f, &scene, &q, size, pixels as f64, &frame);
                         any = Some(work);
                         let dup = out.samples.iter().any(|s| {
                             s.scene == i && s.object == o.name && s.method == o.method.name && s.knobs == *v && s.work.screen == work.screen

@@ -143,11 +143,15 @@ pub fn run_calibrate(
     use specula::plan::predict::features::{MAP_FEATURES, SCREEN_FEATURES, SHARED_FEATURES};
     let names: Vec<&str> = MAP_FEATURES.iter().chain(&SCREEN_FEATURES).chain(&SHARED_FEATURES).copied().collect();
     println!("unit costs (ms per unit of each feature: plan::predict::features)");
-    println!("{:<24} {}", "method", names.iter().map(|n| format!("{n:>17}")).collect::<String>());
+    println!("{:<24} {:>17}{}", "method", "margin", names.iter().map(|n| format!("{n:>17}")).collect::<String>());
     for (m, u) in &c.methods {
         let all: Vec<f64> = u.fixed.iter().chain(&u.screen).chain(&u.shared).copied().collect();
-        println!("{m:<24} {}", all.iter().map(|v| format!("{v:>17.3}")).collect::<String>());
+        println!("{m:<24} {:>17.2}{}", u.under, all.iter().map(|v| format!("{v:>17.3}")).collect::<String>());
     }
+    use specula::plan::predict::cost_model::BASE_FEATURES;
+    println!("\nthe frame's base (its own stages and effects)");
+    println!("{}", BASE_FEATURES.iter().map(|n| format!("{n:>17}")).collect::<String>());
+    println!("{}", c.base.iter().map(|v| format!("{v:>17.3}")).collect::<String>());
     Ok(())
 }
 

@@ -78,7 +78,7 @@ pub fn run(args: &RenderArgs, out: &Path, profile: Option<&Path>, budget: &Budge
             })
             .collect();
         println!("\n{}", specula::plan::budget::report(pr, Some((&objects, (frame_ms, psnr("specular"))))));
-        println!("(actual: this frame's passes split as the models split them — maps and frame effects, camera passes and kernels — base {base:.3} ms; PSNR against the exact tracer, bvh supersampled 4×4)");
+        println!("(actual: this frame's passes split as the models split them — maps, camera passes and kernels — base {base:.3} ms with its shadow maps and caustics; PSNR against the exact tracer, bvh supersampled 4×4)");
     }
     if let Some(p) = profile {
         let json = specula::profile::chrome_trace(&frame.passes, &frame.memory, &ctx.device_name);

@@ -75,7 +75,8 @@ impl CausticsPlan {
         self.filter != Caustics::PhotonMap && self.space != CausticSpace::Screen
     }
 
-    /// caustics=photon-map: every photon of every layer (photons² a layer).
+    /// Every photon of every layer (photons² a layer): what `caustics.photons` traces, and
+    /// with caustics=photon-map what the grid sorts.
     pub fn photon_count(&self, q: &Quality) -> u64 {
         self.photon_layers as u64 * (q.caustics.photons as u64).pow(2)
     }
@@ -246,6 +247,21 @@ fn light_inside(position: Vec3, centre: Vec3, radius: f32) -> bool {
 /// surface receives them, no punctual light, or no specular object a light sees. Every
 /// method's diffuse shading projects them, the ray tracers' (§2) shading kernels too.
 pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<CausticsPlan> {
+    plan_of(scene, objects.iter().map(|o| (o.mesh, o.name.clone(), o.own_reference_point)), q)
+}
+
+/// What the caustics stage of a frame whose specular objects are `meshes` does under `q`,
+/// as the cost model counts it (`plan::predict::features::Workload`): photons traced (every
+/// photon image's texels) and caustic cube texels (receiver distance cubes and light cubes,
+/// six faces of `cube_size`² each). Zero where the frame has no caustics.
+pub fn photon_work(scene: &Scene, meshes: &[usize], q: &Quality) -> (f64, f64) {
+    let texels = 6.0 * (q.cube.cube_size as f64).powi(2);
+    plan_of(scene, meshes.iter().map(|&m| (m, String::new(), Vec3::ZERO)), q)
+        .map_or((0.0, 0.0), |c| (c.photon_count(q) as f64, c.cubes.len() as f64 * texels))
+}
+
+/// [`plan`] over (mesh, name, reference point) of each specular object.
+fn plan_of(scene: &Scene, objects: impl Iterator<Item = (usize, String, Vec3)>, q: &Quality) -> Option<CausticsPlan> {
     if q.caustics.caustics == Caustics::Off || scene.lights.is_empty() {
         return None;
     }
@@ -255,10 +271,10 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
     let mut generators = Vec::new();
     let mut cubes: Vec<CausticCube> = Vec::new();
     let mut layers = 0;
-    for o in objects {
-        let (centre, radius) = bounding_sphere(scene, o.mesh);
-        let dielectric = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
-        let thin = matches!(scene.materials[scene.meshes[o.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: true, .. });
+    for (mesh, name, reference_point) in objects {
+        let (centre, radius) = bounding_sphere(scene, mesh);
+        let dielectric = matches!(scene.materials[scene.meshes[mesh].material].kind, crate::scene::SurfaceKind::Dielectric { .. });
+        let thin = matches!(scene.materials[scene.meshes[mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: true, .. });
         let branches = match q.caustics.caustic_paths {
             _ if !dielectric => 1,
             CausticPaths::Refracted => 1,
@@ -289,7 +305,7 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
             layers += faces * branches;
         }
         if !lights.is_empty() {
-            generators.push(Generator { mesh: o.mesh, name: o.name.clone(), reference_point: o.own_reference_point, lights });
+            generators.push(Generator { mesh, name, reference_point, lights });
         }
     }
     if generators.is_empty() {

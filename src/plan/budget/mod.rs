@@ -11,7 +11,8 @@
 //! plan lists it (`ObjectPlan::passes`); a pass a stage records under the prefix its
 //! camera pass declares (`Profiled::prefix`: a ray tracer's per-bounce kernels, planar
 //! mirrors' views), to the objects of the camera stages that declare it; what belongs to
-//! none is the frame's base (its own stages: direct light, shadow maps). Map and camera
+//! none is the frame's base (its own stages: direct light, shadow maps), and so is a frame
+//! effect's (caustics: the same whatever methods the objects get). Map and camera
 //! passes work per object (a layer, the object's pixels) and are split evenly among their
 //! objects; a ray tracer's kernels run over the whole screen whatever it serves, so its
 //! camera pass declares them *shared* (`Profiled::shared`): paid once per method a frame

@@ -69,7 +69,7 @@ pub struct ObjectPrediction {
     pub name: String,
     pub method: Method,
     pub ms: f64,
-    /// Of `ms`, its maps and frame effects (passes that do not scale with the output); the
+    /// Of `ms`, its maps (passes that do not scale with the output); the
     /// rest is its camera work (its camera passes, in every view that shows it, and its share
     /// of its method's whole-screen kernels).
     pub maps_ms: f64,

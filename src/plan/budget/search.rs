@@ -114,7 +114,7 @@ impl Timing<'_> {
         methods
     }
 
-    /// Object `i`'s part of the frame by pass kind: (its maps and frame effects, which do not
+    /// Object `i`'s part of the frame by pass kind: (its maps, which do not
     /// scale with the output; its camera work, repeated in the others' views, with its
     /// share of its method's whole-screen kernels).
     pub(super) fn object_parts(&self, picks: &[&Candidate], i: usize, whole: bool) -> (f64, f64) {

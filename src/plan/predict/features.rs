@@ -106,6 +106,37 @@ pub struct Workload {
     /// multisampled (one raster, shading per sample): the two cost differently.
     #[serde(default)]
     pub supersampled: f64,
+    /// Photons the frame's caustics trace, every generator's and light's
+    /// (`methods::caustics::photon_work`; 0 without caustics): a frame effect's work, the
+    /// same whatever methods the objects get.
+    #[serde(default)]
+    pub caustic_photons: f64,
+    /// Texels of the frame's caustic cubes (receiver distance cubes and light cubes).
+    #[serde(default)]
+    pub caustic_texels: f64,
+    /// The frame's pixels that show geometry (not the environment), where rays start and
+    /// diffuse shading runs; `None` (measured before it): the whole screen, as every
+    /// calibration scene is a closed room.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub covered: Option<f64>,
+}
+
+/// What a frame does beyond its objects' own work, the same for each of them: its caustics
+/// (`methods::caustics::photon_work`) and the pixels that show geometry.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FrameWork {
+    pub caustic_photons: f64,
+    pub caustic_texels: f64,
+    pub covered: f64,
+}
+
+impl FrameWork {
+    /// The frame of `scene` whose specular objects are `meshes`, under `q`, with `covered`
+    /// pixels showing geometry.
+    pub fn new(scene: &Scene, meshes: &[usize], q: &Quality, covered: f64) -> FrameWork {
+        let (caustic_photons, caustic_texels) = crate::methods::caustics::photon_work(scene, meshes, q);
+        FrameWork { caustic_photons, caustic_texels, covered }
+    }
 }
 
 fn one() -> f64 {
@@ -125,49 +156,87 @@ impl Default for Workload {
             thin: 0.0,
             samples: 1.0,
             supersampled: 0.0,
+            caustic_photons: 0.0,
+            caustic_texels: 0.0,
+            covered: None,
         }
     }
 }
 
 /// Names of the per-object map features, in the order [`map_features`] returns them.
-pub const MAP_FEATURES: [&str; 3] = ["object", "cube_raster", "cube_texels"];
+pub const MAP_FEATURES: [&str; 5] = ["object", "cube_raster", "cube_texels", "lit_cube_texels", "caustic_cube_texels"];
 
 /// What an object's maps cost scales with: a constant per object (its passes), cube-map
-/// rasterisation (texels × scene triangles, 1e9) and cube texels (1e6).
+/// rasterisation (texels × scene triangles, 1e9), cube texels (1e6), cube texels times
+/// lights (1e6: every texel's diffuse surface shaded with each light's shadow map; on
+/// lavapipe a lit 256² cube costs 3–5× an unlit one) and times the frame's caustic cubes
+/// (1e6: the caustics projected onto them).
 pub fn map_features(w: &Workload) -> Vec<f64> {
-    vec![1.0, w.cube_texels * w.scene_triangles / 1e9, w.cube_texels / 1e6]
+    let t = w.cube_texels / 1e6;
+    vec![1.0, w.cube_texels * w.scene_triangles / 1e9, t, t * w.lights, t * caustic_cubes(w)]
+}
+
+/// The frame's caustic cubes (each a light cube map that diffuse shading reads).
+fn caustic_cubes(w: &Workload) -> f64 {
+    if w.cube_texels > 0.0 {
+        w.caustic_texels / w.cube_texels
+    } else {
+        0.0
+    }
 }
 
 /// Names of the per-object screen features, in the order [`screen_features`] returns them.
-pub const SCREEN_FEATURES: [&str; 6] =
-    ["pixels", "extra_msaa_samples", "extra_ssaa_samples", "pixel_rays", "solid_pixel_rays", "thin_pixel_rays"];
+pub const SCREEN_FEATURES: [&str; 8] = [
+    "pixels",
+    "extra_msaa_samples",
+    "extra_ssaa_samples",
+    "pixel_rays",
+    "solid_pixel_rays",
+    "thin_pixel_rays",
+    "object",
+    "dielectric_object",
+];
 
 /// What an object's camera work scales with: its pixels (1e4), the anti-aliasing samples it
 /// shades beyond one per pixel, multisampled and supersampled (unit costs of their own: a
 /// sample-rate search does not cost what a pixel's does, nor a multisample what a
-/// supersample does), and its shaded samples times the depth of a hierarchy over the
+/// supersample does), its shaded samples times the depth of a hierarchy over the
 /// scene's triangles (log₂ / 16: a traversal per ray), again for a solid dielectric's and a
-/// thin one's (more rays per sample).
+/// thin one's (more rays per sample), and a constant per object, again for a dielectric
+/// (its draws and dispatches; a dielectric's rays branch at every hit).
 pub fn screen_features(w: &Workload) -> Vec<f64> {
     let px = w.pixels / 1e4;
     let rays = px * w.samples * depth(w);
     let [msaa, ssaa] = extra(w);
-    vec![px, px * msaa, px * ssaa, rays, rays * w.solid, rays * w.thin]
+    vec![px, px * msaa, px * ssaa, rays, rays * w.solid, rays * w.thin, 1.0, w.solid + w.thin]
 }
 
 /// Names of the whole-screen features, in the order [`shared_features`] returns them.
-pub const SHARED_FEATURES: [&str; 6] =
-    ["frame", "frame_triangles", "screen", "screen_extra_msaa_samples", "screen_extra_ssaa_samples", "screen_rays"];
+pub const SHARED_FEATURES: [&str; 7] = [
+    "frame",
+    "screen",
+    "screen_extra_msaa_samples",
+    "screen_extra_ssaa_samples",
+    "screen_rays",
+    "screen_shadow_rays",
+    "screen_caustic_rays",
+];
 
 /// What a method's whole-screen kernels scale with: a constant per frame (its dispatches,
-/// barriers and resets: a ray tracer's frame at 64² is mostly that), the scene's triangles
-/// (1e4: the structures it rebuilds when objects move), the frame's pixels (1e4), its
-/// samples beyond one per pixel, and its samples times the hierarchy depth (every sample's
-/// primary ray).
+/// barriers and resets: a ray tracer's frame at 64² is mostly that), the frame's pixels
+/// (1e4), its samples beyond one per pixel, its samples on geometry times the hierarchy
+/// depth (every such sample's rays: one on the environment ends at once), that times the
+/// lights (a ray tracer's shadow rays) and times the caustic cubes (the caustics its
+/// diffuse hits read). Not the scene's triangles but their
+/// logarithm: a traversal's frame grows with the hierarchy's depth (survey Table 1 measured,
+/// BENCHMARKS.md: bvh 226 ms at 1.7·10³ triangles, 527 ms at 10⁶); a term linear in
+/// triangles, fitted on six calibration scenes, took their noise and predicted bvh on the
+/// concave mirror 2.5× its measured frame.
 pub fn shared_features(w: &Workload) -> Vec<f64> {
     let px = w.screen / 1e4;
     let [msaa, ssaa] = extra(w);
-    vec![1.0, w.scene_triangles / 1e4, px, px * msaa, px * ssaa, px * w.samples * depth(w)]
+    let rays = w.covered.unwrap_or(w.screen).min(w.screen) / 1e4 * w.samples * depth(w);
+    vec![1.0, px, px * msaa, px * ssaa, rays, rays * w.lights, rays * caustic_cubes(w)]
 }
 
 /// Samples beyond one per pixel, multisampled and supersampled.
@@ -180,8 +249,8 @@ fn depth(w: &Workload) -> f64 {
     w.scene_triangles.max(2.0).log2() / 16.0
 }
 
-/// The workload of object `f` at `size` covering `pixels` of it.
-pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), pixels: f64) -> Workload {
+/// The workload of object `f` at `size` covering `pixels` of it, in `frame`.
+pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), pixels: f64, frame: &FrameWork) -> Workload {
     let visible = |m: &&crate::scene::Mesh| !m.hidden;
     Workload {
         pixels,
@@ -194,5 +263,8 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         thin: (f.class == ObjectClass::ThinDielectric) as u8 as f64,
         samples: aa_samples(q).0,
         supersampled: (q.frame.aa.ssaa() > 1) as u8 as f64,
+        caustic_photons: frame.caustic_photons,
+        caustic_texels: frame.caustic_texels,
+        covered: Some(frame.covered),
     }
 }

@@ -36,7 +36,7 @@ use std::sync::{Arc, OnceLock};
 
 use cost_model::CostModel;
 use error_model::ErrorModel;
-use features::{error_features, workload};
+use features::{error_features, workload, FrameWork};
 use samples::Corpus;
 
 use super::budget::{self, Budget, Cost, Models, ObjectModel, Prediction, VariantModel};
@@ -137,9 +137,11 @@ fn models_measured(
         let (aa, aa_n, per_sample) = (q.get("aa"), features::aa_samples(&q).1, q.frame.msaa_per_sample);
         let mut objects = Vec::new();
         let mut base = 0.0;
+        let meshes: Vec<usize> = facts.objects.iter().map(|f| f.mesh).collect();
+        let frame = FrameWork::new(scene, &meshes, &q, px.iter().sum());
         for f in &facts.objects {
             let name = &scene.meshes[f.mesh].name;
-            let work = workload(f, scene, &q, target.size, px[f.mesh]);
+            let work = workload(f, scene, &q, target.size, px[f.mesh], &frame);
             base = target.costs.base_ms(&work);
             let feats = error_features(f, scene, &q);
             for &m in Method::ALL.iter().filter(|m| m.is_gpu() && m.fits(f)) {

@@ -128,7 +128,17 @@ impl Corpus {
 }
 
 fn check_work(w: &Workload, what: &str) -> Result<()> {
-    let all = [w.pixels, w.screen, w.scene_triangles, w.triangles, w.cube_texels, w.lights];
+    let all = [
+        w.pixels,
+        w.screen,
+        w.scene_triangles,
+        w.triangles,
+        w.cube_texels,
+        w.lights,
+        w.caustic_photons,
+        w.caustic_texels,
+        w.covered.unwrap_or(0.0),
+    ];
     if all.iter().any(|x| !x.is_finite() || *x < 0.0) || !(w.samples.is_finite() && w.samples >= 1.0) {
         return Err(Error::invalid(what.to_string(), format!("{w:?}: every count must be finite and non-negative")));
     }
