@@ -317,11 +317,10 @@ fn anti_aliasing_removes_at_most_the_exact_tracers_aliasing_at_the_frames_size()
 /// far less than 64× more at 512² than at 64² (measured on lavapipe: 11.8 ms at 64², 72–99 ms
 /// at 512² when this test was written; 19.5 ms at 64², 29 / 51 ms at 128² / 256² and 106–140
 /// ms at 512² on 2026-12-06, `specula bench builtin:concave-occluder --method bvh --size NxN
-/// -q map_updates=always`; a model without the constant predicted 449 ms), and every method's
-/// frame grows with its pixels. The calibration of 2026-12-06 (64² and 256²) predicts 19.5
-/// and 231 ms: 1.65–2.2× over at 512², where lavapipe's cost per pixel is lower than the
-/// calibration rooms' mirrors at 256² show (corpus-00 at 512²: 155 ms measured, 214
-/// predicted); the bound at 512² is twice the highest measured frame.
+/// -q map_updates=always`; a model without the constant predicted 449 ms; the stored
+/// calibration, 64² and 256², predicts 15.7 and 126 ms), and no method's frame shrinks with
+/// its pixels (curved-reflector's does not grow: its calibration frames took 39 / 33 ms and
+/// 68 / 73 ms at 64² / 256², its search is over the geometry image, not the pixels).
 #[test]
 fn unit_costs_follow_the_frame_size() {
     let frame = |size: (u32, u32)| {
@@ -335,10 +334,10 @@ fn unit_costs_follow_the_frame_size() {
     let (small, large) = (frame((64, 64)), frame((512, 512)));
     println!("predicted ms at 64² and 512²: {:?}", small.iter().map(|(m, v)| format!("{m} {v:.1} / {:.1}", large[m])).collect::<Vec<_>>());
     let bvh = (small["bvh"], large["bvh"]);
-    assert!((5.0..25.0).contains(&bvh.0) && (36.0..280.0).contains(&bvh.1), "bvh {bvh:?} ms");
+    assert!((5.0..25.0).contains(&bvh.0) && (36.0..200.0).contains(&bvh.1), "bvh {bvh:?} ms");
     assert!(bvh.1 / bvh.0 < 16.0, "bvh grows {:.1}× for 64× the pixels", bvh.1 / bvh.0);
     for (m, v) in &small {
-        assert!(large[m] > *v, "{m}: {v:.2} ms at 64², {:.2} at 512²", large[m]);
+        assert!(large[m] >= *v, "{m}: {v:.2} ms at 64², {:.2} at 512²", large[m]);
     }
 }
 
@@ -734,9 +733,9 @@ fn a_calibration_measures_pixels_and_the_knobs_a_method_reads() {
 /// An unseen scene with a light: a glass blob beside a mirror sphere in a closed room lit by
 /// a point light (caustics from both, shadow maps; the calibration's lit scenes are 3 and 7).
 const LIT_SCENE: usize = 39;
-/// How far a lit frame's measured time may lie from its prediction, either way. The
-/// calibration's own frames fit within 1.6× (BENCHMARKS.md, "The light in the cost
-/// models"); before the light terms, envmap's lit frames were predicted up to 12× short.
+/// How far a lit frame's measured time may lie from its prediction, either way (measured
+/// 0.97–1.63× with the stored calibration, BENCHMARKS.md, "The light in the cost models";
+/// before the light terms, envmap's lit frames were predicted up to 12× short).
 const LIT_SPREAD: f64 = 2.0;
 
 /// The cost models predict frames with a light and caustics on a scene they never measured:
