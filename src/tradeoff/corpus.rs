@@ -132,9 +132,9 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                     let passes: Vec<(String, f64)> = frame.passes.iter().map(|p| (p.name.clone(), p.gpu_ms)).collect();
                     let (costs, base) = crate::plan::budget::attribute(&plan, &passes);
                     let mut any = None;
-                    let meshes: Vec<usize> = plan.objects.iter().map(|o| o.mesh).collect();
                     let covered = object_pixels[1..].iter().sum::<usize>() as f64;
-                    let frame = crate::plan::predict::features::FrameWork::new(&scene, &meshes, &q, covered);
+                    let caustics = plan.caustics.as_ref().map_or((0.0, 0.0), |c| c.work(&q));
+                    let frame = crate::plan::predict::features::FrameWork::with(caustics, covered);
                     for (o, (mesh, own, shared)) in plan.objects.iter().zip(costs) {
                         let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
                         let pixels = object_pixels[mesh + 1];

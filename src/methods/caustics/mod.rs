@@ -81,6 +81,12 @@ impl CausticsPlan {
         self.photon_layers as u64 * (q.caustics.photons as u64).pow(2)
     }
 
+    /// What it does as the cost model counts it ([`photon_work`]): photons traced, and
+    /// texels of its caustic cubes (six faces of `cube_size`² each).
+    pub fn work(&self, q: &Quality) -> (f64, f64) {
+        (self.photon_count(q) as f64, self.cubes.len() as f64 * 6.0 * (q.cube.cube_size as f64).powi(2))
+    }
+
     /// caustics=photon-map: the photon grid's buckets, the power of two at or above the
     /// photons' count (a load factor of at most 1).
     pub fn grid_cells(&self, q: &Quality) -> u32 {
@@ -255,9 +261,7 @@ pub fn plan(scene: &Scene, objects: &[ObjectPlan], q: &Quality) -> Option<Causti
 /// photon image's texels) and caustic cube texels (receiver distance cubes and light cubes,
 /// six faces of `cube_size`² each). Zero where the frame has no caustics.
 pub fn photon_work(scene: &Scene, meshes: &[usize], q: &Quality) -> (f64, f64) {
-    let texels = 6.0 * (q.cube.cube_size as f64).powi(2);
-    plan_of(scene, meshes.iter().map(|&m| (m, String::new(), Vec3::ZERO)), q)
-        .map_or((0.0, 0.0), |c| (c.photon_count(q) as f64, c.cubes.len() as f64 * texels))
+    plan_of(scene, meshes.iter().map(|&m| (m, String::new(), Vec3::ZERO)), q).map_or((0.0, 0.0), |c| c.work(q))
 }
 
 /// [`plan`] over (mesh, name, reference point) of each specular object.

@@ -132,9 +132,14 @@ pub struct FrameWork {
 
 impl FrameWork {
     /// The frame of `scene` whose specular objects are `meshes`, under `q`, with `covered`
-    /// pixels showing geometry.
+    /// pixels showing geometry (its caustics as the plan would make them).
     pub fn new(scene: &Scene, meshes: &[usize], q: &Quality, covered: f64) -> FrameWork {
-        let (caustic_photons, caustic_texels) = crate::methods::caustics::photon_work(scene, meshes, q);
+        Self::with(crate::methods::caustics::photon_work(scene, meshes, q), covered)
+    }
+
+    /// The frame with caustics doing `(photons, caustic cube texels)`
+    /// (`CausticsPlan::work` of a planned frame).
+    pub fn with((caustic_photons, caustic_texels): (f64, f64), covered: f64) -> FrameWork {
         FrameWork { caustic_photons, caustic_texels, covered }
     }
 }
@@ -266,5 +271,30 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         caustic_photons: frame.caustic_photons,
         caustic_texels: frame.caustic_texels,
         covered: Some(frame.covered),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A ray tracer's kernels trace rays from the pixels that show geometry: half the screen
+    /// covered, half the rays (and their shadow and caustic rays); unknown, the whole screen.
+    #[test]
+    fn rays_start_on_covered_pixels() {
+        let w = Workload {
+            screen: 4e4,
+            scene_triangles: 1e3,
+            cube_texels: 1e5,
+            lights: 2.0,
+            caustic_texels: 2e5,
+            covered: None,
+            ..Workload::default()
+        };
+        let (all, half) = (shared_features(&w), shared_features(&Workload { covered: Some(2e4), ..w }));
+        for k in 4..7 {
+            assert!(all[k] > 0.0 && (half[k] - 0.5 * all[k]).abs() < 1e-12, "{k}: {all:?} {half:?}");
+        }
+        assert_eq!(all[..4], half[..4]);
     }
 }
