@@ -12,7 +12,7 @@ mod common;
 
 use specula::metrics::errors_by_object;
 use specula::plan::budget::Budget;
-use specula::plan::predict::{self, Target};
+use specula::plan::predict::{self, error_model, Target};
 use specula::plan::{plan_for, Choices};
 use specula::scenes::corpus;
 use specula::{Choice, Method, Quality, Scene};
@@ -174,6 +174,17 @@ fn auto_and_budgets_on_unseen_scenes() {
                     && p.objects.iter().map(|o| o.method).eq(auto_plan.objects.iter().map(|o| o.method))
             })
             .map(|k| singles[k].ms);
+        let auto_methods: Vec<String> = auto_plan
+            .objects
+            .iter()
+            .map(|o| format!("{}={}", scene.meshes[o.mesh].name, o.method.name))
+            .chain(
+                specula::quality::KNOBS
+                    .iter()
+                    .filter(|k| auto_plan.quality.get(k.name) != q.get(k.name))
+                    .map(|k| format!("{}={}", k.name, auto_plan.quality.get(k.name))),
+            )
+            .collect();
         let mut auto = measure_plan(&ctx, &scene, "auto", auto_plan, &reference, TIMED);
         auto.ms = auto.ms.min(twin.unwrap_or(f64::INFINITY));
         let table: String = singles
@@ -186,8 +197,18 @@ fn auto_and_budgets_on_unseen_scenes() {
             assert!(!dominates, "{name}: {} beats auto in both time and error:{table}", s.label);
         }
         // The default budget is the exact tracer's frame: the best single method within it.
-        let budget = singles.iter().find(|s| s.label == "bvh").unwrap().ms * NOISE;
-        let fits: Vec<&Measured> = singles.iter().filter(|s| s.ms <= budget).collect();
+        let bvh_ms = singles.iter().find(|s| s.label == "bvh").unwrap().ms;
+        let budget = bvh_ms * NOISE;
+        // The exact schemes render one image, and auto takes bvh among them unless another is
+        // predicted faster by more than SCHEME_MARGIN: the exact frame auto is held to is
+        // bvh's, unless a scheme measured faster beyond that margin (a CI run held auto to
+        // octree's 26.7 ms, the fastest of five exact frames within 1.2x of each other).
+        let exact = |s: &Measured| error_model::model_key(&s.label) == error_model::EXACT;
+        let held = |s: &Measured| match exact(s) && s.ms * (1.0 + predict::SCHEME_MARGIN) >= bvh_ms {
+            true => Measured { label: "bvh".into(), ms: bvh_ms, ..s.clone() },
+            false => s.clone(),
+        };
+        let fits: Vec<Measured> = singles.iter().filter(|s| s.ms <= budget).map(held).collect();
         let top = fits.iter().map(|s| s.psnr).fold(f64::NEG_INFINITY, f64::max);
         let best = fits.iter().filter(|s| s.psnr >= top - 0.5).min_by(|a, b| a.ms.total_cmp(&b.ms)).unwrap();
         // A time check that fails is measured again, the two in turns (the machine is shared).
@@ -205,7 +226,8 @@ fn auto_and_budgets_on_unseen_scenes() {
         let richer = auto.psnr > best.psnr + 0.5 && auto_ms <= budget;
         assert!(
             auto.psnr >= best.psnr - 0.5 && (auto_ms <= CHOICE * best_ms || richer),
-            "{name}: auto {:.2} ms {:.1} dB against the best single method {} {:.2} ms {:.1} dB:{table}",
+            "{name}: auto ({}) {:.2} ms {:.1} dB against the best single method {} {:.2} ms {:.1} dB:{table}",
+            auto_methods.join(" "),
             auto_ms,
             auto.psnr,
             best.label,
