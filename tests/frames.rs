@@ -71,13 +71,33 @@ fn incremental_equals_fresh(half: usize) {
         let mut scene = base.clone();
         let mut r = renderer(&ctx, &scene, m, &q);
         r.render(&ctx).unwrap();
+        // bvh follows moves with a linear BVH built on the GPU (bvh_update=lbvh), over the
+        // CPU's SAH tree of its first frame: a fresh renderer that builds the same tree
+        // (bvh_build=lbvh) renders the same bits.
+        let fresh_q = match m == specula::methods::BVH {
+            true => {
+                let mut q = q.clone();
+                q.set("bvh_build", "lbvh").unwrap();
+                q
+            }
+            false => q.clone(),
+        };
         let mut kept = None;
         for k in 1..=frames {
             scene.set_object_transform(i, pose(k, centre)).unwrap();
             let c = r.update(&scene).unwrap();
             assert_eq!(c.moved, vec![i]);
-            let got = bits(&r.render(&ctx).unwrap());
-            assert!(got == fresh(&ctx, &scene, m, &q), "{}: frame {k} after a move differs from a fresh render", m.name());
+            let f = r.render(&ctx).unwrap();
+            if m == specula::methods::BVH {
+                let built: Vec<f64> = ["raytrace.gpu_builds", "raytrace.gpu_refits"]
+                    .iter()
+                    .map(|s| f.stats.iter().find(|(n, _)| n == s).map_or(-1.0, |(_, v)| *v))
+                    .collect();
+                assert_eq!(built, [k as f64, 0.0], "bvh: frame {k} builds its BVH on the GPU");
+                assert!(pass_names(&f).contains(&"raytrace.build"), "{:?}", pass_names(&f));
+            }
+            let got = bits(&f);
+            assert!(got == fresh(&ctx, &scene, m, &fresh_q), "{}: frame {k} after a move differs from a fresh render", m.name());
             // The fresh renderers after the first make no pipeline: the context's serve them.
             let n = ctx.pipeline_counts().0;
             assert!(kept.is_none_or(|k| k == n), "{}: frame {k}'s fresh renderer made pipelines ({kept:?} -> {n})", m.name());

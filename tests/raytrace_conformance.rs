@@ -14,6 +14,7 @@ use glam::{DVec3, Vec3};
 use specula::frame::layout::{GpuRayHit, GpuRayQuery, RAY_ANY_HIT, RAY_NO_TRIANGLE};
 use specula::methods::raytrace::gpu::Intersector;
 use specula::methods::raytrace::knobs::KdTraversal;
+use specula::methods::raytrace::lbvh::Work;
 use specula::methods::raytrace::{Scheme, TriangleList};
 use specula::optics::ray_triangle;
 
@@ -134,8 +135,10 @@ fn agreement(
 
 fn schemes() -> Vec<Scheme> {
     vec![
-        Scheme::Bvh { stackless: false },
-        Scheme::Bvh { stackless: true },
+        Scheme::Bvh { stackless: false, gpu: false },
+        Scheme::Bvh { stackless: true, gpu: false },
+        Scheme::Bvh { stackless: false, gpu: true },
+        Scheme::Bvh { stackless: true, gpu: true },
         Scheme::Grid { density: 2.0, skip_empty: false },
         Scheme::Grid { density: 2.0, skip_empty: true },
         Scheme::Grid { density: 0.25, skip_empty: true },
@@ -209,37 +212,116 @@ fn check_soup(ctx: &specula::vk::Context, n: usize, m: usize, seed: u64) {
     let (agree, total, why) = agreement(&queries, &reference, &cpu, 1e-4, |i| i % 4 == 0 || i % 4 == 3);
     eprintln!("N = {n}: GPU brute force agrees with the CPU on {agree} of {total} nearest-hit rays (random and centroid)");
     assert!(total > 0 && agree == total, "N = {n}: GPU brute force agrees with the CPU on {agree} of {total} rays; {why:?}");
-    let as_expected: Vec<Option<(u32, f64)>> =
-        reference.iter().map(|h| (h.triangle != RAY_NO_TRIANGLE).then_some((h.triangle, h.t as f64))).collect();
     for scheme in schemes() {
         let packed = scheme.build(&list).unwrap();
         let mut x = Intersector::new(ctx, scheme, &list, &packed).unwrap();
         let (hits, ms) = x.intersect(ctx, &queries).unwrap();
         x.destroy(ctx);
-        let nearest = queries.iter().filter(|q| q.flags & RAY_ANY_HIT == 0).count();
         let same =
             queries.iter().zip(&hits).zip(&reference).filter(|((q, h), r)| q.flags & RAY_ANY_HIT == 0 && h.triangle == r.triangle).count();
-        // Same f32 test on the same triangles: equal up to ties, on every ray (those aimed
-        // at corners and edges test that no box or cell culls a boundary hit). Measured:
-        // every ray, every scheme, every N (the same triangle too: no tie was split); none
-        // may disagree (≥ 99.9 % let one of the 1861 rays of N = 1000 through).
-        let (agree, total, why) = agreement(&queries, &hits, &as_expected, 1e-6, |_| true);
-        eprintln!(
-            "N = {n}, {scheme:?}: agrees with brute force on {agree} of {total} nearest-hit rays ({same} the same triangle), {ms:.2} ms"
-        );
-        assert!(total == nearest && agree == total, "N = {n}, {scheme:?}: {agree} of {total} agree with brute force; {why:?}");
-        // Any-hit queries: a hit exactly where brute force finds one, within the ray's bounds.
-        for ((q, h), r) in queries.iter().zip(&hits).zip(&reference) {
-            if q.flags & RAY_ANY_HIT != 0 {
-                assert_eq!(h.triangle != RAY_NO_TRIANGLE, r.triangle != RAY_NO_TRIANGLE, "N = {n}, {scheme:?}, any-hit {q:?}");
-                if h.triangle != RAY_NO_TRIANGLE {
-                    assert!(h.t > q.origin[3] && h.t < q.direction[3] && h.triangle != q.skip);
-                }
-            }
-        }
+        let label = format!("N = {n}, {scheme:?}");
+        assert_agrees(&label, &queries, &hits, &reference, &format!("({same} the same triangle), {ms:.2} ms"));
     }
     check_ray_query(ctx, n, &list, &queries, &reference);
     common::assert_clean(ctx);
+}
+
+/// `hits` against brute force's `reference` on the same queries: the same nearest hit (or
+/// the same t to 1e-6) on every nearest-hit ray, and any-hit answers exactly where brute
+/// force finds a hit, within the ray's bounds.
+fn assert_agrees(label: &str, queries: &[GpuRayQuery], hits: &[GpuRayHit], reference: &[GpuRayHit], note: &str) {
+    let as_expected: Vec<Option<(u32, f64)>> =
+        reference.iter().map(|h| (h.triangle != RAY_NO_TRIANGLE).then_some((h.triangle, h.t as f64))).collect();
+    let nearest = queries.iter().filter(|q| q.flags & RAY_ANY_HIT == 0).count();
+    // Same f32 test on the same triangles: equal up to ties, on every ray (those aimed
+    // at corners and edges test that no box or cell culls a boundary hit). Measured:
+    // every ray, every scheme, every N (the same triangle too: no tie was split); none
+    // may disagree (≥ 99.9 % let one of the 1861 rays of N = 1000 through).
+    let (agree, total, why) = agreement(queries, hits, &as_expected, 1e-6, |_| true);
+    eprintln!("{label}: agrees with brute force on {agree} of {total} nearest-hit rays {note}");
+    assert!(total == nearest && agree == total, "{label}: {agree} of {total} agree with brute force; {why:?}");
+    for ((q, h), r) in queries.iter().zip(hits).zip(reference) {
+        if q.flags & RAY_ANY_HIT != 0 {
+            assert_eq!(h.triangle != RAY_NO_TRIANGLE, r.triangle != RAY_NO_TRIANGLE, "{label}, any-hit {q:?}");
+            if h.triangle != RAY_NO_TRIANGLE {
+                assert!(h.t > q.origin[3] && h.t < q.direction[3] && h.triangle != q.skip, "{label}, any-hit {q:?}: {h:?}");
+            }
+        }
+    }
+}
+
+/// BVHs that follow deforming geometry on the GPU (issue 36 item 4): a soup whose
+/// triangles all move (a jitter of each corner, and half of them carried 2 units away, which
+/// stretches the old grouping's boxes across the gap). The CPU's SAH tree and a GPU linear
+/// BVH, both built on the old soup and refitted on the GPU, and the linear BVH built again
+/// on the GPU, each agree with brute force on the new soup on every ray; the rebuilt tree
+/// equals one built fresh over the new soup, hit for hit.
+#[test]
+fn gpu_builds_and_refits_follow_deformed_soups() {
+    let ctx = common::gpu();
+    let n = 3000;
+    let mut rng = Rng(99);
+    let before = soup(n, &mut rng);
+    let after: Vec<[Vec3; 3]> = before
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            let carry = if k % 2 == 0 { Vec3::new(2.0, 0.0, 0.0) } else { Vec3::ZERO };
+            t.map(|v| v + carry + 0.02 * rng.vec())
+        })
+        .collect();
+    let queries = rays(&after, 1024, &mut rng);
+    let (old, new) = (TriangleList::from_soup(before).unwrap(), TriangleList::from_soup(after).unwrap());
+    let mut brute = Intersector::new(&ctx, Scheme::Brute, &new, &Scheme::Brute.build(&new).unwrap()).unwrap();
+    let (reference, _) = brute.intersect(&ctx, &queries).unwrap();
+    brute.destroy(&ctx);
+    let mut fresh_hits = None;
+    for (scheme, work) in [
+        (Scheme::Bvh { stackless: false, gpu: false }, Work::Refit),
+        (Scheme::Bvh { stackless: true, gpu: false }, Work::Refit),
+        (Scheme::Bvh { stackless: false, gpu: true }, Work::Refit),
+        (Scheme::Bvh { stackless: true, gpu: true }, Work::Build),
+        (Scheme::Bvh { stackless: false, gpu: true }, Work::Build),
+    ] {
+        let mut x = Intersector::new(&ctx, scheme, &old, &scheme.build(&old).unwrap()).unwrap();
+        let ms = x.update(&ctx, &new, work).unwrap();
+        let (hits, trace_ms) = x.intersect(&ctx, &queries).unwrap();
+        let b = x.gpu_bvh.as_ref().unwrap();
+        assert_eq!(
+            (b.builds, b.refits),
+            if work == Work::Build { (2, 0) } else { (u32::from(scheme == (Scheme::Bvh { stackless: false, gpu: true })), 1) }
+        );
+        x.destroy(&ctx);
+        let label = format!("N = {n} deformed, {scheme:?} then {work:?}");
+        assert_agrees(&label, &queries, &hits, &reference, &format!("({ms:.2} ms on the GPU, traced in {trace_ms:.2} ms)"));
+        if scheme == (Scheme::Bvh { stackless: false, gpu: true }) && work == Work::Build {
+            let mut fresh = Intersector::new(&ctx, scheme, &new, &scheme.build(&new).unwrap()).unwrap();
+            fresh_hits = Some(fresh.intersect(&ctx, &queries).unwrap().0);
+            fresh.destroy(&ctx);
+            let same = fresh_hits.as_ref().unwrap().iter().zip(&hits).all(|(a, b)| bytemuck::bytes_of(a) == bytemuck::bytes_of(b));
+            assert!(same, "{label}: the rebuilt tree's hits differ from a fresh build's");
+        }
+    }
+    assert!(fresh_hits.is_some());
+    // A refit of a structure with no tree, and a rebuild of a CPU tree, are refused by name.
+    let mut x = Intersector::new(
+        &ctx,
+        Scheme::Grid { density: 2.0, skip_empty: true },
+        &old,
+        &Scheme::Grid { density: 2.0, skip_empty: true }.build(&old).unwrap(),
+    )
+    .unwrap();
+    let e = x.update(&ctx, &new, Work::Refit).unwrap_err().to_string();
+    assert!(e.contains("raytrace.update") && e.contains("Grid"), "{e}");
+    x.destroy(&ctx);
+    let scheme = Scheme::Bvh { stackless: false, gpu: false };
+    let mut x = Intersector::new(&ctx, scheme, &old, &scheme.build(&old).unwrap()).unwrap();
+    let e = x.update(&ctx, &new, Work::Build).unwrap_err().to_string();
+    assert!(e.contains("bvh_update=lbvh") && e.contains("only refits"), "{e}");
+    let e = x.update(&ctx, &TriangleList::from_soup(vec![[Vec3::ZERO, Vec3::X, Vec3::Y]]).unwrap(), Work::Refit).unwrap_err().to_string();
+    assert!(e.contains("1 triangles where the structure has 3000"), "{e}");
+    x.destroy(&ctx);
+    common::assert_clean(&ctx);
 }
 
 #[test]
@@ -290,8 +372,9 @@ fn triangles_beyond_the_loop_budget_are_tested() {
         let list = TriangleList::from_soup(tris).unwrap();
         for scheme in [
             Scheme::Brute,
-            Scheme::Bvh { stackless: false },
-            Scheme::Bvh { stackless: true },
+            Scheme::Bvh { stackless: false, gpu: false },
+            Scheme::Bvh { stackless: true, gpu: false },
+            Scheme::Bvh { stackless: true, gpu: true },
             Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::ShortStack },
             Scheme::KdTree { max_depth: 0, leaf_size: ONE_LEAF, traversal: KdTraversal::Restart },
             Scheme::KdTree { max_depth: 0, leaf_size: 2, traversal: KdTraversal::Ropes },

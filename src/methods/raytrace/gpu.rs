@@ -5,6 +5,7 @@
 
 use ash::vk;
 
+use super::lbvh::{GpuBvh, Work};
 use super::ray_query::accel::{AccelStructures, MeshInput};
 use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result};
@@ -57,10 +58,18 @@ impl Structure {
         self.triangles = Buffer::with_data(ctx, &name("triangles"), &list.gpu(), STORAGE)?;
         // Empty parts get one word, so that every binding holds a valid buffer.
         let or_one = |v: &[u32]| if v.is_empty() { vec![0u32] } else { v.to_vec() };
-        let nodes: Vec<u32> = packed.nodes.iter().flatten().copied().collect();
-        self.nodes = Buffer::with_data(ctx, &name("nodes"), &or_one(&nodes), STORAGE)?;
-        self.refs = Buffer::with_data(ctx, &name("refs"), &or_one(&packed.refs), STORAGE)?;
-        self.aux = Buffer::with_data(ctx, &name("aux"), &or_one(&packed.aux), STORAGE)?;
+        if matches!(self.scheme, Scheme::Bvh { gpu: true, .. }) {
+            // The GPU writes them (`lbvh.rs`): device memory, nothing uploaded.
+            let words = |n: usize| 4 * n.max(1) as u64;
+            self.nodes = Buffer::new(ctx, &name("nodes"), 4 * words(packed.nodes.len()), STORAGE, MemoryLocation::GpuOnly)?;
+            self.refs = Buffer::new(ctx, &name("refs"), words(packed.refs.len()), STORAGE, MemoryLocation::GpuOnly)?;
+            self.aux = Buffer::new(ctx, &name("aux"), words(packed.aux.len()), STORAGE, MemoryLocation::GpuOnly)?;
+        } else {
+            let nodes: Vec<u32> = packed.nodes.iter().flatten().copied().collect();
+            self.nodes = Buffer::with_data(ctx, &name("nodes"), &or_one(&nodes), STORAGE)?;
+            self.refs = Buffer::with_data(ctx, &name("refs"), &or_one(&packed.refs), STORAGE)?;
+            self.aux = Buffer::with_data(ctx, &name("aux"), &or_one(&packed.aux), STORAGE)?;
+        }
         self.params = Buffer::with_data(ctx, &name("params"), &[packed.accel], STORAGE)?;
         Ok(())
     }
@@ -79,6 +88,29 @@ impl Structure {
     /// triangle list that every scheme shares.
     pub fn structure_bytes(&self) -> u64 {
         self.structure_bytes
+    }
+
+    /// The triangle list, nodes, references and auxiliary words (what a GPU builder writes).
+    pub fn buffers(&self) -> [vk::Buffer; 4] {
+        [self.triangles.raw, self.nodes.raw, self.refs.raw, self.aux.raw]
+    }
+
+    /// The node words as the device holds them (host-visible; no frame may be writing them).
+    pub fn node_words(&self) -> Result<&[u8]> {
+        self.nodes.read()
+    }
+
+    /// Rewrites the triangle list in place (the frames that read it have completed): the
+    /// same number of triangles, moved or deformed; the structure is then stale until a
+    /// GPU build or refit (`lbvh.rs`).
+    pub fn write_triangles(&mut self, list: &TriangleList) -> Result<()> {
+        if list.len() as u32 != self.accel.triangle_count {
+            return Err(Error::invalid(
+                "raytrace.triangles",
+                format!("{} triangles where the structure has {}", list.len(), self.accel.triangle_count),
+            ));
+        }
+        self.triangles.write(bytemuck::cast_slice(&list.gpu()))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
@@ -100,6 +132,8 @@ pub struct Intersector {
     set: vk::DescriptorSet,
     /// The ray-query scheme's structures (over the list as one mesh) and its set 5.
     pub accel: Option<AccelStructures>,
+    /// The GPU builder (`bvh_build=lbvh`, or a refit asked for by `update`).
+    pub gpu_bvh: Option<GpuBvh>,
     rq_pool: vk::DescriptorPool,
     rq_set: vk::DescriptorSet,
 }
@@ -117,6 +151,7 @@ impl Intersector {
             pool: vk::DescriptorPool::null(),
             set: vk::DescriptorSet::null(),
             accel: None,
+            gpu_bvh: None,
             rq_pool: vk::DescriptorPool::null(),
             rq_set: vk::DescriptorSet::null(),
         };
@@ -163,7 +198,42 @@ impl Intersector {
         let ty = vk::DescriptorType::STORAGE_BUFFER;
         write_buffer(ctx, set, binding::RAY_COUNT, ty, self.count.raw);
         write_buffer(ctx, set, binding::RAY_PAYLOADS, ty, vk::Buffer::null());
+        if matches!(self.structure.scheme, Scheme::Bvh { gpu: true, .. }) && !list.is_empty() {
+            self.gpu_bvh = Some(GpuBvh::linear(ctx, &self.structure, list)?);
+            self.run_gpu_work(ctx)?;
+        }
         Ok(())
+    }
+
+    /// Moves the triangles to `list` (the same count) and brings the structure up to date
+    /// on the GPU by `work`: a fresh linear BVH (only for `bvh_build=lbvh` structures) or a
+    /// refit of the current tree (any BVH). Returns the GPU milliseconds it took.
+    pub fn update(&mut self, ctx: &Context, list: &TriangleList, work: Work) -> Result<f64> {
+        if !matches!(self.structure.scheme, Scheme::Bvh { .. }) {
+            return Err(Error::invalid("raytrace.update", format!("{:?} has no GPU build or refit", self.structure.scheme)));
+        }
+        self.structure.write_triangles(list)?;
+        if self.gpu_bvh.is_none() {
+            self.gpu_bvh = Some(GpuBvh::refit_of(ctx, &self.structure)?);
+        }
+        let b = self.gpu_bvh.as_mut().expect("just set");
+        b.set_bounds(list);
+        b.request(work)?;
+        self.run_gpu_work(ctx)
+    }
+
+    /// Submits the builder's pending work and waits; its GPU milliseconds.
+    fn run_gpu_work(&mut self, ctx: &Context) -> Result<f64> {
+        let Some(b) = self.gpu_bvh.as_mut() else { return Ok(0.0) };
+        let mut profiler = Profiler::new(ctx, 2)?;
+        let r = ctx.one_shot(|cmd| {
+            let mut rec = Recorder::new(ctx, cmd, &mut profiler);
+            b.record(ctx, &mut rec, |pass| crate::frame::layout::Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; 8] });
+            Ok(())
+        });
+        let ms = r.and_then(|_| profiler.results(ctx)).map(|p| p.iter().map(|p| p.gpu_ms).sum::<f64>());
+        profiler.destroy(ctx);
+        ms
     }
 
     /// Records the intersection of `count` queries into `hits` under the pass name
@@ -240,6 +310,9 @@ impl Intersector {
         crate::vk::pipeline::destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
         if let Some(mut a) = self.accel.take() {
             a.destroy(ctx);
+        }
+        if let Some(mut b) = self.gpu_bvh.take() {
+            b.destroy(ctx);
         }
         self.count.destroy(ctx);
         self.structure.destroy(ctx);

@@ -9,6 +9,10 @@ knobs! {
         ray_budget: u32 = 4, count(1..=64, "rays per pixel");
         /// bvh (§2.3.5): nearest child first with a short stack, or stackless along hit/miss links (CHCH06)
         bvh_stackless as bvh_traversal: bool = "stack", one_of()["stack" => false, "stackless" => true];
+        /// bvh: the first build, on the CPU by the surface area heuristic (sah), or on the GPU as a linear BVH over Morton codes (lbvh: Karras's construction, one triangle per leaf; faster to build, slower to traverse)
+        bvh_gpu_build as bvh_build: bool = "sah", one_of()["sah" => false, "lbvh" => true];
+        /// bvh: when objects move or deform, a linear BVH built again on the GPU (lbvh), the current tree's boxes recomputed on the GPU (refit: no new grouping, so boxes grow loose as objects travel apart), or the SAH tree built again on the CPU (sah)
+        bvh_update: BvhUpdate = "lbvh", one_of()["lbvh" => BvhUpdate::Lbvh, "refit" => BvhUpdate::Refit, "sah" => BvhUpdate::Sah];
         /// grid (§2.3.1): cells of the uniform grid per triangle of the scene
         grid_density: f32 = 2, real(0.01..=64, "cells per triangle");
         /// grid: skip empty space by each empty cell's distance to the nearest non-empty cell (KL04)
@@ -47,4 +51,16 @@ pub enum KdTraversal {
     Restart,
     /// Stackless: each leaf's six ropes name its neighbours across its faces (PGSS07).
     Ropes,
+}
+
+/// How the BVH follows objects that move or deform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BvhUpdate {
+    /// A linear BVH built on the GPU from the triangles as they are now.
+    Lbvh,
+    /// The current tree's boxes recomputed on the GPU (its grouping kept).
+    Refit,
+    /// The SAH tree built again on the CPU.
+    Sah,
 }

@@ -122,9 +122,32 @@ gpu_structs! {
         node_count: uint,
         pad: uint,
     }
+
+    /// The GPU BVH builder's parameters (src/methods/raytrace/lbvh.rs): a linear BVH over
+    /// Morton codes (Karras 2012) and the bottom-up refit of any BVH of the `Accel` form.
+    struct GpuLbvh => struct Lbvh {
+        /// triangles in the list (the leaves of a linear BVH)
+        triangle_count: uint,
+        /// workgroups of LBVH_TILE keys per radix-sort pass
+        groups: uint,
+        /// leaf nodes (the refit's first threads); n for a linear BVH
+        leaves: uint,
+        /// nodes of the tree (2n - 1 for a linear BVH)
+        nodes: uint,
+        /// the Morton grid's minimum corner (xyz): the triangle list's bounds
+        lo: vec4,
+        /// Morton cells per world unit along each axis (xyz): 1024 over the bounds
+        scale: vec4,
+    }
 }
 
 gpu_consts! {
+    /// The GPU BVH builder's workgroup of keys (one per invocation) in the radix sort, and
+    /// the bits of the radix sort's digit (16 bins per pass, 8 passes over 32-bit keys).
+    LBVH_TILE: uint = 256;
+    LBVH_RADIX_BITS: uint = 4;
+    /// `lbvh_parents`: the root's parent.
+    LBVH_NONE: uint = 4294967295;
     /// Bins of a queue budget's weight histogram: half an octave each, from 2^16 down to
     /// 2^-16 (the first and last bins hold everything heavier and lighter); and sub-bins of
     /// the cut bin.
@@ -218,5 +241,30 @@ descriptor_sets! {
         /// Per object two counters a raster pass that traces keeps (distance_fallback=rays:
         /// the rays its search answered, the rays it traced)
         RQ_COUNTS = 2: STORAGE_BUFFER => "buffer RqCounts { uint rq_counts[]; }";
+    }
+
+    /// The GPU BVH builder (src/methods/raytrace/lbvh.rs), set 6 of its own kernels: it
+    /// writes the nodes, references and miss links that set 2 reads, in `Accel`'s BVH form.
+    LBVH_BINDINGS = set 6 {
+        LBVH_TRIANGLES = 0: STORAGE_BUFFER => "readonly buffer LbvhTriangles { Triangle lbvh_triangles[]; }";
+        /// The BVH's nodes (bvh.glsl's form: min bits and first, max bits and count); the
+        /// refit reads children its other invocations wrote
+        LBVH_NODES = 1: STORAGE_BUFFER => "coherent buffer LbvhNodes { uvec4 lbvh_nodes[]; }";
+        LBVH_REFS = 2: STORAGE_BUFFER => "buffer LbvhRefs { uint lbvh_refs[]; }";
+        /// Each node's miss link (the stackless traversal)
+        LBVH_AUX = 3: STORAGE_BUFFER => "buffer LbvhAux { uint lbvh_aux[]; }";
+        /// Morton keys and their triangles, two halves of n each (the radix sort's ping-pong)
+        LBVH_KEYS = 4: STORAGE_BUFFER => "buffer LbvhKeys { uint lbvh_keys[]; }";
+        LBVH_VALS = 5: STORAGE_BUFFER => "buffer LbvhVals { uint lbvh_vals[]; }";
+        /// Per radix-sort pass the keys per (digit, workgroup), digit-major, then scanned
+        LBVH_COUNTS = 6: STORAGE_BUFFER => "buffer LbvhCounts { uint lbvh_counts[]; }";
+        /// Each node's parent node (LBVH_NONE at the root)
+        LBVH_PARENTS = 7: STORAGE_BUFFER => "buffer LbvhParents { uint lbvh_parents[]; }";
+        /// The leaf nodes (the refit starts there), then a linear BVH's internal nodes by
+        /// their Karras index
+        LBVH_SLOTS = 8: STORAGE_BUFFER => "buffer LbvhSlots { uint lbvh_slots[]; }";
+        /// Per node the refit's arrivals (the second child to finish unites the boxes)
+        LBVH_FLAGS = 9: STORAGE_BUFFER => "coherent buffer LbvhFlags { uint lbvh_flags[]; }";
+        LBVH_PARAMS = 10: STORAGE_BUFFER => "readonly buffer LbvhParams { Lbvh lbvh; }";
     }
 }

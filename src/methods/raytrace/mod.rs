@@ -9,7 +9,8 @@
 //! [`Packed`]: 16-byte node words whose meaning is the scheme's, a reference list into the
 //! triangle list, an auxiliary word list, the kernel's parameters and its shader:
 //! - [`Scheme::Brute`]: every triangle for every ray (the baseline the tests compare with);
-//! - [`Scheme::Bvh`]: the CPU reference's SAH BVH (`reference::bvh`), traversed nearest
+//! - [`Scheme::Bvh`]: the CPU reference's SAH BVH (`reference::bvh`), or a linear BVH built
+//!   on the GPU ([`lbvh`]), traversed nearest
 //!   child first with a short stack, or stackless along hit/miss links (CHCH06);
 //! - [`Scheme::Grid`]: a uniform grid with 3D-DDA traversal (Amanatides–Woo), optionally
 //!   skipping empty space by each empty cell's Chebyshev distance to the nearest
@@ -28,8 +29,11 @@
 //! - [`Scheme::RayQuery`]: Vulkan's ray queries through acceleration structures that the
 //!   driver builds on the GPU (`ray_query`).
 //!
-//! A GPU build would need a parallel sort (Morton codes, LBVH) or per-cell atomic counters
-//! and a prefix sum (the grid); the structures are rebuilt only when geometry changes.
+//! The BVH is also built on the GPU ([`lbvh`]: a linear BVH over Morton codes, Karras's
+//! construction, and a bottom-up refit of any BVH): `bvh_build=lbvh` for the first build,
+//! and by default (`bvh_update=lbvh`) whenever objects move or deform, so that a moving
+//! scene does not wait for the CPU's SAH builder every frame. The other schemes are
+//! rebuilt on the CPU when geometry changes.
 
 pub mod bench;
 pub mod bih;
@@ -38,6 +42,7 @@ pub mod gpu;
 pub mod grid;
 pub mod kdtree;
 pub mod knobs;
+pub mod lbvh;
 pub mod octree;
 mod ray_order;
 pub mod ray_query;
@@ -90,7 +95,14 @@ pub(crate) const fn ray_tracer(name: &'static str, create: fn(&StageInit, &Camer
     }
 }
 
-const RAY_KNOBS_BVH: &[&str] = &[FrameKnobs::depth, FrameKnobs::fresnel, RaytraceKnobs::ray_budget, RaytraceKnobs::bvh_traversal];
+const RAY_KNOBS_BVH: &[&str] = &[
+    FrameKnobs::depth,
+    FrameKnobs::fresnel,
+    RaytraceKnobs::ray_budget,
+    RaytraceKnobs::bvh_traversal,
+    RaytraceKnobs::bvh_build,
+    RaytraceKnobs::bvh_update,
+];
 const RAY_KNOBS_KD: &[&str] = &[
     FrameKnobs::depth,
     FrameKnobs::fresnel,
@@ -132,7 +144,7 @@ pub const BVH_INFO: &MethodInfo = &MethodInfo {
     knobs: RAY_KNOBS_BVH,
     gpu: Some(ray_tracer("raytrace.bvh", |init, plan| {
             let q = &init.plan.quality;
-            stage::create(init, plan, Scheme::Bvh { stackless: q.raytrace.bvh_stackless })
+            stage::create(init, plan, Scheme::Bvh { stackless: q.raytrace.bvh_stackless, gpu: q.raytrace.bvh_gpu_build })
         })),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
@@ -313,8 +325,9 @@ impl TriangleList {
 pub enum Scheme {
     /// Every triangle for every ray.
     Brute,
-    /// SAH BVH; `stackless`: the threaded traversal along hit/miss links (CHCH06).
-    Bvh { stackless: bool },
+    /// SAH BVH built on the CPU, or (`gpu`) a linear BVH built on the GPU (`lbvh`);
+    /// `stackless`: the threaded traversal along hit/miss links (CHCH06).
+    Bvh { stackless: bool, gpu: bool },
     /// Uniform grid of about `density` × N cells; `skip_empty`: KL04 empty-space skipping.
     Grid { density: f32, skip_empty: bool },
     /// SAH kd-tree of at most `max_depth` levels (0: 8 + 1.3 log₂ N, at most
@@ -376,7 +389,9 @@ impl Scheme {
                 accel: GpuAccel { triangle_count: list.len() as u32, ..bytemuck::Zeroable::zeroed() },
                 shader: "raytrace/intersect_ray_query.comp",
             }),
-            Scheme::Bvh { stackless } => bvh::pack(list, stackless),
+            Scheme::Bvh { stackless, gpu: false } => bvh::pack(list, stackless),
+            // The nodes are the GPU's to fill (`lbvh::GpuBvh`).
+            Scheme::Bvh { stackless, gpu: true } => lbvh::placeholder(list, stackless),
             Scheme::Grid { density, skip_empty } => grid::pack(list, density, skip_empty),
             Scheme::KdTree { max_depth, leaf_size, traversal } => kdtree::pack(list, max_depth, leaf_size, traversal),
             Scheme::Octree { max_depth, leaf_size, volume } => octree::pack(list, max_depth, leaf_size, volume),

@@ -24,13 +24,15 @@
 use ash::vk;
 
 use super::gpu::Structure;
+use super::knobs::BvhUpdate;
+use super::lbvh::{GpuBvh, Work};
 use super::ray_order::RayOrder;
 use super::ray_query::accel::{AccelStructures, MeshInput};
-use super::{Scheme, TriangleList};
+use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
-    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuSpawnBudget, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, RAY_QUERY_BINDINGS,
-    TRACE_BINDINGS,
+    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuSpawnBudget, GpuTraceParams, GpuTriangleShading, Push, RAY_BINDINGS,
+    RAY_QUERY_BINDINGS, TRACE_BINDINGS,
 };
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
@@ -168,6 +170,10 @@ pub struct RayTrace {
     primary_set: vk::DescriptorSet,
     /// The structure's CPU build time (`raytrace.build`), milliseconds.
     pub build_ms: f64,
+    /// The BVH's GPU builder or refitter (`bvh_build=lbvh`, or once objects moved under
+    /// `bvh_update=lbvh|refit`), and how moves update the BVH.
+    gpu_bvh: Option<GpuBvh>,
+    bvh_update: BvhUpdate,
 }
 
 /// Creates the stage of a ray-tracing method for the plan's objects.
@@ -219,6 +225,8 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         trace_sets: Vec::new(),
         primary_set: vk::DescriptorSet::null(),
         build_ms: 0.0,
+        gpu_bvh: None,
+        bvh_update: q.raytrace.bvh_update,
     };
     match me.init(init, plan) {
         Ok(()) => Ok(Box::new(me)),
@@ -262,6 +270,10 @@ impl RayTrace {
         let packed = self.scheme.build(&list)?;
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
         self.structure = Some(Structure::new(ctx, self.scheme, &list, &packed)?);
+        // A BVH built on the GPU: recorded into the first frame (`raytrace.build`).
+        if let (Scheme::Bvh { gpu: true, .. }, Some(s), false) = (self.scheme, &self.structure, list.is_empty()) {
+            self.gpu_bvh = Some(GpuBvh::linear(ctx, s, &list)?);
+        }
         if self.scheme == Scheme::RayQuery {
             self.accel = Some(AccelStructures::new(ctx, &MeshInput::from_scene(scene))?);
         }
@@ -752,6 +764,66 @@ fn list_offset(list: &TriangleList) -> f32 {
     }
 }
 
+impl RayTrace {
+    /// A BVH follows moved or deformed objects on the GPU (`bvh_update`): the new triangles
+    /// written in place, then a linear BVH built again or the current tree refitted in the
+    /// next frame. False where the CPU builds instead (another scheme, `bvh_update=sah`, an
+    /// empty list, or a refit where the triangle count changed).
+    fn update_bvh_on_gpu(&mut self, ctx: &Context, list: &TriangleList) -> Result<bool> {
+        let Scheme::Bvh { stackless, .. } = self.scheme else { return Ok(false) };
+        let same_count = self.structure.as_ref().is_some_and(|s| s.accel.triangle_count as usize == list.len());
+        match self.bvh_update {
+            BvhUpdate::Sah => Ok(false),
+            _ if list.is_empty() => Ok(false),
+            BvhUpdate::Refit if !same_count => Ok(false),
+            BvhUpdate::Refit => {
+                let structure = self.structure.as_mut().expect("same_count");
+                structure.write_triangles(list)?;
+                if self.gpu_bvh.is_none() {
+                    self.gpu_bvh = Some(GpuBvh::refit_of(ctx, structure)?);
+                }
+                self.gpu_bvh.as_mut().expect("just set").request(Work::Refit)?;
+                Ok(true)
+            }
+            BvhUpdate::Lbvh => {
+                let linear = self.gpu_bvh.as_ref().is_some_and(|b| b.builds_linear());
+                if linear && same_count {
+                    self.structure.as_mut().expect("same_count").write_triangles(list)?;
+                    let b = self.gpu_bvh.as_mut().expect("linear");
+                    b.set_bounds(list);
+                    b.request(Work::Build)?;
+                } else {
+                    // The first move of a CPU-built tree (or a new triangle count): a
+                    // structure of the linear BVH's size, built in the next frame.
+                    self.scheme = Scheme::Bvh { stackless, gpu: true };
+                    let packed = self.scheme.build(list)?;
+                    self.replace_structure(ctx, list, &packed)?;
+                    let s = self.structure.as_ref().expect("just set");
+                    self.gpu_bvh = Some(GpuBvh::linear(ctx, s, list)?);
+                }
+                Ok(true)
+            }
+        }
+    }
+
+    /// A fresh structure over `list` in place of the current one (and of its GPU builder),
+    /// written into the ray sets.
+    fn replace_structure(&mut self, ctx: &Context, list: &TriangleList, packed: &Packed) -> Result<()> {
+        let fresh = Structure::new(ctx, self.scheme, list, packed)?;
+        if let Some(mut old) = self.structure.replace(fresh) {
+            old.destroy(ctx);
+        }
+        if let Some(mut b) = self.gpu_bvh.take() {
+            b.destroy(ctx);
+        }
+        let structure = self.structure.as_ref().expect("just set");
+        for &set in self.ray_sets.iter().chain(&self.shadow_sets) {
+            structure.write(ctx, set);
+        }
+        Ok(())
+    }
+}
+
 impl Stage for RayTrace {
     fn name(&self) -> &'static str {
         self.name
@@ -768,16 +840,11 @@ impl Stage for RayTrace {
         let ctx = init.ctx;
         let list = TriangleList::from_scene(init.scene);
         let start = std::time::Instant::now();
-        let packed = self.scheme.build(&list)?;
+        if !self.update_bvh_on_gpu(ctx, &list)? {
+            let packed = self.scheme.build(&list)?;
+            self.replace_structure(ctx, &list, &packed)?;
+        }
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
-        let fresh = Structure::new(ctx, self.scheme, &list, &packed)?;
-        if let Some(mut old) = self.structure.replace(fresh) {
-            old.destroy(ctx);
-        }
-        let structure = self.structure.as_ref().expect("just set");
-        for &set in self.ray_sets.iter().chain(&self.shadow_sets) {
-            structure.write(ctx, set);
-        }
         // Ray queries: new instances (a TLAS rebuild in the next frame), BLAS only for
         // deformed meshes.
         if let Some(accel) = self.accel.as_mut() {
@@ -805,6 +872,14 @@ impl Stage for RayTrace {
                 accel.touch();
             }
             accel.record(ctx, rec);
+        }
+        if let Some(b) = self.gpu_bvh.as_mut() {
+            if self.tlas_every_frame && b.pending().is_none() {
+                // map_updates=always: every frame pays what a move costs.
+                let work = if b.builds_linear() { Work::Build } else { Work::Refit };
+                let _ = b.request(work);
+            }
+            b.record(ctx, rec, |pass| Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; 8] });
         }
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
 
@@ -962,6 +1037,10 @@ impl Stage for RayTrace {
         }
         out.push(("raytrace.dropped_rays".to_string(), dropped as f64));
         out.push(("raytrace.build_ms".to_string(), self.build_ms));
+        if let Some(b) = &self.gpu_bvh {
+            out.push(("raytrace.gpu_builds".to_string(), b.builds as f64));
+            out.push(("raytrace.gpu_refits".to_string(), b.refits as f64));
+        }
         if let Some(a) = &self.accel {
             out.push(("raytrace.blas_builds".to_string(), a.stats.blas_builds as f64));
             out.push(("raytrace.tlas_builds".to_string(), a.stats.tlas_builds as f64));
@@ -1014,6 +1093,9 @@ impl Stage for RayTrace {
         }
         if let Some(mut a) = self.accel.take() {
             a.destroy(ctx);
+        }
+        if let Some(mut b) = self.gpu_bvh.take() {
+            b.destroy(ctx);
         }
         self.structure = None;
         for q in self.queues.iter_mut().chain(self.shadow.iter_mut()) {
