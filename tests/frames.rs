@@ -69,19 +69,21 @@ fn incremental_equals_fresh(half: usize) {
             _ => 4,
         };
         let mut scene = base.clone();
+        // bvh follows these moves with a linear BVH built on the GPU (bvh_update=lbvh; auto
+        // would refit, `bvh_follows_moves_by_refit_or_rebuild` below), over the CPU's SAH
+        // tree of its first frame: a fresh renderer that builds the same tree
+        // (bvh_build=lbvh) renders the same bits.
+        let (q, fresh_q) = match m == specula::methods::BVH {
+            true => {
+                let (mut a, mut b) = (q.clone(), q.clone());
+                a.set("bvh_update", "lbvh").unwrap();
+                b.set("bvh_build", "lbvh").unwrap();
+                (a, b)
+            }
+            false => (q.clone(), q.clone()),
+        };
         let mut r = renderer(&ctx, &scene, m, &q);
         r.render(&ctx).unwrap();
-        // bvh follows moves with a linear BVH built on the GPU (bvh_update=lbvh), over the
-        // CPU's SAH tree of its first frame: a fresh renderer that builds the same tree
-        // (bvh_build=lbvh) renders the same bits.
-        let fresh_q = match m == specula::methods::BVH {
-            true => {
-                let mut q = q.clone();
-                q.set("bvh_build", "lbvh").unwrap();
-                q
-            }
-            false => q.clone(),
-        };
         let mut kept = None;
         for k in 1..=frames {
             scene.set_object_transform(i, pose(k, centre)).unwrap();
@@ -105,6 +107,84 @@ fn incremental_equals_fresh(half: usize) {
         }
         r.destroy(&ctx);
     }
+    common::assert_clean(&ctx);
+}
+
+/// How `bvh` follows moves (`bvh_update=auto`, the default): a rigid move, however far,
+/// refits the tree on the GPU (pass `raytrace.refit`); a turn of more than REFIT_TURN since
+/// the tree was built, or a deformation, rebuilds it — on lavapipe by the CPU's SAH builder
+/// (its compute runs on the same cores); the next move refits again. A rebuilt frame
+/// equals a fresh renderer's bit for bit; a refitted one traces the same triangles through
+/// looser boxes, the same nearest hits: its pixels equal a fresh render's (at most a
+/// pixel where two triangles tie; none measured).
+#[test]
+fn bvh_follows_moves_by_refit_or_rebuild() {
+    let ctx = common::gpu();
+    let base = common::mirror_and_glass(24);
+    let i = mirror_index(&base);
+    let q = quality();
+    let mut scene = base.clone();
+    let mut r = renderer(&ctx, &scene, specula::methods::BVH, &q);
+    r.render(&ctx).unwrap();
+    let size = base.meshes[i].bounds().diagonal();
+    let stat = |f: &specula::Frame, s: &str| f.stats.iter().find(|(n, _)| n == s).map(|(_, v)| *v);
+    let glass = base.meshes.iter().position(|m| m.name == "glass").unwrap();
+    let centre = base.meshes[i].bounds().center();
+    let turned = |deg: f32| Mat4::from_translation(centre) * Mat4::from_rotation_z(deg.to_radians()) * Mat4::from_translation(-centre);
+    // (what changes, the GPU pass expected, the refits its refitter counted)
+    let steps: [(&str, Option<&str>, Option<f64>); 5] = [
+        ("a move of 0.02 diagonals", Some("raytrace.refit"), Some(1.0)),
+        ("a move of 1.5 diagonals", Some("raytrace.refit"), Some(2.0)),
+        ("a turn of 30 degrees", None, None),
+        ("a move of 0.1 diagonals", Some("raytrace.refit"), Some(1.0)),
+        ("a squash of the glass's own vertices", None, None),
+    ];
+    for (k, (what, pass, refits)) in steps.into_iter().enumerate() {
+        match k {
+            0 | 1 | 3 => {
+                let step = [0.02, 1.5, 0.0, 0.1][k] * size;
+                let at = Mat4::from_translation(Vec3::new(0.0, 0.0, -step)) * scene.meshes[i].world;
+                scene.set_object_transform(i, at).unwrap();
+            }
+            2 => {
+                let at = scene.meshes[i].world * turned(30.0);
+                scene.set_object_transform(i, at).unwrap();
+            }
+            _ => {
+                // The glass, never moved: its world positions are its own.
+                let c = scene.meshes[glass].bounds().center();
+                for p in &mut scene.meshes[glass].positions {
+                    p.y = c.y + (p.y - c.y) * 0.8;
+                }
+            }
+        }
+        assert_eq!(r.update(&scene).unwrap().moved, vec![if k == 4 { glass } else { i }], "{what}");
+        let f = r.render(&ctx).unwrap();
+        let names = pass_names(&f);
+        let gpu_pass = names.iter().find(|n| **n == "raytrace.refit" || **n == "raytrace.build").copied();
+        assert_eq!((gpu_pass, stat(&f, "raytrace.gpu_refits")), (pass, refits), "{what}: {names:?}");
+        let fresh = fresh(&ctx, &scene, specula::methods::BVH, &q);
+        let got = bits(&f);
+        let differ = got.chunks(4).zip(fresh.chunks(4)).filter(|(a, b)| a != b).count();
+        println!("{what}: {gpu_pass:?}, {differ} pixels differ from a fresh render");
+        match pass {
+            None => assert!(differ == 0, "{what}: a rebuilt tree renders a fresh renderer's bits ({differ} pixels differ)"),
+            Some(_) => assert!(differ <= 1, "{what}: the refitted tree's image differs from a fresh render in {differ} pixels"),
+        }
+    }
+    r.destroy(&ctx);
+    // bvh_update=sah: every move rebuilds on the CPU, never a GPU pass.
+    let mut q_sah = q.clone();
+    q_sah.set("bvh_update", "sah").unwrap();
+    let mut r = renderer(&ctx, &scene, specula::methods::BVH, &q_sah);
+    r.render(&ctx).unwrap();
+    let at = Mat4::from_translation(Vec3::new(0.0, 0.02 * size, 0.0)) * scene.meshes[i].world;
+    scene.set_object_transform(i, at).unwrap();
+    r.update(&scene).unwrap();
+    let f = r.render(&ctx).unwrap();
+    assert!(!pass_names(&f).iter().any(|n| *n == "raytrace.build" || *n == "raytrace.refit"), "{:?}", pass_names(&f));
+    assert!(bits(&f) == fresh(&ctx, &scene, specula::methods::BVH, &q_sah));
+    r.destroy(&ctx);
     common::assert_clean(&ctx);
 }
 

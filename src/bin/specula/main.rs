@@ -195,8 +195,9 @@ enum Command {
         /// Image size of the distance-vs-bvh comparison.
         #[arg(long, default_value = "512x512")]
         headline_size: String,
-        /// Parts to run (comma-separated): table1, culling, headline, mutual.
-        #[arg(long, default_value = "table1,culling,headline,mutual")]
+        /// Parts to run (comma-separated): table1, culling, headline, mutual, moves (what a
+        /// move costs bvh: the CPU's SAH rebuild, the GPU's linear BVH, the GPU refit).
+        #[arg(long, default_value = "table1,culling,headline,mutual,moves")]
         parts: String,
         #[arg(long, default_value = "raytrace-bench")]
         out: PathBuf,

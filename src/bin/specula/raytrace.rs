@@ -38,7 +38,10 @@ pub fn run(
         .split(',')
         .map(|p| {
             bench::Part::parse(p.trim()).ok_or_else(|| {
-                specula::Error::invalid("--parts", format!("'{}' is not one of table1, culling, headline, mutual", specula::error::clip(p)))
+                specula::Error::invalid(
+                    "--parts",
+                    format!("'{}' is not one of table1, culling, headline, mutual, moves", specula::error::clip(p)),
+                )
             })
         })
         .collect::<specula::Result<Vec<_>>>()?;

@@ -85,6 +85,7 @@ pub enum Part {
     Culling,
     Headline,
     Mutual,
+    Moves,
 }
 
 impl Part {
@@ -94,6 +95,7 @@ impl Part {
             "culling" => Part::Culling,
             "headline" => Part::Headline,
             "mutual" => Part::Mutual,
+            "moves" => Part::Moves,
             _ => return None,
         })
     }
@@ -185,6 +187,9 @@ pub fn run(ctx: &Context, c: &Config, out: &Path) -> Result<String> {
     }
     if c.parts.contains(&Part::Mutual) {
         mutual(ctx, c, &q, &mut md)?;
+    }
+    if c.parts.contains(&Part::Moves) {
+        moves(ctx, c, &mut md)?;
     }
     if !rows.is_empty() {
         write_table1(&rows, c, out)?;
@@ -339,6 +344,67 @@ fn mutual(ctx: &Context, c: &Config, q: &Quality, md: &mut String) -> Result<()>
         }
     }
     Ok(())
+}
+
+/// What a move costs `bvh` on Table 1's ladder: the mirror sphere moves every frame by
+/// 0.02 or 0.3 of its diagonal (`frames` moves after a first frame), and the tree follows
+/// by `bvh_update` — the CPU's SAH builder (the frame waits for it), a linear BVH built on
+/// the GPU, a GPU refit of the first frame's SAH tree (its boxes loosen as the sphere
+/// travels), or auto's choice between them. Per way: the
+/// median CPU milliseconds of the update, the GPU milliseconds of the build or refit pass,
+/// and of the frame's traversal and shading without it.
+fn moves(ctx: &Context, c: &Config, md: &mut String) -> Result<()> {
+    let (w, h) = c.size;
+    let _ = writeln!(md, "\n### What a move costs bvh: {w}×{h}, depth {}, median of {} moves of the mirror sphere\n", c.depth, c.frames);
+    let _ = writeln!(md, "| N (objects) | move (of the sphere's diagonal) | bvh_update | update ms (CPU) | build or refit ms (GPU) | frame ms without it (GPU) |");
+    let _ = writeln!(md, "|---:|---:|---|---:|---:|---:|");
+    for &n in &c.sizes {
+        let scene = scene_with(&c.demo, n)?;
+        let mirror = scene
+            .meshes
+            .iter()
+            .position(|m| matches!(scene.materials[m.material].kind, crate::scene::SurfaceKind::Mirror { .. }))
+            .ok_or_else(|| Error::invalid("raytrace-bench", "the demo scene should have a mirror sphere"))?;
+        let size = scene.meshes[mirror].bounds().diagonal();
+        for (step, way) in [0.02f32, 0.3, 1.0].into_iter().flat_map(|s| ["sah", "lbvh", "refit", "auto"].map(|w| (s, w))) {
+            let mut q = Quality::default();
+            q.frame.depth = c.depth;
+            q.set("bvh_update", way)?;
+            let plan = crate::plan::plan_with(&scene, &crate::plan::Choices::all(BVH), &q)?;
+            let mut r = crate::Renderer::new(ctx, &scene, plan, w, h)?;
+            let mut moved = scene.clone();
+            let result = (|| {
+                r.render(ctx)?;
+                let (mut cpu, mut gpu, mut frame) = (Vec::new(), Vec::new(), Vec::new());
+                for k in 1..=c.frames {
+                    let world =
+                        glam::Mat4::from_translation(glam::Vec3::new(step * size * k as f32, 0.0, 0.0)) * scene.meshes[mirror].world;
+                    moved.set_object_transform(mirror, world)?;
+                    r.update(&moved)?;
+                    let f = r.render(ctx)?;
+                    let stat = |name: &str| f.stats.iter().find(|(k, _)| k == name).map_or(0.0, |(_, v)| *v);
+                    let pass: f64 =
+                        f.passes.iter().filter(|p| p.name == "raytrace.build" || p.name == "raytrace.refit").map(|p| p.gpu_ms).sum();
+                    // The CPU side of the update: the SAH build, or the triangles rewritten.
+                    cpu.push(stat("raytrace.build_ms"));
+                    gpu.push(pass);
+                    frame.push(f.gpu_ms() - pass);
+                }
+                Ok::<_, Error>((median(&mut cpu), median(&mut gpu), median(&mut frame)))
+            })();
+            r.destroy(ctx);
+            let (cpu, gpu, frame) = result?;
+            let line = format!("| {n} | {step} | {way} | {cpu:.1} | {:.1} | {frame:.1} |", gpu.max(0.0));
+            println!("{line}");
+            let _ = writeln!(md, "{line}");
+        }
+    }
+    Ok(())
+}
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(0.0)
 }
 
 fn write_table1(rows: &[Row], c: &Config, out: &Path) -> Result<()> {

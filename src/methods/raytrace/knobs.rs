@@ -11,8 +11,8 @@ knobs! {
         bvh_stackless as bvh_traversal: bool = "stack", one_of()["stack" => false, "stackless" => true];
         /// bvh: the first build, on the CPU by the surface area heuristic (sah), or on the GPU as a linear BVH over Morton codes (lbvh: Karras's construction, one triangle per leaf; faster to build, slower to traverse)
         bvh_gpu_build as bvh_build: bool = "sah", one_of()["sah" => false, "lbvh" => true];
-        /// bvh: when objects move or deform, a linear BVH built again on the GPU (lbvh), the current tree's boxes recomputed on the GPU (refit: no new grouping, so boxes grow loose as objects travel apart), or the SAH tree built again on the CPU (sah)
-        bvh_update: BvhUpdate = "lbvh", one_of()["lbvh" => BvhUpdate::Lbvh, "refit" => BvhUpdate::Refit, "sah" => BvhUpdate::Sah];
+        /// bvh: when objects move or deform, the current tree's boxes recomputed on the GPU when objects moved rigidly (turned less than 20° in all since the tree was built), else the tree built again where it is faster (auto: by the CPU's SAH builder on a device whose compute runs on the CPU, such as lavapipe, else on the GPU); always a linear BVH built on the GPU (lbvh); always a refit (refit: no new grouping, so boxes grow loose as objects travel apart); or always the SAH tree built on the CPU (sah)
+        bvh_update: BvhUpdate = "auto", one_of()["auto" => BvhUpdate::Auto, "lbvh" => BvhUpdate::Lbvh, "refit" => BvhUpdate::Refit, "sah" => BvhUpdate::Sah];
         /// grid (§2.3.1): cells of the uniform grid per triangle of the scene
         grid_density: f32 = 2, real(0.01..=64, "cells per triangle");
         /// grid: skip empty space by each empty cell's distance to the nearest non-empty cell (KL04)
@@ -57,6 +57,9 @@ pub enum KdTraversal {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum BvhUpdate {
+    /// A refit over rigid moves (`stage::REFIT_TURN`), else a rebuild by the builder that
+    /// is faster on the device.
+    Auto,
     /// A linear BVH built on the GPU from the triangles as they are now.
     Lbvh,
     /// The current tree's boxes recomputed on the GPU (its grouping kept).

@@ -22,6 +22,7 @@
 //! frame is the same in every run too; the dropped rays and their path weight are stats.
 
 use ash::vk;
+use glam::Mat4;
 
 use super::gpu::Structure;
 use super::knobs::BvhUpdate;
@@ -174,6 +175,49 @@ pub struct RayTrace {
     /// `bvh_update=lbvh|refit`), and how moves update the BVH.
     gpu_bvh: Option<GpuBvh>,
     bvh_update: BvhUpdate,
+    /// Each mesh's world transform and object-space shape (a hash of its positions) when the
+    /// tree was last built: what `bvh_update=auto` refits over (moves) or rebuilds after
+    /// (deformation, turns beyond REFIT_TURN).
+    built_at: Vec<(Mat4, u64)>,
+    /// The device runs compute on the CPU (lavapipe): rebuilds there take the CPU's SAH
+    /// builder, measured faster than the GPU's linear BVH (BENCHMARKS.md).
+    cpu_device: bool,
+}
+
+/// `bvh_update=auto` refits the tree over objects that moved rigidly (translated, scaled,
+/// turned by less than this many radians in all since the tree was built) and rebuilds it
+/// after a deformation (an object's own positions changed) or a larger turn. Translation
+/// costs a refitted tree nothing measurable (the demo's mirror sphere carried 5 diagonals
+/// at 10⁵ triangles: frames within the noise of a rebuilt tree's, BENCHMARKS.md, "What a
+/// move costs bvh"): its subtree keeps its boxes, and only the few nodes that joined it
+/// to its neighbours stretch. A turn widens every box of its subtree: an axis-aligned box
+/// of a turned box grows by cos θ + sin θ along an axis, 1.34 at 20°.
+pub const REFIT_TURN: f32 = 20.0 * std::f32::consts::PI / 180.0;
+
+fn shapes_of(scene: &crate::scene::Scene) -> Vec<(Mat4, u64)> {
+    scene.meshes.iter().map(|m| (m.world, shape_hash(m))).collect()
+}
+
+fn shape_hash(m: &crate::scene::Mesh) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in m.object_positions() {
+        p.to_array().map(f32::to_bits).hash(&mut h);
+    }
+    m.indices.hash(&mut h);
+    h.finish()
+}
+
+/// The rotation, in radians, between two transforms' rotation parts.
+fn turn(a: Mat4, b: Mat4) -> f32 {
+    let (_, ra, _) = a.to_scale_rotation_translation();
+    let (_, rb, _) = b.to_scale_rotation_translation();
+    let angle = ra.normalize().angle_between(rb.normalize());
+    if angle.is_finite() {
+        angle
+    } else {
+        f32::INFINITY
+    }
 }
 
 /// Creates the stage of a ray-tracing method for the plan's objects.
@@ -227,6 +271,8 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         build_ms: 0.0,
         gpu_bvh: None,
         bvh_update: q.raytrace.bvh_update,
+        built_at: shapes_of(init.scene),
+        cpu_device: ctx.properties.device_type == vk::PhysicalDeviceType::CPU,
     };
     match me.init(init, plan) {
         Ok(()) => Ok(Box::new(me)),
@@ -765,17 +811,31 @@ fn list_offset(list: &TriangleList) -> f32 {
 }
 
 impl RayTrace {
-    /// A BVH follows moved or deformed objects on the GPU (`bvh_update`): the new triangles
-    /// written in place, then a linear BVH built again or the current tree refitted in the
-    /// next frame. False where the CPU builds instead (another scheme, `bvh_update=sah`, an
-    /// empty list, or a refit where the triangle count changed).
-    fn update_bvh_on_gpu(&mut self, ctx: &Context, list: &TriangleList) -> Result<bool> {
-        let Scheme::Bvh { stackless, .. } = self.scheme else { return Ok(false) };
+    /// The structure follows moved or deformed objects: a BVH by `bvh_update` (the new
+    /// triangles written in place, then a refit or a linear BVH built on the GPU in the next
+    /// frame, or the SAH tree built again on the CPU), every other scheme by its CPU build.
+    fn follow(&mut self, ctx: &Context, scene: &crate::scene::Scene, list: &TriangleList, moved: &[usize]) -> Result<()> {
+        let Scheme::Bvh { stackless, .. } = self.scheme else {
+            let packed = self.scheme.build(list)?;
+            return self.replace_structure(ctx, list, &packed);
+        };
         let same_count = self.structure.as_ref().is_some_and(|s| s.accel.triangle_count as usize == list.len());
-        match self.bvh_update {
-            BvhUpdate::Sah => Ok(false),
-            _ if list.is_empty() => Ok(false),
-            BvhUpdate::Refit if !same_count => Ok(false),
+        let refit = same_count && !list.is_empty();
+        let now = shapes_of(scene);
+        let rigid = |m: usize| match (self.built_at.get(m), now.get(m)) {
+            (Some(&(w0, h0)), Some(&(w, h))) => h == h0 && turn(w0, w) < REFIT_TURN,
+            _ => false,
+        };
+        let far = !moved.iter().all(|&m| rigid(m));
+        let way = match self.bvh_update {
+            BvhUpdate::Auto if refit && !far => BvhUpdate::Refit,
+            BvhUpdate::Auto if self.cpu_device => BvhUpdate::Sah,
+            BvhUpdate::Auto => BvhUpdate::Lbvh,
+            BvhUpdate::Refit if !refit => BvhUpdate::Sah,
+            w => w,
+        };
+        match way {
+            _ if list.is_empty() => self.build_on_cpu(ctx, list, stackless)?,
             BvhUpdate::Refit => {
                 let structure = self.structure.as_mut().expect("same_count");
                 structure.write_triangles(list)?;
@@ -783,7 +843,7 @@ impl RayTrace {
                     self.gpu_bvh = Some(GpuBvh::refit_of(ctx, structure)?);
                 }
                 self.gpu_bvh.as_mut().expect("just set").request(Work::Refit)?;
-                Ok(true)
+                return Ok(());
             }
             BvhUpdate::Lbvh => {
                 let linear = self.gpu_bvh.as_ref().is_some_and(|b| b.builds_linear());
@@ -793,17 +853,26 @@ impl RayTrace {
                     b.set_bounds(list);
                     b.request(Work::Build)?;
                 } else {
-                    // The first move of a CPU-built tree (or a new triangle count): a
-                    // structure of the linear BVH's size, built in the next frame.
+                    // The first GPU build after a CPU-built tree (or a new triangle count):
+                    // a structure of the linear BVH's size, built in the next frame.
                     self.scheme = Scheme::Bvh { stackless, gpu: true };
                     let packed = self.scheme.build(list)?;
                     self.replace_structure(ctx, list, &packed)?;
                     let s = self.structure.as_ref().expect("just set");
                     self.gpu_bvh = Some(GpuBvh::linear(ctx, s, list)?);
                 }
-                Ok(true)
             }
+            _ => self.build_on_cpu(ctx, list, stackless)?,
         }
+        self.built_at = now;
+        Ok(())
+    }
+
+    /// The SAH tree built again on the CPU.
+    fn build_on_cpu(&mut self, ctx: &Context, list: &TriangleList, stackless: bool) -> Result<()> {
+        self.scheme = Scheme::Bvh { stackless, gpu: false };
+        let packed = self.scheme.build(list)?;
+        self.replace_structure(ctx, list, &packed)
     }
 
     /// A fresh structure over `list` in place of the current one (and of its GPU builder),
@@ -840,10 +909,7 @@ impl Stage for RayTrace {
         let ctx = init.ctx;
         let list = TriangleList::from_scene(init.scene);
         let start = std::time::Instant::now();
-        if !self.update_bvh_on_gpu(ctx, &list)? {
-            let packed = self.scheme.build(&list)?;
-            self.replace_structure(ctx, &list, &packed)?;
-        }
+        self.follow(ctx, init.scene, &list, &changes.moved)?;
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
         // Ray queries: new instances (a TLAS rebuild in the next frame), BLAS only for
         // deformed meshes.
