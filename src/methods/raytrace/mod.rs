@@ -139,7 +139,7 @@ pub const BVH_INFO: &MethodInfo = &MethodInfo {
     abi: 7,
     section: "§2.3.5",
     family: "raytrace",
-    summary: "exact ray tracing in the original geometry: primary hits by rasterisation, then per bounce intersect → shade (exact shadow rays) → spawn both Fresnel-weighted branches on the GPU, through the CPU reference's SAH BVH (short-stack or stackless traversal)",
+    summary: "exact ray tracing in the original geometry: primary hits by rasterisation, then per bounce intersect → shade (exact shadow rays) → spawn both Fresnel-weighted branches on the GPU, through the CPU reference's SAH BVH or a linear BVH built on the GPU (short-stack or stackless traversal); moving objects refit or rebuild it on the GPU (bvh_update)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_BVH,
     gpu: Some(ray_tracer("raytrace.bvh", |init, plan| {
