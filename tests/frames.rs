@@ -173,6 +173,29 @@ fn bvh_follows_moves_by_refit_or_rebuild() {
         }
     }
     r.destroy(&ctx);
+    // Where the device's costs predict the GPU's linear BVH cheaper, a deformation builds
+    // it on the GPU (raytrace.build); where they predict the CPU's SAH build cheaper, the CPU
+    // builds. (The stored calibration's own costs are lavapipe's: the CPU's build there.)
+    let target = specula::target_for(&ctx, SIZE).expect("unit costs");
+    for (gpu_cheaper, pass) in [(true, Some("raytrace.build")), (false, None)] {
+        let mut costs = (*target.costs).clone();
+        let (cheap, dear) = ([0.0, 1.0], [0.0, 100.0]);
+        let (sah, lbvh) = if gpu_cheaper { (dear, cheap) } else { (cheap, dear) };
+        costs.bvh_updates = Some(specula::plan::predict::cost_model::BvhUpdateCosts { sah, lbvh, refit: cheap });
+        let t = specula::plan::predict::Target { size: SIZE, costs: std::sync::Arc::new(costs) };
+        let plan = specula::plan::plan_for(&scene, &Choices::all(specula::methods::BVH), &q, Some(&t)).unwrap();
+        let mut r = Renderer::new(&ctx, &scene, plan, SIZE.0, SIZE.1).unwrap();
+        r.render(&ctx).unwrap();
+        for p in &mut scene.meshes[glass].positions {
+            p.x *= 1.01;
+        }
+        r.update(&scene).unwrap();
+        let f = r.render(&ctx).unwrap();
+        let got = pass_names(&f).iter().find(|n| **n == "raytrace.build" || **n == "raytrace.refit").copied();
+        assert_eq!(got, pass, "GPU build predicted cheaper: {gpu_cheaper}");
+        r.destroy(&ctx);
+    }
+
     // bvh_update=sah: every move rebuilds on the CPU, never a GPU pass.
     let mut q_sah = q.clone();
     q_sah.set("bvh_update", "sah").unwrap();

@@ -576,6 +576,7 @@ fn a_corrupt_cost_cache_is_named_and_replaced() {
         methods: Default::default(),
         base: vec![0.0; 4],
         calibration_s: 0.0,
+        bvh_updates: None,
     };
     store(&dir, &other).unwrap();
     std::fs::write(dir.join(key.file_name()), b"{\"format\":\"specula-costs 1\",\"key\":").unwrap();
@@ -749,6 +750,30 @@ fn a_calibration_measures_pixels_and_the_knobs_a_method_reads() {
     assert!(!off(3).is_empty() && off(3).iter().all(|s| s.work.caustic_photons == 0.0), "{:?}", off(3));
     let lit = c.samples.iter().find(|s| s.scene == 3 && s.knobs == "default").unwrap();
     assert!(lit.work.caustic_photons > 0.0 && lit.work.caustic_texels > 0.0, "{:?}", lit.work);
+    common::assert_clean(&ctx);
+}
+
+/// What a move costs the BVH, as a calibration times it (`measure_bvh_updates`, at small
+/// triangle counts here): every way at every count, positive, and a line per way fitted;
+/// `specula plan` states the policy with the predicted milliseconds.
+#[test]
+fn a_calibration_times_how_the_bvh_follows_moves() {
+    let _turn = turn();
+    let ctx = common::gpu();
+    let samples = specula::tradeoff::calibrate::measure_bvh_updates(&ctx, &[300, 3000]).unwrap();
+    for way in ["sah", "lbvh", "refit"] {
+        let ms: Vec<f64> = samples.iter().filter(|s| s.way == way).map(|s| s.ms).collect();
+        assert!(ms.len() == 2 && ms.iter().all(|v| *v > 0.0 && v.is_finite()), "{way}: {samples:?}");
+    }
+    let c = specula::plan::predict::cost_model::BvhUpdateCosts::fit(&samples).expect("a line per way");
+    let target = specula::target_for(&ctx, SIZE).unwrap();
+    let mut costs = (*target.costs).clone();
+    costs.bvh_updates = Some(c);
+    let t = Target { size: SIZE, costs: std::sync::Arc::new(costs) };
+    let scene = corpus::scene(0).unwrap();
+    let plan = plan_for(&scene, &Choices::all(specula::methods::BVH), &Quality::default(), Some(&t)).unwrap();
+    let text = specula::plan::table(&plan, &scene);
+    assert!(text.contains("bvh_update=auto") && text.contains("rigid moves refit it on the GPU (refit predicted"), "{text}");
     common::assert_clean(&ctx);
 }
 

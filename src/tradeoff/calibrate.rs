@@ -10,7 +10,7 @@ use super::corpus::{gpu_methods, measure, Measure};
 use crate::error::Result;
 use crate::methods::{RAY_ENGINE, RAY_HIERARCHY};
 use crate::plan::predict::cost_model::{cache_dir, load_cached, store, CostModel, DeviceKey};
-use crate::plan::predict::samples::Corpus;
+use crate::plan::predict::samples::{BvhUpdateSample, Corpus};
 use crate::quality::Quality;
 use crate::vk::Context;
 
@@ -70,9 +70,62 @@ pub fn calibrate(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<CostMo
 /// [`calibrate`], with the measurements the unit costs were fitted on.
 pub fn calibrate_measured(ctx: &Context, progress: &mut dyn FnMut(&str)) -> Result<(Corpus, CostModel)> {
     let t = std::time::Instant::now();
-    let corpus = measure(ctx, &plan(), progress)?;
+    let mut corpus = measure(ctx, &plan(), progress)?;
+    progress("what a move costs the BVH");
+    corpus.bvh_updates = measure_bvh_updates(ctx, &BVH_LADDER)?;
     let c = CostModel::fit(&corpus, DeviceKey::of(ctx), t.elapsed().as_secs_f64());
     Ok((corpus, c))
+}
+
+/// Triangle counts at which a calibration times how the BVH follows moved geometry
+/// (tessellated spheres; a few seconds on lavapipe in all).
+pub const BVH_LADDER: [usize; 3] = [2_000, 20_000, 200_000];
+
+/// Times each way a BVH follows moved geometry (`bvh_update`) over tessellated spheres of
+/// each of `ladder`'s triangle counts, the median of 3: the CPU's SAH build (host ms; the
+/// frame waits for it), a linear BVH built on the GPU and a refit on the GPU (GPU ms of their
+/// passes).
+pub fn measure_bvh_updates(ctx: &Context, ladder: &[usize]) -> Result<Vec<BvhUpdateSample>> {
+    use crate::methods::raytrace::gpu::Intersector;
+    use crate::methods::raytrace::lbvh::Work;
+    use crate::methods::raytrace::{Scheme, TriangleList};
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut out = Vec::new();
+    for &n in ladder {
+        // A uv sphere of `seg` segments and seg/2 rings has seg · (seg − 2) triangles.
+        let seg = ((1.0 + (1.0 + n as f64).sqrt()).round() as u32).max(4);
+        let mesh = crate::scene::shapes::uv_sphere("ladder", glam::Vec3::ZERO, 1.0, seg, seg / 2, 0);
+        let tris: Vec<[glam::Vec3; 3]> = mesh.indices.chunks_exact(3).map(|t| [0, 1, 2].map(|k| mesh.positions[t[k] as usize])).collect();
+        let list = TriangleList::from_soup(tris)?;
+        let triangles = list.len() as f64;
+        let cpu = Scheme::Bvh { stackless: false, gpu: false };
+        let mut sah = Vec::new();
+        for _ in 0..3 {
+            let t = std::time::Instant::now();
+            cpu.build(&list)?;
+            sah.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let gpu = Scheme::Bvh { stackless: false, gpu: true };
+        let mut x = Intersector::new(ctx, gpu, &list, &gpu.build(&list)?)?;
+        let timed = (|| {
+            let mut lbvh = Vec::new();
+            let mut refit = Vec::new();
+            for _ in 0..3 {
+                lbvh.push(x.update(ctx, &list, Work::Build)?);
+                refit.push(x.update(ctx, &list, Work::Refit)?);
+            }
+            Ok::<_, crate::Error>((lbvh, refit))
+        })();
+        x.destroy(ctx);
+        let (lbvh, refit) = timed?;
+        for (way, ms) in [("sah", median(sah)), ("lbvh", median(lbvh)), ("refit", median(refit))] {
+            out.push(BvhUpdateSample { way: way.into(), triangles, ms });
+        }
+    }
+    Ok(out)
 }
 
 /// Where `ctx`'s costs came from.

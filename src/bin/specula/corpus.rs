@@ -99,6 +99,53 @@ pub fn run_corpus(
     Ok(())
 }
 
+/// Writes unit costs to `out`, or to the cache; where they went.
+fn write_costs(out: Option<&Path>, c: &specula::plan::predict::cost_model::CostModel) -> specula::Result<std::path::PathBuf> {
+    match out {
+        Some(p) => {
+            specula::output::write_file(p, c.to_json().as_bytes())?;
+            Ok(p.to_path_buf())
+        }
+        None => {
+            let dir = specula::plan::predict::cost_model::cache_dir().ok_or_else(|| {
+                specula::Error::invalid("cache", "no SPECULA_CACHE_DIR, XDG_CACHE_HOME or HOME to cache into: pass --out")
+            })?;
+            specula::plan::predict::cost_model::store(&dir, c)
+        }
+    }
+}
+
+/// `specula calibrate --bvh-updates`: measures what a move costs the BVH on this device and
+/// adds it to its unit costs (`out` if it exists, else those `auto` would use), written to
+/// `out` or the cache.
+pub fn run_bvh_updates(out: Option<&Path>, validate: bool, device: &Option<String>) -> specula::Result<()> {
+    use specula::plan::predict::cost_model::{BvhUpdateCosts, CostModel, DeviceKey};
+    let ctx = Context::new(&DeviceOptions { validation: validate, device_filter: device.clone(), ..Default::default() })?;
+    let mut c = match out.filter(|p| p.exists()) {
+        Some(p) => {
+            let text = std::fs::read_to_string(p).map_err(|e| specula::Error::io(p, e))?;
+            CostModel::parse(&text, &p.display().to_string())?
+        }
+        None => (*tradeoff::costs_for(&ctx, None, &mut |w| eprintln!("specula: {w}"))?.0).clone(),
+    };
+    if c.key != DeviceKey::of(&ctx) {
+        return Err(specula::Error::invalid(
+            "--out",
+            format!("its costs are {}'s, not this device's ({})", c.key.label(), DeviceKey::of(&ctx).label()),
+        ));
+    }
+    let samples = tradeoff::calibrate::measure_bvh_updates(&ctx, &tradeoff::calibrate::BVH_LADDER)?;
+    for s in &samples {
+        println!("{:<6} {:>8} triangles {:>10.2} ms", s.way, s.triangles, s.ms);
+    }
+    c.bvh_updates =
+        Some(BvhUpdateCosts::fit(&samples).ok_or_else(|| specula::Error::invalid("bvh updates", "too few timings to fit a line per way"))?);
+    let path = write_costs(out, &c)?;
+    let b = c.bvh_updates.as_ref().expect("just set");
+    println!("ms = a + b · triangles/1e6: sah {:?}, lbvh {:?}, refit {:?}; wrote {}", b.sah, b.lbvh, b.refit, path.display());
+    Ok(())
+}
+
 /// Calibrates this device's unit costs and writes them to `out`, or to the cache.
 /// `samples`: also write the measurements; `refit`: fit from such measurements instead of
 /// measuring (no device is opened).
@@ -127,18 +174,7 @@ pub fn run_calibrate(
             c
         }
     };
-    let path = match out {
-        Some(p) => {
-            specula::output::write_file(p, c.to_json().as_bytes())?;
-            p.to_path_buf()
-        }
-        None => {
-            let dir = specula::plan::predict::cost_model::cache_dir().ok_or_else(|| {
-                specula::Error::invalid("cache", "no SPECULA_CACHE_DIR, XDG_CACHE_HOME or HOME to cache into: pass --out")
-            })?;
-            specula::plan::predict::cost_model::store(&dir, &c)?
-        }
-    };
+    let path = write_costs(out, &c)?;
     println!("calibrated {} in {:.1} s; wrote {}", c.key.label(), c.calibration_s, path.display());
     use specula::plan::predict::features::{MAP_FEATURES, SCREEN_FEATURES, SHARED_FEATURES};
     let names: Vec<&str> = MAP_FEATURES.iter().chain(&SCREEN_FEATURES).chain(&SHARED_FEATURES).copied().collect();

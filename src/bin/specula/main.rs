@@ -170,6 +170,11 @@ enum Command {
         /// (after a change to the cost model; the device is the one they were measured on)
         #[arg(long, conflicts_with = "samples")]
         refit: Option<PathBuf>,
+        /// Measure only what a move costs the BVH (the CPU's SAH build, the GPU's linear BVH
+        /// and refit, a few seconds) and add it to this device's costs: those in --out if it
+        /// exists (else the cache, the stored file or a full calibration), written back there
+        #[arg(long, conflicts_with_all = ["samples", "refit"])]
+        bvh_updates: bool,
         #[arg(long)]
         validate: bool,
         #[arg(long)]
@@ -324,7 +329,8 @@ fn run(cmd: Command) -> specula::Result<()> {
             let pick = corpus::Selection { scenes: &scenes, variants: &variants, methods: &methods };
             corpus::run_corpus(&out, &size, pick, merge.as_deref(), validate, &device)
         }
-        Command::Calibrate { out, samples, refit, validate, device } => {
+        Command::Calibrate { out, bvh_updates: true, validate, device, .. } => corpus::run_bvh_updates(out.as_deref(), validate, &device),
+        Command::Calibrate { out, samples, refit, validate, device, .. } => {
             corpus::run_calibrate(out.as_deref(), samples.as_deref(), refit.as_deref(), validate, &device)
         }
         #[cfg(feature = "viewer")]

@@ -131,8 +131,44 @@ const RAY_KNOBS_GRID: &[&str] =
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "raytrace",
     methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, OCTREE_INFO, BIH_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO, ray_query::RAY_QUERY_INFO],
+    describe: Some(describe_updates),
     ..crate::methods::registry::Family::NONE
 };
+
+/// `specula plan`'s line on how `bvh` follows moves (`bvh_update`), with the device's
+/// predicted costs for the scene's triangles where its calibration measured them.
+fn describe_updates(p: &crate::plan::Plan, scene: &Scene) -> Option<String> {
+    use crate::methods::raytrace::knobs::BvhUpdate;
+    use crate::plan::predict::cost_model::BvhUpdateCosts;
+    let traced = p.stages.iter().any(|s| matches!(s, crate::plan::types::StageSpec::Camera(c) if c.name == "raytrace.bvh"));
+    if !traced {
+        return None;
+    }
+    let n = scene.triangle_count() as f64;
+    let costs = p.target.as_ref().and_then(|t| t.costs.bvh_updates.as_ref());
+    let ms = |way: [f64; 2]| BvhUpdateCosts::predict(way, n);
+    let predicted = |way: fn(&BvhUpdateCosts) -> [f64; 2], what: &str| {
+        costs.map_or(String::new(), |c| format!(" ({what} predicted {:.1} ms)", ms(way(c))))
+    };
+    let rebuild = match costs {
+        Some(c) if ms(c.lbvh) < ms(c.sah) => {
+            format!("a linear BVH built on the GPU (predicted {:.1} ms; the CPU's SAH build {:.1} ms)", ms(c.lbvh), ms(c.sah))
+        }
+        Some(c) => format!("the CPU's SAH build (predicted {:.1} ms; a linear BVH on the GPU {:.1} ms)", ms(c.sah), ms(c.lbvh)),
+        None => "the CPU's SAH build where the device computes on the CPU, else a linear BVH on the GPU (no measured update costs)".into(),
+    };
+    let how = match p.quality.raytrace.bvh_update {
+        BvhUpdate::Auto => format!(
+            "rigid moves refit it on the GPU{}; a deformation or a turn beyond {:.0}° rebuilds it by {rebuild}",
+            predicted(|c| c.refit, "refit"),
+            stage::REFIT_TURN.to_degrees()
+        ),
+        BvhUpdate::Lbvh => format!("every move builds a linear BVH on the GPU{}", predicted(|c| c.lbvh, "build")),
+        BvhUpdate::Refit => format!("every move refits it on the GPU{}", predicted(|c| c.refit, "refit")),
+        BvhUpdate::Sah => format!("every move rebuilds it on the CPU by SAH{}", predicted(|c| c.sah, "build")),
+    };
+    Some(format!("bvh over {n} triangles (bvh_update={}): {how}", p.quality.get("bvh_update")))
+}
 
 pub const BVH_INFO: &MethodInfo = &MethodInfo {
     name: "bvh",

@@ -38,6 +38,7 @@ use crate::frame::layout::{
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
 use crate::methods::Choice;
+use crate::plan::predict::cost_model::BvhUpdateCosts;
 use crate::plan::types::CameraPlan;
 use crate::vk::pipeline::{
     compute_pipeline, descriptor_set_layout, graphics_pipeline, pipeline_layout, write_buffer, GraphicsDesc, Multisample, VertexInput,
@@ -179,9 +180,22 @@ pub struct RayTrace {
     /// tree was last built: what `bvh_update=auto` refits over (moves) or rebuilds after
     /// (deformation, turns beyond REFIT_TURN).
     built_at: Vec<(Mat4, u64)>,
-    /// The device runs compute on the CPU (lavapipe): rebuilds there take the CPU's SAH
-    /// builder, measured faster than the GPU's linear BVH (BENCHMARKS.md).
+    /// Which builder `bvh_update=auto` rebuilds with: the one the device's unit costs predict
+    /// faster for the scene's triangles, or without them the CPU's SAH builder where the
+    /// device runs compute on the CPU (lavapipe: measured faster than the GPU's linear BVH
+    /// there, BENCHMARKS.md), else the GPU's.
+    update_costs: Option<BvhUpdateCosts>,
     cpu_device: bool,
+}
+
+/// Whether `bvh_update=auto` rebuilds a BVH of `triangles` on the GPU (else the CPU's SAH
+/// builder): by the device's measured update costs where there are some, else by whether
+/// the device runs its compute on the CPU.
+pub fn rebuild_on_gpu(costs: Option<&BvhUpdateCosts>, triangles: usize, cpu_device: bool) -> bool {
+    match costs {
+        Some(c) => BvhUpdateCosts::predict(c.lbvh, triangles as f64) < BvhUpdateCosts::predict(c.sah, triangles as f64),
+        None => !cpu_device,
+    }
 }
 
 /// `bvh_update=auto` refits the tree over objects that moved rigidly (translated, scaled,
@@ -272,6 +286,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         gpu_bvh: None,
         bvh_update: q.raytrace.bvh_update,
         built_at: shapes_of(init.scene),
+        update_costs: init.plan.target.as_ref().and_then(|t| t.costs.bvh_updates.clone()),
         cpu_device: ctx.properties.device_type == vk::PhysicalDeviceType::CPU,
     };
     match me.init(init, plan) {
@@ -829,8 +844,8 @@ impl RayTrace {
         let far = !moved.iter().all(|&m| rigid(m));
         let way = match self.bvh_update {
             BvhUpdate::Auto if refit && !far => BvhUpdate::Refit,
-            BvhUpdate::Auto if self.cpu_device => BvhUpdate::Sah,
-            BvhUpdate::Auto => BvhUpdate::Lbvh,
+            BvhUpdate::Auto if rebuild_on_gpu(self.update_costs.as_ref(), list.len(), self.cpu_device) => BvhUpdate::Lbvh,
+            BvhUpdate::Auto => BvhUpdate::Sah,
             BvhUpdate::Refit if !refit => BvhUpdate::Sah,
             w => w,
         };

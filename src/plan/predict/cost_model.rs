@@ -90,6 +90,59 @@ pub struct CostModel {
     pub base: Vec<f64>,
     /// Seconds the calibration took.
     pub calibration_s: f64,
+    /// What following moved geometry costs the BVH on this device (`bvh_update=auto`
+    /// rebuilds by the cheaper builder); none in files from before they were measured.
+    #[serde(default)]
+    pub bvh_updates: Option<BvhUpdateCosts>,
+}
+
+/// What following moved geometry costs the BVH on one device, per way milliseconds =
+/// `[a, b]`: a + b · triangles / 10⁶, fitted over the calibration's ladder of triangle counts
+/// (`tradeoff::calibrate::BVH_LADDER`).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BvhUpdateCosts {
+    /// The CPU's SAH build (host milliseconds: the frame waits for it).
+    pub sah: [f64; 2],
+    /// A linear BVH built on the GPU (its pass, `raytrace.build`).
+    pub lbvh: [f64; 2],
+    /// A refit on the GPU (`raytrace.refit`).
+    pub refit: [f64; 2],
+}
+
+impl BvhUpdateCosts {
+    /// Milliseconds of `way` over `triangles`.
+    pub fn predict(way: [f64; 2], triangles: f64) -> f64 {
+        (way[0] + way[1] * triangles / 1e6).max(0.0)
+    }
+
+    /// Fitted from timings: per way the least-squares line through its (triangles, ms),
+    /// slope and intercept at least 0 (the other refitted where one is clamped). None unless
+    /// every way has timings at two triangle counts or more.
+    pub fn fit(samples: &[super::samples::BvhUpdateSample]) -> Option<BvhUpdateCosts> {
+        let line = |way: &str| -> Option<[f64; 2]> {
+            let pts: Vec<(f64, f64)> = samples
+                .iter()
+                .filter(|s| s.way == way && s.triangles.is_finite() && s.ms.is_finite())
+                .map(|s| (s.triangles / 1e6, s.ms))
+                .collect();
+            let n = pts.len() as f64;
+            let (sx, sy) = pts.iter().fold((0.0, 0.0), |(a, b), (x, y)| (a + x, b + y));
+            let (mx, my) = (sx / n, sy / n);
+            let sxx: f64 = pts.iter().map(|(x, _)| (x - mx) * (x - mx)).sum();
+            if pts.len() < 2 || sxx <= 0.0 {
+                return None;
+            }
+            let b = pts.iter().map(|(x, y)| (x - mx) * (y - my)).sum::<f64>() / sxx;
+            let a = my - b * mx;
+            Some(match (a >= 0.0, b >= 0.0) {
+                (true, true) => [a, b],
+                // Through the origin: the slope alone.
+                (false, _) => [0.0, (pts.iter().map(|(x, y)| x * y).sum::<f64>() / pts.iter().map(|(x, _)| x * x).sum::<f64>()).max(0.0)],
+                (true, false) => [my.max(0.0), 0.0],
+            })
+        };
+        Some(BvhUpdateCosts { sah: line("sah")?, lbvh: line("lbvh")?, refit: line("refit")? })
+    }
 }
 
 /// Names of the frame's base features, in the order [`base_features`] returns them.
@@ -142,7 +195,8 @@ impl CostModel {
         let yb: Vec<f64> = corpus.frames.iter().map(|f| f.base_ms).collect();
         let wb = vec![1.0; yb.len()];
         let base = linear::fit(&xb, &yb, &wb, 1e-4, true);
-        CostModel { format: FORMAT.into(), key, methods, base, calibration_s }
+        let bvh_updates = BvhUpdateCosts::fit(&corpus.bvh_updates);
+        CostModel { format: FORMAT.into(), key, methods, base, calibration_s, bvh_updates }
     }
 
     /// One candidate's unit costs from its samples; over `plain` (its method's), as extra
@@ -309,6 +363,29 @@ pub fn store(dir: &Path, c: &CostModel) -> Result<PathBuf> {
 mod tests {
     use super::*;
 
+    /// Per way a line through its timings: exact on a line, through the origin where the
+    /// intercept would be negative, none with timings at one triangle count only.
+    #[test]
+    fn bvh_update_costs_are_a_line_per_way() {
+        use super::super::samples::BvhUpdateSample;
+        let at = |way: &str, n: f64, ms: f64| BvhUpdateSample { way: way.into(), triangles: n, ms };
+        let samples = vec![
+            at("sah", 1e4, 9.0),
+            at("sah", 1e5, 90.0),
+            at("lbvh", 1e4, 22.0),
+            at("lbvh", 1e5, 40.0),
+            at("refit", 1e4, 0.0),
+            at("refit", 1e5, 10.0),
+        ];
+        let c = BvhUpdateCosts::fit(&samples).unwrap();
+        assert!((c.sah[0]).abs() < 1e-9 && (c.sah[1] - 900.0).abs() < 1e-6, "{c:?}");
+        assert!((c.lbvh[0] - 20.0).abs() < 1e-9 && (c.lbvh[1] - 200.0).abs() < 1e-6, "{c:?}");
+        assert!(c.refit[0] == 0.0 && c.refit[1] > 0.0, "a negative intercept goes through the origin: {c:?}");
+        assert!((BvhUpdateCosts::predict(c.lbvh, 1e6) - 220.0).abs() < 1e-6);
+        assert_eq!(BvhUpdateCosts::fit(&samples[..2]), None, "no lbvh or refit timings");
+        assert_eq!(BvhUpdateCosts::fit(&[at("sah", 1e4, 1.0), at("lbvh", 1e4, 1.0), at("refit", 1e4, 1.0)]), None, "one count each");
+    }
+
     fn key(device: u32) -> DeviceKey {
         DeviceKey { vendor: 0x10005, device, driver: 1, name: format!("fake {device}"), driver_info: "fake driver".into() }
     }
@@ -320,6 +397,7 @@ mod tests {
             methods: BTreeMap::new(),
             base: vec![1.0, 0.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             calibration_s: 1.0,
+            bvh_updates: None,
         }
     }
 

@@ -52,6 +52,16 @@ pub struct FrameSample {
     pub base_ms: f64,
 }
 
+/// One timing of how a BVH follows moved geometry (`bvh_update`): `way` is `sah` (the CPU's
+/// build, host milliseconds), `lbvh` (a linear BVH built on the GPU) or `refit` (on the
+/// GPU), over `triangles`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct BvhUpdateSample {
+    pub way: String,
+    pub triangles: f64,
+    pub ms: f64,
+}
+
 /// A measurement run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Corpus {
@@ -60,11 +70,15 @@ pub struct Corpus {
     pub device: super::device::DeviceKey,
     pub samples: Vec<Sample>,
     pub frames: Vec<FrameSample>,
+    /// What following moved geometry costs the BVH (a calibration's; none in the error
+    /// corpus, nor in runs from before they were measured).
+    #[serde(default)]
+    pub bvh_updates: Vec<BvhUpdateSample>,
 }
 
 impl Corpus {
     pub fn new(device: super::device::DeviceKey) -> Corpus {
-        Corpus { format: FORMAT.into(), device, samples: Vec::new(), frames: Vec::new() }
+        Corpus { format: FORMAT.into(), device, samples: Vec::new(), frames: Vec::new(), bvh_updates: Vec::new() }
     }
 
     /// Parses and checks a corpus file (`what` names it in errors).
@@ -116,6 +130,9 @@ impl Corpus {
         self.frames.retain(|f| !fnew.contains(&fkey(f)));
         self.samples.extend(other.samples);
         self.frames.extend(other.frames);
+        if !other.bvh_updates.is_empty() {
+            self.bvh_updates = other.bvh_updates;
+        }
     }
 
     /// The scene numbers it measured.
