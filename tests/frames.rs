@@ -172,6 +172,19 @@ fn bvh_follows_moves_by_refit_or_rebuild() {
             Some(_) => assert!(differ <= 1, "{what}: the refitted tree's image differs from a fresh render in {differ} pixels"),
         }
     }
+    // Ten more moves along an arc (translations: after the rebuild above, ten refits by a
+    // new refitter), each frame a fresh render's.
+    let start = scene.meshes[i].world;
+    for k in 1..=10 {
+        let t = k as f32 * 0.3;
+        let arc = Vec3::new(0.3 * t.sin(), 0.0, 0.3 * (1.0 - t.cos())) * size;
+        scene.set_object_transform(i, Mat4::from_translation(arc) * start).unwrap();
+        r.update(&scene).unwrap();
+        let f = r.render(&ctx).unwrap();
+        assert_eq!(stat(&f, "raytrace.gpu_refits"), Some(k as f64), "move {k} of ten");
+        let differ = bits(&f).chunks(4).zip(fresh(&ctx, &scene, specula::methods::BVH, &q).chunks(4)).filter(|(a, b)| a != b).count();
+        assert!(differ <= 1, "move {k} of ten: {differ} pixels differ from a fresh render");
+    }
     r.destroy(&ctx);
     // Where the device's costs predict the GPU's linear BVH cheaper, a deformation builds
     // it on the GPU (raytrace.build); where they predict the CPU's SAH build cheaper, the CPU

@@ -201,9 +201,9 @@ pub fn rebuild_on_gpu(costs: Option<&BvhUpdateCosts>, triangles: usize, cpu_devi
 /// `bvh_update=auto` refits the tree over objects that moved rigidly (translated, scaled,
 /// turned by less than this many radians in all since the tree was built) and rebuilds it
 /// after a deformation (an object's own positions changed) or a larger turn. Translation
-/// costs a refitted tree nothing measurable (the demo's mirror sphere carried 5 diagonals
-/// at 10⁵ triangles: frames within the noise of a rebuilt tree's, BENCHMARKS.md, "What a
-/// move costs bvh"): its subtree keeps its boxes, and only the few nodes that joined it
+/// costs a refitted tree nothing measurable (the demo's mirror sphere carried 3 diagonals
+/// at 10³ to 10⁶ triangles: frames within the noise of a rebuilt tree's, BENCHMARKS.md,
+/// "BVHs for moving geometry"): its subtree keeps its boxes, and only the few nodes that joined it
 /// to its neighbours stretch. A turn widens every box of its subtree: an axis-aligned box
 /// of a turned box grows by cos θ + sin θ along an axis, 1.34 at 20°.
 pub const REFIT_TURN: f32 = 20.0 * std::f32::consts::PI / 180.0;
@@ -836,14 +836,13 @@ impl RayTrace {
         };
         let same_count = self.structure.as_ref().is_some_and(|s| s.accel.triangle_count as usize == list.len());
         let refit = same_count && !list.is_empty();
-        let now = shapes_of(scene);
-        let rigid = |m: usize| match (self.built_at.get(m), now.get(m)) {
-            (Some(&(w0, h0)), Some(&(w, h))) => h == h0 && turn(w0, w) < REFIT_TURN,
+        // Only the moved meshes' shapes are hashed (a rebuild records every mesh's).
+        let rigid = |m: usize| match (self.built_at.get(m), scene.meshes.get(m)) {
+            (Some(&(w0, h0)), Some(mesh)) => turn(w0, mesh.world) < REFIT_TURN && shape_hash(mesh) == h0,
             _ => false,
         };
-        let far = !moved.iter().all(|&m| rigid(m));
         let way = match self.bvh_update {
-            BvhUpdate::Auto if refit && !far => BvhUpdate::Refit,
+            BvhUpdate::Auto if refit && moved.iter().all(|&m| rigid(m)) => BvhUpdate::Refit,
             BvhUpdate::Auto if rebuild_on_gpu(self.update_costs.as_ref(), list.len(), self.cpu_device) => BvhUpdate::Lbvh,
             BvhUpdate::Auto => BvhUpdate::Sah,
             BvhUpdate::Refit if !refit => BvhUpdate::Sah,
@@ -879,7 +878,7 @@ impl RayTrace {
             }
             _ => self.build_on_cpu(ctx, list, stackless)?,
         }
-        self.built_at = now;
+        self.built_at = shapes_of(scene);
         Ok(())
     }
 
