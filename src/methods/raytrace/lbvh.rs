@@ -76,7 +76,7 @@ pub enum Work {
 pub fn placeholder(list: &TriangleList, stackless: bool) -> Result<super::Packed> {
     let n = list.len() as u64;
     if n > MAX_TRIANGLES {
-        return Err(Error::invalid("bvh_build=lbvh", format!("{n} triangles exceed the GPU build's {MAX_TRIANGLES}")));
+        return Err(Error::invalid("bvh_build=lbvh or bvh_update=lbvh", format!("{n} triangles exceed the GPU build's {MAX_TRIANGLES}")));
     }
     let nodes = if n == 0 { 0 } else { 2 * n as usize - 1 };
     Ok(super::Packed {
@@ -117,7 +117,10 @@ impl GpuBvh {
     pub fn linear(ctx: &Context, structure: &Structure, list: &TriangleList) -> Result<GpuBvh> {
         let n = list.len() as u64;
         if n == 0 || n > MAX_TRIANGLES {
-            return Err(Error::invalid("bvh_build=lbvh", format!("{n} triangles: the GPU build takes 1 to {MAX_TRIANGLES}")));
+            return Err(Error::invalid(
+                "bvh_build=lbvh or bvh_update=lbvh",
+                format!("{n} triangles: the GPU build takes 1 to {MAX_TRIANGLES}"),
+            ));
         }
         if structure.accel.node_count as u64 != 2 * n - 1 {
             return Err(Error::invalid("bvh_build=lbvh", format!("a structure of {} nodes for {n} triangles", structure.accel.node_count)));

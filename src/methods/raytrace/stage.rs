@@ -190,8 +190,11 @@ pub struct RayTrace {
 
 /// Whether `bvh_update=auto` rebuilds a BVH of `triangles` on the GPU (else the CPU's SAH
 /// builder): by the device's measured update costs where there are some, else by whether
-/// the device runs its compute on the CPU.
+/// the device runs its compute on the CPU; never beyond the GPU build's `MAX_TRIANGLES`.
 pub fn rebuild_on_gpu(costs: Option<&BvhUpdateCosts>, triangles: usize, cpu_device: bool) -> bool {
+    if triangles as u64 > super::lbvh::MAX_TRIANGLES {
+        return false;
+    }
     match costs {
         Some(c) => BvhUpdateCosts::predict(c.lbvh, triangles as f64) < BvhUpdateCosts::predict(c.sah, triangles as f64),
         None => !cpu_device,
