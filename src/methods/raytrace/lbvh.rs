@@ -12,7 +12,8 @@
 //! second child to reach a node uniting its children's; the stackless traversal's miss
 //! links. Internal node i keeps its children in nodes 2i + 1 and 2i + 2, so the traversal's
 //! "children `first` and `first + 1`" holds; every leaf holds one triangle. The tree is
-//! at most 62 levels deep (32 key bits, then the index's), inside the traversal's stack.
+//! at most 57 levels deep (each level splits on a longer common prefix of the
+//! 32 key bits and then the index's 24), inside the traversal's stack of 96.
 //!
 //! The **refit** recomputes the boxes of a tree whose topology is kept (the same bottom-up
 //! kernel over its leaves): for a linear BVH from the build's own parents, for the CPU's
