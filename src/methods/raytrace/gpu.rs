@@ -228,7 +228,7 @@ impl Intersector {
         let mut profiler = Profiler::new(ctx, 2)?;
         let r = ctx.one_shot(|cmd| {
             let mut rec = Recorder::new(ctx, cmd, &mut profiler);
-            b.record(ctx, &mut rec, |pass| crate::frame::layout::Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; 8] });
+            b.record(ctx, &mut rec);
             Ok(())
         });
         let ms = r.and_then(|_| profiler.results(ctx)).map(|p| p.iter().map(|p| p.gpu_ms).sum::<f64>());

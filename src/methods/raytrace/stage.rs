@@ -32,8 +32,8 @@ use super::ray_query::accel::{AccelStructures, MeshInput};
 use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
-    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuSpawnBudget, GpuTraceParams, GpuTriangleShading, Push, RAY_BINDINGS,
-    RAY_QUERY_BINDINGS, TRACE_BINDINGS,
+    binding, GpuRayHit, GpuRayPayload, GpuRayQuery, GpuSpawnBudget, GpuTraceParams, GpuTriangleShading, RAY_BINDINGS, RAY_QUERY_BINDINGS,
+    TRACE_BINDINGS,
 };
 use crate::frame::stage::{FrameIo, Stage, StageInit};
 use crate::frame::{begin_camera_rendering, destroy_pipelines, FrameInputs, PUSH_BYTES};
@@ -172,8 +172,8 @@ pub struct RayTrace {
     primary_set: vk::DescriptorSet,
     /// The structure's CPU build time (`raytrace.build`), milliseconds.
     pub build_ms: f64,
-    /// The BVH's GPU builder or refitter (`bvh_build=lbvh`, or once objects moved under
-    /// `bvh_update=lbvh|refit`), and how moves update the BVH.
+    /// The BVH's GPU builder or refitter (`bvh_build=lbvh`, or once a move refitted or
+    /// rebuilt the tree on the GPU), and how moves update the BVH (`bvh_update`).
     gpu_bvh: Option<GpuBvh>,
     bvh_update: BvhUpdate,
     /// Each mesh's world transform and object-space shape (a hash of its positions) when the
@@ -915,10 +915,10 @@ impl Stage for RayTrace {
         self.name
     }
 
-    /// Moved objects: the structure is rebuilt from the new triangles (on the CPU, like the
-    /// first one; a refit would keep a BVH's topology but let its boxes grow loose as
-    /// objects travel, and the grid and kd-tree have no refit), the per-triangle shading
-    /// rewritten in place and the rays' start offset follows the scene's size.
+    /// Moved objects: the structure follows the new triangles (`follow`: a BVH refitted or
+    /// rebuilt on the GPU, or rebuilt on the CPU, by `bvh_update`; the other schemes rebuilt
+    /// on the CPU, having no refit), the per-triangle shading is rewritten in place and the
+    /// rays' start offset follows the scene's size. `raytrace.build_ms` is the CPU's part.
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut crate::frame::stage::Maps) -> Result<()> {
         if changes.moved.is_empty() {
             return Ok(());
@@ -962,7 +962,7 @@ impl Stage for RayTrace {
                 let work = if b.builds_linear() { Work::Build } else { Work::Refit };
                 let _ = b.request(work);
             }
-            b.record(ctx, rec, |pass| Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; 8] });
+            b.record(ctx, rec);
         }
         let (Some(vis), Some(vis_depth)) = (self.vis.as_mut(), self.vis_depth.as_mut()) else { return };
 
