@@ -288,7 +288,11 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         build_ms: 0.0,
         gpu_bvh: None,
         bvh_update: q.raytrace.bvh_update,
-        built_at: shapes_of(init.scene),
+        // Only `bvh_update=auto` reads it (hashing every mesh costs a pass over the scene).
+        built_at: match (scheme, q.raytrace.bvh_update) {
+            (Scheme::Bvh { .. }, BvhUpdate::Auto) => shapes_of(init.scene),
+            _ => Vec::new(),
+        },
         update_costs: init.plan.target.as_ref().and_then(|t| t.costs.bvh_updates.clone()),
         cpu_device: ctx.properties.device_type == vk::PhysicalDeviceType::CPU,
     };
@@ -881,7 +885,9 @@ impl RayTrace {
             }
             _ => self.build_on_cpu(ctx, list, stackless)?,
         }
-        self.built_at = shapes_of(scene);
+        if self.bvh_update == BvhUpdate::Auto {
+            self.built_at = shapes_of(scene);
+        }
         Ok(())
     }
 
