@@ -655,13 +655,13 @@ fn auto_chooses_only_the_knobs_left_to_it() {
     // (with the reason) on a device without them; asked for, it is the caller's.
     let distance = Choices::all(Choice::Method(specula::methods::DISTANCE));
     let mut chose = plan_for(&scene, &distance, &q, Some(&t)).unwrap();
-    chose.quality.distance.hybrid = true;
+    chose.quality.distance.hybrid = specula::methods::distance::knobs::Hybrid::Rays;
     let none = |m: Method| (m == specula::methods::RAY_QUERY).then(|| (specula::methods::BVH, "no ray queries".to_string()));
     let off = chose.clone().for_device(&scene, none).unwrap();
-    assert!(!off.quality.distance.hybrid);
+    assert!(!off.quality.distance.hybrid.traces());
     assert!(off.objects.iter().all(|o| o.reason.contains("hybrid=rays cannot run on this device (no ray queries)")), "{:?}", off.objects);
     let asked = plan_for(&scene, &distance, &with(&["hybrid=rays"]), Some(&t)).unwrap().for_device(&scene, none).unwrap();
-    assert!(asked.quality.distance.hybrid, "asked for: kept (the stage then refuses with its reason)");
+    assert!(asked.quality.distance.hybrid.traces(), "asked for: kept (the stage then refuses with its reason)");
 
     // Rendered (128²: at 64² the maps' fixed cost outweighs what anti-aliasing gains, and
     // auto ray traces; this device's costs): the variant auto takes is more accurate than

@@ -19,14 +19,25 @@ layout(early_fragment_tests) in;
 const float HYBRID_TOLERANCE = 0.002;
 const float HYBRID_GAP = 0.1;
 
-// The nearest triangle along o + t d, t ≥ t_min, of any object but `mesh` (inside: false; the
-// distance map leaves the object out, its rays' fallback does too), or of `mesh` alone
-// (inside: true; a refractor's own surface).
-RayHit rq_trace_mesh(vec3 o, vec3 d, float t_min, uint mesh, bool inside) {
+// hybrid=confirm (FLAG_HYBRID_CONFIRM): the ray query that confirms a search's hit reaches
+// this fraction of the map's distance either side of it.
+const float HYBRID_WINDOW = 0.01;
+
+bool hybrid_confirms() {
+    return (push.flags & FLAG_HYBRID_CONFIRM) != 0u;
+}
+
+// The nearest triangle along o + t d, t_min ≤ t ≤ t_max, of any object but `mesh` (inside:
+// false; the distance map leaves the object out, its rays' fallback does too), or of `mesh`
+// alone (inside: true; a refractor's own surface); of every object for mesh RQ_EVERY_MESH
+// and inside false.
+const uint RQ_EVERY_MESH = 0xffffffffu;
+RayHit rq_trace_mesh(vec3 o, vec3 d, float t_min, float t_max, uint mesh, bool inside) {
     RayHit best = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
-    if (!is_finite(o) || !is_finite(d) || dot(d, d) == 0.0) return best;
+    t_max = min(t_max, RQ_T_MAX);
+    if (!is_finite(o) || !is_finite(d) || dot(d, d) == 0.0 || !(0.0 <= t_min && t_min <= t_max)) return best;
     rayQueryEXT rq;
-    rayQueryInitializeEXT(rq, tlas, gl_RayFlagsNoOpaqueEXT, 0xffu, o, t_min, d, RQ_T_MAX);
+    rayQueryInitializeEXT(rq, tlas, gl_RayFlagsNoOpaqueEXT, 0xffu, o, t_min, d, t_max);
     while (rayQueryProceedEXT(rq)) {
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionTriangleEXT) continue;
         if ((floatBitsToUint(rq_shading[RQ_TRIANGLE(rq, false)].uv2.z) == mesh) == inside) rayQueryConfirmIntersectionEXT(rq);
@@ -46,9 +57,20 @@ bool hybrid_resolved(SearchResult s, vec3 x, vec3 dir, float stored, vec4 around
     return !s.escaped && abs(length(x + dir * s.d) - stored) <= HYBRID_TOLERANCE * stored && farthest - nearest <= HYBRID_GAP * nearest;
 }
 
+// Radiance arriving at p from dir along ray-query hit h (none: the environment at infinity,
+// as the map holds it in that direction): a diffuse surface lit as the camera's; a specular
+// one by what the map holds in its direction.
+vec3 hybrid_shade(Object o, vec3 p, vec3 dir, RayHit h) {
+    if (h.triangle == RAY_NO_TRIANGLE) return textureLod(distance_maps, vec4(dir, search_layer), 0.0).rgb;
+    RqSurface sf = rq_surface(h, dir);
+    Material m2 = materials[sf.material];
+    vec3 q = p + dir * h.t;
+    if (m2.kind == KIND_DIFFUSE) return shade_diffuse(m2, q, sf.n, p, sf.uv);
+    return textureLod(distance_maps, vec4(normalize(q - o.reference_point.xyz), search_layer), 0.0).rgb;
+}
+
 // Radiance arriving at p from dir: the distance-map search's, or where it cannot answer, the
-// ray query's hit shaded (a diffuse surface lit as the camera's; a specular one by what the
-// map holds in its direction). Counts per object the rays asked and traced.
+// ray query's hit shaded (hybrid_shade). Counts per object the rays asked and traced.
 vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     search_map = 0;
     search_layer = float(o.envmap_layer);
@@ -57,17 +79,54 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     vec4 texel = textureLod(distance_maps, vec4(s.dir, search_layer), 0.0);
     bool resolved = hybrid_resolved(s, x, dir, texel.a, textureGather(distance_maps, vec4(s.dir, search_layer), 3));
     atomicAdd(rq_counts[2u * push.object], 1u);
-    if (resolved) return texel.rgb;
-    atomicAdd(rq_counts[2u * push.object + 1u], 1u);
     // Off the surface by 10⁻⁵ of its distance from the reference point (f32 rounding of p).
-    RayHit h = rq_trace_mesh(p, dir, 1e-5 * length(x) + 1e-30, push.object, false);
-    // Nothing: the environment at infinity, as the map holds it in that direction.
-    if (h.triangle == RAY_NO_TRIANGLE) return textureLod(distance_maps, vec4(dir, search_layer), 0.0).rgb;
-    RqSurface sf = rq_surface(h, dir);
-    Material m2 = materials[sf.material];
-    vec3 q = p + dir * h.t;
-    if (m2.kind == KIND_DIFFUSE) return shade_diffuse(m2, q, sf.n, p, sf.uv);
-    return textureLod(distance_maps, vec4(normalize(q - o.reference_point.xyz), search_layer), 0.0).rgb;
+    float t_min = 1e-5 * length(x) + 1e-30;
+    RayHit h = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
+    if (resolved) {
+        if (!hybrid_confirms()) return texel.rgb;
+        // The map's hit confirmed: the nearest triangle in a window around it, shaded.
+        float w = HYBRID_WINDOW * texel.a;
+        h = rq_trace_mesh(p, dir, max(s.d - w, t_min), s.d + w, push.object, false);
+    }
+    if (h.triangle == RAY_NO_TRIANGLE) {
+        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        h = rq_trace_mesh(p, dir, t_min, RQ_T_MAX, push.object, false);
+    }
+    return hybrid_shade(o, p, dir, h);
+}
+
+// The geometric normal of the camera fragment's triangle, turned to the eye
+// (hybrid_geometric_normal; set by the camera pass's main).
+vec3 hybrid_ng = vec3(0.0);
+
+// The reflected ray r from the camera fragment's point p: a ray that goes into the object's
+// own surface (below its triangle's plane: the interpolated normal tilted past the
+// triangle's, near a silhouette) goes on inside, as through the exact tracers (its own
+// surface is no part of its maps): off a mirror nothing reaches p from there where it meets
+// the object; a refractor's camera pass follows it inside (HYBRID_INSIDE); others see what
+// the hybrid search finds. The rest as hybrid_radiance.
+vec3 hybrid_reflected(Object o, vec3 p, vec3 r) {
+    if (!(dot(r, hybrid_ng) < 0.0)) return hybrid_radiance(o, p, r);
+#ifdef HYBRID_INSIDE
+    return HYBRID_INSIDE(o, p, r);
+#else
+    if (materials[o.material].kind != KIND_MIRROR) return hybrid_radiance(o, p, r);
+    search_layer = float(o.envmap_layer);
+    atomicAdd(rq_counts[2u * push.object], 1u);
+    atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+    RayHit h = rq_trace_mesh(p, r, 1e-5 * length(p - o.reference_point.xyz) + 1e-30, RQ_T_MAX, RQ_EVERY_MESH, false);
+    if (h.triangle != RAY_NO_TRIANGLE && floatBitsToUint(rq_shading[h.triangle].uv2.z) == push.object) return vec3(0.0);
+    return hybrid_shade(o, p, r, h);
+#endif
+}
+
+// The geometric normal of the fragment's triangle at p, on the side of the eye (the side the
+// reflected ray leaves on); 0 where the derivatives degenerate (no ray is then taken for one
+// into the surface). Called in uniform control flow.
+vec3 hybrid_geometric_normal(vec3 p, vec3 eye) {
+    vec3 ng = cross(dFdx(p), dFdy(p));
+    if (!(dot(ng, ng) > 0.0) || !is_finite(ng)) return vec3(0.0);
+    return dot(ng, eye - p) < 0.0 ? -ng : ng;
 }
 
 // refractor_exit (distance/refractor/trace.glsl) where its refractor-map search cannot
@@ -83,14 +142,23 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     vec4 texel = textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0);
     vec4 around = textureGather(refractor_maps, vec4(h.dir, search_layer), 3);
     atomicAdd(rq_counts[2u * push.object], 1u);
+    float t_min = 1e-5 * length(pos - ref) + 1e-30;
+    RayHit r = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (hybrid_resolved(h, x, dir, texel.w, around)) {
-        hit = pos + dir * (eps + h.d);
-        n2 = normalize(texel.xyz);
-        if (dot(n2, dir) < 0.0) n2 = -n2;
-        return true;
+        if (!hybrid_confirms()) {
+            hit = pos + dir * (eps + h.d);
+            n2 = normalize(texel.xyz);
+            if (dot(n2, dir) < 0.0) n2 = -n2;
+            return true;
+        }
+        // The map's exit confirmed: the refractor's own triangle in a window around it.
+        float w = HYBRID_WINDOW * texel.w;
+        r = rq_trace_mesh(pos, dir, max(eps + h.d - w, t_min), eps + h.d + w, push.object, true);
     }
-    atomicAdd(rq_counts[2u * push.object + 1u], 1u);
-    RayHit r = rq_trace_mesh(pos, dir, 1e-5 * length(pos - ref) + 1e-30, push.object, true);
+    if (r.triangle == RAY_NO_TRIANGLE) {
+        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        r = rq_trace_mesh(pos, dir, t_min, RQ_T_MAX, push.object, true);
+    }
     if (r.triangle == RAY_NO_TRIANGLE) return false;  // an open refractor: the ray is out
     n2 = rq_surface(r, dir).n;
     if (dot(n2, dir) < 0.0) n2 = -n2;

@@ -25,17 +25,22 @@ layout(location = 0) out vec4 out_color;
 #ifdef HYBRID
 #include "distance/hybrid.glsl"
 #define RADIANCE hybrid_radiance
+#define REFLECTED hybrid_reflected
 #else
 #define RADIANCE traced_radiance
+#define REFLECTED traced_radiance
 #endif
 
 void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
+#ifdef HYBRID
+    hybrid_ng = hybrid_geometric_normal(in_position, views[in_view].eye.xyz);
+#endif
     // The test knob debug_fault=flip_reflection: a deliberately broken reflection.
     if ((push.flags & FLAG_DEBUG_FLIP_REFLECTION) != 0u) s.r = -s.r;
-    vec3 c = s.fr * RADIANCE(o, in_position, s.r);
+    vec3 c = s.fr * REFLECTED(o, in_position, s.r);
     vec3 refracted;
     REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, normalize(in_normal), dir) * RADIANCE(o, in_position, dir));
     c += refracted;

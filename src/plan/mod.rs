@@ -157,12 +157,13 @@ impl Plan {
         // The hybrid search auto chose (on another device's costs) needs ray queries too:
         // off where the device has none, said in the reasons of the objects that read it.
         // (Asked for by the caller, it stays, and the stage refuses with the reason.)
-        if self.quality.distance.hybrid && !self.asked_quality.distance.hybrid {
+        if self.quality.distance.hybrid.traces() && !self.asked_quality.distance.hybrid.traces() {
             if let Some((_, why)) = missing(crate::methods::RAY_QUERY) {
-                self.quality.distance.hybrid = false;
+                let hybrid = self.quality.get("hybrid");
+                self.quality.distance.hybrid = crate::methods::distance::knobs::Hybrid::Off;
                 for o in self.objects.iter_mut().filter(|o| o.method.knobs.contains(&"hybrid")) {
                     o.knobs = o.method.knobs.iter().map(|k| (*k, self.quality.get(k))).collect();
-                    o.reason = format!("{}; hybrid=rays cannot run on this device ({why}): off", o.reason);
+                    o.reason = format!("{}; hybrid={hybrid} cannot run on this device ({why}): off", o.reason);
                 }
             }
         }

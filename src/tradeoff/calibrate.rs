@@ -162,7 +162,8 @@ pub fn costs_for(ctx: &Context, dir: Option<PathBuf>, warn: &mut dyn FnMut(Strin
     let mut runnable = (*c).clone();
     runnable.methods.retain(|name, _| {
         let method = crate::plan::predict::error_model::candidate_method(name);
-        !name.ends_with("+hybrid") && crate::methods::Method::parse(method).is_ok_and(|m| m.needs.missing_on(ctx).is_none())
+        !crate::plan::predict::error_model::candidate_traces(name)
+            && crate::methods::Method::parse(method).is_ok_and(|m| m.needs.missing_on(ctx).is_none())
     });
     Ok((Arc::new(runnable), source))
 }

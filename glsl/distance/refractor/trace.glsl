@@ -36,6 +36,10 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 #ifndef REFRACTOR_EXIT
 #define REFRACTOR_EXIT refractor_exit
 #endif
+// The camera's ray reflected off the refractor's outer surface.
+#ifndef REFRACTOR_REFLECTED
+#define REFRACTOR_REFLECTED REFRACTOR_ENV
+#endif
 
 // c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
 // ray that runs inside it, times weight: searched in its refractor map to the surface it
@@ -74,7 +78,7 @@ vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 
 // towards eye; under dispersion each channel traced inside along its own refraction.
 vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
-    vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
+    vec3 c = s.fr * REFRACTOR_REFLECTED(o, p, s.r);
     if (!material_disperses(m)) return refractor_inside(o, m, p, s.t, s.ft, c);
     for (int k = 0; k < 3; ++k) {
         if (s.ft[k] > 0.0) c = refractor_inside_ior(o, m, p, s.tc[k], s.ft * channel_mask(k), c, m.nu[k]);

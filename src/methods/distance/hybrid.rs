@@ -5,7 +5,11 @@
 //! point hidden behind a silhouette from the reference point, beyond the search's tolerance)
 //! — fires a Vulkan ray query and shades what it meets (`glsl/distance/search.frag`,
 //! HYBRID). Approximate where the map is right, exact where it is wrong; the statistics say
-//! which fraction of each object's rays were traced.
+//! which fraction of each object's rays were traced in full. `hybrid=confirm` also confirms
+//! each answer the map gives by a ray query over a short window around its hit and shades
+//! the triangle there (exact point, normal and texture instead of the map's filtered
+//! radiance). Both modes trace with the object itself a reflected ray that goes into its own
+//! surface (below the fragment's triangle, near a silhouette), which the map cannot see.
 
 use ash::vk;
 

@@ -30,7 +30,29 @@ knobs! {
         frame_latency: bool = "off", one_of()["on" => true, "off" => false];
         /// distance, distance-multi, refractor-map: the camera pass's searches that the map cannot answer (escaped, or a hit the
         /// map does not hold: a gap behind a silhouette, beyond the search's tolerance; inside a refractor too) are traced through
-        /// Vulkan ray queries and their hits shaded (`rays`; needs a device with ray queries), or left to the map (`off`)
-        hybrid: bool = "off", one_of()["off" => false, "rays" => true];
+        /// Vulkan ray queries and their hits shaded (`rays`; needs a device with ray queries), or left to the map (`off`); `confirm`
+        /// also checks every answer the map gives by a ray query over ±1 % of its distance around the map's hit and shades the
+        /// triangle it meets there (exact geometry, normal and texture), tracing the whole ray where the window holds none
+        hybrid: Hybrid = "off", one_of()["off" => Hybrid::Off, "rays" => Hybrid::Rays, "confirm" => Hybrid::Confirm];
+    }
+}
+
+/// What the distance-map camera passes do where their maps cannot answer (`hybrid`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Hybrid {
+    /// The map's answer, whatever it is.
+    Off,
+    /// A ray query where the search cannot answer; the map's radiance where it can.
+    Rays,
+    /// As `Rays`, and every answer of the map confirmed by a ray query over a short window
+    /// around its hit, whose triangle is shaded.
+    Confirm,
+}
+
+impl Hybrid {
+    /// The camera passes fire ray queries.
+    pub fn traces(self) -> bool {
+        self != Hybrid::Off
     }
 }

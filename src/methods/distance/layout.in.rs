@@ -6,10 +6,13 @@ gpu_consts! {
     /// `Push.flags` of `distance.search` only (`debug_fault=flip_reflection`, a test knob):
     /// the reflected ray is traced in the opposite direction.
     FLAG_DEBUG_FLIP_REFLECTION: uint = 16384;
+    /// `Push.flags` of the hybrid camera passes (`hybrid=confirm`): every answer of the map
+    /// confirmed by a ray query around its hit.
+    FLAG_HYBRID_CONFIRM: uint = 32768;
 }
 
 flag_bits! {
-    own_passes 14..15 { FLAG_DEBUG_FLIP_REFLECTION }
+    own_passes 14..16 { FLAG_DEBUG_FLIP_REFLECTION, FLAG_HYBRID_CONFIRM }
 }
 
 descriptor_sets! {

@@ -108,15 +108,20 @@ const SEARCH: CameraPass = CameraPass {
     profiled: Profiled::OWN,
 };
 
-/// A camera pass of the plain shader, or with `hybrid=rays` its HYBRID variant and the ray
-/// queries it fires (hybrid.rs).
+/// A camera pass of the plain shader, or with `hybrid=rays|confirm` its HYBRID variant and
+/// the ray queries it fires (hybrid.rs).
 fn create_hybrid_or_plain(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn Stage>> {
-    if init.plan.quality.distance.hybrid {
+    let mode = init.plan.quality.distance.hybrid;
+    if mode.traces() {
         let extra = hybrid::HybridRays::new(init, c)?;
+        let mut c = c.clone();
+        if mode == knobs::Hybrid::Confirm {
+            c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_HYBRID_CONFIRM);
+        }
         return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
             init.ctx,
             init.layout,
-            c,
+            &c,
             init.multisample,
             Some("HYBRID"),
             Some(Box::new(extra)),

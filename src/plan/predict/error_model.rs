@@ -87,13 +87,24 @@ pub const EXACT: &str = "ray tracing (every scheme)";
 
 /// The candidate a (method, knob variant) pair is, for the models: the method, or
 /// `METHOD+hybrid` where the variant turns on the hybrid search (`hybrid=rays`) of a method
-/// that reads it (its error and its cost are another method's).
+/// that reads it, `METHOD+confirm` for `hybrid=confirm` (their errors and costs are other
+/// methods').
 pub fn candidate(method: &str, knobs: &str) -> String {
-    let hybrid = knobs.split_whitespace().any(|p| p == "hybrid=rays");
+    let mode = knobs.split_whitespace().find_map(|p| p.strip_prefix("hybrid="));
+    let suffix = match mode {
+        Some("rays") => "hybrid",
+        Some("confirm") => "confirm",
+        _ => return method.to_string(),
+    };
     match crate::plan::Method::parse(method) {
-        Ok(m) if hybrid && m.knobs.contains(&"hybrid") => format!("{method}+hybrid"),
+        Ok(m) if m.knobs.contains(&"hybrid") => format!("{method}+{suffix}"),
         _ => method.to_string(),
     }
+}
+
+/// A candidate fires ray queries of its own (the hybrid searches), beyond what its method needs.
+pub fn candidate_traces(name: &str) -> bool {
+    name.ends_with("+hybrid") || name.ends_with("+confirm")
 }
 
 /// The method of a [`candidate`] name.
@@ -388,4 +399,20 @@ pub fn abs_error_quantiles(held: &[Held]) -> (f64, f64) {
     e.sort_by(f64::total_cmp);
     let q = |p: f64| e[((e.len() - 1) as f64 * p).round() as usize];
     (q(0.5), q(0.9))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each hybrid mode is a candidate of its own, only for methods that read the knob.
+    #[test]
+    fn hybrid_modes_are_candidates_of_their_own() {
+        assert_eq!(candidate("distance", "hybrid=rays"), "distance+hybrid");
+        assert_eq!(candidate("refractor-map", "aa=msaa4 hybrid=confirm"), "refractor-map+confirm");
+        assert_eq!(candidate("distance", "hybrid=off"), "distance");
+        assert_eq!(candidate("bvh", "hybrid=confirm"), "bvh");
+        assert_eq!(candidate_method("distance+confirm"), "distance");
+        assert!(candidate_traces("distance+confirm") && candidate_traces("distance+hybrid") && !candidate_traces("distance"));
+    }
 }
