@@ -379,3 +379,41 @@ fn hybrid_self_refraction_in_a_non_convex_glass_object() {
     assert!((0.05..=0.518).contains(&traced), "traced share {traced}");
     common::assert_clean(&ctx);
 }
+
+/// One set of acceleration structures per frame, whoever traces through it: the ray-query
+/// scheme (the mirror), the hybrid search (the glass, on distance maps) and the exact caustic
+/// photons share one BLAS per mesh and one TLAS, built once a frame even under
+/// map_updates=always (each of the three asks for it), and freed with the renderer.
+#[test]
+fn stages_that_trace_share_one_set_of_structures() {
+    let ctx = common::gpu();
+    assert_ray_queries(&ctx);
+    let scene = lit(&common::mirror_and_glass(16));
+    let mut q = quality();
+    for p in ["hybrid=rays", "caustic_paths=exact", "photons=32", "map_updates=always"] {
+        q.set_pair(p).unwrap();
+    }
+    let choices = Choices { method: specula::Choice::Method(RAY_QUERY), objects: vec![("glass".into(), specula::methods::DISTANCE)] };
+    let plan = plan_with(&scene, &choices, &q).unwrap();
+    assert!(plan.caustics.is_some(), "caustics planned");
+    let mut r = Renderer::new(&ctx, &scene, plan, SIZE.0, SIZE.1).unwrap();
+    let count = |name: &str| ctx.memory.snapshot().iter().filter(|(n, _)| n == name).count();
+    let meshes = scene.meshes.iter().filter(|m| !m.indices.is_empty()).count();
+    assert_eq!(count("raytrace.ray-query.tlas"), 1, "one TLAS");
+    assert_eq!(count("raytrace.ray-query.blas"), meshes, "one BLAS per mesh");
+    let frames: Vec<specula::Frame> = (0..3).map(|_| r.render(&ctx).unwrap()).collect();
+    let f = &frames[2];
+    assert!(stat(f, "distance.hybrid.rays.glass") > 0.0, "the hybrid search traced");
+    assert_eq!(stat(f, "raytrace.tlas_builds"), 3.0, "one TLAS build a frame");
+    assert_eq!(stat(f, "caustics.exact.tlas_builds"), 3.0, "the photons' TLAS is the ray tracer's");
+    assert_eq!(stat(f, "raytrace.blas_builds"), stat(f, "caustics.exact.blas_builds"));
+    assert_eq!(
+        f.passes.iter().filter(|p| p.name == "raytrace.tlas").count(),
+        1,
+        "{:?}",
+        f.passes.iter().map(|p| &p.name).collect::<Vec<_>>()
+    );
+    r.destroy(&ctx);
+    assert_eq!(count("raytrace.ray-query.tlas") + count("raytrace.ray-query.blas"), 0, "freed with the renderer");
+    common::assert_clean(&ctx);
+}

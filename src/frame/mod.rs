@@ -14,6 +14,7 @@ pub mod maps;
 pub mod output;
 pub mod schedule;
 pub mod shadow;
+pub mod shared;
 pub mod stage;
 pub mod views;
 pub mod words;

@@ -133,6 +133,8 @@ pub struct StageInit<'a> {
     /// The camera target's samples per pixel, and whether specular camera passes shade
     /// each sample (`aa=msaaN`, `msaa_shading`).
     pub multisample: crate::vk::pipeline::Multisample,
+    /// Resources the frame's stages share (made by the first that asks).
+    pub shared: &'a crate::frame::shared::Shared,
 }
 
 /// A frame effect's constructor: its stage, its images into `maps`.

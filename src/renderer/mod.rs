@@ -68,6 +68,8 @@ pub struct Renderer {
     view_eyes: Vec<glam::Vec3>,
     /// `frame.object_ids`, with `object_ids=on`.
     ids: Option<crate::frame::ids::ObjectIds>,
+    /// What stages share (one set of ray-query acceleration structures, whoever traces).
+    shared: crate::frame::shared::Shared,
 }
 
 /// The frame-wide part of what stages see, built once a frame; `io` adds one view's target.
@@ -109,6 +111,7 @@ impl<'a> FrameShared<'a> {
 }
 
 /// What a stage's or frame part's constructor may look at.
+#[allow(clippy::too_many_arguments)]
 fn stage_init<'a>(
     ctx: &'a Context,
     scene: &'a Scene,
@@ -117,9 +120,10 @@ fn stage_init<'a>(
     b: &Bindings,
     t: &Targets,
     size: (u32, u32),
+    shared: &'a crate::frame::shared::Shared,
 ) -> StageInit<'a> {
     let (width, height) = t.size(size.0, size.1);
-    StageInit { ctx, scene, gpu, plan, layout: b.layout, set_layouts: b.set_layouts(), width, height, multisample: t.multisample }
+    StageInit { ctx, scene, gpu, plan, layout: b.layout, set_layouts: b.set_layouts(), width, height, multisample: t.multisample, shared }
 }
 
 impl Renderer {
@@ -169,6 +173,7 @@ impl Renderer {
             updates: updates::Updates::new(scene),
             view_eyes: Vec::new(),
             ids: None,
+            shared: Default::default(),
         };
         crate::vk::build(ctx, r, |r| r.init(ctx, scene))
     }
@@ -192,7 +197,7 @@ impl Renderer {
         if self.plan.quality.frame.object_ids {
             self.ids = Some(crate::frame::ids::ObjectIds::new(ctx, self.bindings.layout, self.width, self.height)?);
         }
-        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height), &self.shared);
         for family in FAMILIES {
             if let Some(create) = family.frame_part {
                 if let Some(part) = create(&init, &mut self.maps)? {
@@ -210,7 +215,7 @@ impl Renderer {
 
     /// Creates the plan's stages in order; each map stage puts its images into `maps`.
     fn create_stages(&mut self, ctx: &Context, scene: &Scene) -> Result<()> {
-        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+        let init = stage_init(ctx, scene, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height), &self.shared);
         let multisample = self.targets.multisample;
         let mut objects = Vec::new();
         for spec in &self.plan.stages {
@@ -290,6 +295,7 @@ impl Renderer {
     pub fn record(&mut self, ctx: &Context, cmd: vk::CommandBuffer) -> Result<()> {
         self.apply_updates(ctx)?;
         self.write_views()?;
+        self.shared.begin_frame();
         let words = self.push_words(&self.plan.quality);
         let mut rec = Recorder::new(ctx, cmd, &mut self.profiler);
         self.scene.record_upload(&mut rec);
@@ -366,6 +372,7 @@ impl Renderer {
             p.destroy(ctx);
         }
         self.parts.clear();
+        self.shared.destroy(ctx);
         if let Some(mut i) = self.ids.take() {
             crate::vk::Owner::destroy(&mut i, ctx);
         }

@@ -235,7 +235,8 @@ impl Renderer {
             }
         }
         if !c.is_empty() {
-            let init: StageInit = stage_init(ctx, cpu, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height));
+            let init: StageInit =
+                stage_init(ctx, cpu, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height), &self.shared);
             let puts = self.maps.changes();
             for s in &mut self.stages {
                 s.update(&init, c, &mut self.maps)?;

@@ -445,8 +445,9 @@ impl Stage for CausticsStage {
             ("caustics.photon_layers".into(), self.plan.photon_layers as f64),
         ];
         if let Some(e) = &self.exact {
-            v.push(("caustics.exact.blas_builds".into(), e.accel.stats.blas_builds as f64));
-            v.push(("caustics.exact.tlas_builds".into(), e.accel.stats.tlas_builds as f64));
+            let stats = e.accel.borrow().stats;
+            v.push(("caustics.exact.blas_builds".into(), stats.blas_builds as f64));
+            v.push(("caustics.exact.tlas_builds".into(), stats.tlas_builds as f64));
         }
         v
     }

@@ -119,8 +119,9 @@ pub struct RayTrace {
     samples: u32,
     triangle_count: u32,
     structure: Option<Structure>,
-    /// The ray-query scheme's acceleration structures, and its set 5 (the TLAS).
-    accel: Option<AccelStructures>,
+    /// The ray-query scheme's acceleration structures (the frame's, shared with every stage
+    /// that traces ray queries; the renderer destroys them), and its set 5 (the TLAS).
+    accel: Option<std::rc::Rc<std::cell::RefCell<AccelStructures>>>,
     rq_set: vk::DescriptorSet,
     /// `map_updates=always`: the TLAS is rebuilt every frame, as when objects move.
     tlas_every_frame: bool,
@@ -343,7 +344,7 @@ impl RayTrace {
             self.gpu_bvh = Some(GpuBvh::linear(ctx, s, &list)?);
         }
         if self.scheme == Scheme::RayQuery {
-            self.accel = Some(AccelStructures::new(ctx, &MeshInput::from_scene(scene))?);
+            self.accel = Some(super::ray_query::accel::scene_structures(init)?);
         }
         self.shading = Buffer::with_data(ctx, "raytrace.shading", &triangle_shading(scene), STORAGE)?;
         // Its objects' pixels; every pixel when the whole scene is ray traced (the plan then
@@ -592,7 +593,7 @@ impl RayTrace {
         self.trace_sets = sets[ray_sets + 1..ray_sets + trace_sets].to_vec();
         if let Some(accel) = &self.accel {
             self.rq_set = sets[ray_sets + trace_sets];
-            super::ray_query::accel::write_tlas(ctx, self.rq_set, accel.tlas());
+            super::ray_query::accel::write_tlas(ctx, self.rq_set, accel.borrow().tlas());
             write_buffer(ctx, self.rq_set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, self.shading.raw);
             write_buffer(ctx, self.rq_set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
         }
@@ -936,8 +937,8 @@ impl Stage for RayTrace {
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
         // Ray queries: new instances (a TLAS rebuild in the next frame), BLAS only for
         // deformed meshes.
-        if let Some(accel) = self.accel.as_mut() {
-            accel.update(ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
+        if let Some(accel) = &self.accel {
+            accel.borrow_mut().update(ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
         }
         self.shading.write(bytemuck::cast_slice(&triangle_shading(init.scene)))?;
         let mut params = self.params.read()?.to_vec();
@@ -956,7 +957,8 @@ impl Stage for RayTrace {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let view = io.views.camera;
         let compute = vk::PipelineBindPoint::COMPUTE;
-        if let Some(accel) = self.accel.as_mut() {
+        if let Some(accel) = &self.accel {
+            let mut accel = accel.borrow_mut();
             if self.tlas_every_frame {
                 accel.touch();
             }
@@ -1131,6 +1133,7 @@ impl Stage for RayTrace {
             out.push(("raytrace.gpu_refits".to_string(), b.refits as f64));
         }
         if let Some(a) = &self.accel {
+            let a = a.borrow();
             out.push(("raytrace.blas_builds".to_string(), a.stats.blas_builds as f64));
             out.push(("raytrace.tlas_builds".to_string(), a.stats.tlas_builds as f64));
             out.push(("raytrace.blas_build_ms".to_string(), a.stats.blas_build_ms));
@@ -1180,9 +1183,8 @@ impl Stage for RayTrace {
         if let Some(s) = self.structure.as_mut() {
             s.destroy(ctx);
         }
-        if let Some(mut a) = self.accel.take() {
-            a.destroy(ctx);
-        }
+        // The frame's acceleration structures: the renderer destroys them.
+        self.accel = None;
         if let Some(mut b) = self.gpu_bvh.take() {
             b.destroy(ctx);
         }

@@ -205,7 +205,31 @@ pub struct AccelStructures {
     /// Meshes whose BLAS build is still to be recorded (host-device contexts).
     pending: Vec<usize>,
     tlas_dirty: bool,
+    /// The TLAS was recorded since the frame began (`touch` then asks for no other build:
+    /// the stages that share it all touch it under `map_updates=always`).
+    tlas_built_this_frame: bool,
     pub stats: AccelStats,
+}
+
+/// Where the frame keeps the scene's structures (`frame::shared`).
+const SHARED_KEY: &str = "ray-query.scene";
+
+/// The scene's structures over `init`'s scene, one set per frame whichever stages trace
+/// through them (the ray-query scheme, caustic_paths=exact, the hybrid searches): made by the
+/// first that asks, updated by each after a change (the second finds nothing left to do),
+/// recorded by the first that records in a frame, destroyed by the renderer.
+pub fn scene_structures(init: &crate::frame::stage::StageInit) -> Result<std::rc::Rc<std::cell::RefCell<AccelStructures>>> {
+    init.shared.get_or_create(SHARED_KEY, || AccelStructures::new(init.ctx, &MeshInput::from_scene(init.scene)))
+}
+
+impl crate::frame::shared::SharedResource for AccelStructures {
+    fn begin_frame(&mut self) {
+        self.tlas_built_this_frame = false;
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        AccelStructures::destroy(self, ctx);
+    }
 }
 
 fn rq(ctx: &Context) -> Result<&RayQueryDevice> {
@@ -237,6 +261,7 @@ impl AccelStructures {
             tlas_scratch_address: 0,
             pending: Vec::new(),
             tlas_dirty: true,
+            tlas_built_this_frame: false,
             stats: AccelStats::default(),
         };
         match me.init(ctx, meshes) {
@@ -454,11 +479,19 @@ impl AccelStructures {
             .geometries(&geometry)
             .scratch_data(vk::DeviceOrHostAddressKHR { device_address: self.tlas_scratch_address })];
         let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(self.inputs.len() as u32)];
+        // Ray queries recorded before (an earlier frame in the same command buffer) finish
+        // reading the TLAS before it is written again.
+        let before = [vk::MemoryBarrier2::default()
+            .src_stage_mask(READERS)
+            .src_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR)
+            .dst_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
+            .dst_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)];
+        unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&before)) };
         unsafe { rq.accel.cmd_build_acceleration_structures(cmd, &info, &[&range[..]]) };
         let b = [vk::MemoryBarrier2::default()
             .src_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
             .src_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)
-            .dst_stage_mask(vk::PipelineStageFlags2::COMPUTE_SHADER | vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
+            .dst_stage_mask(READERS | vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
             .dst_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR | vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)];
         unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
     }
@@ -634,15 +667,16 @@ impl AccelStructures {
             rec.end(open);
             self.stats.tlas_builds += 1;
             self.tlas_dirty = false;
+            self.tlas_built_this_frame = true;
             recorded = true;
         }
         recorded
     }
 
     /// Rebuilds the TLAS in the next `record` although nothing moved (`map_updates=always`:
-    /// what a frame costs when objects move).
+    /// what a frame costs when objects move), unless this frame built it already.
     pub fn touch(&mut self) {
-        self.tlas_dirty = true;
+        self.tlas_dirty |= !self.tlas_built_this_frame;
     }
 
     /// Builds the TLAS now (standalone contexts: tests and tools that intersect without a frame).
@@ -696,14 +730,17 @@ pub fn write_tlas(ctx: &Context, set: vk::DescriptorSet, tlas: vk::AccelerationS
 }
 
 /// BLAS builds before the TLAS build (and any later build) reads them.
+/// The stages whose shaders trace ray queries: the ray pipeline's kernels, the raster passes'
+/// fragments (exact caustic photons, the hybrid searches).
+const READERS: vk::PipelineStageFlags2 =
+    vk::PipelineStageFlags2::from_raw(vk::PipelineStageFlags2::COMPUTE_SHADER.as_raw() | vk::PipelineStageFlags2::FRAGMENT_SHADER.as_raw());
+
 fn build_barrier(ctx: &Context, cmd: vk::CommandBuffer) {
     let b = [vk::MemoryBarrier2::default()
         .src_stage_mask(vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR)
         .src_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)
         .dst_stage_mask(
-            vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR
-                | vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_COPY_KHR
-                | vk::PipelineStageFlags2::COMPUTE_SHADER,
+            vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR | vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_COPY_KHR | READERS,
         )
         .dst_access_mask(vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR | vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR)];
     unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };

@@ -1,11 +1,15 @@
 //! What a raster pass traces ray queries through (the exact caustic photons, the hybrid
-//! camera pass): the scene's acceleration structures, the triangles' shading, a pair of
-//! counters per object, set 5 over them, and the pipeline layout that adds set 5 to the
-//! frame's sets 0 and 1 (sets 2–4 empty).
+//! camera pass): the scene's acceleration structures (the frame's one set, shared with every
+//! stage that traces), the triangles' shading, a pair of counters per object, set 5 over
+//! them, and the pipeline layout that adds set 5 to the frame's sets 0 and 1 (sets 2–4
+//! empty).
+
+use std::cell::RefCell;
+use std::rc::Rc;
 
 use ash::vk;
 
-use super::accel::{write_tlas, AccelStructures, MeshInput};
+use super::accel::{scene_structures, write_tlas, AccelStructures, MeshInput};
 use crate::frame::layout::{binding, RAY_QUERY_BINDINGS};
 use crate::frame::stage::StageInit;
 use crate::frame::PUSH_BYTES;
@@ -14,7 +18,8 @@ use crate::vk::{build, Buffer, Context, MemoryLocation, Owner, Recorder};
 use crate::Result;
 
 pub struct SceneRays {
-    pub accel: AccelStructures,
+    /// The frame's structures (the renderer destroys them).
+    pub accel: Rc<RefCell<AccelStructures>>,
     shading: Buffer,
     /// Per mesh two words (`RQ_COUNTS`): rays a pass asked about, rays it traced.
     counts: Buffer,
@@ -33,7 +38,7 @@ impl SceneRays {
     pub fn new(init: &StageInit, name: &str) -> Result<SceneRays> {
         let ctx = init.ctx;
         let me = SceneRays {
-            accel: AccelStructures::new(ctx, &MeshInput::from_scene(init.scene))?,
+            accel: scene_structures(init)?,
             shading: Buffer::placeholder(),
             counts: Buffer::placeholder(),
             set_layouts: [vk::DescriptorSetLayout::null(); 4],
@@ -62,7 +67,7 @@ impl SceneRays {
             let layouts = [init.set_layouts[0], init.set_layouts[1], l[0], l[1], l[2], l[3]];
             me.layout = pipeline_layout(ctx, name, &layouts, PUSH_BYTES, stages)?;
             (me.pool, me.set) = allocate_set(ctx, name, me.set_layouts[3], RAY_QUERY_BINDINGS)?;
-            write_tlas(ctx, me.set, me.accel.tlas());
+            write_tlas(ctx, me.set, me.accel.borrow().tlas());
             write_buffer(ctx, me.set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, me.shading.raw);
             write_buffer(ctx, me.set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, me.counts.raw);
             Ok(())
@@ -75,17 +80,19 @@ impl SceneRays {
         if moved.is_empty() {
             return Ok(());
         }
-        self.accel.update(init.ctx, &MeshInput::from_scene(init.scene), moved)?;
+        self.accel.borrow_mut().update(init.ctx, &MeshInput::from_scene(init.scene), moved)?;
         self.shading.write(bytemuck::cast_slice(&super::super::stage::triangle_shading(init.scene)))
     }
 
     /// Records the builds this frame needs and zeroes the counters, before the pass that
     /// traces.
     pub fn record(&mut self, ctx: &Context, rec: &mut Recorder) {
+        let mut accel = self.accel.borrow_mut();
         if self.tlas_every_frame {
-            self.accel.touch();
+            accel.touch();
         }
-        self.accel.record(ctx, rec);
+        accel.record(ctx, rec);
+        drop(accel);
         let cmd = rec.cmd;
         unsafe { ctx.device.cmd_fill_buffer(cmd, self.counts.raw, 0, vk::WHOLE_SIZE, 0) };
         let b = [vk::MemoryBarrier2::default()
@@ -119,7 +126,6 @@ impl SceneRays {
 impl Owner for SceneRays {
     fn destroy(&mut self, ctx: &Context) {
         destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
-        self.accel.destroy(ctx);
         self.shading.destroy(ctx);
         self.counts.destroy(ctx);
     }
