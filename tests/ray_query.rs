@@ -382,8 +382,9 @@ fn hybrid_self_refraction_in_a_non_convex_glass_object() {
 
 /// One set of acceleration structures per frame, whoever traces through it: the ray-query
 /// scheme (the mirror), the hybrid search (the glass, on distance maps) and the exact caustic
-/// photons share one BLAS per mesh and one TLAS, built once a frame even under
-/// map_updates=always (each of the three asks for it), and freed with the renderer.
+/// photons share one BLAS per mesh, one TLAS, built once a frame even under
+/// map_updates=always (each of the three asks for it), and one table of the triangles'
+/// shading, all freed with the renderer.
 #[test]
 fn stages_that_trace_share_one_set_of_structures() {
     let ctx = common::gpu();
@@ -401,6 +402,7 @@ fn stages_that_trace_share_one_set_of_structures() {
     let meshes = scene.meshes.iter().filter(|m| !m.indices.is_empty()).count();
     assert_eq!(count("raytrace.ray-query.tlas"), 1, "one TLAS");
     assert_eq!(count("raytrace.ray-query.blas"), meshes, "one BLAS per mesh");
+    assert_eq!(count("raytrace.shading"), 1, "one table of the triangles' shading");
     let frames: Vec<specula::Frame> = (0..3).map(|_| r.render(&ctx).unwrap()).collect();
     let f = &frames[2];
     assert!(stat(f, "distance.hybrid.rays.glass") > 0.0, "the hybrid search traced");

@@ -125,7 +125,8 @@ pub struct RayTrace {
     rq_set: vk::DescriptorSet,
     /// `map_updates=always`: the TLAS is rebuilt every frame, as when objects move.
     tlas_every_frame: bool,
-    shading: Buffer,
+    /// The frame's triangle shading (shared; the renderer destroys it).
+    shading: Option<std::rc::Rc<std::cell::RefCell<SceneShading>>>,
     handled: Buffer,
     queues: Vec<Queue>,
     shadow: Option<Queue>,
@@ -254,7 +255,7 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
         accel: None,
         rq_set: vk::DescriptorSet::null(),
         tlas_every_frame: q.frame.map_updates_always,
-        shading: Buffer::placeholder(),
+        shading: None,
         handled: Buffer::placeholder(),
         queues: Vec::new(),
         shadow: None,
@@ -306,6 +307,30 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
     }
 }
 
+/// Every triangle's shading attributes on the GPU (`raytrace.shading`), one buffer per frame
+/// whoever reads it (the ray pipeline, the exact caustic photons, the hybrid searches).
+pub(crate) struct SceneShading(pub Buffer);
+
+impl crate::frame::shared::SharedResource for SceneShading {
+    fn destroy(&mut self, ctx: &crate::vk::Context) {
+        self.0.destroy(ctx);
+    }
+}
+
+impl SceneShading {
+    /// The frame's buffer over `init`'s scene (made by the first stage that asks).
+    pub(crate) fn of(init: &StageInit) -> Result<std::rc::Rc<std::cell::RefCell<SceneShading>>> {
+        init.shared.get_or_create("raytrace.shading", || {
+            Ok(SceneShading(Buffer::with_data(init.ctx, "raytrace.shading", &triangle_shading(init.scene), STORAGE)?))
+        })
+    }
+
+    /// Rewritten after moves (each reader asks; the data is the scene's either way).
+    pub(crate) fn update(&mut self, scene: &crate::scene::Scene) -> Result<()> {
+        self.0.write(bytemuck::cast_slice(&triangle_shading(scene)))
+    }
+}
+
 /// The shading attributes of every triangle of the list, in its order.
 pub(crate) fn triangle_shading(scene: &crate::scene::Scene) -> Vec<GpuTriangleShading> {
     let mut out = Vec::with_capacity(scene.triangle_count());
@@ -329,6 +354,10 @@ pub(crate) fn triangle_shading(scene: &crate::scene::Scene) -> Vec<GpuTriangleSh
 }
 
 impl RayTrace {
+    fn shading_raw(&self) -> vk::Buffer {
+        self.shading.as_ref().map_or(vk::Buffer::null(), |s| s.borrow().0.raw)
+    }
+
     fn init(&mut self, init: &StageInit, plan: &CameraPlan) -> Result<()> {
         let ctx = init.ctx;
         let scene = init.scene;
@@ -346,7 +375,7 @@ impl RayTrace {
         if self.scheme == Scheme::RayQuery {
             self.accel = Some(super::ray_query::accel::scene_structures(init)?);
         }
-        self.shading = Buffer::with_data(ctx, "raytrace.shading", &triangle_shading(scene), STORAGE)?;
+        self.shading = Some(SceneShading::of(init)?);
         // Its objects' pixels; every pixel when the whole scene is ray traced (the plan then
         // makes no shadow maps: diffuse surfaces seen directly get exact shadow rays too).
         let whole_scene = matches!(init.plan.choice, Choice::Method(m) if m.gpu.is_some_and(|g| g.camera.name == plan.name));
@@ -594,7 +623,7 @@ impl RayTrace {
         if let Some(accel) = &self.accel {
             self.rq_set = sets[ray_sets + trace_sets];
             super::ray_query::accel::write_tlas(ctx, self.rq_set, accel.borrow().tlas());
-            write_buffer(ctx, self.rq_set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, self.shading.raw);
+            write_buffer(ctx, self.rq_set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, self.shading_raw());
             write_buffer(ctx, self.rq_set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
         }
 
@@ -635,7 +664,7 @@ impl RayTrace {
             write_buffer(ctx, set, binding::SHADOW_PAYLOADS, sb, shadow.payloads.raw);
             at(set, binding::SHADOW_COUNT, &self.counters, shadow_counter(k), 4);
             write_buffer(ctx, set, binding::ACCUM, sb, self.accum.raw);
-            write_buffer(ctx, set, binding::SHADING, sb, self.shading.raw);
+            write_buffer(ctx, set, binding::SHADING, sb, self.shading_raw());
             write_buffer(ctx, set, binding::HANDLED, sb, self.handled.raw);
             at(set, binding::TRACE, &self.params, k as u64 * stride, std::mem::size_of::<GpuTraceParams>() as u64);
             let budget = std::mem::size_of::<GpuSpawnBudget>() as u64;
@@ -940,7 +969,9 @@ impl Stage for RayTrace {
         if let Some(accel) = &self.accel {
             accel.borrow_mut().update(ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
         }
-        self.shading.write(bytemuck::cast_slice(&triangle_shading(init.scene)))?;
+        if let Some(s) = &self.shading {
+            s.borrow_mut().update(init.scene)?;
+        }
         let mut params = self.params.read()?.to_vec();
         let t_min = list_offset(&list);
         let size = std::mem::size_of::<GpuTraceParams>();
@@ -1194,8 +1225,9 @@ impl Stage for RayTrace {
         }
         self.queues.clear();
         self.shadow = None;
+        // The frame's triangle shading: the renderer destroys it.
+        self.shading = None;
         for b in [
-            &mut self.shading,
             &mut self.handled,
             &mut self.counters,
             &mut self.params,

@@ -9,6 +9,7 @@ use std::rc::Rc;
 
 use ash::vk;
 
+use super::super::stage::SceneShading;
 use super::accel::{scene_structures, write_tlas, AccelStructures, MeshInput};
 use crate::frame::layout::{binding, RAY_QUERY_BINDINGS};
 use crate::frame::stage::StageInit;
@@ -20,7 +21,8 @@ use crate::Result;
 pub struct SceneRays {
     /// The frame's structures (the renderer destroys them).
     pub accel: Rc<RefCell<AccelStructures>>,
-    shading: Buffer,
+    /// The frame's triangle shading (shared, as the structures).
+    shading: Rc<RefCell<SceneShading>>,
     /// Per mesh two words (`RQ_COUNTS`): rays a pass asked about, rays it traced.
     counts: Buffer,
     /// Empty sets 2–4, then set 5.
@@ -39,7 +41,7 @@ impl SceneRays {
         let ctx = init.ctx;
         let me = SceneRays {
             accel: scene_structures(init)?,
-            shading: Buffer::placeholder(),
+            shading: SceneShading::of(init)?,
             counts: Buffer::placeholder(),
             set_layouts: [vk::DescriptorSetLayout::null(); 4],
             layout: vk::PipelineLayout::null(),
@@ -49,7 +51,6 @@ impl SceneRays {
         };
         build(ctx, me, |me| {
             let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            me.shading = Buffer::with_data(ctx, &format!("{name}.shading"), &super::super::stage::triangle_shading(init.scene), storage)?;
             let words = 2 * init.scene.meshes.len().max(1) as u64;
             me.counts = Buffer::new(
                 ctx,
@@ -68,7 +69,7 @@ impl SceneRays {
             me.layout = pipeline_layout(ctx, name, &layouts, PUSH_BYTES, stages)?;
             (me.pool, me.set) = allocate_set(ctx, name, me.set_layouts[3], RAY_QUERY_BINDINGS)?;
             write_tlas(ctx, me.set, me.accel.borrow().tlas());
-            write_buffer(ctx, me.set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, me.shading.raw);
+            write_buffer(ctx, me.set, binding::RQ_SHADING, vk::DescriptorType::STORAGE_BUFFER, me.shading.borrow().0.raw);
             write_buffer(ctx, me.set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, me.counts.raw);
             Ok(())
         })
@@ -81,7 +82,7 @@ impl SceneRays {
             return Ok(());
         }
         self.accel.borrow_mut().update(init.ctx, &MeshInput::from_scene(init.scene), moved)?;
-        self.shading.write(bytemuck::cast_slice(&super::super::stage::triangle_shading(init.scene)))
+        self.shading.borrow_mut().update(init.scene)
     }
 
     /// Records the builds this frame needs and zeroes the counters, before the pass that
@@ -126,7 +127,6 @@ impl SceneRays {
 impl Owner for SceneRays {
     fn destroy(&mut self, ctx: &Context) {
         destroy_layouts(ctx, &mut self.layout, &mut self.pool, &mut self.set_layouts);
-        self.shading.destroy(ctx);
         self.counts.destroy(ctx);
     }
 }
