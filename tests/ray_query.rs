@@ -342,7 +342,8 @@ fn exact_photons_and_the_hybrid_search_follow_moves() {
 /// glass object, a torus in the emissive checkerboard room: the refractor map, one distance
 /// per direction from the reference point, cannot hold the torus's hidden inner walls, so
 /// searches inside it that it cannot answer are traced against the torus's own triangles
-/// (and the environment searches against the rest).
+/// (and the environment searches against the rest); rays that leave it and meet it again
+/// are followed back in.
 #[test]
 fn hybrid_self_refraction_in_a_non_convex_glass_object() {
     let ctx = common::gpu();
@@ -369,14 +370,16 @@ fn hybrid_self_refraction_in_a_non_convex_glass_object() {
         "torus: refractor-map {p:.2} dB, hybrid=rays {h:.2} dB tracing {:.2} % of {rays} searches, hybrid=confirm {c:.2} dB, ray-query {e:.2} dB",
         100.0 * traced
     );
-    // Measured at 64²: refractor-map 8.26 dB, hybrid=rays 30.61 dB tracing 46.17 % of 14825
-    // searches (inside and out), hybrid=confirm 31.35 dB, ray-query 64.87 dB. What remains:
-    // exits that meet the torus again (its own surface is in neither map), rays past hidden
-    // parts of its surface, the bounce budgets. Floors: 1 dB under the hybrids; the traced
-    // share at most 1.122 × measured.
-    assert!(h >= 29.61 && h < e, "hybrid=rays {h:.2} dB (refractor-map {p:.2}, ray-query {e:.2})");
-    assert!(c >= 30.35 && c < e, "hybrid=confirm {c:.2} dB (rays {h:.2}, ray-query {e:.2})");
-    assert!((0.05..=0.518).contains(&traced), "traced share {traced}");
+    // Measured at 64²: refractor-map 8.26 dB, hybrid=rays 34.81 dB tracing 61.31 % of 21932
+    // searches and ray queries (inside and out; the torus is saddle-shaped, so every ray that
+    // leaves it is traced against it first, and where it meets it again it is followed back
+    // in), hybrid=confirm 36.84 dB, ray-query 64.87 dB (before rays that left it were
+    // followed back in: 30.61 and 31.35 dB). What remains: rays past hidden parts of its
+    // surface, the bounce budgets, the list of paths that came back in (4). Floors: 1 dB
+    // under the hybrids; the traced share at most 1.122 × measured.
+    assert!(h >= 33.81 && h < e, "hybrid=rays {h:.2} dB (refractor-map {p:.2}, ray-query {e:.2})");
+    assert!(c >= 35.84 && c < e, "hybrid=confirm {c:.2} dB (rays {h:.2}, ray-query {e:.2})");
+    assert!((0.05..=0.688).contains(&traced), "traced share {traced}");
     common::assert_clean(&ctx);
 }
 

@@ -103,21 +103,16 @@ vec3 hybrid_ng = vec3(0.0);
 // own surface (below its triangle's plane: the interpolated normal tilted past the
 // triangle's, near a silhouette) goes on inside, as through the exact tracers (its own
 // surface is no part of its maps): off a mirror nothing reaches p from there where it meets
-// the object; a refractor's camera pass follows it inside (HYBRID_INSIDE); others see what
-// the hybrid search finds. The rest as hybrid_radiance.
+// the object; others see what the hybrid search finds (a solid refractor's camera pass
+// follows it inside: refractor/search.frag). The rest as hybrid_radiance.
 vec3 hybrid_reflected(Object o, vec3 p, vec3 r) {
-    if (!(dot(r, hybrid_ng) < 0.0)) return hybrid_radiance(o, p, r);
-#ifdef HYBRID_INSIDE
-    return HYBRID_INSIDE(o, p, r);
-#else
-    if (materials[o.material].kind != KIND_MIRROR) return hybrid_radiance(o, p, r);
+    if (!(dot(r, hybrid_ng) < 0.0) || materials[o.material].kind != KIND_MIRROR) return hybrid_radiance(o, p, r);
     search_layer = float(o.envmap_layer);
     atomicAdd(rq_counts[2u * push.object], 1u);
     atomicAdd(rq_counts[2u * push.object + 1u], 1u);
     RayHit h = rq_trace_mesh(p, r, 1e-5 * length(p - o.reference_point.xyz) + 1e-30, RQ_T_MAX, RQ_EVERY_MESH, false);
     if (h.triangle != RAY_NO_TRIANGLE && floatBitsToUint(rq_shading[h.triangle].uv2.z) == push.object) return vec3(0.0);
     return hybrid_shade(o, p, r, h);
-#endif
 }
 
 // The geometric normal of the fragment's triangle at p, on the side of the eye (the side the
@@ -127,6 +122,54 @@ vec3 hybrid_geometric_normal(vec3 p, vec3 eye) {
     vec3 ng = cross(dFdx(p), dFdy(p));
     if (!(dot(ng, ng) > 0.0) || !is_finite(ng)) return vec3(0.0);
     return dot(ng, eye - p) < 0.0 ? -ng : ng;
+}
+
+// A solid refractor that is not convex (FLAG_HYBRID_REENTERS): a ray that leaves it may meet
+// it again, which neither map holds (the distance map leaves the object out). Such rays are
+// traced against the object first; where they meet it, the reflection there is searched and
+// the refracted path queued here, followed inside after the path that found it (a work
+// list instead of recursion; a path that finds the list full is dropped).
+const uint HYBRID_PATHS = 4u;
+struct HybridPath {
+    vec3 pos;
+    vec3 dir;
+    vec3 weight;
+};
+HybridPath hybrid_paths[HYBRID_PATHS];
+uint hybrid_queued = 0u;
+// The index the current inside paths refract with (a channel's under dispersion).
+float hybrid_ior = 1.0;
+
+// What a ray that left refractor o at p along d brings back, times w: hybrid_radiance, or
+// where it meets the refractor again before anything else, the reflection there plus the
+// refracted path queued (refractor/trace.glsl's REFRACTOR_OUT).
+vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w) {
+    // One search at the end whatever the ray met (every call site is a copy of the search
+    // in the compiled shader).
+    vec3 from = p;
+    vec3 along = d;
+    vec3 times = w;
+    if ((push.flags & FLAG_HYBRID_REENTERS) != 0u) {
+        float t_min = 1e-5 * length(p - o.reference_point.xyz) + 1e-30;
+        atomicAdd(rq_counts[2u * push.object], 1u);
+        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        RayHit own = rq_trace_mesh(p, d, t_min, RQ_T_MAX, push.object, true);
+        if (own.triangle != RAY_NO_TRIANGLE && rq_trace_mesh(p, d, t_min, own.t, push.object, false).triangle == RAY_NO_TRIANGLE) {
+            vec3 q = p + d * own.t;
+            vec3 n = rq_surface(own, d).n;
+            if (dot(n, d) > 0.0) n = -n;  // against the ray: it comes from outside
+            vec3 f = material_fresnel(materials[o.material], -dot(d, n), hybrid_ior);
+            vec3 t;
+            if (hybrid_queued < HYBRID_PATHS && refract_dir(d, n, 1.0 / hybrid_ior, t)) {
+                hybrid_paths[hybrid_queued] = HybridPath(q, t, w * (1.0 - f));
+                hybrid_queued += 1u;
+            }
+            from = q;
+            along = reflect_dir(d, n);
+            times = w * f;
+        }
+    }
+    return times * hybrid_radiance(o, from, along);
 }
 
 // refractor_exit (distance/refractor/trace.glsl) where its refractor-map search cannot

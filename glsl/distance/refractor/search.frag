@@ -10,24 +10,59 @@
 #define SPECULA_RAY_QUERY
 #endif
 // refractor.search: self refraction with a refractor map (survey §4.4), seen by the camera.
-// HYBRID (hybrid=rays): searches that cannot answer, inside the refractor and out in the
+// HYBRID (hybrid=rays|confirm): searches that cannot answer, inside the refractor and out in the
 // environment, traced through Vulkan ray queries (distance/hybrid.glsl).
 #ifdef HYBRID
-#include "common/scene.glsl"
-// A reflected ray into the refractor's own surface goes on inside it (hybrid_reflected).
-vec3 refractor_reflected_inside(Object o, vec3 p, vec3 r);
-#define HYBRID_INSIDE refractor_reflected_inside
 #include "distance/hybrid.glsl"
 #define REFRACTOR_ENV hybrid_radiance
 #define REFRACTOR_EXIT hybrid_exit
-#define REFRACTOR_REFLECTED hybrid_reflected
+#define REFRACTOR_OUT hybrid_outside
 #endif
 #include "distance/refractor/trace.glsl"
 
 #ifdef HYBRID
-vec3 refractor_reflected_inside(Object o, vec3 p, vec3 r) {
-    return refractor_inside(o, materials[o.material], p, r, vec3(1.0), vec3(0.0));
+// The inside path, then those queued (by rays that came back in, hybrid_outside; by the
+// camera's reflection into the refractor itself): at most twice the list's length of them,
+// each of which may queue more. One call site of the inside search, as below: each is a copy
+// of every search in the compiled shader.
+vec3 hybrid_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c, float ior) {
+    hybrid_ior = ior;
+    HybridPath path = HybridPath(p, dir, weight);
+    for (uint k = 0u; k <= 2u * HYBRID_PATHS; ++k) {
+        c = refractor_inside_ior(o, m, path.pos, path.dir, path.weight, c, ior);
+        if (hybrid_queued == 0u) break;
+        hybrid_queued -= 1u;
+        path = hybrid_paths[hybrid_queued];
+    }
+    hybrid_queued = 0u;
+    return c;
 }
+
+// refractor_radiance (refractor/trace.glsl) for the hybrid search: the camera's reflection
+// that goes into the refractor's own surface (below its triangle, near a silhouette) goes on
+// inside it, as through the exact tracers; every channel (one, without dispersion) inside
+// through one call site.
+vec3 hybrid_refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
+    SpecularSplit s = specular_split(m, p, n, eye);
+    vec3 c = vec3(0.0);
+    hybrid_queued = 0u;
+    if (dot(s.r, hybrid_ng) < 0.0) {
+        hybrid_paths[0] = HybridPath(p, s.r, s.fr);
+        hybrid_queued = 1u;
+    } else {
+        c = s.fr * hybrid_radiance(o, p, s.r);
+    }
+    bool disperses = material_disperses(m);
+    for (int k = 0; k < (disperses ? 3 : 1); ++k) {
+        vec3 w = disperses ? s.ft * channel_mask(k) : s.ft;
+        vec3 dir = disperses ? s.tc[k] : s.t;
+        if (any(greaterThan(w, vec3(0.0))) || hybrid_queued > 0u) c = hybrid_inside_ior(o, m, p, dir, w, c, disperses ? m.nu[k] : material_ior(m));
+    }
+    return c;
+}
+#define REFRACTOR_RADIANCE hybrid_refractor_radiance
+#else
+#define REFRACTOR_RADIANCE refractor_radiance
 #endif
 
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
@@ -42,5 +77,5 @@ void main() {
 #ifdef HYBRID
     hybrid_ng = hybrid_geometric_normal(in_position, views[in_view].eye.xyz);
 #endif
-    out_color = vec4(refractor_radiance(o, m, in_position, normalize(in_normal), views[in_view].eye.xyz), 1.0);
+    out_color = vec4(REFRACTOR_RADIANCE(o, m, in_position, normalize(in_normal), views[in_view].eye.xyz), 1.0);
 }

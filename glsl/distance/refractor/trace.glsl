@@ -36,9 +36,10 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 #ifndef REFRACTOR_EXIT
 #define REFRACTOR_EXIT refractor_exit
 #endif
-// The camera's ray reflected off the refractor's outer surface.
-#ifndef REFRACTOR_REFLECTED
-#define REFRACTOR_REFLECTED REFRACTOR_ENV
+// What a ray that left the refractor at p along d brings back, times w (the hybrid search
+// follows it into the refractor again where it meets it).
+#ifndef REFRACTOR_OUT
+#define REFRACTOR_OUT(o, p, d, w) ((w) * REFRACTOR_ENV(o, p, d))
 #endif
 
 // c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
@@ -50,7 +51,7 @@ vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, v
     for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
         if (!REFRACTOR_EXIT(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
-            c += weight * REFRACTOR_ENV(o, pos, dir);
+            c += REFRACTOR_OUT(o, pos, dir, weight);
             weight = vec3(0.0);
             break;
         }
@@ -60,7 +61,7 @@ vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, v
         // Leaving the object: ν_i/ν_t = ior, the normal faces the inside (−n2).
         if (refract_dir(dir, -n2, ior, out_dir)) {
             vec3 f = material_fresnel(m, cos_i, 1.0 / ior);
-            c += weight * (1.0 - f) * REFRACTOR_ENV(o, hit, out_dir);
+            c += REFRACTOR_OUT(o, hit, out_dir, weight * (1.0 - f));
             weight *= f;
         }
         // Total internal reflection (or the reflected part): on inside the object.
@@ -78,7 +79,7 @@ vec3 refractor_inside(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 
 // towards eye; under dispersion each channel traced inside along its own refraction.
 vec3 refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
-    vec3 c = s.fr * REFRACTOR_REFLECTED(o, p, s.r);
+    vec3 c = s.fr * REFRACTOR_ENV(o, p, s.r);
     if (!material_disperses(m)) return refractor_inside(o, m, p, s.t, s.ft, c);
     for (int k = 0; k < 3; ++k) {
         if (s.ft[k] > 0.0) c = refractor_inside_ior(o, m, p, s.tc[k], s.ft * channel_mask(k), c, m.nu[k]);

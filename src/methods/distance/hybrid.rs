@@ -9,7 +9,9 @@
 //! each answer the map gives by a ray query over a short window around its hit and shades
 //! the triangle there (exact point, normal and texture instead of the map's filtered
 //! radiance). Both modes trace with the object itself a reflected ray that goes into its own
-//! surface (below the fragment's triangle, near a silhouette), which the map cannot see.
+//! surface (below the fragment's triangle, near a silhouette), which the map cannot see; and
+//! on a solid refractor that is neither convex nor flat, every ray that leaves it is traced
+//! against it first and followed back in where it meets it again.
 
 use ash::vk;
 

@@ -9,10 +9,13 @@ gpu_consts! {
     /// `Push.flags` of the hybrid camera passes (`hybrid=confirm`): every answer of the map
     /// confirmed by a ray query around its hit.
     FLAG_HYBRID_CONFIRM: uint = 32768;
+    /// `Push.flags` of a hybrid camera pass's object that is neither convex nor flat: rays
+    /// that leave it are traced against it first (they may meet it again).
+    FLAG_HYBRID_REENTERS: uint = 65536;
 }
 
 flag_bits! {
-    own_passes 14..16 { FLAG_DEBUG_FLIP_REFLECTION, FLAG_HYBRID_CONFIRM }
+    own_passes 14..17 { FLAG_DEBUG_FLIP_REFLECTION, FLAG_HYBRID_CONFIRM, FLAG_HYBRID_REENTERS }
 }
 
 descriptor_sets! {

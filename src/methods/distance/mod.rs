@@ -115,8 +115,15 @@ fn create_hybrid_or_plain(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn St
     if mode.traces() {
         let extra = hybrid::HybridRays::new(init, c)?;
         let mut c = c.clone();
-        if mode == knobs::Hybrid::Confirm {
-            c.objects.iter_mut().for_each(|(_, f)| *f |= crate::frame::layout::FLAG_HYBRID_CONFIRM);
+        for (m, f) in c.objects.iter_mut() {
+            if mode == knobs::Hybrid::Confirm {
+                *f |= crate::frame::layout::FLAG_HYBRID_CONFIRM;
+            }
+            // Rays that leave an object that is not convex may meet it again.
+            use crate::plan::facts::{curvature, Curvature};
+            if matches!(curvature(&init.scene.meshes[*m]), Curvature::Concave | Curvature::Saddle) {
+                *f |= crate::frame::layout::FLAG_HYBRID_REENTERS;
+            }
         }
         return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
             init.ctx,
