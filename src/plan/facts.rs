@@ -413,6 +413,13 @@ fn area_centroid(m: &Mesh) -> Vec3 {
     }
 }
 
+/// Whether a ray that leaves mesh `m` may meet it again: its surface bends inwards or both
+/// ways, or part of it is hidden by itself from `x` (its reference point), as a torus's outer
+/// side from its centre.
+pub fn may_meet_itself(m: &Mesh, x: Vec3) -> bool {
+    matches!(curvature(m), Curvature::Concave | Curvature::Saddle) || visible_fraction_cached(m, x) < 0.999
+}
+
 /// `visible_fraction`, cached per mesh and reference point.
 fn visible_fraction_cached(m: &Mesh, x: Vec3) -> f32 {
     let key = (mesh_hash(m), [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]);
@@ -638,6 +645,20 @@ impl SceneFacts {
 mod tests {
     use super::*;
     use crate::scene::shapes;
+
+    /// The hybrid search follows rays back into an object only where they may meet it again:
+    /// never a sphere's, a torus's (saddle-shaped, its outer side hidden from its centre)
+    /// and a thick torus's whose inner bend is too slight to count as a saddle (hidden from
+    /// its centre all the same).
+    #[test]
+    fn rays_may_meet_a_torus_again_never_a_sphere() {
+        let s = shapes::uv_sphere("s", Vec3::ZERO, 1.0, 24, 12, 0);
+        assert!(!may_meet_itself(&s, Vec3::ZERO));
+        let t = shapes::torus("t", Vec3::ZERO, Vec3::Y, (0.6, 0.25), (48, 24), 0);
+        assert!(may_meet_itself(&t, Vec3::ZERO));
+        let fat = shapes::torus("fat", Vec3::ZERO, Vec3::Y, (0.6, 0.55), (48, 24), 0);
+        assert!(visible_fraction(&fat, Vec3::ZERO) < 0.999 && may_meet_itself(&fat, Vec3::ZERO));
+    }
 
     #[test]
     fn sphere_is_closed_and_convex_quad_is_planar() {

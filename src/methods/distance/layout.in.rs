@@ -9,8 +9,8 @@ gpu_consts! {
     /// `Push.flags` of the hybrid camera passes (`hybrid=confirm`): every answer of the map
     /// confirmed by a ray query around its hit.
     FLAG_HYBRID_CONFIRM: uint = 32768;
-    /// `Push.flags` of a hybrid camera pass's object that is neither convex nor flat: rays
-    /// that leave it are traced against it first (they may meet it again).
+    /// `Push.flags` of a hybrid camera pass's object that rays leaving it may meet again
+    /// (`plan::facts::may_meet_itself`): they are traced against it first.
     FLAG_HYBRID_REENTERS: uint = 65536;
 }
 

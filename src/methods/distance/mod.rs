@@ -120,8 +120,8 @@ fn create_hybrid_or_plain(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn St
                 *f |= crate::frame::layout::FLAG_HYBRID_CONFIRM;
             }
             // Rays that leave an object that is not convex may meet it again.
-            use crate::plan::facts::{curvature, Curvature};
-            if matches!(curvature(&init.scene.meshes[*m]), Curvature::Concave | Curvature::Saddle) {
+            let x = init.plan.objects.iter().find(|o| o.mesh == *m).map_or(glam::Vec3::ZERO, |o| o.reference_point);
+            if crate::plan::facts::may_meet_itself(&init.scene.meshes[*m], x) {
                 *f |= crate::frame::layout::FLAG_HYBRID_REENTERS;
             }
         }
