@@ -1,17 +1,24 @@
 //! Resources several stages of one frame share: made by the first stage that asks for one,
-//! held by every stage that uses it, told when a frame begins, and destroyed by the renderer
-//! after its stages. The frame names none of them: each is declared where it is made (the
+//! held by every stage that uses it, told once of each scene change (before the stages) and
+//! when a frame begins, and destroyed by the renderer after its stages. The frame names none of them: each is declared where it is made (the
 //! scene's acceleration structures for ray queries, `methods::raytrace::ray_query::shared`).
 
 use std::any::Any;
 use std::cell::RefCell;
 use std::rc::Rc;
 
+use crate::frame::stage::StageInit;
+use crate::scene::update::Changes;
 use crate::vk::Context;
 use crate::{Error, Result};
 
 /// What a shared resource does beyond being used.
 pub trait SharedResource: Any {
+    /// The scene changed (`init` holds it as it is now): called once per change, before the
+    /// stages' own updates.
+    fn scene_changed(&mut self, _init: &StageInit, _changes: &Changes) -> Result<()> {
+        Ok(())
+    }
     /// A frame begins (before any stage records).
     fn begin_frame(&mut self) {}
     fn destroy(&mut self, ctx: &Context);
@@ -49,6 +56,13 @@ impl Shared {
     /// Keys of the resources made, in order.
     pub fn keys(&self) -> Vec<&'static str> {
         self.entries.borrow().iter().map(|e| e.key).collect()
+    }
+
+    pub fn scene_changed(&self, init: &StageInit, changes: &Changes) -> Result<()> {
+        for e in self.entries.borrow().iter() {
+            e.resource.borrow_mut().scene_changed(init, changes)?;
+        }
+        Ok(())
     }
 
     pub fn begin_frame(&self) {

@@ -238,6 +238,7 @@ impl Renderer {
             let init: StageInit =
                 stage_init(ctx, cpu, &self.scene, &self.plan, &self.bindings, &self.targets, (self.width, self.height), &self.shared);
             let puts = self.maps.changes();
+            self.shared.scene_changed(&init, c)?;
             for s in &mut self.stages {
                 s.update(&init, c, &mut self.maps)?;
             }

@@ -453,10 +453,7 @@ impl Stage for CausticsStage {
     }
 
     /// Reference points follow their objects; the table is rewritten before the frame.
-    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
-        if let Some(e) = self.exact.as_mut() {
-            e.update(init, &changes.moved)?;
-        }
+    fn update(&mut self, init: &StageInit, _: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
         if let Some(p) = init.plan.caustics.as_ref() {
             for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
                 g.reference_point = fresh.reference_point;

@@ -52,8 +52,9 @@ impl PassExtra for HybridRays {
         self.rays.bind(ctx, cmd);
     }
 
-    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes) -> Result<()> {
-        self.rays.update(init, &changes.moved)
+    /// The structures it traces through are the frame's (updated by the renderer).
+    fn update(&mut self, _: &StageInit, _: &crate::scene::update::Changes) -> Result<()> {
+        Ok(())
     }
 
     /// Per object the fraction of its search's rays that were traced

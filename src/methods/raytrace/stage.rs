@@ -28,7 +28,7 @@ use super::gpu::Structure;
 use super::knobs::BvhUpdate;
 use super::lbvh::{GpuBvh, Work};
 use super::ray_order::RayOrder;
-use super::ray_query::accel::{AccelStructures, MeshInput};
+use super::ray_query::accel::AccelStructures;
 use super::{Packed, Scheme, TriangleList};
 use crate::error::{Error, Result, VkCall};
 use crate::frame::layout::{
@@ -312,6 +312,14 @@ pub fn create(init: &StageInit, plan: &CameraPlan, scheme: Scheme) -> Result<Box
 pub(crate) struct SceneShading(pub Buffer);
 
 impl crate::frame::shared::SharedResource for SceneShading {
+    /// Rewritten after moves (world-space normals).
+    fn scene_changed(&mut self, init: &StageInit, changes: &crate::scene::update::Changes) -> Result<()> {
+        if changes.moved.is_empty() {
+            return Ok(());
+        }
+        self.0.write(bytemuck::cast_slice(&triangle_shading(init.scene)))
+    }
+
     fn destroy(&mut self, ctx: &crate::vk::Context) {
         self.0.destroy(ctx);
     }
@@ -323,11 +331,6 @@ impl SceneShading {
         init.shared.get_or_create("raytrace.shading", || {
             Ok(SceneShading(Buffer::with_data(init.ctx, "raytrace.shading", &triangle_shading(init.scene), STORAGE)?))
         })
-    }
-
-    /// Rewritten after moves (each reader asks; the data is the scene's either way).
-    pub(crate) fn update(&mut self, scene: &crate::scene::Scene) -> Result<()> {
-        self.0.write(bytemuck::cast_slice(&triangle_shading(scene)))
     }
 }
 
@@ -964,14 +967,8 @@ impl Stage for RayTrace {
         let start = std::time::Instant::now();
         self.follow(ctx, init.scene, &list, &changes.moved)?;
         self.build_ms = start.elapsed().as_secs_f64() * 1e3;
-        // Ray queries: new instances (a TLAS rebuild in the next frame), BLAS only for
-        // deformed meshes.
-        if let Some(accel) = &self.accel {
-            accel.borrow_mut().update(ctx, &MeshInput::from_scene(init.scene), &changes.moved)?;
-        }
-        if let Some(s) = &self.shading {
-            s.borrow_mut().update(init.scene)?;
-        }
+        // The ray queries' structures and the triangles' shading are the frame's: the
+        // renderer updated them before the stages.
         let mut params = self.params.read()?.to_vec();
         let t_min = list_offset(&list);
         let size = std::mem::size_of::<GpuTraceParams>();

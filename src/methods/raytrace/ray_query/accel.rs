@@ -216,13 +216,21 @@ const SHARED_KEY: &str = "ray-query.scene";
 
 /// The scene's structures over `init`'s scene, one set per frame whichever stages trace
 /// through them (the ray-query scheme, caustic_paths=exact, the hybrid searches): made by the
-/// first that asks, updated by each after a change (the second finds nothing left to do),
-/// recorded by the first that records in a frame, destroyed by the renderer.
+/// first that asks, updated by the renderer once per scene change, recorded by the first that
+/// records in a frame, destroyed by the renderer.
 pub fn scene_structures(init: &crate::frame::stage::StageInit) -> Result<std::rc::Rc<std::cell::RefCell<AccelStructures>>> {
     init.shared.get_or_create(SHARED_KEY, || AccelStructures::new(init.ctx, &MeshInput::from_scene(init.scene)))
 }
 
 impl crate::frame::shared::SharedResource for AccelStructures {
+    /// Moved objects: new instances (a TLAS in the next frame), BLAS for deformed meshes.
+    fn scene_changed(&mut self, init: &crate::frame::stage::StageInit, changes: &crate::scene::update::Changes) -> Result<()> {
+        if changes.moved.is_empty() {
+            return Ok(());
+        }
+        self.update(init.ctx, &MeshInput::from_scene(init.scene), &changes.moved)
+    }
+
     fn begin_frame(&mut self) {
         self.tlas_built_this_frame = false;
     }

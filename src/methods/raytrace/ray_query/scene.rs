@@ -10,7 +10,7 @@ use std::rc::Rc;
 use ash::vk;
 
 use super::super::stage::SceneShading;
-use super::accel::{scene_structures, write_tlas, AccelStructures, MeshInput};
+use super::accel::{scene_structures, write_tlas, AccelStructures};
 use crate::frame::layout::{binding, RAY_QUERY_BINDINGS};
 use crate::frame::stage::StageInit;
 use crate::frame::PUSH_BYTES;
@@ -73,16 +73,6 @@ impl SceneRays {
             write_buffer(ctx, me.set, binding::RQ_COUNTS, vk::DescriptorType::STORAGE_BUFFER, me.counts.raw);
             Ok(())
         })
-    }
-
-    /// Moved objects: new instances (a TLAS in the next frame), BLAS for deformed meshes,
-    /// the shading rewritten.
-    pub fn update(&mut self, init: &StageInit, moved: &[usize]) -> Result<()> {
-        if moved.is_empty() {
-            return Ok(());
-        }
-        self.accel.borrow_mut().update(init.ctx, &MeshInput::from_scene(init.scene), moved)?;
-        self.shading.borrow_mut().update(init.scene)
     }
 
     /// Records the builds this frame needs and zeroes the counters, before the pass that
