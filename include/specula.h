@@ -45,6 +45,8 @@
 #define SPECULA_METHOD_PROXY_SPHERE 1
 /* proxy-box (§3.2) */
 #define SPECULA_METHOD_PROXY_BOX 2
+/* image-based (§3.3) */
+#define SPECULA_METHOD_IMAGE_BASED 19
 /* distance (§4.1, §4.2) */
 #define SPECULA_METHOD_DISTANCE 3
 /* distance-multi (§4.3) */

@@ -6,6 +6,7 @@
 // reference point or a box (a "parallax-corrected cube map"), and the cube map is looked
 // up in the direction of the proxy hit.
 #include "common/specular.glsl"
+#include "envmap/proxy.glsl"
 
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
@@ -17,13 +18,9 @@ layout(location = 0) out vec4 out_color;
 vec3 proxy_direction(Object o, vec3 p, vec3 dir) {
     vec3 c = o.reference_point.xyz;
     if ((push.flags & FLAG_PROXY_BOX) != 0u) {
-        // Exit of the slab intersection; a point outside the box keeps its direction.
-        vec3 inv = 1.0 / dir;
-        vec3 t0 = (o.proxy_min.xyz - p) * inv;
-        vec3 t1 = (o.proxy_max.xyz - p) * inv;
-        vec3 tmax = max(t0, t1);
-        float t = min(min(tmax.x, tmax.y), tmax.z);
-        return t > 0.0 ? p + dir * t - c : dir;
+        // A point outside the box keeps its direction.
+        vec3 exit;
+        return proxy_box_exit(o, p, dir, exit) ? exit - c : dir;
     }
     float r = o.reference_point.w;
     vec3 x = p - c;

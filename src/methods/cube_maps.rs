@@ -27,6 +27,9 @@ pub enum MapKind {
     Radiance,
     /// Radiance and distance from the reference point (ray tracing in sampled geometry).
     Distance,
+    /// Image-based reflections' captures (§3.3): radiance and distance, `captures`³ cubes per
+    /// object around it (`envmap::captures`).
+    Captures,
 }
 
 impl MapKind {
@@ -35,6 +38,7 @@ impl MapKind {
         match self {
             MapKind::Radiance => &crate::methods::envmap::slots::RADIANCE,
             MapKind::Distance => &crate::methods::distance::slots::DISTANCE,
+            MapKind::Captures => &crate::methods::envmap::slots::CAPTURES,
         }
     }
 }
@@ -44,7 +48,7 @@ impl MapKind {
 /// inter-object cycles).
 pub struct CubeMaps {
     pub kind: MapKind,
-    /// Meshes, in layer order.
+    /// Meshes, in layer order (captures: each object's `captures`³ layers in a row).
     objects: Vec<usize>,
     depth: Image,
     sky: vk::Pipeline,
@@ -77,6 +81,14 @@ pub fn create_radiance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> 
     Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Radiance)?))
 }
 
+/// `envmap.captures`' constructor (`envmap::captures::CAPTURE_CUBES`): each object's layers
+/// in a row.
+pub fn create_captures(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    let k = crate::methods::envmap::captures::per_object(&init.plan.quality) as usize;
+    let layers: Vec<usize> = objects.iter().flat_map(|&m| std::iter::repeat_n(m, k)).collect();
+    Ok(Box::new(CubeMaps::new(init, &layers, maps, MapKind::Captures)?))
+}
+
 pub fn radiance_format(p: Precision) -> vk::Format {
     match p {
         Precision::Half => vk::Format::R16G16B16A16_SFLOAT,
@@ -99,7 +111,7 @@ impl CubeMaps {
             surface: vk::Pipeline::null(),
             mirror_mask: vk::Pipeline::null(),
             mirror_weight: vk::Pipeline::null(),
-            map_mirrors: plan.map_mirrors.clone(),
+            map_mirrors: if kind == MapKind::Captures { Vec::new() } else { plan.map_mirrors.clone() },
             mode: q.cube.cube_mode,
             cycles: plan.cycles.max(1),
             frame_latency: plan.frame_latency && inter_object,
@@ -128,6 +140,7 @@ impl CubeMaps {
         let base = match self.kind {
             MapKind::Radiance => "envmap.cubes",
             MapKind::Distance => "distance.cubes",
+            MapKind::Captures => "envmap.captures",
         };
         for i in 0..images {
             let name = if images == 1 { base.to_string() } else { format!("{base}.{}", ["ping", "pong"][i]) };
@@ -139,7 +152,7 @@ impl CubeMaps {
         let (sky, surface) = match self.kind {
             MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
             MapKind::Distance if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
-            MapKind::Distance => ("distance/sky.frag", "distance/generate.frag"),
+            MapKind::Distance | MapKind::Captures => ("distance/sky.frag", "distance/generate.frag"),
         };
         let formats = [format];
         let desc = |name: &'static str, vertex, fragment, vertex_input, depth_test| GraphicsDesc {
@@ -161,7 +174,11 @@ impl CubeMaps {
             ctx,
             layout,
             &desc(
-                if self.kind == MapKind::Radiance { "envmap.sky" } else { "distance.sky" },
+                match self.kind {
+                    MapKind::Radiance => "envmap.sky",
+                    MapKind::Distance => "distance.sky",
+                    MapKind::Captures => "envmap.captures.sky",
+                },
                 "scene/sky.vert",
                 sky,
                 VertexInput::None,
@@ -172,7 +189,11 @@ impl CubeMaps {
             ctx,
             layout,
             &desc(
-                if self.kind == MapKind::Radiance { "envmap.surface" } else { "distance.surface" },
+                match self.kind {
+                    MapKind::Radiance => "envmap.surface",
+                    MapKind::Distance => "distance.surface",
+                    MapKind::Captures => "envmap.captures.surface",
+                },
                 "scene/mesh.vert",
                 surface,
                 VertexInput::Mesh,
@@ -192,6 +213,9 @@ impl CubeMaps {
 
     /// Each layer's centre in `plan` (its cube views' eye).
     fn eyes(&self, plan: &Plan) -> Vec<glam::Vec3> {
+        if self.kind == MapKind::Captures {
+            return plan.captures.iter().flat_map(|c| c.centres.iter().copied()).collect();
+        }
         let eye = |m: usize| plan.envmaps.iter().find(|e| e.mesh == m).map_or(glam::Vec3::ZERO, |e| e.reference_point);
         self.objects.iter().map(|&m| eye(m)).collect()
     }
@@ -233,6 +257,7 @@ impl Stage for CubeMaps {
         match self.kind {
             MapKind::Radiance => "envmap.generate",
             MapKind::Distance => "distance.generate",
+            MapKind::Captures => "envmap.captures",
         }
     }
 
@@ -308,10 +333,14 @@ impl Stage for CubeMaps {
             let (target, depth) = (&images[write], &mut self.depth);
             let read_set =
                 if self.inter_object && !first { io.sets.generate.get(read).copied().unwrap_or(io.sets.empty) } else { io.sets.empty };
-            let uses_maps = self.kind == MapKind::Distance;
-            let clear = [0.0, 0.0, 0.0, if self.kind == MapKind::Distance { 1e30 } else { 0.0 }];
+            let uses_maps = self.kind != MapKind::Radiance;
+            let clear = [0.0, 0.0, 0.0, if uses_maps { 1e30 } else { 0.0 }];
+            let captures = io.views.first(crate::methods::envmap::captures::VIEWS);
             for (layer, &mesh) in self.objects.iter().enumerate() {
-                let view = io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views");
+                let view = match self.kind {
+                    MapKind::Captures => captures.expect("captures have views") + 6 * layer as u32,
+                    _ => io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views"),
+                };
                 let skip = match io.plan.object(mesh).map(|o| o.leaves_out) {
                     Some(LeavesOut::Nothing) => None,
                     _ => Some(mesh),

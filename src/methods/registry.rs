@@ -196,8 +196,9 @@ pub struct Family {
     /// reflectors: their environment's specular objects), so that composition gives those
     /// objects maps as it does beside a distance-mapped object.
     pub shows_others_by_maps: &'static [Method],
-    /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame.
-    pub push_words: Option<fn(&Quality, &mut crate::frame::words::PushWords)>,
+    /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame
+    /// (from the knobs, and the view table's layout where a word names a view).
+    pub push_words: Option<fn(&Quality, &crate::frame::stage::ViewLayout, &mut crate::frame::words::PushWords)>,
     /// Its part of `specula plan`'s table, if it planned anything.
     pub describe: Option<fn(&Plan, &Scene) -> Option<String>>,
     /// State it keeps across frames: views of its own in the view table, extra camera views

@@ -348,7 +348,7 @@ fn distance_to_mesh(m: &Mesh, x: DVec3) -> f64 {
 
 /// Why point x cannot serve as object `own`'s reference point: it lies inside another
 /// (closed) object, or closer to another object's surface than `clearance`.
-fn blocked(scene: &Scene, own: usize, x: Vec3, clearance: f64) -> Option<String> {
+pub(crate) fn blocked(scene: &Scene, own: usize, x: Vec3, clearance: f64) -> Option<String> {
     let xd = x.as_dvec3();
     for (i, m) in scene.meshes.iter().enumerate() {
         if i == own || m.indices.is_empty() {

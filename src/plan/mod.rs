@@ -135,6 +135,7 @@ impl Plan {
             e.reference_point = f.reference_point;
         }
         self.layered_centre = fresh.layered_centre;
+        self.captures = fresh.captures;
         for f in FAMILIES {
             if let Some(h) = f.refresh {
                 h(self);
@@ -266,6 +267,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         objects: Vec::new(),
         envmaps: Vec::new(),
         layered_centre: None,
+        captures: Vec::new(),
         stages: Vec::new(),
         passes: vec![REFERENCE_PASS],
         cube_near: 1e-4,
@@ -478,6 +480,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         objects,
         envmaps: Vec::new(),
         layered_centre: None,
+        captures: Vec::new(),
         stages: Vec::new(),
         passes: Vec::new(),
         cube_near,

@@ -21,6 +21,17 @@ pub struct EnvmapPlan {
     pub reference_point: Vec3,
 }
 
+/// One object's image-based captures (§3.3): a lattice of `per_axis`³ cube-map centres,
+/// x fastest, then y, then z (the order of their layers and views).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CaptureSet {
+    pub mesh: usize,
+    pub per_axis: u32,
+    pub centres: Vec<Vec3>,
+    /// Captures moved out of other objects, with where from.
+    pub notes: Vec<String>,
+}
+
 /// One map an object gets.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ObjectMap {
@@ -220,6 +231,9 @@ pub struct Plan {
     /// The shared layered map's centre (§4.5), when an object takes `layered`: its six
     /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
     pub layered_centre: Option<Vec3>,
+    /// Image-based reflections' captures (§3.3): per object that takes the method, in the
+    /// order of its layers in `envmap.captures`, the centres of its cube maps.
+    pub captures: Vec<CaptureSet>,
     /// What the renderer records, in order.
     pub stages: Vec<StageSpec>,
     /// The stages' names, in order: the stable profiler keys.

@@ -246,7 +246,7 @@ impl Renderer {
         let mut w = crate::frame::words::PushWords::default();
         w.set(RECURSION_DEPTH, q.frame.depth);
         w.set(EXTRA_VIEW_BASE, self.views.first(EXTRA_VIEWS).unwrap_or(self.views.count));
-        FAMILIES.iter().filter_map(|f| f.push_words).for_each(|fill| fill(q, &mut w));
+        FAMILIES.iter().filter_map(|f| f.push_words).for_each(|fill| fill(q, &self.views, &mut w));
         w
     }
 

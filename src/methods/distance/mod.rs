@@ -224,7 +224,7 @@ fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::P
 }
 
 /// The search's words (every cube-map search reads them) and self refraction's bounces.
-fn push_words(q: &crate::quality::Quality, w: &mut crate::frame::words::PushWords) {
+fn push_words(q: &crate::quality::Quality, _: &crate::frame::stage::ViewLayout, w: &mut crate::frame::words::PushWords) {
     use crate::frame::layout::*;
     let s = &q.search;
     w.set(SEARCH_LINEAR_STEPS, s.linear_steps);

@@ -1,11 +1,43 @@
-//! The envmap family's own knob (its cube maps' are `CubeKnobs`).
+//! The envmap family's own knobs (its cube maps' are `CubeKnobs`).
 
 use crate::quality::knob::knobs;
 
 knobs! {
-    /// Localised environment mapping (§3.2).
+    /// Localised environment mapping (§3.2) and image-based reflections (§3.3).
     pub struct EnvmapKnobs {
         /// proxy-sphere radius (§3.2); auto: mean half-extent of the scene's box
         proxy_radius: Option<f32> = auto, auto_metres();
+        /// image-based (§3.3): captures per axis of the lattice of cube maps (radiance and distance) each object's rays are
+        /// reconstructed from: 1, 8, 27 or 64 cube maps an object, at the centres of the lattice's cells in capture_box
+        captures: u32 = 2, count(1..=4, "per axis");
+        /// image-based: where the captures lie: in the object's bounding box, following it as it moves (`object`), or in the
+        /// scene's box (`room`): fixed in the world, the engine practice of probes that objects move between, redrawn only when
+        /// something they see changes (the object itself is not in its own captures); a capture inside another object is moved
+        /// towards its box's centre until it is clear
+        capture_box: CaptureBox = "object", one_of()["object" => CaptureBox::Object, "room" => CaptureBox::Room];
+        /// image-based: how the captures around the shaded point (its lattice cell's corners, trilinear weights) give a ray's
+        /// radiance: `depth` warps each by its distances (the ray searched in each capture's distance map, §4.1; captures whose
+        /// hit is not a surface they hold, or lies beyond the nearest hit any of them holds, are left out, the rest blended),
+        /// `blend` blends the captures' radiance looked up towards where the ray leaves the scene's box (several
+        /// parallax-corrected cube maps blended by position, as engines blend their reflection probes)
+        capture_warp: CaptureWarp = "depth", one_of()["depth" => CaptureWarp::Depth, "blend" => CaptureWarp::Blend];
     }
+}
+
+/// Where image-based reflections' captures lie (`capture_box`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum CaptureBox {
+    /// A lattice over the object's bounding box, moving with it.
+    Object,
+    /// A lattice over the scene's box, fixed in the world.
+    Room,
+}
+
+/// How image-based reflections combine their captures (`capture_warp`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum CaptureWarp {
+    /// Per-pixel depth warping: the ray searched in each capture's distance map.
+    Depth,
+    /// Position-weighted blend of parallax-corrected lookups (proxy: the scene's box).
+    Blend,
 }

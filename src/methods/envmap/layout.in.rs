@@ -20,5 +20,22 @@ flag_bits! {
 descriptor_sets! {
     BINDINGS = set 0 {
         ENVMAPS = 8: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray envmaps";
+        /// image-based (§3.3): per object `captures`³ cube maps, radiance in rgb and the
+        /// distance from the capture's centre in alpha; object o's capture k is layer
+        /// `o.envmap_layer · captures³ + k`, centred at the eye of view
+        /// `push_capture_view_base() + 6 · layer`.
+        CAPTURES = 22: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray captures";
+    }
+}
+
+push_words! {
+    /// image-based reflections (§3.3).
+    8..11 {
+        /// captures per axis of each object's lattice (`captures`)
+        CAPTURES_PER_AXIS: uint,
+        /// the view table's first capture view (the `envmap.captures` block)
+        CAPTURE_VIEW_BASE: uint,
+        /// how the captures combine (`capture_warp`): 0 warped by their distances, 1 blended
+        CAPTURE_WARP: uint,
     }
 }

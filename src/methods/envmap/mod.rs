@@ -1,8 +1,10 @@
 //! Environment mapping (survey §3): one radiance cube map per specular object, rasterised
 //! from its reference point without the object (`generate`, shared with the distance maps
 //! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
-//! towards where the ray leaves a proxy of the environment (§3.2).
+//! towards where the ray leaves a proxy of the environment (§3.2); or several cube maps
+//! captured around the object, warped by their distances or blended (§3.3, `captures`).
 
+pub mod captures;
 pub mod knobs;
 pub mod slots;
 
@@ -12,7 +14,7 @@ use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Metho
 use crate::methods::EVERY_CLASS;
 use crate::plan::types::Plan;
 use crate::quality::Quality;
-use crate::quality::{CubeKnobs, EnvmapKnobs, FrameKnobs};
+use crate::quality::{CubeKnobs, EnvmapKnobs, FrameKnobs, SearchKnobs};
 
 /// `envmap.generate`: the radiance cube maps.
 pub const RADIANCE_CUBES: MapInfo = MapInfo {
@@ -71,11 +73,17 @@ const fn proxy(flags: u32) -> CameraPass {
     }
 }
 
-/// Environment mapping (§3): maps and camera passes only, no hooks.
+/// Environment mapping (§3): its maps and camera passes; the image-based captures' places,
+/// views and words.
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "envmap",
     slots: slots::SLOTS,
-    methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO],
+    methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO, IMAGE_BASED_INFO],
+    plan_views: Some(captures::plan_captures),
+    views: Some(captures::view_blocks),
+    frame_part: Some(captures::frame_part),
+    push_words: Some(captures::push_words),
+    describe: Some(captures::describe),
     ..crate::methods::registry::Family::NONE
 };
 
@@ -123,3 +131,38 @@ pub const PROXY_BOX_INFO: &MethodInfo = &MethodInfo {
     needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PROXY_BOX: Method = Method(PROXY_BOX_INFO.name);
+
+const CAPTURES_SHADE: CameraPass = CameraPass {
+    name: "image-based.shade",
+    vertex: "scene/mesh.vert",
+    fragment: "envmap/captures.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+    profiled: Profiled::OWN,
+};
+
+pub const IMAGE_BASED_INFO: &MethodInfo = &MethodInfo {
+    name: "image-based",
+    abi: 19,
+    section: "§3.3",
+    family: "envmap",
+    summary: "image-based reflections: captures³ cube maps (radiance and distance) on a lattice over the object's box (or the scene's: fixed probes); a ray takes the captures at its lattice cell's corners, each warped by its distances (the ray searched in it, §4.1; hits it does not hold or beyond the nearest left out) or blended parallax-corrected (capture_warp=blend)",
+    serves: EVERY_CLASS,
+    knobs: &[
+        EnvmapKnobs::captures, EnvmapKnobs::capture_box, EnvmapKnobs::capture_warp, CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance,
+    ],
+    gpu: Some(GpuSpec {
+        maps: &[captures::CAPTURE_CUBES],
+        camera: CAPTURES_SHADE,
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Itself,
+        cycles: one,
+        views: |_| 0,
+        shades_every_pixel: false,
+    }),
+    fallback: None,
+    shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
+};
+pub const IMAGE_BASED: Method = Method(IMAGE_BASED_INFO.name);

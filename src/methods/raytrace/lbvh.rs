@@ -311,7 +311,7 @@ impl GpuBvh {
     /// when none is pending. Later passes see the nodes (a memory barrier closes the pass).
     pub fn record(&mut self, ctx: &Context, rec: &mut Recorder) {
         // The kernels read `push.object` alone: the radix-sort pass.
-        let push = |pass: u32| Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; 8] };
+        let push = |pass: u32| Push { view: 0, object: pass, flags: 0, light_count: 0, words: [0; crate::frame::words::COUNT] };
         let Some(work) = self.pending.take() else { return };
         let cmd = rec.cmd;
         let name = if work == Work::Build { "raytrace.build" } else { "raytrace.refit" };
