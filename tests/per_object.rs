@@ -289,7 +289,9 @@ fn auto_is_as_good_as_the_best_single_method() {
         // not measure yet (no error or cost model: never a candidate of `auto`).
         let singles: Vec<(&str, f64)> = Method::ALL
             .iter()
-            .filter(|m| m.is_gpu() && m.family != "raytrace" && m.family != "layered" && !matches!(m.name(), "curved-reflector" | "image-based"))
+            .filter(|m| {
+                m.is_gpu() && m.family != "raytrace" && m.family != "layered" && !matches!(m.name(), "curved-reflector" | "image-based")
+            })
             .map(|&m| (m.name(), psnr(&render(&ctx, scene, &whole(m), &q, (w, h)))))
             .collect();
         let best = singles.iter().cloned().fold(("", f64::MIN), |a, b| if b.1 > a.1 { b } else { a });

@@ -95,12 +95,21 @@ pub struct FaceDeps {
     eyes: Vec<Vec3>,
     /// Per mesh the bounds the faces were drawn with.
     bounds: Vec<(Vec3, Vec3)>,
+    /// Per layer the mesh its faces leave out (`leaving_out`).
+    left_out: Vec<Option<usize>>,
 }
 
 impl FaceDeps {
     /// `layers` cubes, every face to draw.
     pub fn new(layers: usize) -> FaceDeps {
-        FaceDeps { faces: vec![ALL_FACES; layers], eyes: Vec::new(), bounds: Vec::new() }
+        FaceDeps { faces: vec![ALL_FACES; layers], eyes: Vec::new(), bounds: Vec::new(), left_out: Vec::new() }
+    }
+
+    /// The mesh each layer leaves out of its faces (its own object), whose moves it does not
+    /// see (but their shadows, which fall on what it draws).
+    pub fn leaving_out(mut self, left_out: Vec<Option<usize>>) -> FaceDeps {
+        self.left_out = left_out;
+        self
     }
 
     /// Every face of every layer.
@@ -152,13 +161,15 @@ impl FaceDeps {
             union(&mut world, (d.lo, d.hi));
             union(&mut world, self.bounds[k]);
         }
-        // What each moved object reaches: its box before and after, and the shadows those cast.
-        let mut reached: Vec<Option<(Vec3, Vec3)>> = Vec::new();
+        // What each moved object reaches: its box before and after (`Some(mesh)`: a layer
+        // that leaves the mesh out does not see it), and the shadows those cast (`None`).
+        type Reach = (Option<usize>, Option<(Vec3, Vec3)>);
+        let mut reached: Vec<Reach> = Vec::new();
         for &m in &changes.moved {
             let now = draws.get(m).map(|d| (d.lo, d.hi));
             for b in [self.bounds.get(m).copied(), now].into_iter().flatten() {
-                reached.push(Some(b));
-                reached.extend(lighting.shadows.iter().map(|&l| shadow_bounds(l, b, world)));
+                reached.push((Some(m), Some(b)));
+                reached.extend(lighting.shadows.iter().map(|&l| (None, shadow_bounds(l, b, world))));
             }
         }
         let now = |m: usize| draws.get(m).map_or((Vec3::splat(f32::NEG_INFINITY), Vec3::splat(f32::INFINITY)), |d| (d.lo, d.hi));
@@ -171,7 +182,8 @@ impl FaceDeps {
                 continue;
             }
             for f in 0..6 {
-                let hit = reached.iter().any(|r| r.is_none_or(|b| sees(k, f, b)))
+                let own = self.left_out.get(k).copied().flatten();
+                let hit = reached.iter().any(|&(m, r)| (m.is_none() || m != own) && r.is_none_or(|b| sees(k, f, b)))
                     || (0..draws.len()).any(|m| changed_material(m) && sees(k, f, now(m)))
                     || (any_move && mirrors.iter().any(|&m| sees(k, f, now(m))));
                 if hit {
@@ -276,5 +288,14 @@ mod tests {
         d.drawn(vec![eye], &[floor, before]);
         d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &Lighting { shadows: Vec::new(), caustics: true });
         assert_eq!(d.count(), (6, 6));
+
+        // A cube that leaves the box out (its own object, as image-based's fixed captures): the
+        // box's move alone marks nothing, its shadow still the faces that see it.
+        let mut d = FaceDeps::new(1).leaving_out(vec![Some(1)]);
+        d.drawn(vec![eye], &[floor, before]);
+        d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &Lighting::default());
+        assert_eq!(d.faces, vec![0], "its own object's move");
+        d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &light);
+        assert!(d.faces[0] & (1 << 3) != 0, "its own object's shadow (which reaches up to it): {:#08b}", d.faces[0]);
     }
 }

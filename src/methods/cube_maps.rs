@@ -118,7 +118,9 @@ impl CubeMaps {
             inter_object,
             frames: 0,
             face_draws: [0; 6],
-            deps: crate::frame::cube_deps::FaceDeps::new(objects.len()),
+            deps: crate::frame::cube_deps::FaceDeps::new(objects.len()).leaving_out(
+                objects.iter().map(|&m| (plan.object(m).map(|o| o.leaves_out) != Some(LeavesOut::Nothing)).then_some(m)).collect(),
+            ),
             always: q.frame.map_updates_always,
             faces_drawn: 0,
         };

@@ -196,4 +196,38 @@ mod tests {
         // A flat box keeps its lattice in its plane.
         assert!(lattice(Vec3::ZERO, Vec3::new(1.0, 0.0, 1.0), 3).iter().all(|c| c.y == 0.0));
     }
+
+    /// A capture inside another object moves towards the box's centre until it is clear and
+    /// says so; the others stay on the lattice; `room` puts the lattice in the scene's box.
+    #[test]
+    fn captures_inside_other_objects_move_out() {
+        use crate::scene::{shapes, Material, SurfaceKind};
+        let mut s = Scene::new();
+        let mirror = s
+            .add_material(Material {
+                name: "m".into(),
+                kind: SurfaceKind::Mirror { nu: Vec3::splat(3.0), kappa: Vec3::ZERO },
+                ..Default::default()
+            })
+            .unwrap();
+        let grey = s.add_material(Material { name: "grey".into(), ..Default::default() }).unwrap();
+        s.add_mesh(shapes::uv_sphere("ball", Vec3::ZERO, 0.5, 16, 8, mirror)).unwrap();
+        // A closed box around the lattice point (0.25, 0.25, 0.25).
+        s.add_mesh(shapes::cuboid("block", Vec3::splat(0.25), Vec3::splat(0.15), grey)).unwrap();
+        let p = crate::plan::plan(&s, super::super::IMAGE_BASED, &Quality::default());
+        assert_eq!(p.captures.len(), 1);
+        let set = &p.captures[0];
+        let nominal = lattice(s.meshes[0].bounds().min, s.meshes[0].bounds().max, 2);
+        assert_eq!(set.centres[..7], nominal[..7]);
+        let moved = set.centres[7];
+        // Three quarters of the way to the centre: the first of the steps out of the block.
+        assert!(moved.distance(Vec3::splat(0.0625)) < 1e-4, "moved towards the centre, out of the block: {moved}");
+        assert_eq!(set.notes.len(), 1, "{:?}", set.notes);
+        assert!(set.notes[0].starts_with("capture 7 moved"), "{:?}", set.notes);
+        let mut q = Quality::default();
+        q.set("capture_box", "room").unwrap();
+        q.set("captures", "1").unwrap();
+        let p = crate::plan::plan(&s, super::super::IMAGE_BASED, &q);
+        assert_eq!(p.captures[0].centres, vec![(p.proxy_box.0 + p.proxy_box.1) * 0.5]);
+    }
 }
