@@ -459,3 +459,52 @@ fn image_based_reflections_against_one_map() {
     r.destroy(&ctx);
     common::assert_clean(&ctx);
 }
+
+/// Displacement-mapped proxies (§3.2): the height map of the floor face holds, seen from
+/// the ceiling, a box standing on the floor at its top's depth and the floor elsewhere,
+/// and its radiance; the object itself is left out.
+#[test]
+fn relief_height_maps_hold_what_stands_before_each_face() {
+    let ctx = common::gpu();
+    let mut scene = Scene::new();
+    common::emissive_room(&mut scene, Vec3::ZERO, 2.0);
+    let grey = scene
+        .add_material(specula::scene::Material {
+            name: "block".into(),
+            base_color: Vec3::ZERO,
+            emissive: Vec3::new(0.2, 0.4, 0.6),
+            ..Default::default()
+        })
+        .unwrap();
+    scene.add_mesh(shapes::cuboid("block", Vec3::new(1.0, -1.5, 1.0), Vec3::splat(0.5), grey)).unwrap();
+    let m = scene.add_material(common::mirror(0.9)).unwrap();
+    scene.add_mesh(shapes::uv_sphere("ball", Vec3::new(-0.5, -1.0, -0.5), 0.4, 32, 16, m)).unwrap();
+    scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.9), Vec3::new(-0.5, -1.0, -0.5), 1.0));
+    let mut q = Quality::default();
+    q.set("relief_size", "64").unwrap();
+    q.set("cube_precision", "single").unwrap();
+    let p = plan(&scene, specula::methods::PROXY_RELIEF, &q);
+    let (lo, hi) = p.proxy_box;
+    let mut r = Renderer::new(&ctx, &scene, p, 32, 32).unwrap();
+    r.render(&ctx).unwrap();
+    let maps = specula::vk::read_image(&ctx, r.maps().image(&specula::methods::envmap::slots::RELIEF).unwrap()).unwrap();
+    assert_eq!((maps.layers, maps.width), (6, 64));
+    // Face 3 (−y, the floor): seen from beyond the ceiling, looking down; its screen axes are
+    // the cube face's: s = +x, t = −z.
+    let texel = |x: f32, z: f32| {
+        let (s, t) = ((x - lo.x) / (hi.x - lo.x), (hi.z - z) / (hi.z - lo.z));
+        maps.texel(3, (s * 64.0) as u32, (t * 64.0) as u32).to_vec()
+    };
+    let margin = 1e-3 * (hi - lo).length();
+    let (floor, block) = (texel(-1.5, 1.5), texel(1.0, 1.0));
+    eprintln!("floor texel {floor:?}, block texel {block:?}");
+    // Depths from the eye's plane, the margin below the ceiling (whose own wall it clips).
+    assert!((floor[3] - (hi.y - lo.y - margin)).abs() < 1e-3, "the floor at the room's height: {floor:?}");
+    assert!((block[3] - (hi.y - margin - (-1.0))).abs() < 1e-3, "the block's top 1 m below the ceiling: {block:?}");
+    assert!((block[0] - 0.2).abs() < 1e-3 && (block[2] - 0.6).abs() < 1e-3, "the block's radiance: {block:?}");
+    // The ball is not in its own maps: the floor under it.
+    let under = texel(-0.5, -0.5);
+    assert!((under[3] - floor[3]).abs() < 1e-3, "the ball left out: {under:?}");
+    r.destroy(&ctx);
+    common::assert_clean(&ctx);
+}

@@ -118,7 +118,7 @@ fn bindings_come_from_the_declaration() {
     let text = layout::glsl(&layout::declared()).unwrap();
     assert!(text.contains("layout(std430, set = 1, binding = 3) readonly buffer Thickness { float thickness[]; };"), "{text}");
     assert!(text.contains("layout(push_constant) uniform Push {"), "{text}");
-    assert!(text.contains("    uint words[12];\n"), "{text}");
+    assert!(text.contains("    uint words[14];\n"), "{text}");
     assert!(text.contains("float push_search_tolerance() { return uintBitsToFloat(push.words[6]); }"), "{text}");
     assert!(text.contains("uint push_recursion_depth() { return push.words[0]; }"), "{text}");
     assert!(text.contains("    uint pad[2];\n"), "{text}");

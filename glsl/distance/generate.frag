@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // variants: INTER_OBJECT
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
-// the reference point (not window-space z). Specular objects other than the map's owner
+// the reference point (not window-space z); also image-based reflections' captures (§3.3)
+// and, in planar views, displacement-mapped proxies' height maps (§3.2). Specular objects other than the map's owner
 // reflect the environment map, or, in inter-object mode (§4.3), are shaded by their own
 // method from their maps of the previous cycle: searched in their distance map, or self
 // refracted in their refractor map (§4.4). The inter-object paths are compiled only into
@@ -46,5 +47,8 @@ void main() {
         c += refracted;
 #endif
     }
-    out_radiance_distance = vec4(c, length(in_position - eye));
+    // Planar views (eye.w 1: displacement-mapped proxies' height maps, envmap/relief.frag)
+    // store the depth along their direction; the cube maps the distance from their centre.
+    View v = views[in_view];
+    out_radiance_distance = vec4(c, v.eye.w > 0.5 ? dot(in_position - eye, v.dir.xyz) : length(in_position - eye));
 }

@@ -100,7 +100,7 @@ gpu_structs! {
         light_count: uint,
         /// Parameters the frame and the families declare word by word (`push_words!`), set
         /// once a frame for every pass; shaders read them through `push_<name>()`.
-        words: [uint; 12],
+        words: [uint; 14],
     }
 }
 

@@ -6,7 +6,7 @@
 use std::marker::PhantomData;
 
 /// How many words the push block holds (its `words` array).
-pub const COUNT: usize = 12;
+pub const COUNT: usize = 14;
 
 /// One word of `Push.words`, of the type its shaders read it as (`u32`: `uint`, `f32`:
 /// `float`, by its bits).

@@ -30,6 +30,9 @@ pub enum MapKind {
     /// Image-based reflections' captures (§3.3): radiance and distance, `captures`³ cubes per
     /// object around it (`envmap::captures`).
     Captures,
+    /// Displacement-mapped proxies' height maps (§3.2): six orthographic layers per object
+    /// (`envmap::relief`), radiance and depth, in a 2D array.
+    Relief,
 }
 
 impl MapKind {
@@ -39,6 +42,7 @@ impl MapKind {
             MapKind::Radiance => &crate::methods::envmap::slots::RADIANCE,
             MapKind::Distance => &crate::methods::distance::slots::DISTANCE,
             MapKind::Captures => &crate::methods::envmap::slots::CAPTURES,
+            MapKind::Relief => &crate::methods::envmap::slots::RELIEF,
         }
     }
 }
@@ -89,6 +93,11 @@ pub fn create_captures(init: &StageInit, objects: &[usize], maps: &mut Maps) -> 
     Ok(Box::new(CubeMaps::new(init, &layers, maps, MapKind::Captures)?))
 }
 
+/// `envmap.relief`'s constructor (`envmap::relief::RELIEF_MAPS`).
+pub fn create_relief(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Relief)?))
+}
+
 pub fn radiance_format(p: Precision) -> vk::Format {
     match p {
         Precision::Half => vk::Format::R16G16B16A16_SFLOAT,
@@ -112,7 +121,7 @@ impl CubeMaps {
             mirror_mask: vk::Pipeline::null(),
             mirror_weight: vk::Pipeline::null(),
             map_mirrors: if kind == MapKind::Captures { Vec::new() } else { plan.map_mirrors.clone() },
-            mode: q.cube.cube_mode,
+            mode: if kind == MapKind::Relief { CubeMode::SixPasses } else { q.cube.cube_mode },
             cycles: plan.cycles.max(1),
             frame_latency: plan.frame_latency && inter_object,
             inter_object,
@@ -138,23 +147,26 @@ impl CubeMaps {
     ) -> Result<()> {
         let q = &plan.quality;
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
-        let kind = ImageKind::CubeArray { cubes: self.objects.len() as u32 };
+        let (size, kind) = match self.kind {
+            MapKind::Relief => (q.envmap.relief_size, ImageKind::D2Array { layers: 6 * self.objects.len() as u32 }),
+            _ => (q.cube.cube_size, ImageKind::CubeArray { cubes: self.objects.len() as u32 }),
+        };
         let base = match self.kind {
             MapKind::Radiance => "envmap.cubes",
             MapKind::Distance => "distance.cubes",
             MapKind::Captures => "envmap.captures",
+            MapKind::Relief => "envmap.relief",
         };
         for i in 0..images {
             let name = if images == 1 { base.to_string() } else { format!("{base}.{}", ["ping", "pong"][i]) };
-            let image =
-                Image::new(ctx, &ImageDesc { name: &name, format, width: q.cube.cube_size, height: q.cube.cube_size, kind, usage })?;
+            let image = Image::new(ctx, &ImageDesc { name: &name, format, width: size, height: size, kind, usage })?;
             maps.push_image(self.kind.slot(), image);
         }
-        self.depth = cube_depth(ctx, &format!("{base}.depth"), q.cube.cube_size, q.cube.cube_mode)?;
+        self.depth = cube_depth(ctx, &format!("{base}.depth"), size, self.mode)?;
         let (sky, surface) = match self.kind {
             MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
             MapKind::Distance if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
-            MapKind::Distance | MapKind::Captures => ("distance/sky.frag", "distance/generate.frag"),
+            MapKind::Distance | MapKind::Captures | MapKind::Relief => ("distance/sky.frag", "distance/generate.frag"),
         };
         let formats = [format];
         let desc = |name: &'static str, vertex, fragment, vertex_input, depth_test| GraphicsDesc {
@@ -180,6 +192,7 @@ impl CubeMaps {
                     MapKind::Radiance => "envmap.sky",
                     MapKind::Distance => "distance.sky",
                     MapKind::Captures => "envmap.captures.sky",
+                    MapKind::Relief => "envmap.relief.sky",
                 },
                 "scene/sky.vert",
                 sky,
@@ -195,6 +208,7 @@ impl CubeMaps {
                     MapKind::Radiance => "envmap.surface",
                     MapKind::Distance => "distance.surface",
                     MapKind::Captures => "envmap.captures.surface",
+                    MapKind::Relief => "envmap.relief.surface",
                 },
                 "scene/mesh.vert",
                 surface,
@@ -260,6 +274,7 @@ impl Stage for CubeMaps {
             MapKind::Radiance => "envmap.generate",
             MapKind::Distance => "distance.generate",
             MapKind::Captures => "envmap.captures",
+            MapKind::Relief => "envmap.relief",
         }
     }
 
@@ -283,9 +298,10 @@ impl Stage for CubeMaps {
         if self.frame_latency && seen {
             self.frames = 0;
         }
-        if self.every_face() {
+        if self.every_face() || (self.kind == MapKind::Relief && seen) {
+            // Height maps: orthographic views over the whole box, every face on any change.
             self.deps.all();
-        } else {
+        } else if self.kind != MapKind::Relief {
             let eyes = self.eyes(init.plan);
             let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
             self.deps.mark(init.scene, &self.objects, &eyes, &init.gpu.draws, changes, (self.inter_object, &self.map_mirrors), &lighting);
@@ -321,7 +337,8 @@ impl Stage for CubeMaps {
             self.deps.all();
         }
         self.faces_drawn = self.deps.count().0;
-        let (eyes, six) = (io.view_eyes, self.mode == CubeMode::SixPasses);
+        // Per-face culling by the cube faces' frusta (not the height maps' orthographic views).
+        let (eyes, six) = (io.view_eyes, self.mode == CubeMode::SixPasses && self.kind != MapKind::Relief);
         for cycle in 0..cycles {
             let write = (first_write + cycle as usize) % count;
             let read = (write + 1) % count;
@@ -338,9 +355,11 @@ impl Stage for CubeMaps {
             let uses_maps = self.kind != MapKind::Radiance;
             let clear = [0.0, 0.0, 0.0, if uses_maps { 1e30 } else { 0.0 }];
             let captures = io.views.first(crate::methods::envmap::captures::VIEWS);
+            let relief = io.views.first(crate::methods::envmap::relief::VIEWS);
             for (layer, &mesh) in self.objects.iter().enumerate() {
                 let view = match self.kind {
                     MapKind::Captures => captures.expect("captures have views") + 6 * layer as u32,
+                    MapKind::Relief => relief.expect("height maps have views") + 6 * layer as u32,
                     _ => io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views"),
                 };
                 let skip = match io.plan.object(mesh).map(|o| o.leaves_out) {

@@ -20,7 +20,7 @@ pub mod reference;
 pub mod registry;
 
 pub use distance::{DISTANCE, DISTANCE_MULTI, IMAGE_SPACE_REFRACTION, REFRACTOR_MAP};
-pub use envmap::{ENVMAP, IMAGE_BASED, PROXY_BOX, PROXY_SPHERE};
+pub use envmap::{ENVMAP, IMAGE_BASED, PROXY_BOX, PROXY_RELIEF, PROXY_SPHERE};
 pub use geometry::{CURVED_REFLECTOR, PLANAR_MIRROR, PLANAR_REFRACTION};
 pub use layered::LAYERED;
 pub use raytrace::ray_query::RAY_QUERY;

@@ -11,12 +11,12 @@
 //! (`capture_warp=blend`: the proxy is the scene's box, §3.2).
 //!
 //! Here: where the captures lie (`plan_captures`, the family's `plan_views` hook), their
-//! views (`CaptureViews`), the map (`CAPTURE_CUBES`, drawn by `cube_maps::CubeMaps`) and the
+//! views (`write_views`), the map (`CAPTURE_CUBES`, drawn by `cube_maps::CubeMaps`) and the
 //! words that tell the camera pass where to find them.
 
 use glam::Vec3;
 
-use crate::frame::stage::{cube_texel_bytes, describe_cube, order, FramePart, LayerField, MapInfo, ViewFrame, ViewLayout};
+use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, ViewFrame, ViewLayout};
 use crate::plan::types::{CaptureSet, Plan};
 use crate::quality::{CaptureBox, CaptureWarp, Quality};
 use crate::scene::Scene;
@@ -138,39 +138,28 @@ pub fn push_words(q: &Quality, layout: &ViewLayout, w: &mut crate::frame::words:
     w.set(CAPTURE_WARP, matches!(q.envmap.capture_warp, CaptureWarp::Blend) as u32);
 }
 
-/// The captures' part of a frame: their cube views. Each capture's six views have its centre
-/// as eye and its nominal lattice point in `dir.xyz` (the camera pass's trilinear weights
-/// are taken over the nominal lattice, whichever captures had to move).
-pub struct CaptureViews;
-
-impl FramePart for CaptureViews {
-    fn write_views(&mut self, fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
-        let Some(mut v) = fr.layout.first(VIEWS) else { return };
-        let q = &fr.plan.quality;
-        for set in &fr.plan.captures {
-            let nominal = match q.envmap.capture_box {
-                CaptureBox::Object => {
-                    let b = fr.scene.meshes[set.mesh].bounds();
-                    lattice(b.min, b.max, set.per_axis)
-                }
-                CaptureBox::Room => lattice(fr.plan.proxy_box.0, fr.plan.proxy_box.1, set.per_axis),
-            };
-            for (&c, &n) in set.centres.iter().zip(&nominal) {
-                for f in 0..6 {
-                    let vp = crate::cube::face_view_proj(f, c, fr.plan.cube_near);
-                    table[v as usize] = crate::frame::views::view(vp, c.extend(0.0), n.extend(0.0));
-                    v += 1;
-                }
+/// Writes the captures' cube views. Each capture's six views have its centre as eye and its
+/// nominal lattice point in `dir.xyz` (the camera pass's trilinear weights are taken over
+/// the nominal lattice, whichever captures had to move).
+pub fn write_views(fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
+    let Some(mut v) = fr.layout.first(VIEWS) else { return };
+    let q = &fr.plan.quality;
+    for set in &fr.plan.captures {
+        let nominal = match q.envmap.capture_box {
+            CaptureBox::Object => {
+                let b = fr.scene.meshes[set.mesh].bounds();
+                lattice(b.min, b.max, set.per_axis)
+            }
+            CaptureBox::Room => lattice(fr.plan.proxy_box.0, fr.plan.proxy_box.1, set.per_axis),
+        };
+        for (&c, &n) in set.centres.iter().zip(&nominal) {
+            for f in 0..6 {
+                let vp = crate::cube::face_view_proj(f, c, fr.plan.cube_near);
+                table[v as usize] = crate::frame::views::view(vp, c.extend(0.0), n.extend(0.0));
+                v += 1;
             }
         }
     }
-
-    fn destroy(&mut self, _ctx: &crate::vk::Context) {}
-}
-
-/// The family's frame part, where the plan has captures.
-pub fn frame_part(init: &crate::frame::stage::StageInit, _: &mut crate::frame::stage::Maps) -> crate::Result<Option<Box<dyn FramePart>>> {
-    Ok((!init.plan.captures.is_empty()).then(|| Box::new(CaptureViews) as Box<dyn FramePart>))
 }
 
 /// `specula plan`'s lines for the captures that had to move.

@@ -3,7 +3,7 @@
 use crate::quality::knob::knobs;
 
 knobs! {
-    /// Localised environment mapping (§3.2) and image-based reflections (§3.3).
+    /// Localised environment mapping (§3.2: proxies, displacement-mapped proxies) and image-based reflections (§3.3).
     pub struct EnvmapKnobs {
         /// proxy-sphere radius (§3.2); auto: mean half-extent of the scene's box
         proxy_radius: Option<f32> = auto, auto_metres();
@@ -21,6 +21,11 @@ knobs! {
         /// `blend` blends the captures' radiance looked up towards where the ray leaves the scene's box (several
         /// parallax-corrected cube maps blended by position, as engines blend their reflection probes)
         capture_warp: CaptureWarp = "depth", one_of()["depth" => CaptureWarp::Depth, "blend" => CaptureWarp::Blend];
+        /// proxy-relief (§3.2, PMDS06): edge of each of the six height maps per object (one per face of the scene's box: what
+        /// stands in front of that face, rasterised orthographically from the opposite face: radiance and height)
+        relief_size: u32 = 256, count(16..=4096, "texels");
+        /// proxy-relief: linear steps of each ray's march through a height map (then 8 halvings)
+        relief_steps: u32 = 32, count(1..=256);
     }
 }
 

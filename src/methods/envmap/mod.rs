@@ -1,11 +1,13 @@
 //! Environment mapping (survey §3): one radiance cube map per specular object, rasterised
 //! from its reference point without the object (`generate`, shared with the distance maps
 //! of §4), looked up in the reflected and refracted directions — as they are (§3.1), or
-//! towards where the ray leaves a proxy of the environment (§3.2); or several cube maps
-//! captured around the object, warped by their distances or blended (§3.3, `captures`).
+//! towards where the ray leaves a proxy of the environment (§3.2), or meets a proxy displaced
+//! by height maps (§3.2, `relief`); or several cube maps captured around the object, warped
+//! by their distances or blended (§3.3, `captures`).
 
 pub mod captures;
 pub mod knobs;
+pub mod relief;
 pub mod slots;
 
 use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo};
@@ -78,14 +80,38 @@ const fn proxy(flags: u32) -> CameraPass {
 pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::Family {
     name: "envmap",
     slots: slots::SLOTS,
-    methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO, IMAGE_BASED_INFO],
+    methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO, PROXY_RELIEF_INFO, IMAGE_BASED_INFO],
     plan_views: Some(captures::plan_captures),
-    views: Some(captures::view_blocks),
-    frame_part: Some(captures::frame_part),
-    push_words: Some(captures::push_words),
+    views: Some(|p| captures::view_blocks(p).into_iter().chain(relief::view_blocks(p)).collect()),
+    frame_part: Some(frame_part),
+    push_words: Some(|q, layout, w| {
+        captures::push_words(q, layout, w);
+        relief::push_words(q, layout, w);
+    }),
     describe: Some(captures::describe),
     ..crate::methods::registry::Family::NONE
 };
+
+/// The family's part of a frame: the captures' cube views and the relief maps' orthographic
+/// ones.
+struct EnvmapViews;
+
+impl crate::frame::stage::FramePart for EnvmapViews {
+    fn write_views(&mut self, fr: &crate::frame::stage::ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
+        captures::write_views(fr, table);
+        relief::write_views(fr, table);
+    }
+
+    fn destroy(&mut self, _ctx: &crate::vk::Context) {}
+}
+
+fn frame_part(
+    init: &crate::frame::stage::StageInit,
+    _: &mut crate::frame::stage::Maps,
+) -> crate::Result<Option<Box<dyn crate::frame::stage::FramePart>>> {
+    let any = !init.plan.captures.is_empty() || !relief::objects(init.plan).is_empty();
+    Ok(any.then(|| Box::new(EnvmapViews) as Box<dyn crate::frame::stage::FramePart>))
+}
 
 pub const ENVMAP_INFO: &MethodInfo = &MethodInfo {
     name: "envmap",
@@ -131,6 +157,39 @@ pub const PROXY_BOX_INFO: &MethodInfo = &MethodInfo {
     needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const PROXY_BOX: Method = Method(PROXY_BOX_INFO.name);
+
+const RELIEF_SHADE: CameraPass = CameraPass {
+    name: "proxy-relief.shade",
+    vertex: "scene/mesh.vert",
+    fragment: "envmap/relief.frag",
+    flags: 0,
+    order: order::CAMERA,
+    create: None,
+    profiled: Profiled::OWN,
+};
+
+pub const PROXY_RELIEF_INFO: &MethodInfo = &MethodInfo {
+    name: "proxy-relief",
+    abi: 20,
+    section: "§3.2",
+    family: "envmap",
+    summary: "displacement-mapped proxies (PMDS06): the scene's box as six rectangles displaced by height maps (what stands in front of each face, rasterised from the opposite face: radiance and depth); the ray is marched through the height maps of the faces it moves towards (relief_steps, then halvings) and the nearest hit that is not a height map's cliff is shaded",
+    serves: EVERY_CLASS,
+    knobs: &[EnvmapKnobs::relief_size, EnvmapKnobs::relief_steps, CubeKnobs::cube_precision, FrameKnobs::fresnel],
+    gpu: Some(GpuSpec {
+        maps: &[relief::RELIEF_MAPS],
+        camera: RELIEF_SHADE,
+        map_shading: MapShading::Sky,
+        leaves_out: LeavesOut::Itself,
+        cycles: one,
+        views: |_| 0,
+        shades_every_pixel: false,
+    }),
+    fallback: None,
+    shape: crate::methods::registry::Shape::Any,
+    needs: crate::methods::registry::DeviceNeeds::Nothing,
+};
+pub const PROXY_RELIEF: Method = Method(PROXY_RELIEF_INFO.name);
 
 const CAPTURES_SHADE: CameraPass = CameraPass {
     name: "image-based.shade",

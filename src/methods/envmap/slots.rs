@@ -10,4 +10,8 @@ pub const RADIANCE: Slot = Slot { camera: true, ..Slot::image("envmap.radiance",
 /// and distance; filtered lookups (the distance search interpolates as the distance maps').
 pub const CAPTURES: Slot = Slot { camera: true, ..Slot::image("envmap.captures", 0, binding::CAPTURES, Sampler::Linear) };
 
-pub const SLOTS: &[Slot] = &[RADIANCE, CAPTURES];
+/// Set 0: displacement-mapped proxies' height maps (§3.2), six layers per object; filtered
+/// lookups (the march interpolates heights between texels).
+pub const RELIEF: Slot = Slot { camera: true, ..Slot::image("envmap.relief", 0, binding::RELIEF_MAPS, Sampler::Linear) };
+
+pub const SLOTS: &[Slot] = &[RADIANCE, CAPTURES, RELIEF];
