@@ -45,6 +45,8 @@
 #define SPECULA_METHOD_PROXY_SPHERE 1
 /* proxy-box (§3.2) */
 #define SPECULA_METHOD_PROXY_BOX 2
+/* proxy-relief (§3.2) */
+#define SPECULA_METHOD_PROXY_RELIEF 20
 /* image-based (§3.3) */
 #define SPECULA_METHOD_IMAGE_BASED 19
 /* distance (§4.1, §4.2) */

@@ -32,6 +32,7 @@ const MEASURED: &[(&str, f64, f64, f64)] = &[
     ("proxy-sphere", -3.984e-3, 2.032e-3, 0.6867),
     ("proxy-box", -4.900e-3, -8.805e-4, 0.6913),
     ("image-based", -3.164e-3, 1.219e-3, 0.6902),
+    ("proxy-relief", -5.284e-3, 4.808e-4, 0.6967),
     ("distance", -4.831e-3, -9.063e-4, 0.6914),
     ("distance-multi", -4.354e-3, -3.193e-4, 0.6909),
     ("refractor-map", -3.647e-3, 7.448e-3, 0.7137),

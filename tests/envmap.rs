@@ -362,19 +362,21 @@ fn lone_object_sees_the_environment_map() {
     common::assert_clean(&ctx);
 }
 
-/// Image-based reflections (§3.3) against one map per object (proxy-box, distance) and the
-/// exact tracer, at the same size against the same reference, on the ball's pixels away
-/// from its silhouette (whose anti-aliasing is the same for every method):
+/// Displacement-mapped proxies (§3.2) and image-based reflections (§3.3) against one map per
+/// object (proxy-box, distance) and the exact tracer, at the same size against the same
+/// reference, on the ball's pixels away from its silhouette (whose anti-aliasing is the same
+/// for every method):
 /// 1. the survey's difficult corner (`concave-occluder`, Figure 21: the ball's reference point
 ///    at the room's centre, a box on the floor hiding part of what the ball reflects): the
-///    captures around the ball see behind the box, warped by their distances;
+///    captures around the ball see behind the box, warped by their distances; the height maps
+///    see the box from every side;
 /// 2. the ball moving from the room's middle into that corner with captures fixed in the
-///    room (`capture_box=room`, the probes engines place): the captures are not drawn again
-///    as it moves (it is not in its own captures), where the one-map methods' maps follow it,
-///    and the error at the end against the reference is measured for each.
+///    room (`capture_box=room`, the probes engines place): neither the captures nor the height
+///    maps are drawn again as it moves (it is in neither), where the one-map methods' maps
+///    follow it; the error at the end against the reference is measured for each.
 #[test]
-fn image_based_reflections_against_one_map() {
-    use specula::methods::{BVH, DISTANCE, IMAGE_BASED, PROXY_BOX};
+fn localised_and_image_based_reflections_against_one_map() {
+    use specula::methods::{BVH, DISTANCE, IMAGE_BASED, PROXY_BOX, PROXY_RELIEF};
     let ctx = common::gpu();
     let size = 64;
     let q = |pairs: &[&str]| {
@@ -408,12 +410,14 @@ fn image_based_reflections_against_one_map() {
         render(&scene, IMAGE_BASED, &["capture_warp=blend"]),
         render(&scene, IMAGE_BASED, &["captures=1"]),
         render(&scene, IMAGE_BASED, &["captures=3"]),
+        render(&scene, PROXY_RELIEF, &["relief_size=64"]),
     ];
     let e = ball_psnr(&scene, &runs.iter().collect::<Vec<_>>());
     eprintln!(
         "concave occluder {size}², the ball: proxy-box {:.2}, distance {:.2}, bvh {:.2} dB; image-based depth {:.2}, blend {:.2}, one capture {:.2}, 27 captures {:.2} dB",
         e[0], e[1], e[2], e[3], e[4], e[5], e[6]
     );
+    eprintln!("                            proxy-relief {:.2} dB", e[7]);
     // Measured: proxy-box 19.36, distance 21.75, bvh 40.06 dB; image-based depth 26.05, blend
     // 20.87, one capture 21.85, 27 captures 27.39 dB. Floors and margins 1 dB under those.
     let (boxed, dist, exact, depth, blend, one, many) = (e[0], e[1], e[2], e[3], e[4], e[5], e[6]);
@@ -421,6 +425,9 @@ fn image_based_reflections_against_one_map() {
     assert!(blend - boxed > 0.51, "blended captures localise better than one proxy-box map: {e:?}");
     assert!(depth - one > 3.2 && many - depth > 0.34, "more captures, less error: {e:?}");
     assert!(exact - depth > 13.0, "the exact tracer stays the yardstick: {e:?}");
+    // proxy-relief (relief_size 64): measured 22.53 dB, 3.17 over proxy-box (the box seen from
+    // every side; its height maps' cliffs and the spaces they hide keep it under the captures).
+    assert!(e[7] > 21.53 && e[7] - boxed > 2.17, "height maps localise the box: {e:?}");
 
     // 2. The ball moves from the room's middle into the corner.
     let base = specula::scenes::corner_mirror().unwrap();
@@ -434,29 +441,39 @@ fn image_based_reflections_against_one_map() {
     assert_eq!(plan.captures[0].centres.len(), 8);
     let fixed = plan.captures[0].centres.clone();
     let mut r = Renderer::new(&ctx, &scene, plan, size, size).unwrap();
+    let relief_plan = specula::plan::plan_with(&scene, &specula::plan::Choices::all(PROXY_RELIEF), &q(&["relief_size=64"])).unwrap();
+    let mut relief = Renderer::new(&ctx, &scene, relief_plan, size, size).unwrap();
     r.render(&ctx).unwrap();
+    relief.render(&ctx).unwrap();
     for k in 1..=3 {
         scene.set_object_transform(ball, at(k)).unwrap();
         r.update(&scene).unwrap();
+        relief.update(&scene).unwrap();
         let f = r.render(&ctx).unwrap();
+        let g = relief.render(&ctx).unwrap();
         assert!(f.map_updates.iter().all(|u| u.stage != "envmap.captures"), "frame {k}: {:?}", f.map_updates);
+        assert!(g.map_updates.iter().all(|u| u.stage != "envmap.relief"), "frame {k}: {:?}", g.map_updates);
         assert_eq!(r.plan.captures[0].centres, fixed, "room captures stay where they are");
         if k == 3 {
-            let runs = [f.image, render(&scene, IMAGE_BASED, &[]), render(&scene, PROXY_BOX, &[]), render(&scene, DISTANCE, &[])];
+            let runs = [f.image, render(&scene, IMAGE_BASED, &[]), render(&scene, PROXY_BOX, &[]), render(&scene, DISTANCE, &[]), g.image];
             let e = ball_psnr(&scene, &runs.iter().collect::<Vec<_>>());
             eprintln!(
-                "moved ball in the corner, the ball: image-based room captures {:.2}, object captures {:.2}, proxy-box {:.2}, distance {:.2} dB",
-                e[0], e[1], e[2], e[3]
+                "moved ball in the corner, the ball: image-based room captures {:.2}, object captures {:.2}, proxy-box {:.2}, distance {:.2}, proxy-relief {:.2} dB",
+                e[0], e[1], e[2], e[3], e[4]
             );
             // Measured: room captures 27.28, object captures 26.94, proxy-box 36.90, distance
-            // 32.54 dB. In this empty box room proxy-box's proxy is the room itself (exact up to
+            // 32.54, proxy-relief 53.48 dB. In this empty box room proxy-box's proxy is the room itself (exact up to
             // its texels), and captures by the ball see the far walls it reflects from 1.7× as far
             // as the room's centre does (coarser texels): the limit of captures, kept in view.
             assert!(e[0] > 26.28 && e[1] > 25.94, "{e:?}");
             assert!(e[2] - e[0] > 8.6, "proxy-box is exact in a box room: {e:?}");
+            // proxy-relief: 53.48 dB measured (the walls' height maps are the walls, sampled at
+            // 6 cm, nearer than one cube map's texels).
+            assert!(e[4] > 52.48 && e[4] - e[2] > 15.58, "{e:?}");
         }
     }
     r.destroy(&ctx);
+    relief.destroy(&ctx);
     common::assert_clean(&ctx);
 }
 

@@ -298,10 +298,21 @@ impl Stage for CubeMaps {
         if self.frame_latency && seen {
             self.frames = 0;
         }
-        if self.every_face() || (self.kind == MapKind::Relief && seen) {
-            // Height maps: orthographic views over the whole box, every face on any change.
+        if self.every_face() {
             self.deps.all();
-        } else if self.kind != MapKind::Relief {
+        } else if self.kind == MapKind::Relief {
+            // Height maps: orthographic views over the whole box, every face of a layer that
+            // sees the change: a light or material, another object's move, or its own
+            // object's where its shadows or caustics fall on what the layer draws.
+            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
+            let casts = !lighting.shadows.is_empty() || lighting.caustics;
+            let global = !changes.lights.is_empty() || !changes.materials.is_empty();
+            for (k, &own) in self.objects.iter().enumerate() {
+                if global || changes.moved.iter().any(|&m| m != own || casts) {
+                    self.deps.faces[k] = crate::frame::ALL_FACES;
+                }
+            }
+        } else {
             let eyes = self.eyes(init.plan);
             let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
             self.deps.mark(init.scene, &self.objects, &eyes, &init.gpu.draws, changes, (self.inter_object, &self.map_mirrors), &lighting);
