@@ -1,9 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: INTER_OBJECT
+// variants: INTER_OBJECT PLANAR
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
 // the reference point (not window-space z); also image-based reflections' captures (§3.3)
-// and, in planar views, displacement-mapped proxies' height maps (§3.2). Specular objects other than the map's owner
+// and (PLANAR: the depth along an orthographic view's direction) displacement-mapped
+// proxies' height maps (§3.2). Specular objects other than the map's owner
 // reflect the environment map, or, in inter-object mode (§4.3), are shaded by their own
 // method from their maps of the previous cycle: searched in their distance map, or self
 // refracted in their refractor map (§4.4). The inter-object paths are compiled only into
@@ -47,8 +48,11 @@ void main() {
         c += refracted;
 #endif
     }
-    // Planar views (eye.w 1: displacement-mapped proxies' height maps, envmap/relief.frag)
-    // store the depth along their direction; the cube maps the distance from their centre.
-    View v = views[in_view];
-    out_radiance_distance = vec4(c, v.eye.w > 0.5 ? dot(in_position - eye, v.dir.xyz) : length(in_position - eye));
+#ifdef PLANAR
+    // Planar views (displacement-mapped proxies' height maps, envmap/relief.frag) store the
+    // depth along their direction.
+    out_radiance_distance = vec4(c, dot(in_position - eye, views[in_view].dir.xyz));
+#else
+    out_radiance_distance = vec4(c, length(in_position - eye));
+#endif
 }

@@ -166,7 +166,8 @@ impl CubeMaps {
         let (sky, surface) = match self.kind {
             MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
             MapKind::Distance if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
-            MapKind::Distance | MapKind::Captures | MapKind::Relief => ("distance/sky.frag", "distance/generate.frag"),
+            MapKind::Distance | MapKind::Captures => ("distance/sky.frag", "distance/generate.frag"),
+            MapKind::Relief => ("distance/sky.frag", "distance/generate.frag#PLANAR"),
         };
         let formats = [format];
         let desc = |name: &'static str, vertex, fragment, vertex_input, depth_test| GraphicsDesc {

@@ -11,7 +11,7 @@ pub use crate::frame::knobs::{Aa, DebugFault, FrameKnobs, FresnelMode};
 pub use crate::methods::caustics::knobs::{CausticPaths, CausticSpace, Caustics, CausticsKnobs};
 pub use crate::methods::cube_knobs::{CubeKnobs, CubeMode, Precision};
 pub use crate::methods::distance::knobs::{DistanceKnobs, SearchKnobs};
-pub use crate::methods::envmap::knobs::{CaptureBox, CaptureWarp, EnvmapKnobs};
+pub use crate::methods::envmap::knobs::{CaptureBox, CaptureWarp, EnvmapKnobs, ReliefSource};
 pub use crate::methods::geometry::knobs::GeometryKnobs;
 pub use crate::methods::layered::knobs::{LayeredKnobs, MAX_LAYERS};
 pub use crate::methods::raytrace::knobs::RaytraceKnobs;

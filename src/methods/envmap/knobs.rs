@@ -26,6 +26,11 @@ knobs! {
         relief_size: u32 = 256, count(16..=4096, "texels");
         /// proxy-relief: linear steps of each ray's march through a height map (then 8 halvings)
         relief_steps: u32 = 32, count(1..=256);
+        /// proxy-relief: where the height maps come from: rasterised orthographically from each face's opposite face
+        /// (`raster`: what stands in front of the face, whatever the object's reference point sees) or sampled from the
+        /// object's distance map (`distance`: per texel the distance-map search along the face's direction, §4.1; only what
+        /// the reference point sees, as PMDS06 and the survey describe it)
+        relief_source: ReliefSource = "raster", one_of()["raster" => ReliefSource::Raster, "distance" => ReliefSource::Distance];
     }
 }
 
@@ -45,4 +50,13 @@ pub enum CaptureWarp {
     Depth,
     /// Position-weighted blend of parallax-corrected lookups (proxy: the scene's box).
     Blend,
+}
+
+/// Where displacement-mapped proxies' height maps come from (`relief_source`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub enum ReliefSource {
+    /// Rasterised orthographically from the opposite face.
+    Raster,
+    /// Sampled from the object's distance map by a search per texel.
+    Distance,
 }

@@ -81,6 +81,7 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     name: "envmap",
     slots: slots::SLOTS,
     methods: &[ENVMAP_INFO, PROXY_SPHERE_INFO, PROXY_BOX_INFO, PROXY_RELIEF_INFO, IMAGE_BASED_INFO],
+    plan_stages: Some(relief::plan_sources),
     plan_views: Some(captures::plan_captures),
     views: Some(|p| captures::view_blocks(p).into_iter().chain(relief::view_blocks(p)).collect()),
     frame_part: Some(frame_part),
@@ -175,7 +176,9 @@ pub const PROXY_RELIEF_INFO: &MethodInfo = &MethodInfo {
     family: "envmap",
     summary: "displacement-mapped proxies (PMDS06): the scene's box as six rectangles displaced by height maps (what stands in front of each face, rasterised from the opposite face: radiance and depth); the ray is marched through the height maps of the faces it moves towards (relief_steps, then halvings) and the nearest hit that is not a height map's cliff is shaded",
     serves: EVERY_CLASS,
-    knobs: &[EnvmapKnobs::relief_size, EnvmapKnobs::relief_steps, CubeKnobs::cube_precision, FrameKnobs::fresnel],
+    knobs: &[
+        EnvmapKnobs::relief_size, EnvmapKnobs::relief_steps, EnvmapKnobs::relief_source, CubeKnobs::cube_precision, FrameKnobs::fresnel, CubeKnobs::cube_size, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance,
+    ],
     gpu: Some(GpuSpec {
         maps: &[relief::RELIEF_MAPS],
         camera: RELIEF_SHADE,

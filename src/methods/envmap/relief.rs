@@ -9,35 +9,47 @@
 //!
 //! What a box proxy (`proxy-box`, what engines call a parallax-corrected probe) becomes with
 //! depth: a room's contents in front of its walls, seen from every side, so that parts
-//! hidden from any one reference point (the far side of a box on the floor) are held. The
-//! height maps are rasterised, not sampled from a distance map: sampled from one reference
-//! point, they would hold only what that point sees, which is what the distance maps (§4)
-//! already search.
+//! hidden from any one reference point (the far side of a box on the floor) are held.
+//! The height maps are rasterised (`relief_source=raster`, the default) or, as PMDS06 and the
+//! survey put it, sampled from the object's distance map (`relief_source=distance`: per texel
+//! the distance-map search along the face's direction, `ReliefSampled`): then they hold only
+//! what the object's reference point sees, as the distance map does (BENCHMARKS.md compares
+//! the two).
 
+use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 
-use crate::frame::stage::{order, LayerField, MapInfo, ViewFrame};
-use crate::plan::types::Plan;
-use crate::quality::Quality;
+use crate::frame::stage::{order, FrameIo, LayerField, MapInfo, Maps, Stage, StageInit, ViewFrame};
+use crate::frame::{destroy_pipelines, FrameInputs};
+use crate::plan::types::{Plan, PlanStages};
+use crate::quality::{Quality, ReliefSource};
+use crate::vk::pipeline::{graphics_pipeline, GraphicsDesc, Multisample, VertexInput};
+use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
+use crate::Result;
 
 /// The view block of every relief object's six orthographic views, in layer order.
 pub const VIEWS: &str = "envmap.relief";
 
-/// `envmap.relief`: per object six height maps `relief_size`², RGBA (radiance, depth).
+/// `envmap.relief`: per object six height maps `relief_size`², RGBA (radiance, depth); after
+/// the distance maps, which `relief_source=distance` samples.
 pub const RELIEF_MAPS: MapInfo = MapInfo {
     name: "envmap.relief",
-    order: order::ENVIRONMENT_MAPS,
+    order: order::ENVIRONMENT_MAPS + 1,
     cube: false,
     layer_field: Some(LayerField::Envmap),
-    create: crate::methods::cube_maps::create_relief,
+    create,
     bytes: |p, objects, _| {
         let s = p.quality.envmap.relief_size as u64;
         6 * s * s * crate::frame::stage::cube_texel_bytes(&p.quality) * objects as u64
     },
     describe: |q, _| {
         format!(
-            "six height maps {}² (one per face of the scene's box: radiance and depth, {})",
+            "six height maps {}² (one per face of the scene's box: radiance and depth, {}, {})",
             q.envmap.relief_size,
+            match q.envmap.relief_source {
+                ReliefSource::Raster => "rasterised",
+                ReliefSource::Distance => "sampled from its distance map",
+            },
             match q.cube.cube_precision {
                 crate::quality::Precision::Half => "RGBA16F",
                 crate::quality::Precision::Single => "RGBA32F",
@@ -91,15 +103,156 @@ pub fn view_blocks(p: &Plan) -> Vec<(&'static str, u32)> {
     }
 }
 
-/// Writes the relief objects' views: eye.w 1 (planar depth along dir.xyz).
+/// Writes the relief objects' views: eye.w 1 (planar depth along dir.xyz); dir.w the object's
+/// layer in the distance maps (`relief_source=distance`), else 0.
 pub fn write_views(fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
     let Some(mut v) = fr.layout.first(VIEWS) else { return };
-    for _ in objects(fr.plan) {
+    for mesh in objects(fr.plan) {
+        let layer = distance_layer(fr.plan, mesh).unwrap_or(0);
         for f in 0..6 {
             let (vp, eye, dir) = face_view(f, fr.plan.proxy_box);
-            table[v as usize] = crate::frame::views::view(vp, eye.extend(1.0), dir.extend(0.0));
+            table[v as usize] = crate::frame::views::view(vp, eye.extend(1.0), dir.extend(layer as f32));
             v += 1;
         }
+    }
+}
+
+/// Object `mesh`'s layer in the distance maps, if it has one.
+fn distance_layer(p: &Plan, mesh: usize) -> Option<u32> {
+    p.object(mesh)?.maps.iter().find(|m| m.pass == crate::methods::distance::DISTANCE_CUBES.name).map(|m| m.layer)
+}
+
+/// The family's `plan_stages` part: with `relief_source=distance` every proxy-relief object
+/// gets a distance map of its own to sample (its layer not the object's `envmap_layer`, which
+/// stays its height maps').
+pub fn plan_sources(_: &crate::scene::Scene, p: &mut Plan, st: &mut PlanStages) {
+    if p.quality.envmap.relief_source != ReliefSource::Distance {
+        return;
+    }
+    let what = crate::frame::stage::describe_cube(&p.quality) + " with distance, which its height maps sample";
+    for o in p.objects.iter_mut().filter(|o| o.method == super::PROXY_RELIEF) {
+        let kind = crate::plan::types::MapKind { layer_field: None, ..crate::methods::distance::DISTANCE_CUBES.kind() };
+        st.add_map(o, kind, what.clone());
+    }
+}
+
+/// `envmap.relief`'s constructor: rasterised (`cube_maps::CubeMaps`) or sampled.
+fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
+    match init.plan.quality.envmap.relief_source {
+        ReliefSource::Raster => crate::methods::cube_maps::create_relief(init, objects, maps),
+        ReliefSource::Distance => Ok(Box::new(ReliefSampled::new(init, objects, maps)?)),
+    }
+}
+
+/// `relief_source=distance`: the height maps sampled from the objects' distance maps, one
+/// full-screen draw per layer (`glsl/envmap/relief_sample.frag`), drawn again whenever
+/// anything the distance maps hold changed.
+pub struct ReliefSampled {
+    objects: Vec<usize>,
+    pipeline: vk::Pipeline,
+    dirty: bool,
+    /// `map_updates=always`: every frame.
+    always: bool,
+}
+
+impl ReliefSampled {
+    fn new(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<ReliefSampled> {
+        let (ctx, q) = (init.ctx, &init.plan.quality);
+        let me = ReliefSampled { objects: objects.to_vec(), pipeline: vk::Pipeline::null(), dirty: true, always: q.frame.map_updates_always };
+        build(ctx, me, |me| {
+            let format = crate::methods::cube_maps::radiance_format(q.cube.cube_precision);
+            let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
+            let size = q.envmap.relief_size;
+            let kind = ImageKind::D2Array { layers: 6 * me.objects.len() as u32 };
+            maps.push_image(&super::slots::RELIEF, Image::new(ctx, &ImageDesc { name: "envmap.relief", format, width: size, height: size, kind, usage })?);
+            me.pipeline = graphics_pipeline(
+                ctx,
+                init.layout,
+                &GraphicsDesc {
+                    name: "envmap.relief.sample",
+                    vertex: "scene/sky.vert",
+                    fragment: "envmap/relief_sample.frag",
+                    vertex_input: VertexInput::None,
+                    color_formats: &[format],
+                    depth_format: None,
+                    depth_test: false,
+                    depth_write: false,
+                    view_mask: 0,
+                    cull: vk::CullModeFlags::NONE,
+                    multisample: Multisample::OFF,
+                    blend: crate::vk::pipeline::Blend::Replace,
+                    depth_op: crate::vk::pipeline::DepthOp::Nearer,
+                },
+            )?;
+            Ok(())
+        })
+    }
+}
+
+impl Stage for ReliefSampled {
+    fn name(&self) -> &'static str {
+        "envmap.relief"
+    }
+
+    fn update(&mut self, _: &StageInit, changes: &crate::scene::update::Changes, _: &mut Maps) -> Result<()> {
+        self.dirty |= !changes.moved.is_empty() || !changes.materials.is_empty() || !changes.lights.is_empty();
+        Ok(())
+    }
+
+    fn redraw(&self) -> Option<(u32, u32)> {
+        let all = 6 * self.objects.len() as u32;
+        Some((if self.dirty || self.always { all } else { 0 }, all))
+    }
+
+    fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        let Some(mut image) = io.maps.take_images(&super::slots::RELIEF).into_iter().next() else { return };
+        let distance = io.maps.image(&crate::methods::distance::slots::DISTANCE);
+        let mut pass = rec.pass("envmap.relief").writes(&mut image, Access::ColorAttachment);
+        for img in io.scene_images.iter().copied().chain(distance) {
+            pass = pass.reads(img, Access::FragmentSampled);
+        }
+        let open = pass.begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let sets = io.sets.camera.get(io.maps.latest).copied().unwrap_or(io.sets.empty);
+        let base = io.views.first(VIEWS).unwrap_or(0);
+        for (k, &mesh) in self.objects.iter().enumerate() {
+            for face in 0..6u32 {
+                let layer = 6 * k as u32 + face;
+                let colors = [image.layer_view(layer)];
+                let target = Target {
+                    color: &colors,
+                    depth: None,
+                    width: image.width,
+                    height: image.height,
+                    view_mask: 0,
+                    layer_count: 1,
+                    clear_color: [0.0, 0.0, 0.0, 1e30],
+                    clear: true,
+                };
+                begin_rendering(ctx, cmd, &target);
+                f.bind(ctx, cmd, self.pipeline);
+                f.bind_maps(ctx, cmd, sets);
+                f.push(ctx, cmd, base + layer, mesh as u32);
+                unsafe {
+                    ctx.device.cmd_draw(cmd, 3, 1, 0, 0);
+                    ctx.device.cmd_end_rendering(cmd);
+                }
+            }
+        }
+        rec.end(open);
+        io.maps.set_images(&super::slots::RELIEF, vec![image]);
+        self.dirty = false;
+    }
+
+    fn destroy(&mut self, ctx: &Context) {
+        destroy_pipelines(ctx, &mut [self.pipeline]);
+        self.pipeline = vk::Pipeline::null();
+    }
+}
+
+impl Owner for ReliefSampled {
+    fn destroy(&mut self, ctx: &Context) {
+        Stage::destroy(self, ctx)
     }
 }
 
