@@ -158,13 +158,17 @@ pub struct ReliefSampled {
 impl ReliefSampled {
     fn new(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<ReliefSampled> {
         let (ctx, q) = (init.ctx, &init.plan.quality);
-        let me = ReliefSampled { objects: objects.to_vec(), pipeline: vk::Pipeline::null(), dirty: true, always: q.frame.map_updates_always };
+        let me =
+            ReliefSampled { objects: objects.to_vec(), pipeline: vk::Pipeline::null(), dirty: true, always: q.frame.map_updates_always };
         build(ctx, me, |me| {
             let format = crate::methods::cube_maps::radiance_format(q.cube.cube_precision);
             let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
             let size = q.envmap.relief_size;
             let kind = ImageKind::D2Array { layers: 6 * me.objects.len() as u32 };
-            maps.push_image(&super::slots::RELIEF, Image::new(ctx, &ImageDesc { name: "envmap.relief", format, width: size, height: size, kind, usage })?);
+            maps.push_image(
+                &super::slots::RELIEF,
+                Image::new(ctx, &ImageDesc { name: "envmap.relief", format, width: size, height: size, kind, usage })?,
+            );
             me.pipeline = graphics_pipeline(
                 ctx,
                 init.layout,
