@@ -78,6 +78,8 @@ pub struct CubeMaps {
     always: bool,
     /// Faces drawn by the last record.
     faces_drawn: u32,
+    /// The family's view block its layers' views are in (`with_views`), six per layer.
+    view_block: Option<&'static str>,
 }
 
 /// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
@@ -85,17 +87,12 @@ pub fn create_radiance(init: &StageInit, objects: &[usize], maps: &mut Maps) -> 
     Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Radiance)?))
 }
 
-/// `envmap.captures`' constructor (`envmap::captures::CAPTURE_CUBES`): each object's layers
-/// in a row.
-pub fn create_captures(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
-    let k = crate::methods::envmap::captures::per_object(&init.plan.quality) as usize;
-    let layers: Vec<usize> = objects.iter().flat_map(|&m| std::iter::repeat_n(m, k)).collect();
-    Ok(Box::new(CubeMaps::new(init, &layers, maps, MapKind::Captures)?))
-}
-
-/// `envmap.relief`'s constructor (`envmap::relief::RELIEF_MAPS`).
-pub fn create_relief(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
-    Ok(Box::new(CubeMaps::new(init, objects, maps, MapKind::Relief)?))
+/// A cube-map pass whose layers' views are a family's block (`ViewLayout::first(block)`,
+/// six per layer: image-based captures, height maps), not the objects' own cube views.
+pub fn with_views(init: &StageInit, layers: &[usize], maps: &mut Maps, kind: MapKind, block: &'static str) -> Result<Box<dyn Stage>> {
+    let mut me = CubeMaps::new(init, layers, maps, kind)?;
+    me.view_block = Some(block);
+    Ok(Box::new(me))
 }
 
 pub fn radiance_format(p: Precision) -> vk::Format {
@@ -132,6 +129,7 @@ impl CubeMaps {
             ),
             always: q.frame.map_updates_always,
             faces_drawn: 0,
+            view_block: None,
         };
         build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
@@ -366,13 +364,11 @@ impl Stage for CubeMaps {
                 if self.inter_object && !first { io.sets.generate.get(read).copied().unwrap_or(io.sets.empty) } else { io.sets.empty };
             let uses_maps = self.kind != MapKind::Radiance;
             let clear = [0.0, 0.0, 0.0, if uses_maps { 1e30 } else { 0.0 }];
-            let captures = io.views.first(crate::methods::envmap::captures::VIEWS);
-            let relief = io.views.first(crate::methods::envmap::relief::VIEWS);
+            let block = self.view_block.and_then(|b| io.views.first(b));
             for (layer, &mesh) in self.objects.iter().enumerate() {
-                let view = match self.kind {
-                    MapKind::Captures => captures.expect("captures have views") + 6 * layer as u32,
-                    MapKind::Relief => relief.expect("height maps have views") + 6 * layer as u32,
-                    _ => io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views"),
+                let view = match block {
+                    Some(first) => first + 6 * layer as u32,
+                    None => io.views.cube_of(io.plan, mesh).expect("cube-mapped object has views"),
                 };
                 let skip = match io.plan.object(mesh).map(|o| o.leaves_out) {
                     Some(LeavesOut::Nothing) => None,

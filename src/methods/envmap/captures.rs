@@ -16,7 +16,7 @@
 
 use glam::Vec3;
 
-use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, ViewFrame, ViewLayout};
+use crate::frame::stage::{cube_texel_bytes, describe_cube, order, LayerField, MapInfo, Maps, Stage, StageInit, ViewFrame, ViewLayout};
 use crate::plan::types::{CaptureSet, Plan};
 use crate::quality::{CaptureBox, CaptureWarp, Quality};
 use crate::scene::Scene;
@@ -32,7 +32,7 @@ pub const CAPTURE_CUBES: MapInfo = MapInfo {
     order: order::ENVIRONMENT_MAPS,
     cube: true,
     layer_field: Some(LayerField::Envmap),
-    create: crate::methods::cube_maps::create_captures,
+    create: create_captures,
     bytes: |p, objects, _| {
         let s = p.quality.cube.cube_size as u64;
         6 * s * s * cube_texel_bytes(&p.quality) * objects as u64 * per_object(&p.quality) as u64
@@ -51,6 +51,14 @@ pub const CAPTURE_CUBES: MapInfo = MapInfo {
     },
     shared: false,
 };
+
+/// `envmap.captures`' constructor: the cube-map pass over each object's `captures`³ layers in
+/// a row, their views this block's.
+fn create_captures(init: &StageInit, objects: &[usize], maps: &mut Maps) -> crate::Result<Box<dyn Stage>> {
+    let k = per_object(&init.plan.quality) as usize;
+    let layers: Vec<usize> = objects.iter().flat_map(|&m| std::iter::repeat_n(m, k)).collect();
+    crate::methods::cube_maps::with_views(init, &layers, maps, crate::methods::cube_maps::MapKind::Captures, VIEWS)
+}
 
 /// Captures per object: `captures`³.
 pub fn per_object(q: &Quality) -> u32 {

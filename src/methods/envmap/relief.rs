@@ -139,7 +139,9 @@ pub fn plan_sources(_: &crate::scene::Scene, p: &mut Plan, st: &mut PlanStages) 
 /// `envmap.relief`'s constructor: rasterised (`cube_maps::CubeMaps`) or sampled.
 fn create(init: &StageInit, objects: &[usize], maps: &mut Maps) -> Result<Box<dyn Stage>> {
     match init.plan.quality.envmap.relief_source {
-        ReliefSource::Raster => crate::methods::cube_maps::create_relief(init, objects, maps),
+        ReliefSource::Raster => {
+            crate::methods::cube_maps::with_views(init, objects, maps, crate::methods::cube_maps::MapKind::Relief, VIEWS)
+        }
         ReliefSource::Distance => Ok(Box::new(ReliefSampled::new(init, objects, maps)?)),
     }
 }
