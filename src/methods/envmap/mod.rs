@@ -42,8 +42,14 @@ const fn one(_: &Quality) -> u32 {
 }
 
 const fn spec(camera: CameraPass) -> GpuSpec {
+    spec_with(&[RADIANCE_CUBES], camera)
+}
+
+/// The family's methods' GPU description: its maps and camera pass; shown in the other
+/// objects' maps as the environment's reflection, leaving itself out of its own.
+const fn spec_with(maps: &'static [MapInfo], camera: CameraPass) -> GpuSpec {
     GpuSpec {
-        maps: &[RADIANCE_CUBES],
+        maps,
         camera,
         map_shading: MapShading::Sky,
         leaves_out: LeavesOut::Itself,
@@ -179,15 +185,7 @@ pub const PROXY_RELIEF_INFO: &MethodInfo = &MethodInfo {
     knobs: &[
         EnvmapKnobs::relief_size, EnvmapKnobs::relief_steps, EnvmapKnobs::relief_source, CubeKnobs::cube_precision, FrameKnobs::fresnel, CubeKnobs::cube_size, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance,
     ],
-    gpu: Some(GpuSpec {
-        maps: &[relief::RELIEF_MAPS],
-        camera: RELIEF_SHADE,
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Itself,
-        cycles: one,
-        views: |_| 0,
-        shades_every_pixel: false,
-    }),
+    gpu: Some(spec_with(&[relief::RELIEF_MAPS], RELIEF_SHADE)),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
     needs: crate::methods::registry::DeviceNeeds::Nothing,
@@ -214,15 +212,7 @@ pub const IMAGE_BASED_INFO: &MethodInfo = &MethodInfo {
     knobs: &[
         EnvmapKnobs::captures, EnvmapKnobs::capture_box, EnvmapKnobs::capture_warp, CubeKnobs::cube_size, CubeKnobs::cube_precision, CubeKnobs::cube_mode, FrameKnobs::fresnel, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance,
     ],
-    gpu: Some(GpuSpec {
-        maps: &[captures::CAPTURE_CUBES],
-        camera: CAPTURES_SHADE,
-        map_shading: MapShading::Sky,
-        leaves_out: LeavesOut::Itself,
-        cycles: one,
-        views: |_| 0,
-        shades_every_pixel: false,
-    }),
+    gpu: Some(spec_with(&[captures::CAPTURE_CUBES], CAPTURES_SHADE)),
     fallback: None,
     shape: crate::methods::registry::Shape::Any,
     needs: crate::methods::registry::DeviceNeeds::Nothing,
