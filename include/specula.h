@@ -257,6 +257,17 @@ typedef struct {
   // Solid dielectric (KHR_materials_dispersion): 20 / Abbe number (≥ 0); 0: none. Also
   // added after the first release (zero for a caller whose `size` ends before it).
   float dispersion;
+  // Solid dielectric (survey §6.5): non-zero for an index that varies in space, the field
+  // n(x) = ior + g·(x − o) + ½ (x − o)ᵀ H (x − o) in world space (`ior` its value at the
+  // origin o); rays inside it curve, traced by the ray tracers. Added after the volume
+  // fields (a caller whose `size` ends before it gets a uniform index).
+  uint32_t graded;
+  // The field's origin o [m].
+  float index_origin[3];
+  // Its gradient g at the origin [1/m].
+  float index_gradient[3];
+  // Its symmetric Hessian H [1/m²]: xx, yy, zz, xy, xz, yz.
+  float index_hessian[6];
 } SpeculaMaterialDesc;
 
 // A triangle mesh. Arrays are read during the call only (the library copies them).

@@ -69,6 +69,10 @@ pub fn gpu_material(m: &crate::scene::Material) -> GpuMaterial {
         emissive_texture: m.emissive_texture.map_or(-1, |t| t as i32),
         thin,
         absorption: if m.absorbs() { v4(m.absorption.to_array()) } else { [0.0; 4] },
+        medium_origin: m.medium().map_or([0.0; 4], |f| [f.origin.x, f.origin.y, f.origin.z, 1.0]),
+        medium_gradient: m.medium().map_or([0.0; 4], |f| [f.gradient.x, f.gradient.y, f.gradient.z, f.hessian_norm() as f32]),
+        medium_hessian: m.medium().map_or([0.0; 4], |f| [f.hessian[0].x, f.hessian[1].y, f.hessian[2].z, f.hessian[0].y]),
+        medium_hessian2: m.medium().map_or([0.0; 4], |f| [f.hessian[0].z, f.hessian[1].z, 0.0, 0.0]),
     }
 }
 

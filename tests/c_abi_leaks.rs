@@ -136,6 +136,10 @@ unsafe fn build_scene(ctx: *mut SpeculaContext) {
             attenuation_color: [0.0; 3],
             attenuation_distance: 0.0,
             dispersion: 0.0,
+            graded: 0,
+            index_origin: [0.0; 3],
+            index_gradient: [0.0; 3],
+            index_hessian: [0.0; 6],
         };
         let mut i = 0;
         ok(specula_context_add_material(ctx, &m, &mut i), ctx);

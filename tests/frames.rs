@@ -628,6 +628,10 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
             attenuation_color: [0.0; 3],
             attenuation_distance: 0.0,
             dispersion: 0.0,
+            graded: 0,
+            index_origin: [0.0; 3],
+            index_gradient: [0.0; 3],
+            index_hessian: [0.0; 6],
         };
         let glass_material = scene
             .meshes

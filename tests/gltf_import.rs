@@ -495,6 +495,52 @@ fn materials_are_classified_with_their_extensions() {
     assert_eq!(material(&s, "rough_metal").kind, SurfaceKind::Diffuse);
 }
 
+/// `extras.specula.graded_index` (survey §6.5): a solid dielectric's index field, linear
+/// plus a radial profile; a malformed one is refused naming the material's JSON path, the
+/// member and the value.
+#[test]
+fn graded_index_from_extras() {
+    let glass = |graded: serde_json::Value| {
+        quad_doc().with_materials(json!([
+            { "name": "grin", "pbrMetallicRoughness": { "metallicFactor": 0.0, "roughnessFactor": 0.0 },
+              "extensions": { "KHR_materials_transmission": { "transmissionFactor": 1.0 }, "KHR_materials_ior": { "ior": 1.6 },
+                              "KHR_materials_volume": { "thicknessFactor": 1.0 } },
+              "extras": { "specula": { "graded_index": graded } } }
+        ]))
+    };
+    let mut doc = glass(json!({ "origin": [0.0, 1.0, 0.0], "gradient": [0.0, 0.25, 0.0], "radial": 2.0, "axis": [0.0, 0.0, 3.0] }));
+    doc.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"]);
+    let s = load_doc("graded", &doc);
+    let m = material(&s, "grin");
+    let f = m.medium().expect("a graded medium");
+    assert_eq!((f.origin, f.gradient), (Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 0.25, 0.0)));
+    // n = 1.6 + 0.25 (y − 1) − ½·2·(x² + y'²) about the z axis through the origin
+    let n = m.ior_at(glam::DVec3::new(0.5, 1.0, 7.0)).unwrap();
+    assert!((n - (1.6 - 0.25)).abs() < 1e-6, "{n}");
+    for (graded, needles) in [
+        (json!({ "gradient": [0.0, 1.0] }), &["materials[0].extras.specula.graded_index.gradient", "3 finite numbers"][..]),
+        (json!({ "hessian": [[0.0, 1.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]] }), &["graded_index.hessian", "symmetric"][..]),
+        (json!({ "slope": 1.0 }), &["graded_index.slope", "unknown member"][..]),
+        (json!({ "radial": 1.0, "axis": [0.0, 0.0, 0.0] }), &["graded_index.axis", "non-zero"][..]),
+        (json!(3.0), &["materials[0].extras.specula.graded_index", "must be an object"][..]),
+    ] {
+        let mut doc = glass(graded);
+        doc.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"]);
+        expect_error("graded_bad", &doc, needles);
+    }
+    // On a thin-walled pane there is no volume for the index to vary in.
+    let mut doc = glass(json!({ "gradient": [0.0, 1.0, 0.0] }));
+    doc.json["materials"][0]["extensions"]["KHR_materials_volume"]["thicknessFactor"] = json!(0.0);
+    doc.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"]);
+    expect_error("graded_thin", &doc, &["materials[0].extras.specula.graded_index", "solid"]);
+    // An index that falls to zero inside its object is refused where the scene is checked.
+    let mut doc = glass(json!({ "gradient": [-10.0, 0.0, 0.0] }));
+    doc.json["extensionsUsed"] = json!(["KHR_materials_transmission", "KHR_materials_ior", "KHR_materials_volume"]);
+    let s = load_doc("graded_negative", &doc);
+    let e = s.validate().unwrap_err().to_string();
+    assert!(e.contains("graded_index") && e.contains("must stay > 0") && e.contains("grin"), "{e}");
+}
+
 #[test]
 fn base_colour_texture_from_embedded_png() {
     let img = image::RgbaImage::from_fn(2, 2, |x, y| image::Rgba([x as u8 * 200, y as u8 * 100, 7, 255]));

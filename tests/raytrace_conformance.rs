@@ -55,7 +55,7 @@ fn soup(n: usize, rng: &mut Rng) -> Vec<[Vec3; 3]> {
 }
 
 fn query(o: Vec3, d: Vec3, t_min: f32, t_max: f32, skip: u32, flags: u32) -> GpuRayQuery {
-    GpuRayQuery { origin: o.extend(t_min).to_array(), direction: d.extend(t_max).to_array(), skip, flags, pad: [0; 2] }
+    GpuRayQuery { origin: o.extend(t_min).to_array(), direction: d.extend(t_max).to_array(), skip, flags, medium: 0, before: 0 }
 }
 
 /// Random rays (i mod 4 = 0), rays aimed at corners (1), edge midpoints (2) and centroids

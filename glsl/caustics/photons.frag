@@ -57,11 +57,43 @@ float photon_ior(Material m) {
 // Specular surfaces a photon passes after its generator before it is given up.
 const uint EXACT_BOUNCES = 8u;
 
-// The shading normal and material at hit h of a ray along d.
-void exact_surface(RayHit h, vec3 d, out vec3 n, out Material m) {
+// The shading normal and material (and its index) at hit h of a ray along d.
+void exact_surface(RayHit h, vec3 d, out vec3 n, out Material m, out uint material) {
     RqSurface s = rq_surface(h, d);
     n = s.n;
+    material = s.material;
     m = materials[s.material];
+}
+
+// Graded media (survey §6.5): a photon inside one follows the curved path that the ray
+// tracers' rays do (common/medium_march.glsl through ray queries).
+RayHit rq_chord(vec3 o, vec3 d, float t_min, float t_max, uint skip) {
+    return rq_trace(o, d, t_min, t_max, skip, false);
+}
+#define MEDIUM_TRACE rq_chord
+#include "common/medium_march.glsl"
+
+// The next surface a photon meets leaving pos along dir (off triangle skip): straight, or
+// curved through the graded medium `medium` (its material + 1; 0: none), pos and dir then
+// the last chord's. `len`: the path's length (absorption); no hit where it escapes or is lost.
+RayHit photon_next(inout vec3 pos, inout vec3 dir, uint skip, uint medium, out float len) {
+    if (medium == 0u) {
+        RayHit h = rq_trace(pos, dir, caustic.ray_offset, RQ_T_MAX, skip, false);
+        len = h.t * length(dir);
+        return h;
+    }
+    MediumMarch r = medium_march(materials[medium - 1u], pos, dir, caustic.ray_offset, skip, caustic.medium_turn);
+    pos = r.origin;
+    dir = r.dir;
+    len = r.before + r.hit.t;
+    return r.lost ? RayHit(0.0, 0.0, 0.0, RAY_NO_TRIANGLE) : r.hit;
+}
+
+// The medium a photon leaving a surface of material `material` along dir runs in: the ray
+// pipeline's rule (raytrace/spawn.comp child_medium).
+uint photon_medium(uint material, Material m, vec3 n, vec3 dir, bool reflected, uint from) {
+    if (material_graded(m)) return dot(dir, n) < 0.0 ? material + 1u : 0u;
+    return reflected ? from : 0u;
 }
 #endif
 
@@ -117,6 +149,9 @@ void main() {
     vec3 w;
 #ifdef EXACT_PATHS
     uint skip = RAY_NO_TRIANGLE;
+    // The graded medium the photon runs in (material + 1; 0: none): the generator's when it
+    // is one and the photon enters it.
+    uint medium = 0u;
     if (m.kind == KIND_MIRROR || branch == 1u) {
         dir = s.r;
         w = s.fr;
@@ -128,36 +163,43 @@ void main() {
         if (all(lessThanEqual(s.ft, vec3(0.0)))) return;
         w = s.ft;
         dir = photon_refraction(m, s, w);
+        medium = material_graded(m) ? o.material + 1u : 0u;
         uint reflections = branch == 0u ? 0u : branch - 1u;
         for (uint k = 0u; k <= reflections; ++k) {
-            RayHit h = rq_trace(pos, dir, offset, RQ_T_MAX, skip, false);
+            float len;
+            RayHit h = photon_next(pos, dir, skip, medium, len);
             if (h.triangle == RAY_NO_TRIANGLE) return;  // an open object: no exit surface
             vec3 n2;
             Material m2;
-            exact_surface(h, dir, n2, m2);
-            w *= segment_transmittance(m2, n2, dir, h.t * length(dir));  // absorbed inside
+            uint mi;
+            exact_surface(h, dir, n2, m2, mi);
+            w *= segment_transmittance(m2, n2, dir, len);  // absorbed inside
             pos += dir * h.t;
             skip = h.triangle;
             SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
             if (k < reflections) {
                 dir = s2.r;
                 w *= s2.fr;
+                medium = photon_medium(mi, m2, n2, dir, true, medium);
             } else {
                 if (all(lessThanEqual(s2.ft, vec3(0.0)))) return;  // totally reflected: another branch's
                 w *= s2.ft;
                 dir = photon_refraction(m2, s2, w);
+                medium = photon_medium(mi, m2, n2, dir, false, medium);
             }
         }
     }
     // On to the first diffuse surface, through every specular one on the way.
     for (uint bounce = 0u; bounce <= EXACT_BOUNCES; ++bounce) {
         if (all(lessThan(w, vec3(1e-6)))) return;
-        RayHit h = rq_trace(pos, dir, offset, RQ_T_MAX, skip, false);
+        float len;
+        RayHit h = photon_next(pos, dir, skip, medium, len);
         if (h.triangle == RAY_NO_TRIANGLE) return;  // escaped
         vec3 n2;
         Material m2;
-        exact_surface(h, dir, n2, m2);
-        w *= segment_transmittance(m2, n2, dir, h.t * length(dir));  // absorbed inside a solid
+        uint mi;
+        exact_surface(h, dir, n2, m2, mi);
+        w *= segment_transmittance(m2, n2, dir, len);  // absorbed inside a solid
         pos += dir * h.t;
         skip = h.triangle;
         if (m2.kind == KIND_DIFFUSE) {
@@ -169,9 +211,11 @@ void main() {
         if (m2.kind != KIND_MIRROR && any(greaterThan(s2.ft * w, vec3(0.0)))) {
             w *= s2.ft;
             dir = photon_refraction(m2, s2, w);
+            medium = photon_medium(mi, m2, n2, dir, false, medium);
         } else {
             dir = s2.r;
             w *= s2.fr;
+            medium = photon_medium(mi, m2, n2, dir, true, medium);
         }
     }
     return;

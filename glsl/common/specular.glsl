@@ -4,6 +4,7 @@
 #ifndef SPECULAR_GLSL
 #define SPECULAR_GLSL
 #include "common/shading.glsl"
+#include "common/medium.glsl"
 
 struct SpecularSplit {
     vec3 r;    // reflected direction
@@ -47,7 +48,7 @@ SpecularSplit specular_split(Material m, vec3 p, vec3 n, vec3 eye) {
         s.fr = material_fresnel(m, cos_i, 1.0);
         return s;
     }
-    float ior = material_ior(m);
+    float ior = material_ior_at(m, p);  // a graded medium's index where the ray meets it
     if (m.thin != 0u) {
         // Thin-walled: the two interfaces are parallel, the ray leaves undeviated.
         s.fr = material_fresnel(m, cos_i, ior);

@@ -24,6 +24,7 @@ void main() {
     vec3 d = normalize(q.direction.xyz);
     bool count_only = push.object == BUDGET_COUNT || push.object == BUDGET_SUB;
     if (push.object == BUDGET_SUB && shadow_budget.cutoff == SPAWN_BINS) return;  // nothing cut
+    if ((q.flags & RAY_LOST) != 0u) return;  // given up inside a graded medium: black
     if (h.triangle == RAY_NO_TRIANGLE) {
         if (!count_only) accumulate(pl.pixel, w * sky_radiance(d));
         return;

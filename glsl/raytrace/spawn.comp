@@ -11,11 +11,23 @@
 layout(local_size_x = 64) in;
 #include "raytrace/trace.glsl"
 
-void child(vec3 o, vec3 d, uint skip, vec3 w, uint pixel) {
+// `medium`: the graded medium the child runs in (its material + 1; 0: none).
+void child(vec3 o, vec3 d, uint skip, vec3 w, uint pixel, uint medium) {
     if (max(max(w.x, w.y), w.z) < MIN_PATH_WEIGHT) return;
     if (budget_admit(0u, push.object, w, pixel, d)) {
-        push_ray(make_query(o, d, trace.t_min, 1.0 / 0.0, skip, 0u), make_payload(w, pixel));
+        RayQuery q = make_query(o, d, trace.t_min, 1.0 / 0.0, skip, 0u);
+        q.medium = medium;
+        push_ray(q, make_payload(w, pixel));
     }
+}
+
+// The graded medium (survey §6.5) a child leaving surface material `material` (outward
+// normal n) along `dir` runs in, as the reference's Tracer::child_medium: inside a graded
+// material's object, that material; off any other surface a reflected child stays in the
+// medium it came from, a refracted one leaves it.
+uint child_medium(uint material, Material m, vec3 n, vec3 dir, bool reflected, uint from) {
+    if (material_graded(m)) return dot(dir, n) < 0.0 ? material + 1u : 0u;
+    return reflected ? from : 0u;
 }
 
 void main() {
@@ -23,23 +35,28 @@ void main() {
     if (i >= min(ray_count, trace.capacity) || trace.last != 0u) return;
     if (push.object == BUDGET_SUB && spawn_budget.cutoff == SPAWN_BINS) return;  // nothing cut
     RayHit h = hits[i];
-    if (h.triangle == RAY_NO_TRIANGLE) return;
+    if (h.triangle == RAY_NO_TRIANGLE || (queries[i].flags & RAY_LOST) != 0u) return;
     Surface s = hit_surface(h);
     Material m = materials[s.material];
     if (m.kind == KIND_DIFFUSE) return;
     RayPayload pl = payloads[i];
-    vec3 d = normalize(queries[i].direction.xyz);
+    RayQuery q = queries[i];
+    vec3 d = normalize(q.direction.xyz);
     SpecularSplit sp = specular_split(m, s.p, s.n, s.p - d);
-    // A ray that ran inside an absorbing solid to this hit (Beer–Lambert over its length).
-    vec3 w = pl.weight.rgb * segment_transmittance(m, s.n, d, h.t * length(queries[i].direction.xyz));
-    child(s.p, normalize(sp.r), h.triangle, w * sp.fr, pl.pixel);
+    // A ray that ran inside an absorbing solid to this hit (Beer–Lambert over its length,
+    // a curved ray's chords before its last included).
+    float len = h.t * length(q.direction.xyz) + (q.medium != 0u ? uintBitsToFloat(q.before) : 0.0);
+    vec3 w = pl.weight.rgb * segment_transmittance(m, s.n, d, len);
+    vec3 r = normalize(sp.r);
+    child(s.p, r, h.triangle, w * sp.fr, pl.pixel, child_medium(s.material, m, s.n, r, true, q.medium));
     if (!material_disperses(m)) {
-        child(s.p, normalize(sp.t), h.triangle, w * sp.ft, pl.pixel);
+        vec3 t = normalize(sp.t);
+        child(s.p, t, h.triangle, w * sp.ft, pl.pixel, child_medium(s.material, m, s.n, t, false, q.medium));
     } else {
         // KHR_materials_dispersion: a child per channel along its own refraction, carrying
         // that channel alone (a ray that carries one channel spawns one).
         for (int k = 0; k < 3; ++k) {
-            child(s.p, normalize(sp.tc[k]), h.triangle, w * sp.ft * channel_mask(k), pl.pixel);
+            child(s.p, normalize(sp.tc[k]), h.triangle, w * sp.ft * channel_mask(k), pl.pixel, 0u);
         }
     }
 }

@@ -122,7 +122,7 @@ bool budget_admit(uint which, uint mode, vec3 w, uint pixel, vec3 d) {
 }
 
 RayQuery make_query(vec3 o, vec3 d, float t_min, float t_max, uint skip, uint flags) {
-    return RayQuery(vec4(o, t_min), vec4(d, t_max), skip, flags, uint[2](0u, 0u));
+    return RayQuery(vec4(o, t_min), vec4(d, t_max), skip, flags, 0u, 0u);
 }
 
 RayPayload make_payload(vec3 weight, uint pixel) {

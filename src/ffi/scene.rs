@@ -40,10 +40,19 @@ pub unsafe extern "C" fn specula_context_add_material(
     })
 }
 
-/// A material descriptor of any released size, and whether it carries the volume fields.
-pub(super) unsafe fn material_desc(desc: *const SpeculaMaterialDesc) -> FfiResult<(SpeculaMaterialDesc, bool)> {
+/// A material descriptor of any released size, and which of the later fields it carries.
+pub(super) unsafe fn material_desc(desc: *const SpeculaMaterialDesc) -> FfiResult<(SpeculaMaterialDesc, MaterialFields)> {
     let (d, size) = header_grown(desc, SPECULA_STRUCT_MATERIAL_DESC, "material", MATERIAL_DESC_SIZE_V1)?;
-    Ok((d, size >= std::mem::size_of::<SpeculaMaterialDesc>()))
+    Ok((d, MaterialFields { volume: size >= MATERIAL_DESC_SIZE_V2, graded: size >= std::mem::size_of::<SpeculaMaterialDesc>() }))
+}
+
+/// Which fields added after the first release a material descriptor carries.
+#[derive(Clone, Copy)]
+pub(super) struct MaterialFields {
+    /// attenuation and dispersion
+    pub volume: bool,
+    /// the graded index
+    pub graded: bool,
 }
 
 /// The material a descriptor describes (validated by the scene's setters).
@@ -78,6 +87,14 @@ pub(super) fn material_from_desc(d: &SpeculaMaterialDesc, name: String) -> FfiRe
         kind,
         absorption,
         dispersion: d.dispersion,
+        graded: (d.graded != 0).then(|| {
+            let h = d.index_hessian;
+            crate::scene::medium::GradedIndex {
+                origin: vec3(d.index_origin),
+                gradient: vec3(d.index_gradient),
+                hessian: [Vec3::new(h[0], h[3], h[4]), Vec3::new(h[3], h[1], h[5]), Vec3::new(h[4], h[5], h[2])],
+            }
+        }),
         ..Default::default()
     })
 }

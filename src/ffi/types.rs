@@ -248,10 +248,23 @@ pub struct SpeculaMaterialDesc {
     /// Solid dielectric (KHR_materials_dispersion): 20 / Abbe number (≥ 0); 0: none. Also
     /// added after the first release (zero for a caller whose `size` ends before it).
     pub dispersion: f32,
+    /// Solid dielectric (survey §6.5): non-zero for an index that varies in space, the field
+    /// n(x) = ior + g·(x − o) + ½ (x − o)ᵀ H (x − o) in world space (`ior` its value at the
+    /// origin o); rays inside it curve, traced by the ray tracers. Added after the volume
+    /// fields (a caller whose `size` ends before it gets a uniform index).
+    pub graded: u32,
+    /// The field's origin o [m].
+    pub index_origin: [f32; 3],
+    /// Its gradient g at the origin [1/m].
+    pub index_gradient: [f32; 3],
+    /// Its symmetric Hessian H [1/m²]: xx, yy, zz, xy, xz, yz.
+    pub index_hessian: [f32; 6],
 }
 
 /// `sizeof(SpeculaMaterialDesc)` as first released (up to `thin`): still accepted.
 pub const MATERIAL_DESC_SIZE_V1: usize = std::mem::offset_of!(SpeculaMaterialDesc, attenuation_color);
+/// Its size with the volume fields (up to `dispersion`): still accepted.
+pub const MATERIAL_DESC_SIZE_V2: usize = std::mem::offset_of!(SpeculaMaterialDesc, graded);
 
 /// A triangle mesh. Arrays are read during the call only (the library copies them).
 #[repr(C)]

@@ -92,14 +92,16 @@ pub unsafe extern "C" fn specula_context_set_material(
     desc: *const SpeculaMaterialDesc,
 ) -> SpeculaResult {
     with_ctx(ctx, |c| {
-        let (d, volume) = material_desc(desc)?;
+        let (d, fields) = material_desc(desc)?;
         let i = self::index(index, c.scene.materials.len(), "material")?;
         let old = c.scene.materials[i].clone();
         let d = material_from_desc(&d, old.name.clone())?;
         // What the descriptor does not carry (textures, KHR_materials_specular; the
         // absorption from a descriptor of the first release's size) stays.
-        let (absorption, dispersion) = if volume { (d.absorption, d.dispersion) } else { (old.absorption, old.dispersion) };
-        let m = crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, absorption, dispersion, ..old };
+        let (absorption, dispersion) = if fields.volume { (d.absorption, d.dispersion) } else { (old.absorption, old.dispersion) };
+        let graded = if fields.graded { d.graded } else { old.graded };
+        let m =
+            crate::scene::Material { base_color: d.base_color, emissive: d.emissive, kind: d.kind, absorption, dispersion, graded, ..old };
         apply(c, |s| &mut s.materials[i], |s| s.set_material(i, m))
     })
 }

@@ -14,6 +14,10 @@ knobs! {
         /// and planar-refraction (mirrors in mirrors, a face's refraction in, internal reflections, refraction out): paths still
         /// specular after R bounces end black; the default is converged for glass
         depth: u32 = 16, count(1..=64, "bounces");
+        /// graded media (survey §6.5: a dielectric whose index varies, `extras.specula.graded_index`): the most a ray turns in one
+        /// RK4 step of the ray equation through it, in the ray tracers and caustic_paths=exact's photons (the chords between steps
+        /// are what is intersected: smaller is more exact and slower); the CPU reference steps by 0.002
+        medium_turn: f32 = 0.05, real(0.001..=0.5, "radians");
         /// anti-aliasing of every GPU method's camera passes: multisampling with 2, 4 or 8 samples per pixel at the device's
         /// standard positions (ray-tracing methods trace one ray per sample; the counts a device offers vary: lavapipe has 4 only),
         /// or supersampling on a regular 2×2 (ssaa2) or 4×4 (ssaa4) grid per pixel; resolved by averaging on the GPU

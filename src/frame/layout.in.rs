@@ -49,6 +49,15 @@ gpu_structs! {
         /// rgb: a solid dielectric's absorption coefficient σ [1/m] (KHR_materials_volume,
         /// Beer–Lambert inside); zero elsewhere. a: unused
         absorption: vec4,
+        /// A solid dielectric whose index varies (survey §6.5, src/scene/medium.rs): xyz the
+        /// field's origin, w 1 (0: a uniform index, the rest unused)
+        medium_origin: vec4,
+        /// xyz the field's gradient at the origin [1/m], w ‖H‖ (Frobenius)
+        medium_gradient: vec4,
+        /// the Hessian H [1/m²]: xx, yy, zz, xy
+        medium_hessian: vec4,
+        /// xz, yz; zw unused
+        medium_hessian2: vec4,
     }
 
     /// std430 twin of `Object`: one mesh as the passes see it.

@@ -85,9 +85,20 @@ impl Method {
         self.serves.contains(&class)
     }
 
-    /// Whether it can serve this object: its class and its shape.
+    /// Whether it can serve this object: its class and its shape, and for a graded-index
+    /// medium whether its rays curve.
     pub fn fits(self, f: &ObjectFacts) -> bool {
-        self.can_serve(f.class) && self.shape.fits(f)
+        self.can_serve(f.class) && self.shape.fits(f) && (!f.graded || self.traces_curved_rays())
+    }
+
+    /// Whether its rays curve through graded media (`Family::curved_rays`).
+    pub fn traces_curved_rays(self) -> bool {
+        FAMILIES.iter().any(|f| f.curved_rays.contains(&self))
+    }
+
+    /// The methods that trace curved rays, by name (the planner's refusals list them).
+    pub fn curved_ray_tracers() -> Vec<&'static str> {
+        ALL.iter().filter(|m| m.traces_curved_rays()).map(|m| m.name()).collect()
     }
 
     pub fn parse(s: &str) -> Result<Method> {

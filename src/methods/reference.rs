@@ -5,8 +5,13 @@
 use crate::quality::{CausticsKnobs, FrameKnobs, ReferenceKnobs};
 
 /// The reference as the registry's last family: one CPU method, no hooks.
-pub const FAMILY: super::registry::Family =
-    super::registry::Family { name: "reference", methods: &[REFERENCE_INFO], ..super::registry::Family::NONE };
+pub const FAMILY: super::registry::Family = super::registry::Family {
+    name: "reference",
+    methods: &[REFERENCE_INFO],
+    // Its rays curve through graded media (scene::medium, at its own fine turn).
+    curved_rays: &[REFERENCE],
+    ..super::registry::Family::NONE
+};
 
 /// The exact CPU reference as a registered method: it has no GPU passes (`Renderer::new`
 /// refuses its plan); `crate::reference::render_reference` renders it.

@@ -196,6 +196,10 @@ pub struct Family {
     /// reflectors: their environment's specular objects), so that composition gives those
     /// objects maps as it does beside a distance-mapped object.
     pub shows_others_by_maps: &'static [Method],
+    /// Its methods that trace rays curved through graded media (survey §6.5: the ray
+    /// equation marched through the medium, `scene::medium`): the only ones that serve a
+    /// graded-index object.
+    pub curved_rays: &'static [Method],
     /// Fills its words of the push block (`push_words!` in its `layout.in.rs`), once a frame
     /// (from the knobs, and the view table's layout where a word names a view).
     pub push_words: Option<fn(&Quality, &crate::frame::stage::ViewLayout, &mut crate::frame::words::PushWords)>,
@@ -228,6 +232,7 @@ impl Family {
         push_words: None,
         composes: None,
         shows_others_by_maps: &[],
+        curved_rays: &[],
         describe: None,
         frame_part: None,
     };

@@ -20,6 +20,9 @@ use crate::scene::{Mesh, Scene};
 pub struct ObjectFacts {
     pub mesh: usize,
     pub class: ObjectClass,
+    /// A solid dielectric whose index varies in space (survey §6.5): its rays curve, which
+    /// only the methods of `Family::curved_rays` trace.
+    pub graded: bool,
     /// All vertices within 1e-4 of the object's size of one plane, normals agreeing.
     pub planar: bool,
     /// A closed convex solid of at most `faces::MAX_FACES` flat faces (each face's vertex
@@ -627,6 +630,7 @@ impl SceneFacts {
                     reference_point,
                     reference_note,
                     triangles: m.triangle_count(),
+                    graded: scene.materials[m.material].medium().is_some(),
                 })
             })
             .collect::<Vec<ObjectFacts>>();

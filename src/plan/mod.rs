@@ -294,8 +294,14 @@ fn choose(
 ) -> Result<(Method, String)> {
     let mesh = &scene.meshes[facts.mesh];
     let class = facts.class;
+    let curved = || format!("only {} trace them", Method::curved_ray_tracers().join(", "));
     let check = |m: Method, source: &str| -> Result<(Method, String)> {
-        if m.can_serve(class) && !m.shape.fits(facts) {
+        if facts.graded && !m.traces_curved_rays() {
+            Err(Error::invalid(
+                format!("object '{}'", mesh.name),
+                format!("method '{}' cannot serve a graded-index medium, whose rays curve (survey §6.5): {}", m.name, curved()),
+            ))
+        } else if m.can_serve(class) && !m.shape.fits(facts) {
             Err(Error::invalid(format!("object '{}'", mesh.name), format!("method '{}' serves {}", m.name, m.shape.requirement())))
         } else if m.can_serve(class) {
             Ok((m, format!("{source}: {}", m.name)))
@@ -314,6 +320,13 @@ fn choose(
         if m.fits(facts) {
             return Ok((m, format!("--method {}", m.name)));
         }
+        if facts.graded && !m.traces_curved_rays() {
+            let f = crate::methods::BVH;
+            return Ok((
+                f,
+                format!("--method {} does not trace the curved rays of a graded-index medium (survey §6.5): {}", m.name, f.name),
+            ));
+        }
         if let Some(f) = m.fallback.filter(|f| f.fits(facts)) {
             let what = if m.can_serve(class) { format!("{} {}", m.shape.misfit(), class.label()) } else { format!("a {}", class.label()) };
             return Ok((f, format!("--method {} does not serve {what}: its fallback {}", m.name, f.name)));
@@ -329,6 +342,12 @@ fn choose(
         _ => a.choices.objects.iter().find(|(n, _)| names_object(scene, facts.mesh, n)).map(|(_, m)| (a, *m)),
     });
     match picked {
+        // The measured choice among methods whose rays stay straight: a graded medium gets
+        // the exact tracer (the ray pipeline marches its curved rays).
+        Some((_, m)) if facts.graded && !m.traces_curved_rays() => Ok((
+            crate::methods::BVH,
+            format!("auto: a graded-index medium's rays curve (survey §6.5), which {} does not trace: bvh", m.name),
+        )),
         Some((a, m)) => Ok((m, a.reason(&mesh.name, m))),
         // No prediction covers the object (no stored models): the exact tracer serves every
         // class.

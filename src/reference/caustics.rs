@@ -43,7 +43,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::shade::{self, ShadeLight};
-use super::{hash, Tracer};
+use super::{hash, Next, Ray, Tracer};
 use crate::error::{Error, Result};
 use crate::quality::Quality;
 use crate::scene::{LightKind, SurfaceKind};
@@ -257,6 +257,8 @@ impl Tracer<'_> {
         }
         let mut power = DVec3::ZERO;
         let mut bounces = 0;
+        let mut len = hit.t;
+        let mut medium = None;
         loop {
             let s = self.surface(&hit);
             if bounces == 0 {
@@ -268,7 +270,7 @@ impl Tracer<'_> {
                 }
             }
             let m = &self.scene.materials[s.material];
-            power *= shade::segment_transmittance(m, s.normal, d, hit.t); // absorbed inside a solid
+            power *= shade::segment_transmittance(m, s.normal, d, len); // absorbed inside a solid
             if m.kind == SurfaceKind::Diffuse {
                 let normal = if s.normal.dot(d) > 0.0 { -s.normal } else { s.normal };
                 return Some(Photon { position: s.position, normal, power, bounces });
@@ -276,7 +278,7 @@ impl Tracer<'_> {
             if bounces == self.depth {
                 return None;
             }
-            let split = shade::specular_split(m, self.fresnel, d, s.normal);
+            let split = shade::specular_split_at(m, self.fresnel, d, s.normal, s.position);
             let mean = |f: DVec3| f.element_sum() / 3.0;
             let (pr, pt) = (mean(split.fr), mean(split.ft));
             if pr + pt <= 0.0 || (pr + pt).is_nan() {
@@ -302,7 +304,13 @@ impl Tracer<'_> {
             }
             d = dir.normalize();
             bounces += 1;
-            hit = self.bvh.intersect(s.position, d, self.epsilon, f64::INFINITY, Some(hit.triangle))?;
+            // Through a graded medium along the curved path, as the camera's rays.
+            medium = self.child_medium(s.material, s.normal, d, reflected, medium);
+            let ray = Ray { o: s.position, d, t_min: self.epsilon, skip: Some(hit.triangle), medium };
+            (hit, d, len) = match self.next(&ray) {
+                Next::Hit(h, d, len) => (h, d, len),
+                Next::Sky(_) | Next::Lost => return None,
+            };
         }
     }
 }

@@ -33,7 +33,7 @@ use rayon::prelude::*;
 use crate::error::{Error, Result};
 use crate::image::ImageData;
 use crate::quality::{Caustics, FresnelMode, Quality};
-use crate::scene::{Camera, Scene, SurfaceKind};
+use crate::scene::{medium, Camera, Scene, SurfaceKind};
 use bvh::{Bvh, Hit};
 use caustics::PhotonMap;
 use shade::{ShadeLight, Sky, Textures};
@@ -177,7 +177,7 @@ impl<'a> Tracer<'a> {
     /// Radiance arriving at `o` from direction `-d` (d a unit vector): what the ray
     /// o + t d, t > t_min, sees, with `bounces` specular bounces left.
     pub fn radiance(&self, o: DVec3, d: DVec3, t_min: f64, bounces: u32) -> DVec3 {
-        self.trace(Ray { o, d, t_min, skip: None }, bounces, DVec3::ONE, None)
+        self.trace(Ray { o, d, t_min, skip: None, medium: None }, bounces, DVec3::ONE, None)
     }
 
     /// The mesh the ray o + t d, t > t_min, meets first (`None`: the sky).
@@ -200,7 +200,7 @@ impl<'a> Tracer<'a> {
         if m.kind == SurfaceKind::Diffuse {
             return None;
         }
-        let split = shade::specular_split(m, self.fresnel, d, surface.normal);
+        let split = shade::specular_split_at(m, self.fresnel, d, surface.normal, surface.position);
         let mesh = self.bvh.triangles[hit.triangle as usize].mesh;
         Some(SpecularHit { mesh, position: surface.position, material: surface.material, split })
     }
@@ -236,7 +236,9 @@ impl<'a> Tracer<'a> {
     /// one bounce fewer than the camera's.
     pub fn seen_without(&self, c: DVec3, d: DVec3, exclude: u32) -> DVec3 {
         match self.past(c, d, exclude) {
-            Some((_, t_min)) => self.trace(Ray { o: c, d, t_min, skip: None }, self.depth.saturating_sub(1), DVec3::ONE, None),
+            Some((_, t_min)) => {
+                self.trace(Ray { o: c, d, t_min, skip: None, medium: None }, self.depth.saturating_sub(1), DVec3::ONE, None)
+            }
             None => self.sky.radiance(d),
         }
     }
@@ -257,13 +259,55 @@ impl<'a> Tracer<'a> {
 
     /// `radiance`, recording the path's diffuse hits in `sink` for progressive photon
     /// mapping instead of adding a photon map's estimate there.
+    /// The surface `ray` meets next: straight, or along the curved path of the graded
+    /// medium it runs in (`scene::medium::GradedIndex::march`, at `REFERENCE_TURN`).
+    fn next(&self, ray: &Ray) -> Next {
+        let Ray { o, d, t_min, skip, medium } = *ray;
+        let straight = |o, d, t_min, t_max, skip| self.bvh.intersect(o, d, t_min, t_max, skip);
+        let Some((m, f)) = medium.and_then(|i| self.scene.materials[i].medium().map(|f| (&self.scene.materials[i], f))) else {
+            return match straight(o, d, t_min, f64::INFINITY, skip) {
+                Some(h) => Next::Hit(h, d, h.t),
+                None => Next::Sky(d),
+            };
+        };
+        let SurfaceKind::Dielectric { ior, .. } = m.kind else { return Next::Lost };
+        let march = f.march(ior as f64, o, d, medium::REFERENCE_TURN, medium::REFERENCE_REFINE, |p, dir, t_max, first| {
+            if first {
+                straight(p, dir, t_min, t_max, skip)
+            } else {
+                straight(p, dir, 0.0, t_max, None)
+            }
+        });
+        match march {
+            None => Next::Lost,
+            Some(medium::March { hit: Some(h), dir, before, .. }) => Next::Hit(h, dir, before + h.t),
+            Some(medium::March { hit: None, dir, .. }) => Next::Sky(dir),
+        }
+    }
+
+    /// The medium a child ray leaving a surface of material `material` (normal `n`, the
+    /// mesh's outward one) along `dir` runs in: inside a graded material's object it runs in
+    /// that material; off any other surface a reflected child stays in the medium it came
+    /// from (`from`) and a refracted one leaves it (a dielectric nested in a graded medium:
+    /// its rays straight).
+    fn child_medium(&self, material: usize, n: DVec3, dir: DVec3, reflected: bool, from: Option<usize>) -> Option<usize> {
+        if self.scene.materials[material].medium().is_some() {
+            (dir.dot(n) < 0.0).then_some(material)
+        } else if reflected {
+            from
+        } else {
+            None
+        }
+    }
+
     fn trace(&self, ray: Ray, bounces: u32, weight: DVec3, mut sink: Option<&mut HitSink>) -> DVec3 {
-        let Ray { o, d, t_min, skip } = ray;
-        if !d.is_finite() || !o.is_finite() {
+        if !ray.d.is_finite() || !ray.o.is_finite() {
             return DVec3::ZERO; // never a NaN colour
         }
-        let Some(hit) = self.bvh.intersect(o, d, t_min, f64::INFINITY, skip) else {
-            return self.sky.radiance(d);
+        let (hit, d, len) = match self.next(&ray) {
+            Next::Hit(h, d, len) => (h, d, len),
+            Next::Sky(d) => return self.sky.radiance(d),
+            Next::Lost => return DVec3::ZERO,
         };
         let surface = self.surface(&hit);
         let m = &self.scene.materials[surface.material];
@@ -274,8 +318,8 @@ impl<'a> Tracer<'a> {
             return DVec3::ZERO;
         }
         // Absorbed on the way here when the ray ran inside a solid (KHR_materials_volume).
-        let absorbed = shade::segment_transmittance(m, surface.normal, d, hit.t);
-        let split = shade::specular_split(m, self.fresnel, d, surface.normal);
+        let absorbed = shade::segment_transmittance(m, surface.normal, d, len);
+        let split = shade::specular_split_at(m, self.fresnel, d, surface.normal, surface.position);
         // Under dispersion a refracted branch per channel, carrying that channel alone.
         let mask = |k: usize| DVec3::from_array(std::array::from_fn(|j| (j == k) as u32 as f64));
         let refracted: [(DVec3, DVec3); 3] = if m.disperses() {
@@ -284,10 +328,11 @@ impl<'a> Tracer<'a> {
             [(split.t, split.ft * absorbed), (split.t, DVec3::ZERO), (split.t, DVec3::ZERO)]
         };
         let mut c = DVec3::ZERO;
-        for (dir, f) in std::iter::once((split.r, split.fr * absorbed)).chain(refracted) {
+        for (k, (dir, f)) in std::iter::once((split.r, split.fr * absorbed)).chain(refracted).enumerate() {
             let w = weight * f;
             if w.max_element() >= MIN_PATH_WEIGHT {
-                let next = Ray { o: surface.position, d: dir.normalize(), t_min: self.epsilon, skip: Some(hit.triangle) };
+                let medium = self.child_medium(surface.material, surface.normal, dir, k == 0, ray.medium);
+                let next = Ray { o: surface.position, d: dir.normalize(), t_min: self.epsilon, skip: Some(hit.triangle), medium };
                 c += f * self.trace(next, bounces - 1, w, sink.as_deref_mut());
             }
         }
@@ -362,6 +407,19 @@ struct Ray {
     d: DVec3,
     t_min: f64,
     skip: Option<u32>,
+    /// The graded medium (a material index) the ray runs in, its path curving
+    /// (`scene::medium`); `None`: straight.
+    medium: Option<usize>,
+}
+
+/// What a ray meets next ([`Tracer::next`]).
+enum Next {
+    /// A surface: the hit, the (unit) direction the ray meets it along, the path length.
+    Hit(Hit, DVec3, f64),
+    /// Nothing: the sky along this direction.
+    Sky(DVec3),
+    /// Given up inside a graded medium (`scene::medium::max_steps` chords).
+    Lost,
 }
 
 /// Where a camera sample's diffuse hits go (progressive photon mapping): its pixel and the
@@ -406,7 +464,7 @@ pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32,
                 let (o, d, t_min) = rays.ray(x as f64 + jx, y as f64 + jy);
                 let mut sink = HitSink { points: &mut *points, pixel: y * width + x, scale: 1.0 / spp as f64 };
                 let sink = tracer.progressive.then_some(&mut sink);
-                c += tracer.trace(Ray { o, d, t_min, skip: None }, tracer.depth, DVec3::ONE, sink);
+                c += tracer.trace(Ray { o, d, t_min, skip: None, medium: None }, tracer.depth, DVec3::ONE, sink);
             }
             c /= spp as f64;
             let px = &mut row[4 * x as usize..4 * x as usize + 4];

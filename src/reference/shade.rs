@@ -210,6 +210,23 @@ pub struct SpecularSplit {
 /// dielectrics let the ray pass undeviated, weighted 1 − F; dispersive ones refract each
 /// channel with its own index (`Material::channel_iors`, rounded to f32 as the GPU's).
 pub fn specular_split(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3) -> SpecularSplit {
+    let ior = match m.kind {
+        SurfaceKind::Dielectric { ior, .. } => ior as f64,
+        _ => 1.0,
+    };
+    split_with_ior(m, mode, i, n, ior)
+}
+
+/// `specular_split` at the surface point `p`: a graded medium's surface refracts with the
+/// field's index there (`Material::ior_at`).
+pub fn specular_split_at(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3, p: DVec3) -> SpecularSplit {
+    match m.medium().and(m.ior_at(p)) {
+        Some(ior) => split_with_ior(m, mode, i, n, ior),
+        None => specular_split(m, mode, i, n),
+    }
+}
+
+fn split_with_ior(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3, ior: f64) -> SpecularSplit {
     let mut n = n;
     let mut cos_i = -n.dot(i);
     let entering = cos_i >= 0.0;
@@ -219,8 +236,7 @@ pub fn specular_split(m: &Material, mode: FresnelMode, i: DVec3, n: DVec3) -> Sp
     }
     let r = reflect_dir(i, n);
     match m.kind {
-        SurfaceKind::Dielectric { ior, thin } => {
-            let ior = ior as f64;
+        SurfaceKind::Dielectric { thin, .. } => {
             if thin {
                 let fr = material_fresnel(m, mode, cos_i, ior);
                 return SpecularSplit { r, t: i, fr, ft: DVec3::ONE - fr, tc: [i; 3] };

@@ -12,6 +12,7 @@ mod environment;
 pub mod faces;
 mod fingerprint;
 pub mod gltf;
+pub mod medium;
 pub mod shapes;
 pub mod update;
 
@@ -75,6 +76,9 @@ pub struct Material {
     /// index `ior` is then the d line's and each RGB channel refracts with its own
     /// ([`Material::channel_iors`]); 0: none.
     pub dispersion: f32,
+    /// A solid dielectric whose index varies in space (survey §6.5; [`medium::GradedIndex`]:
+    /// `ior` is its value at the field's origin): rays inside it curve. `None`: uniform.
+    pub graded: Option<medium::GradedIndex>,
 }
 
 impl Default for Material {
@@ -90,6 +94,7 @@ impl Default for Material {
             specular_factor: 1.0,
             absorption: Vec3::ZERO,
             dispersion: 0.0,
+            graded: None,
         }
     }
 }
@@ -137,6 +142,20 @@ impl Material {
     /// Whether the channels refract differently: a solid dielectric with dispersion.
     pub fn disperses(&self) -> bool {
         matches!(self.kind, SurfaceKind::Dielectric { thin: false, ior } if ior != 1.0) && self.dispersion > 0.0
+    }
+
+    /// The index field of a solid dielectric whose index varies (`graded`), else `None`.
+    pub fn medium(&self) -> Option<&medium::GradedIndex> {
+        match self.kind {
+            SurfaceKind::Dielectric { thin: false, .. } => self.graded.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// The index at `p`: `ior`, or the graded field's value there.
+    pub fn ior_at(&self, p: glam::DVec3) -> Option<f64> {
+        let SurfaceKind::Dielectric { ior, .. } = self.kind else { return None };
+        Some(self.medium().map_or(ior as f64, |f| f.index(ior as f64, p).0))
     }
 
     /// Whether light inside the surface's volume is absorbed: a solid dielectric with σ > 0.
@@ -518,6 +537,23 @@ impl Scene {
             if let Some(i) = m.uvs.iter().position(|p| !p.is_finite()) {
                 return Err(Error::invalid(format!("{what}: uvs"), format!("vertex {i} is not finite, got {}", m.uvs[i])));
             }
+            // A graded index must stay positive inside the object (the field is sampled
+            // on a 5³ lattice over its box; beyond, it is clamped at medium::MIN_INDEX).
+            let mat = &self.materials[m.material];
+            if let (Some(f), SurfaceKind::Dielectric { ior, .. }) = (mat.medium(), mat.kind) {
+                let b = m.bounds();
+                for i in 0..125 {
+                    let t = Vec3::new((i % 5) as f32, (i / 5 % 5) as f32, (i / 25) as f32) / 4.0;
+                    let p = b.min + (b.max - b.min) * t;
+                    let raw = f.unclamped(ior as f64, p.as_dvec3());
+                    if raw.is_nan() || raw <= 0.0 {
+                        return Err(Error::invalid(
+                            format!("material '{}': graded_index", mat.name),
+                            format!("the index falls to {raw} at {p} inside object '{}' (it must stay > 0)", m.name),
+                        ));
+                    }
+                }
+            }
         }
         if let Some(e) = &self.environment {
             e.validate()?;
@@ -595,6 +631,18 @@ impl Material {
         }
         if !non_negative(self.absorption) {
             return Err(Error::invalid(what("absorption"), format!("σ must be finite and ≥ 0 per channel [1/m], got {}", self.absorption)));
+        }
+        if let Some(f) = &self.graded {
+            f.check().map_err(|(field, why)| Error::invalid(what(field), why))?;
+            if !matches!(self.kind, SurfaceKind::Dielectric { thin: false, .. }) {
+                return Err(Error::invalid(what("graded_index"), "a varying index needs a solid (not thin-walled) dielectric"));
+            }
+            if self.dispersion > 0.0 {
+                return Err(Error::invalid(
+                    what("graded_index"),
+                    format!("a varying index and dispersion ({}) together are not supported", self.dispersion),
+                ));
+            }
         }
         match self.kind {
             SurfaceKind::Dielectric { ior, .. } if !(ior > 0.0 && ior.is_finite()) => {

@@ -142,6 +142,12 @@ impl Scene {
                 format!("is {}, the update makes it {}: a change of kind needs a new plan", kind_name(&old.kind), kind_name(&m.kind)),
             ));
         }
+        if old.medium().is_some() != m.medium().is_some() {
+            return Err(Error::invalid(
+                format!("material '{}': graded_index", old.name),
+                "a varying index appearing or going away changes which methods can serve its objects (curved rays): that needs a new plan",
+            ));
+        }
         m.validate()?;
         for (field, t) in [("base_color_texture", m.base_color_texture), ("emissive_texture", m.emissive_texture)] {
             if let Some(t) = t.filter(|&t| t >= self.textures.len()) {

@@ -2,6 +2,7 @@
 //! `assets/`).
 
 pub mod corpus;
+pub mod media;
 
 use glam::Vec3;
 
@@ -50,11 +51,11 @@ pub fn flat_glass() -> Result<Scene> {
 
 /// The names [`builtin`] knows, in the order `specula` lists them.
 pub const BUILTIN: &[&str] =
-    &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball"];
+    &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball", "mirage", "grin-lens"];
 
 /// A scene built in code by its name (`builtin:NAME` on the command line): `corner-mirror`,
 /// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
-/// `caustic-ball`; `None` for another name.
+/// `caustic-ball`, `mirage`, `grin-lens`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
     if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < 10_000) {
         return Some(corpus::scene(i));
@@ -67,6 +68,8 @@ pub fn builtin(name: &str) -> Option<Result<Scene>> {
         "flat-glass" => flat_glass(),
         "convex-mirror" => convex_mirror(),
         "caustic-ball" => caustic_ball(),
+        "mirage" => media::mirage(),
+        "grin-lens" => media::grin_lens(),
         _ => return None,
     })
 }

@@ -48,7 +48,10 @@ gpu_structs! {
         /// caustic_space=screen: the camera target's size (pixels)
         screen_width: uint,
         screen_height: uint,
-        pad: [uint; 2],
+        /// caustic_paths=exact through graded media: the most a photon turns per RK4 step
+        /// [rad] (the medium_turn knob)
+        medium_turn: float,
+        pad: uint,
     }
 }
 

@@ -87,7 +87,8 @@ pub fn table(
         gather_radius: diag * q.caustics.photon_radius,
         screen_width: width,
         screen_height: height,
-        pad: [0; 2],
+        medium_turn: q.frame.medium_turn,
+        pad: 0,
     };
     let cubes = plan
         .cubes

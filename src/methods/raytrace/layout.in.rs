@@ -12,9 +12,15 @@ gpu_structs! {
         direction: vec4,
         /// the triangle the ray leaves (RAY_NO_TRIANGLE: none)
         skip: uint,
-        /// RAY_ANY_HIT: the first hit found will do (shadow rays)
+        /// RAY_ANY_HIT: the first hit found will do (shadow rays); RAY_LOST (written by the
+        /// intersection kernels): given up inside a graded medium
         flags: uint,
-        pad: [uint; 2],
+        /// The graded medium the ray runs in, its material index + 1 (0: none: straight);
+        /// its intersection then marches the curved path (common/medium.glsl) and writes the
+        /// last chord back as origin and direction
+        medium: uint,
+        /// A curved ray's path length before its last chord (float bits; written back with it)
+        before: uint,
     }
 
     /// The answer to one `RayQuery`: the nearest hit, or `triangle` = RAY_NO_TRIANGLE.
@@ -80,6 +86,10 @@ gpu_structs! {
         /// 1: the ray texture holds the queue's rays in `ray_order` (the ray hierarchy's
         /// pixel order, raytrace/sort.glsl); 0: texel t is ray t
         ordered: uint,
+        /// graded media (survey §6.5, common/medium.glsl): the most a ray turns per RK4 step
+        /// [rad] (the medium_turn knob)
+        medium_turn: float,
+        pad: [uint; 3],
     }
 
     /// One bounce's budget for a queue (raytrace/trace.glsl's budget_*): which rays the
@@ -159,6 +169,9 @@ gpu_consts! {
     /// `RayQuery.flags`: the hit is already known (a primary hit from rasterisation that the
     /// exact triangle test confirmed); the intersection kernels leave it.
     RAY_HIT_KNOWN: uint = 2;
+    /// `RayQuery.flags`: lost inside a graded medium (common/medium.glsl's ⌈MEDIUM_MAX_TURN / turn⌉
+    /// chords without a hit): it adds nothing.
+    RAY_LOST: uint = 4;
 }
 
 descriptor_sets! {
@@ -167,7 +180,8 @@ descriptor_sets! {
     /// words whose meaning is the scheme's (src/methods/raytrace/: BVH nodes, grid cells,
     /// kd-tree nodes); references index the triangle list.
     RAY_BINDINGS = set 2 {
-        RAY_QUERIES = 0: STORAGE_BUFFER => "readonly buffer RayQueries { RayQuery queries[]; }";
+        /// (written back by the intersection kernels for rays in graded media)
+        RAY_QUERIES = 0: STORAGE_BUFFER => "buffer RayQueries { RayQuery queries[]; }";
         RAY_HITS = 1: STORAGE_BUFFER => "buffer RayHits { RayHit hits[]; }";
         RAY_TRIANGLES = 2: STORAGE_BUFFER => "readonly buffer Triangles { Triangle triangles[]; }";
         ACCEL_NODES = 3: STORAGE_BUFFER => "readonly buffer AccelNodes { uvec4 accel_nodes[]; }";

@@ -132,6 +132,10 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     name: "raytrace",
     methods: &[BVH_INFO, KD_TREE_INFO, GRID_INFO, OCTREE_INFO, BIH_INFO, RAY_ENGINE_INFO, RAY_HIERARCHY_INFO, ray_query::RAY_QUERY_INFO],
     describe: Some(describe_updates),
+    // Every scheme of the compute intersection kernels marches graded media
+    // (raytrace/intersect_main.glsl); the ray engine and the ray hierarchy intersect by
+    // rasterisation and cone tiles, straight rays only.
+    curved_rays: &[BVH, KD_TREE, GRID, OCTREE, BIH, ray_query::RAY_QUERY],
     ..crate::methods::registry::Family::NONE
 };
 

@@ -484,6 +484,8 @@ impl RayTrace {
                 tiles_per_row,
                 samples: self.samples,
                 ordered: (tile > 0) as u32,
+                medium_turn: q.frame.medium_turn,
+                pad: [0; 3],
             };
             let at = (k * self.stride) as usize;
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));

@@ -399,6 +399,46 @@ impl Importer<'_> {
         Ok(s)
     }
 
+    /// `extras.specula.graded_index` of a material (survey §6.5, `scene::medium`): a solid
+    /// dielectric's index field in world space, n(x) = ior + g·(x − o) + ½ (x − o)ᵀH(x − o),
+    /// as `{"origin": [x, y, z], "gradient": [gx, gy, gz], "hessian": [[…], […], […]]}`, or a
+    /// radial profile `"radial": k` about `"axis": [ax, ay, az]` through the origin (n falls
+    /// by ½ k r² at r from the axis), which adds to the Hessian. Every member may be left out
+    /// (zero; the axis +y).
+    fn graded_index(&self, material: &gltf::Material, field: &str) -> Result<Option<crate::scene::medium::GradedIndex>> {
+        let Some(extras) = specula_extras(material.extras(), self.file, field)? else { return Ok(None) };
+        let Some(g) = extras.get("graded_index") else { return Ok(None) };
+        let at = |k: &str| format!("{field}.extras.specula.graded_index.{k}");
+        let Some(g) = g.as_object() else {
+            return Err(self.err(format!("{field}.extras.specula.graded_index"), format!("must be an object, got {g}")));
+        };
+        if let Some(k) = g.keys().find(|k| !["origin", "gradient", "hessian", "radial", "axis"].contains(&k.as_str())) {
+            return Err(self.err(at(k), "unknown member (known: origin, gradient, hessian, radial, axis)"));
+        }
+        let v3 = |k: &str, default: Vec3| g.get(k).map_or(Ok(default), |v| json_vec3(v, self.file, &at(k)));
+        let mut hessian = [Vec3::ZERO; 3];
+        if let Some(h) = g.get("hessian") {
+            let rows = h
+                .as_array()
+                .filter(|r| r.len() == 3)
+                .ok_or_else(|| self.err(at("hessian"), format!("expected 3 rows of 3 numbers, got {h}")))?;
+            for (k, r) in rows.iter().enumerate() {
+                hessian[k] = json_vec3(r, self.file, &format!("{}[{k}]", at("hessian")))?;
+            }
+        }
+        if let Some(k) = g.get("radial") {
+            let k =
+                k.as_f64().filter(|k| k.is_finite()).ok_or_else(|| self.err(at("radial"), format!("expected a finite number, got {k}")))?;
+            let axis = v3("axis", Vec3::Y)?;
+            if axis.length_squared() == 0.0 {
+                return Err(self.err(at("axis"), "must be non-zero"));
+            }
+            let r = crate::scene::medium::GradedIndex::radial_hessian(axis, k as f32);
+            hessian = [hessian[0] + r[0], hessian[1] + r[1], hessian[2] + r[2]];
+        }
+        Ok(Some(crate::scene::medium::GradedIndex { origin: v3("origin", Vec3::ZERO)?, gradient: v3("gradient", Vec3::ZERO)?, hessian }))
+    }
+
     fn import_material(&mut self, material: &gltf::Material, i: usize) -> Result<usize> {
         let field = format!("materials[{i}]");
         self.check_material_scalars(material)?;
@@ -483,6 +523,7 @@ impl Importer<'_> {
             specular_factor,
             absorption,
             dispersion,
+            graded: self.graded_index(material, &field)?,
         };
         let file = self.file;
         self.scene.add_material(m).map_err(|e| {
@@ -495,6 +536,7 @@ impl Importer<'_> {
                 Some("specular_factor") => format!("{field}.extensions.KHR_materials_specular.specularFactor"),
                 Some("absorption") => format!("{field}.extensions.KHR_materials_volume"),
                 Some("dispersion") => format!("{field}.extensions.KHR_materials_dispersion.dispersion"),
+                Some(f) if f.starts_with("graded_index") => format!("{field}.extras.specula.{f}"),
                 _ => field.clone(),
             })
         })
