@@ -444,7 +444,9 @@ fn khr_materials_specular_scales_the_reflection() {
 /// compute scheme and through ray queries. The closed-form ray paths are checked in
 /// src/scene/medium.rs's unit tests (the catenary of a linear gradient, the mirage's turning
 /// point). The curving must show: the same scenes with the index uniform (its value at the
-/// field's origin) differ from the reference by far more than the GPU does.
+/// field's origin) differ from the reference by far more than the GPU does. Measured at
+/// 64×48: mirage bvh 49.69 dB (medium_turn 0.01: 57.11), ray-query 49.69, straight 15.93;
+/// grin-lens 41.40 (54.93), 41.40, straight 12.45. Floors: 40 dB; straight under 25.
 #[test]
 fn curved_rays_through_graded_media() {
     let ctx = common::gpu();

@@ -116,6 +116,28 @@ int main(int argc, char **argv) {
     expect("message names dispersion and the value", strstr(specula_context_last_error(ctx), "dispersion") && strstr(specula_context_last_error(ctx), "-0.5") ? 0 : -1, 0,
            specula_context_last_error(ctx));
     glass.dispersion = 0.0f;
+    /* A graded index (survey §6.5): a non-symmetric Hessian cannot be stored (the struct
+       holds six entries), a NaN gradient is refused naming the field, a thin pane has no
+       volume for it; a valid field is accepted. */
+    glass.graded = 1;
+    glass.index_gradient[1] = NAN;
+    CASE("material: NaN index gradient", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    expect("message names graded_index.gradient", strstr(specula_context_last_error(ctx), "graded_index.gradient") ? 0 : -1, 0,
+           specula_context_last_error(ctx));
+    glass.index_gradient[1] = 0.2f;
+    glass.thin = 1;
+    CASE("material: graded thin pane", specula_context_add_material(ctx, &glass, NULL), SPECULA_ERROR_INVALID_ARGUMENT);
+    glass.thin = 0;
+    glass.index_hessian[3] = -0.5f; /* xy */
+    CASE("material: graded index", specula_context_add_material(ctx, &glass, NULL), SPECULA_SUCCESS);
+    /* A host built against the volume release's header (no graded fields) gets a uniform index. */
+    glass.size = (uint32_t)offsetof(SpeculaMaterialDesc, graded);
+    glass.index_gradient[1] = NAN; /* beyond its size: never read */
+    CASE("material of the volume release's size", specula_context_add_material(ctx, &glass, NULL), SPECULA_SUCCESS);
+    glass.size = sizeof glass;
+    glass.graded = 0;
+    glass.index_gradient[1] = 0.0f;
+    glass.index_hessian[3] = 0.0f;
     /* A host built against the first release's header (no volume fields) still adds glass. */
     glass.size = (uint32_t)offsetof(SpeculaMaterialDesc, attenuation_color);
     glass.attenuation_distance = -1.0f; /* beyond its size: never read */
