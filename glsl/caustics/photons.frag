@@ -173,8 +173,17 @@ void main() {
             Material m2;
             uint mi;
             exact_surface(h, dir, n2, m2, mi);
-            w *= segment_transmittance(m2, n2, dir, len);  // absorbed inside
             pos += dir * h.t;
+            if (m2.kind == KIND_DIFFUSE) {
+                // A receiver inside the generator (a pool's floor under its water, §6.4):
+                // branch 0's path ends there (T, then the floor); the others' are not theirs.
+                if (k > 0u || branch != 0u) return;
+                w *= volume_transmittance(m, len);  // absorbed in the generator on the way
+                out_hit = vec4(pos - centre, 1.0);
+                out_power = vec4(w * power, photon_direction_code(dir));
+                return;
+            }
+            w *= segment_transmittance(m2, n2, dir, len);  // absorbed inside
             skip = h.triangle;
             SpecularSplit s2 = specular_split(m2, pos, n2, pos - dir);
             if (k < reflections) {
@@ -236,8 +245,10 @@ void main() {
         w = s.ft;
         dir = photon_refraction(m, s, w);
         float ior = photon_ior(m);
-        bool out_of_it = false;
-        for (uint bounce = 0u; bounce <= push_internal_bounces(); ++bounce) {
+        // caustic_paths=surface (§6.4, water): the receivers lie inside the generator, the
+        // photon goes on from its refraction at the surface.
+        bool out_of_it = (caustic.flags & CAUSTIC_SURFACE_PATHS) != 0u;
+        for (uint bounce = 0u; !out_of_it && bounce <= push_internal_bounces(); ++bounce) {
             vec3 hit, n2;
             if (!refractor_exit(o, pos, dir, hit, n2)) {  // an open refractor: the photon is out
                 out_of_it = true;
@@ -262,6 +273,9 @@ void main() {
     vec3 x = pos - centre;
     SearchResult h = search_ray(x, dir);
     if (h.escaped) return;
+    if ((caustic.flags & CAUSTIC_SURFACE_PATHS) != 0u && m.kind == KIND_DIELECTRIC && m.thin == 0u && branch == 0u) {
+        w *= volume_transmittance(m, h.d * length(dir));  // absorbed inside on the way there
+    }
     out_hit = vec4(x + dir * h.d, 1.0);
     out_power = vec4(w * power, photon_direction_code(dir));
 #endif

@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: GRADED_MEDIA
 // Bounding interval hierarchy traversal (survey §2.3.4, SKSS06: one pass with a stack) over
 // the nodes of src/methods/raytrace/bih.rs: node k is accel_nodes[k] = (left maximum bits,
 // right minimum bits, left child, axis 0/1/2) when interior, the right child the left + 1;

@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: GRADED_MEDIA
 // Brute force: every triangle for every ray (the baseline of the conformance tests).
 #include "raytrace/rays.glsl"
 

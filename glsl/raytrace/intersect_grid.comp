@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: GRADED_MEDIA
 // Uniform grid with 3D-DDA traversal (survey §2.3.1, Amanatides–Woo) and optional
 // empty-space skipping by Chebyshev distance (KL04). Cell c is accel_nodes[c] = (first
 // reference, count, empty distance, 0); see src/methods/raytrace/grid.rs.

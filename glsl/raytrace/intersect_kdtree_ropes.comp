@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: GRADED_MEDIA
 // kd-tree, stackless along ropes (survey §2.3.3, PGSS07): the entry point's leaf is
 // located from the root; then, leaf by leaf, the ray leaves through one face of the leaf's
 // box, follows that face's rope to the node across it and descends from there to the leaf

@@ -1,6 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: OCTREE_VOLUME
+// variants: OCTREE_VOLUME GRADED_MEDIA OCTREE_VOLUME_GRADED_MEDIA
+#ifdef OCTREE_VOLUME_GRADED_MEDIA
+#define OCTREE_VOLUME
+#define GRADED_MEDIA
+#endif
 // Octree traversal (survey §2.3.2, MGK05) over the nodes of src/methods/raytrace/octree.rs:
 // node k is accel_nodes[k] = (first child, 0, 0, OCT_INTERIOR) with eight children first + i,
 // i = x | y << 1 | z << 2 the upper halves, or (first reference, count, aux, OCT_LEAF); node

@@ -1,5 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: GRADED_MEDIA
 #extension GL_EXT_ray_query : require
 // Vulkan's ray queries (src/methods/raytrace/ray_query/): the driver's traversal of the
 // acceleration structures (one bottom level per mesh, one instance per object) answers the

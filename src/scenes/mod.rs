@@ -3,6 +3,7 @@
 
 pub mod corpus;
 pub mod media;
+pub mod water;
 
 use glam::Vec3;
 
@@ -50,12 +51,22 @@ pub fn flat_glass() -> Result<Scene> {
 }
 
 /// The names [`builtin`] knows, in the order `specula` lists them.
-pub const BUILTIN: &[&str] =
-    &["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball", "mirage", "grin-lens"];
+pub const BUILTIN: &[&str] = &[
+    "corner-mirror",
+    "concave-occluder",
+    "glass-1.1",
+    "glass-1.5",
+    "flat-glass",
+    "convex-mirror",
+    "caustic-ball",
+    "mirage",
+    "grin-lens",
+    "pool",
+];
 
 /// A scene built in code by its name (`builtin:NAME` on the command line): `corner-mirror`,
 /// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
-/// `caustic-ball`, `mirage`, `grin-lens`; `None` for another name.
+/// `caustic-ball`, `mirage`, `grin-lens`, `pool`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
     if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < 10_000) {
         return Some(corpus::scene(i));
@@ -70,6 +81,7 @@ pub fn builtin(name: &str) -> Option<Result<Scene>> {
         "caustic-ball" => caustic_ball(),
         "mirage" => media::mirage(),
         "grin-lens" => media::grin_lens(),
+        "pool" => water::pool(),
         _ => return None,
     })
 }

@@ -235,6 +235,13 @@ pub const STUDIES: &[Study] = &[
         base: &["spp=1"],
         sweeps: &["caustics=off,splat,triangles", "photons=32,64,128,256", "caustic_filter=0,1,2,4"],
     },
+    Study {
+        scene: "pool",
+        methods: &["bvh"],
+        base: &["spp=1", "caustics=triangles", "caustic_paths=surface"],
+        sweeps: &["caustic_paths=both,surface,exact", "photons=64,128,256"],
+    },
+    Study { scene: "mirage", methods: &["bvh", "ray-query"], base: &["spp=1"], sweeps: &["medium_turn=0.2,0.05,0.01"] },
 ];
 
 /// The frames per configuration of the showcase studies: (warm-up, timed).
@@ -377,6 +384,19 @@ mod tests {
             }
         }
         let names: Vec<&str> = STUDIES.iter().map(|s| s.scene).collect();
-        assert_eq!(names, ["corner-mirror", "concave-occluder", "glass-1.1", "glass-1.5", "flat-glass", "convex-mirror", "caustic-ball"]);
+        assert_eq!(
+            names,
+            [
+                "corner-mirror",
+                "concave-occluder",
+                "glass-1.1",
+                "glass-1.5",
+                "flat-glass",
+                "convex-mirror",
+                "caustic-ball",
+                "pool",
+                "mirage"
+            ]
+        );
     }
 }

@@ -44,8 +44,11 @@ knobs! {
         /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way. `exact`: photons traced
         /// in the original geometry through Vulkan ray queries (§6.1.1): every specular bounce to the first diffuse hit, a
         /// solid dielectric's paths T·T, R and T·Rᵏ·T (k = 1 … internal_bounces, at most 14) each its own photon image, the
-        /// light's visibility by a shadow ray; needs a device with ray queries
-        caustic_paths: CausticPaths = "both", one_of()["both" => CausticPaths::Both, "refracted" => CausticPaths::Refracted, "exact" => CausticPaths::Exact];
+        /// light's visibility by a shadow ray; needs a device with ray queries. `surface`: §6.4's simplified water caustics, a
+        /// solid generator's photons refracted once at its surface and on straight to the receivers (searched in the receiver
+        /// distance map), never leaving it: for a water body whose floor lies inside it (where the sampled-geometry paths exit
+        /// through its bottom, under the floor), no refractor map
+        caustic_paths: CausticPaths = "both", one_of()["both" => CausticPaths::Both, "refracted" => CausticPaths::Refracted, "exact" => CausticPaths::Exact, "surface" => CausticPaths::Surface];
     }
 }
 
@@ -59,6 +62,9 @@ pub enum CausticPaths {
     Refracted,
     /// Every specular bounce in the original geometry, through ray queries (§6.1.1).
     Exact,
+    /// One refraction at a solid generator's surface, then straight on to the receivers
+    /// inside it (§6.4: water caustics on a pool's floor).
+    Surface,
 }
 
 /// The most internal reflections an `exact` photon layer takes (its branch index has 4 bits).

@@ -70,6 +70,9 @@ gpu_consts! {
     /// `CausticParams.flags`: caustic_space=screen: the camera's own diffuse surfaces take the
     /// caustic from `caustic_screen` at their pixel; every other view, none.
     CAUSTIC_SCREEN_SPACE: uint = 8;
+    /// `CausticParams.flags`: caustic_paths=surface (§6.4): a solid generator's photons go
+    /// from their refraction at its surface straight to the receivers.
+    CAUSTIC_SURFACE_PATHS: uint = 16;
     /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_CUBE_SHIFT: uint = 8;

@@ -121,7 +121,8 @@ pub const PHOTON_VIEWS: &str = "caustics.photon_views";
 const REFRACTOR_MAP: &str = "refractor.generate";
 
 /// Caustics' stages: generators that a light sees; a solid dielectric among them needs its
-/// refractor map for the photons' paths inside it, whatever its own method.
+/// refractor map for the photons' paths inside it, whatever its own method (but with
+/// caustic_paths=surface, where they do not leave it).
 fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
     let Some(c) = p.caustics.clone() else { return };
     let refractor = crate::methods::registry::map_named(REFRACTOR_MAP).expect("a registered method makes refractor maps");
@@ -130,7 +131,8 @@ fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
         let solid =
             matches!(scene.materials[scene.meshes[g.mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: false, .. });
         let o = p.objects.iter_mut().find(|o| o.mesh == g.mesh).expect("generator is a planned object");
-        if solid {
+        // Surface paths (§6.4) never leave the generator: no refractor map.
+        if solid && q.caustics.caustic_paths != CausticPaths::Surface {
             st.add_map(o, refractor.kind(), (refractor.describe)(&q, (0, 0)) + " for its caustics");
         }
     }
@@ -281,7 +283,7 @@ fn plan_of(scene: &Scene, objects: impl Iterator<Item = (usize, String, Vec3)>, 
         let thin = matches!(scene.materials[scene.meshes[mesh].material].kind, crate::scene::SurfaceKind::Dielectric { thin: true, .. });
         let branches = match q.caustics.caustic_paths {
             _ if !dielectric => 1,
-            CausticPaths::Refracted => 1,
+            CausticPaths::Refracted | CausticPaths::Surface => 1,
             CausticPaths::Both => 2,
             CausticPaths::Exact if thin => 2,
             // T·T, R, then T·Rᵏ·T for k = 1 … internal_bounces.

@@ -15,7 +15,7 @@ use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{
     CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_PHOTON_MAP,
-    CAUSTIC_SCREEN_SPACE,
+    CAUSTIC_SCREEN_SPACE, CAUSTIC_SURFACE_PATHS,
 };
 use crate::frame::shadow::FAR;
 use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
@@ -69,7 +69,8 @@ pub fn table(
     let flags = if q.caustics.caustic_distance_test { CAUSTIC_DISTANCE_TEST } else { 0 }
         | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 }
         | if plan.filter == Caustics::PhotonMap { CAUSTIC_PHOTON_MAP } else { 0 }
-        | if plan.space == CausticSpace::Screen { CAUSTIC_SCREEN_SPACE } else { 0 };
+        | if plan.space == CausticSpace::Screen { CAUSTIC_SCREEN_SPACE } else { 0 }
+        | if q.caustics.caustic_paths == CausticPaths::Surface { CAUSTIC_SURFACE_PATHS } else { 0 };
     let diag = scene.bounds().diagonal();
     let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
     let params = GpuCausticParams {

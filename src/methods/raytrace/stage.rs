@@ -517,7 +517,10 @@ impl RayTrace {
             layouts.extend([self.set_layouts[2], self.set_layouts[3]]);
         }
         self.layout = pipeline_layout(ctx, "raytrace.layout", &layouts, PUSH_BYTES, stages)?;
-        self.create_pipelines(ctx, crate::methods::caustics::project::photon_map(init))?;
+        // A scene with graded media (survey §6.5): the intersection kernels' variant that
+        // marches curved rays (raytrace/intersect_main.glsl).
+        let graded = init.scene.materials.iter().any(|m| m.medium().is_some());
+        self.create_pipelines(ctx, crate::methods::caustics::project::photon_map(init), graded)?;
         if tile > 0 {
             self.order = Some(RayOrder::new(ctx, self.layout, most, (self.width, self.height, self.samples, tile))?);
         }
@@ -525,8 +528,8 @@ impl RayTrace {
     }
 
     /// `photon_map`: the plan's caustics are the photon map (the shading kernel's variant that
-    /// gathers it).
-    fn create_pipelines(&mut self, ctx: &Context, photon_map: bool) -> Result<()> {
+    /// gathers it); `graded`: the scene has graded media.
+    fn create_pipelines(&mut self, ctx: &Context, photon_map: bool, graded: bool) -> Result<()> {
         let raster = |name, vertex, fragment, formats: &'static [vk::Format], depth: Option<vk::Format>| GraphicsDesc {
             name,
             vertex,
@@ -577,7 +580,8 @@ impl RayTrace {
             }
             _ => {
                 let shader = self.structure.as_ref().map_or("raytrace/intersect_brute.comp", |s| s.shader);
-                self.p.intersect = compute_pipeline(ctx, self.layout, shader)?;
+                let shader = if graded { graded_variant(shader) } else { shader.to_string() };
+                self.p.intersect = compute_pipeline(ctx, self.layout, &shader)?;
             }
         }
         self.p.primary = compute_pipeline(ctx, self.layout, "raytrace/primary.comp")?;
@@ -1245,5 +1249,14 @@ impl Stage for RayTrace {
         self.vis_depth = None;
         self.engine = None;
         self.engine_depth = None;
+    }
+}
+
+/// The GRADED_MEDIA variant of an intersection kernel (`file#VARIANT` names one variant:
+/// a kernel's own variant gains the suffix, as intersect_octree.comp declares).
+fn graded_variant(shader: &str) -> String {
+    match shader.split_once('#') {
+        Some((file, v)) => format!("{file}#{v}_GRADED_MEDIA"),
+        None => format!("{shader}#GRADED_MEDIA"),
     }
 }
