@@ -224,6 +224,15 @@ pub fn scaled(base: &Scene, k: f32) -> Scene {
     for m in &mut s.meshes {
         m.positions.iter_mut().for_each(|p| *p *= k);
     }
+    // A graded medium's field in the scaled coordinates: n(x/k) — the origin moves, the
+    // gradient and Hessian fall by k and k².
+    for m in &mut s.materials {
+        if let Some(f) = &mut m.graded {
+            f.origin *= k;
+            f.gradient /= k;
+            f.hessian = f.hessian.map(|r| r / (k * k));
+        }
+    }
     let mut cam = base.camera_or_default();
     cam.position *= k;
     cam.world_from_camera.w_axis = (cam.world_from_camera.w_axis.truncate() * k).extend(1.0);
