@@ -31,6 +31,20 @@ vec3 through(Object o, Material m, View v, vec3 eye, vec3 p1, vec3 n1, vec3 t, v
     vec3 p2 = p1 + t * d;
     vec4 clip = v.view_proj * vec4(p2, 1.0);
     vec2 uv2 = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+    // image_space_iterations (beyond the paper): Newton steps on f(d) = |p(d) − eye| − D(p(d)),
+    // D the back faces' distance from the eye where p(d) projects, its derivative taken as
+    // the refracted ray's component along the view direction (D held still).
+    for (uint k = 0u; k < push_image_space_iterations(); ++k) {
+        float back = textureLod(backface_map, uv2, 0.0).w;
+        vec3 to = p2 - eye;
+        float dist = length(to);
+        float slope = dot(t, to / max(dist, 1e-30));
+        if (back <= 0.0 || abs(slope) < 0.05) break;  // no back face there, or grazing
+        d = max(d - (dist - back) / slope, 0.0);
+        p2 = p1 + t * d;
+        clip = v.view_proj * vec4(p2, 1.0);
+        uv2 = clamp(clip.xy / clip.w * 0.5 + 0.5, vec2(0.0), vec2(1.0));
+    }
     vec3 n2 = textureLod(backface_map, uv2, 0.0).xyz;
     n2 = dot(n2, n2) > 0.0 ? normalize(n2) : -n1;
     if (dot(n2, t) < 0.0) n2 = -n2;  // outward, along the leaving ray

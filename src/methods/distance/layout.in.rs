@@ -33,6 +33,12 @@ descriptor_sets! {
 }
 
 push_words! {
+    /// Image-space refraction's exit-point refinement (§4.4).
+    13..14 {
+        /// Newton steps onto the back faces' depth (`image_space_iterations`)
+        IMAGE_SPACE_ITERATIONS: uint,
+    }
+
     /// The distance-map search (§4.1) that every search of a cube map runs (common/search.glsl:
     /// distance's, layered's, the caustics' photons), and self refraction's bounces (§4.4).
     2..8 {

@@ -80,7 +80,17 @@ const SEARCH_KNOB_LIST: [&str; 10] = [
     SearchKnobs::parallax_iterations,
     SearchKnobs::search_tolerance,
 ];
-const SEARCH_KNOBS: &[&str] = &SEARCH_KNOB_LIST;
+/// `image-space-refraction`'s knobs: the search's, and its exit point's refinement.
+const IMAGE_SPACE_KNOBS: &[&str] = &{
+    let mut all = [""; SEARCH_KNOB_LIST.len() + 1];
+    let mut k = 0;
+    while k < SEARCH_KNOB_LIST.len() {
+        all[k] = SEARCH_KNOB_LIST[k];
+        k += 1;
+    }
+    all[k] = DistanceKnobs::image_space_iterations;
+    all
+};
 
 /// `distance`'s knobs: the search's, and the hybrid search's ray queries.
 const DISTANCE_KNOBS: &[&str] = &{
@@ -233,6 +243,7 @@ fn push_words(q: &crate::quality::Quality, _: &crate::frame::stage::ViewLayout, 
     w.set(SEARCH_PARALLAX_ITERATIONS, s.parallax_iterations);
     w.set(SEARCH_TOLERANCE, s.search_tolerance);
     w.set(INTERNAL_BOUNCES, q.distance.internal_bounces);
+    w.set(IMAGE_SPACE_ITERATIONS, q.distance.image_space_iterations);
 }
 
 pub const DISTANCE_INFO: &MethodInfo = &MethodInfo {
@@ -308,7 +319,7 @@ pub const IMAGE_SPACE_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     family: "distance",
     summary: "Wyman's two-pass double refraction: back-face normals and depths from the camera, per-vertex thickness along the inverted normal, the exit ray traced in the distance map",
     serves: SOLIDS,
-    knobs: SEARCH_KNOBS,
+    knobs: IMAGE_SPACE_KNOBS,
     gpu: Some(GpuSpec {
         maps: &[DISTANCE_CUBES, BACKFACES],
         camera: CameraPass {
