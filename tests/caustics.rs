@@ -1385,28 +1385,7 @@ fn a_graded_index_slab_focuses_the_caustic() {
     let (truth, straight) = (light_tracer(&slab(true)), light_tracer(&slab(false)));
     let scene = slab(true);
     let q = quality(&["caustics=splat", "photons=128", "cube_size=128", "caustic_paths=exact", "internal_bounces=4"]);
-    let p = plan(&scene, specula::methods::BVH, &q);
-    let mut r = Renderer::new(&ctx, &scene, p, 16, 16).unwrap();
-    r.render(&ctx).unwrap();
-    let cube = read_image(&ctx, r.maps().image(&specula::methods::caustics::slots::CAUSTIC_MAPS).unwrap()).unwrap();
-    r.destroy(&ctx);
-    let centre = scene.reference_point(1).as_dvec3();
-    let n = cube.width;
-    let mut texels = Vec::new();
-    for face in 0..6 {
-        for y in 0..n {
-            for x in 0..n {
-                let (s, t) = ((x as f64 + 0.5) / n as f64, (y as f64 + 0.5) / n as f64);
-                let d = specula::cube::face_st_to_direction(face as usize, s as f32, t as f32).as_dvec3().normalize();
-                let (u, v) = (2.0 * s - 1.0, 2.0 * t - 1.0);
-                let omega = (2.0 / n as f64).powi(2) / (1.0 + u * u + v * v).powf(1.5);
-                let j = cube.texel(face, x, y)[0] as f64 * omega;
-                if j > 0.0 && d.y < 0.0 {
-                    texels.push((centre + d * (-centre.y / d.y), j));
-                }
-            }
-        }
-    }
+    let texels = light_cube_on_floor(&ctx, &scene, &q, "slab");
     let gpu = spread(&texels);
     eprintln!(
         "graded slab's caustic: power / share within 0.15 m of the axis: light tracer {:.4} W / {:.4}, GPU exact {:.4} W / {:.4}; uniform slab (light tracer) {:.4} W / {:.4}",
@@ -1598,30 +1577,7 @@ fn a_mirror_and_a_glass_ball_chain_their_caustics() {
     let truth = near(&chain);
     let gpu = |paths: &str| {
         let q = quality(&["caustics=splat", "photons=256", "cube_size=256", &format!("caustic_paths={paths}")]);
-        let p = plan(&scene, specula::methods::BVH, &q);
-        let c = p.caustics.as_ref().unwrap();
-        let cube_of_mirror = c.cubes.iter().position(|k| scene.meshes[c.generators[k.generator].mesh].name == "panel").unwrap();
-        let centre = scene.reference_point(c.generators[c.cubes[cube_of_mirror].generator].mesh).as_dvec3();
-        let mut r = Renderer::new(&ctx, &scene, p, 16, 16).unwrap();
-        r.render(&ctx).unwrap();
-        let cube = read_image(&ctx, r.maps().image(&specula::methods::caustics::slots::CAUSTIC_MAPS).unwrap()).unwrap();
-        r.destroy(&ctx);
-        let n = cube.width;
-        let mut texels = Vec::new();
-        for face in 6 * cube_of_mirror as u32..6 * cube_of_mirror as u32 + 6 {
-            for y in 0..n {
-                for x in 0..n {
-                    let (s, t) = ((x as f64 + 0.5) / n as f64, (y as f64 + 0.5) / n as f64);
-                    let d = specula::cube::face_st_to_direction((face % 6) as usize, s as f32, t as f32).as_dvec3().normalize();
-                    let (u, v) = (2.0 * s - 1.0, 2.0 * t - 1.0);
-                    let j = cube.texel(face, x, y)[0] as f64 * (2.0 / n as f64).powi(2) / (1.0 + u * u + v * v).powf(1.5);
-                    if j > 0.0 && d.y < 0.0 {
-                        texels.push((centre + d * (-centre.y / d.y), j));
-                    }
-                }
-            }
-        }
-        near(&texels)
+        near(&light_cube_on_floor(&ctx, &scene, &q, "panel"))
     };
     let (exact, both) = (gpu("exact"), gpu("both"));
     eprintln!(
@@ -1634,4 +1590,34 @@ fn a_mirror_and_a_glass_ball_chain_their_caustics() {
     assert!((exact / truth - 1.0).abs() < 0.03, "exact photons follow the chain: {exact} W against {truth} W");
     assert!(both < 0.5 * truth, "the sampled-geometry paths stop at the ball: {both} W against {truth} W");
     common::assert_clean(&ctx);
+}
+
+/// One frame's light cube of the generator named `generator` (`bvh`, caustics by `q`), as
+/// points on the floor (y = 0): each texel's power J·Ω where its direction from the cube's
+/// centre meets the floor.
+fn light_cube_on_floor(ctx: &specula::vk::Context, scene: &Scene, q: &Quality, generator: &str) -> Vec<(DVec3, f64)> {
+    let p = plan(scene, specula::methods::BVH, q);
+    let c = p.caustics.as_ref().expect("caustics planned");
+    let k = c.cubes.iter().position(|k| scene.meshes[c.generators[k.generator].mesh].name == generator).expect("the generator's cube");
+    let centre = scene.reference_point(c.generators[c.cubes[k].generator].mesh).as_dvec3();
+    let mut r = Renderer::new(ctx, scene, p, 16, 16).unwrap();
+    r.render(ctx).unwrap();
+    let cube = read_image(ctx, r.maps().image(&specula::methods::caustics::slots::CAUSTIC_MAPS).unwrap()).unwrap();
+    r.destroy(ctx);
+    let n = cube.width;
+    let mut texels = Vec::new();
+    for face in 6 * k as u32..6 * k as u32 + 6 {
+        for y in 0..n {
+            for x in 0..n {
+                let (s, t) = ((x as f64 + 0.5) / n as f64, (y as f64 + 0.5) / n as f64);
+                let d = specula::cube::face_st_to_direction((face % 6) as usize, s as f32, t as f32).as_dvec3().normalize();
+                let (u, v) = (2.0 * s - 1.0, 2.0 * t - 1.0);
+                let j = cube.texel(face, x, y)[0] as f64 * (2.0 / n as f64).powi(2) / (1.0 + u * u + v * v).powf(1.5);
+                if j > 0.0 && d.y < 0.0 {
+                    texels.push((centre + d * (-centre.y / d.y), j));
+                }
+            }
+        }
+    }
+    texels
 }

@@ -89,12 +89,6 @@ RayHit photon_next(inout vec3 pos, inout vec3 dir, uint skip, uint medium, out f
     return r.lost ? RayHit(0.0, 0.0, 0.0, RAY_NO_TRIANGLE) : r.hit;
 }
 
-// The medium a photon leaving a surface of material `material` along dir runs in: the ray
-// pipeline's rule (raytrace/spawn.comp child_medium).
-uint photon_medium(uint material, Material m, vec3 n, vec3 dir, bool reflected, uint from) {
-    if (material_graded(m)) return dot(dir, n) < 0.0 ? material + 1u : 0u;
-    return reflected ? from : 0u;
-}
 #endif
 
 layout(location = 0) in vec3 in_position;
@@ -189,12 +183,12 @@ void main() {
             if (k < reflections) {
                 dir = s2.r;
                 w *= s2.fr;
-                medium = photon_medium(mi, m2, n2, dir, true, medium);
+                medium = medium_after(mi, m2, n2, dir, true, medium);
             } else {
                 if (all(lessThanEqual(s2.ft, vec3(0.0)))) return;  // totally reflected: another branch's
                 w *= s2.ft;
                 dir = photon_refraction(m2, s2, w);
-                medium = photon_medium(mi, m2, n2, dir, false, medium);
+                medium = medium_after(mi, m2, n2, dir, false, medium);
             }
         }
     }
@@ -220,11 +214,11 @@ void main() {
         if (m2.kind != KIND_MIRROR && any(greaterThan(s2.ft * w, vec3(0.0)))) {
             w *= s2.ft;
             dir = photon_refraction(m2, s2, w);
-            medium = photon_medium(mi, m2, n2, dir, false, medium);
+            medium = medium_after(mi, m2, n2, dir, false, medium);
         } else {
             dir = s2.r;
             w *= s2.fr;
-            medium = photon_medium(mi, m2, n2, dir, true, medium);
+            medium = medium_after(mi, m2, n2, dir, true, medium);
         }
     }
     return;

@@ -34,6 +34,15 @@ float material_ior_at(Material m, vec3 p) {
     return material_graded(m) ? medium_index(m, p, g) : m.nu.y;
 }
 
+// The graded medium (its material + 1; 0: none) a ray leaving a surface of material
+// `material` (m; n the mesh's outward normal) along `dir` runs in, coming from medium `from`:
+// inside a graded material's object, that material; off any other surface a reflected ray
+// stays in its medium, a refracted one leaves it (the reference's Tracer::child_medium).
+uint medium_after(uint material, Material m, vec3 n, vec3 dir, bool reflected, uint from) {
+    if (material_graded(m)) return dot(dir, n) < 0.0 ? material + 1u : 0u;
+    return reflected ? from : 0u;
+}
+
 vec3 medium_acceleration(Material m, vec3 p) {
     vec3 g;
     float n = medium_index(m, p, g);

@@ -21,15 +21,6 @@ void child(vec3 o, vec3 d, uint skip, vec3 w, uint pixel, uint medium) {
     }
 }
 
-// The graded medium (survey §6.5) a child leaving surface material `material` (outward
-// normal n) along `dir` runs in, as the reference's Tracer::child_medium: inside a graded
-// material's object, that material; off any other surface a reflected child stays in the
-// medium it came from, a refracted one leaves it.
-uint child_medium(uint material, Material m, vec3 n, vec3 dir, bool reflected, uint from) {
-    if (material_graded(m)) return dot(dir, n) < 0.0 ? material + 1u : 0u;
-    return reflected ? from : 0u;
-}
-
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= min(ray_count, trace.capacity) || trace.last != 0u) return;
@@ -48,10 +39,10 @@ void main() {
     float len = h.t * length(q.direction.xyz) + (q.medium != 0u ? uintBitsToFloat(q.before) : 0.0);
     vec3 w = pl.weight.rgb * segment_transmittance(m, s.n, d, len);
     vec3 r = normalize(sp.r);
-    child(s.p, r, h.triangle, w * sp.fr, pl.pixel, child_medium(s.material, m, s.n, r, true, q.medium));
+    child(s.p, r, h.triangle, w * sp.fr, pl.pixel, medium_after(s.material, m, s.n, r, true, q.medium));
     if (!material_disperses(m)) {
         vec3 t = normalize(sp.t);
-        child(s.p, t, h.triangle, w * sp.ft, pl.pixel, child_medium(s.material, m, s.n, t, false, q.medium));
+        child(s.p, t, h.triangle, w * sp.ft, pl.pixel, medium_after(s.material, m, s.n, t, false, q.medium));
     } else {
         // KHR_materials_dispersion: a child per channel along its own refraction, carrying
         // that channel alone (a ray that carries one channel spawns one).
