@@ -1431,6 +1431,10 @@ fn water_caustics_carry_the_light_through_the_surface() {
         caustic_power(&ctx, scene, &quality(&["caustics=splat", "photons=128", "cube_size=128", &format!("caustic_paths={paths}")])).0
     };
     let (surface, exact, both) = (power("surface", &scene), power("exact", &scene), power("both", &scene));
+    // Surface paths never leave the water: no refractor map is drawn for it.
+    let passes = |paths: &str| plan(&scene, specula::methods::BVH, &quality(&["caustics=splat", &format!("caustic_paths={paths}")])).passes;
+    assert!(!passes("surface").iter().any(|p| p.contains("refractor")), "{:?}", passes("surface"));
+    assert!(passes("both").iter().any(|p| p.contains("refractor")), "{:?}", passes("both"));
     let mut q = quality(&["caustics=triangles", "reference_photons=200000"]);
     q.frame.depth = 16;
     let tracer = specula::reference::Tracer::new(&scene, &q).unwrap();
