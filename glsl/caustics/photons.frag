@@ -15,7 +15,8 @@
 // in cube-map space, UPSK08; the light in light space, SP07) with the
 // photon's power: the light's intensity × the texel's solid angle (its area for a
 // directional light) × the Fresnel transmittances along the path, and (w) the direction it
-// arrives along (photon_direction_code, for the photon map's gather).
+// arrives along (photon_direction_code, for the photon map's gather and the texture space's
+// sides).
 //
 // EXACT_PATHS (caustic_paths=exact, survey §6.1.1): the photon is traced in the original
 // geometry through ray queries (set 5) instead: the light's visibility by a shadow ray; at
@@ -87,6 +88,13 @@ RayHit photon_next(inout vec3 pos, inout vec3 dir, uint skip, uint medium, out f
     dir = r.dir;
     len = r.before + r.hit.t;
     return r.lost ? RayHit(0.0, 0.0, 0.0, RAY_NO_TRIANGLE) : r.hit;
+}
+
+// The hit image's w for an exact photon landing on triangle `tri` of the scene's list: 1,
+// or in texture space 2 + tri (the splats find its light-map coordinates there; exact in f32
+// below 2²⁴ triangles, which the stage checks).
+float exact_hit_code(uint tri) {
+    return (caustic.flags & CAUSTIC_TEXTURE_SPACE) != 0u ? 2.0 + float(tri) : 1.0;
 }
 
 #endif
@@ -173,7 +181,7 @@ void main() {
                 // branch 0's path ends there (T, then the floor); the others' are not theirs.
                 if (k > 0u || branch != 0u) return;
                 w *= volume_transmittance(m, len);  // absorbed in the generator on the way
-                out_hit = vec4(pos - centre, 1.0);
+                out_hit = vec4(pos - centre, exact_hit_code(h.triangle));
                 out_power = vec4(w * power, photon_direction_code(dir));
                 return;
             }
@@ -206,7 +214,7 @@ void main() {
         pos += dir * h.t;
         skip = h.triangle;
         if (m2.kind == KIND_DIFFUSE) {
-            out_hit = vec4(pos - centre, 1.0);
+            out_hit = vec4(pos - centre, exact_hit_code(h.triangle));
             out_power = vec4(w * power, photon_direction_code(dir));
             return;
         }

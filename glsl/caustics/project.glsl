@@ -26,8 +26,9 @@ vec3 caustic_irradiance(vec3 p, vec3 n) {
 #else
     if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return e;  // gathered by the camera's passes only
 #endif
-    // Screen space: only the camera's own surfaces (caustic_screen_irradiance) get caustics.
-    if ((caustic.flags & CAUSTIC_SCREEN_SPACE) != 0u) return e;
+    // Screen space: only the camera's own surfaces (caustic_screen_irradiance) get caustics;
+    // texture space: the camera's and the ray tracers' (caustic_texture_irradiance).
+    if ((caustic.flags & (CAUSTIC_SCREEN_SPACE | CAUSTIC_TEXTURE_SPACE)) != 0u) return e;
     float texel = 2.0 / float(caustic.cube_size);
     for (uint g = 0u; g < count; ++g) {
         vec3 w = p - cubes[g].centre.xyz;
@@ -54,5 +55,43 @@ vec3 caustic_irradiance(vec3 p, vec3 n) {
 // as much area.
 vec3 caustic_screen_irradiance(ivec2 pixel, vec3 n, vec3 v) {
     return texelFetch(caustic_screen, pixel, 0).rgb * abs(dot(n, v));
+}
+
+// caustic_space=texture (SKALP05): world point p of triangle `tri` (its index in the scene's
+// list) in its mesh's object space, then in the light map's coordinates of its chart
+// (clamped into the chart), and the chart's normal in world space (src/methods/caustics/atlas.rs
+// lays out caustic_atlas). `false` where the triangle is no receiver's.
+bool caustic_texture_point(uint tri, vec3 p, out vec2 uv, out vec3 normal, out float texel_area) {
+    uint base = caustic.atlas_meshes + 4u * tri;
+    vec4 nm = caustic_atlas[base + 3u];
+    uint h = 4u * floatBitsToUint(nm.w);
+    vec4 rect = caustic_atlas[base + 2u];
+    vec4 mesh = caustic_atlas[h + 3u];
+    if (mesh.z == 0.0 || !(rect.z > rect.x)) return false;
+    vec4 r0 = caustic_atlas[h], r1 = caustic_atlas[h + 1u], r2 = caustic_atlas[h + 2u];
+    vec3 q = vec3(dot(r0.xyz, p) + r0.w, dot(r1.xyz, p) + r1.w, dot(r2.xyz, p) + r2.w);
+    vec4 ru = caustic_atlas[base], rv = caustic_atlas[base + 1u];
+    uv = clamp(vec2(dot(ru.xyz, q) + ru.w, dot(rv.xyz, q) + rv.w), rect.xy, rect.zw);
+    // Normals go by the inverse transpose of the object's transform: the transpose of the
+    // world-to-object rows.
+    normal = r0.xyz * nm.x + r1.xyz * nm.y + r2.xyz * nm.z;
+    texel_area = mesh.y;
+    return true;
+}
+
+// caustic_space=texture: the irradiance of the light map at point p of triangle `tri`,
+// seen from the side `towards` points to (from p to the eye, or back along the ray). The
+// map's alpha holds the signed sum of r + g + b (+ where the photons arrived on the chart's
+// front), so a thin receiver's two sides, one texel of the map, keep their own light.
+vec3 caustic_texture_irradiance(uint tri, vec3 p, vec3 towards) {
+    vec2 uv;
+    vec3 normal;
+    float area;
+    if (caustic.cube_count == 0u || !caustic_texture_point(tri, p, uv, normal, area)) return vec3(0.0);
+    vec4 e = textureLod(caustic_light_map, uv, 0.0);
+    float sum = e.r + e.g + e.b;
+    if (!(sum > 0.0)) return vec3(0.0);
+    float side = dot(towards, normal) >= 0.0 ? 1.0 : -1.0;
+    return e.rgb * clamp(0.5 + 0.5 * side * e.a / sum, 0.0, 1.0);
 }
 #endif

@@ -43,6 +43,7 @@ void main() {
             uint at = pl.pixel / trace.samples;
             e = caustic_screen_irradiance(ivec2(at % trace.width, at / trace.width), n, -d);
         }
+        if ((caustic.flags & CAUSTIC_TEXTURE_SPACE) != 0u) e = caustic_texture_irradiance(h.triangle, s.p, -d);
         accumulate(pl.pixel, w * albedo / PI * e);
     }
     for (uint k = 0u; k < push.light_count; ++k) {

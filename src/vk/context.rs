@@ -181,6 +181,9 @@ pub struct Context {
     /// The device was created with `sampleRateShading` (MSAA's per-sample passes need it).
     /// Only the library's own devices: a host device's enabled features are not known.
     pub sample_rate_shading: bool,
+    /// The device was created with `geometryShader`: fragment shaders may read
+    /// gl_PrimitiveID (caustic_space=texture needs it). Only the library's own devices.
+    pub geometry_shader: bool,
     /// Vulkan's ray-tracing API (acceleration structures and ray queries), where the device
     /// has it and it was enabled; else why not (the `ray-query` method's fallback reason).
     pub ray_query: std::result::Result<RayQueryDevice, String>,
@@ -390,7 +393,11 @@ impl Context {
         let qci = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];
         let supported = unsafe { instance_ref.get_physical_device_features(physical) };
         let sample_rate_shading = supported.sample_rate_shading == vk::TRUE;
-        let features = vk::PhysicalDeviceFeatures::default().image_cube_array(true).sample_rate_shading(sample_rate_shading);
+        let geometry_shader = supported.geometry_shader == vk::TRUE;
+        let features = vk::PhysicalDeviceFeatures::default()
+            .image_cube_array(true)
+            .sample_rate_shading(sample_rate_shading)
+            .geometry_shader(geometry_shader);
         let mut f11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
         let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
@@ -440,6 +447,7 @@ impl Context {
         )?;
         ctx.owned = true;
         ctx.sample_rate_shading = sample_rate_shading;
+        ctx.geometry_shader = geometry_shader;
         ctx.callbacks = alloc;
         Ok(ctx)
     }
@@ -559,6 +567,7 @@ impl Context {
             allocator: Mutex::new(Some(allocator)),
             owned,
             sample_rate_shading: false,
+            geometry_shader: false,
             ray_query,
             callbacks: None,
             pipelines: Default::default(),

@@ -17,7 +17,7 @@ knobs! {
         /// for one photon layer, 592² for three)
         photons: u32 = 128, count(32..=2048, "texels");
         /// caustics=splat: radius of each photon's splat (an Epanechnikov kernel normalised to the photon's power) in light-cube
-        /// texels
+        /// texels (texture space: what that many light-cube texels cover at the photon's distance, 1 to 8 light-map texels)
         splat_size: f32 = 2, real(0.5..=16, "texels");
         /// caustics=photon-map: photons each shaded point gathers (its k nearest on its surface within photon_radius; the
         /// irradiance is their power under an Epanechnikov kernel reaching the (k + 1)-th, or photon_radius where fewer lie
@@ -38,8 +38,15 @@ knobs! {
         /// point (UPSK08), or in light space, one per generator and point or spot light around the light (the shadow-map space of
         /// SP07; directional lights stay in cube-map space): their distance tests leak differently (BENCHMARKS.md); or in screen
         /// space (LC04, WD06b; caustics=splat): splatted straight onto the camera's image of the receivers, depth-tested against
-        /// it, so that caustics seen in mirrors or through glass are missing
-        caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light, "screen" => CausticSpace::Screen];
+        /// it, so that caustics seen in mirrors or through glass are missing; or in texture space (SKALP05; caustics=splat): each
+        /// photon splatted at its receiver's light-map coordinates (an atlas of charts the library cuts, light_map_size²), read
+        /// back by the camera's diffuse surfaces and the ray tracers' diffuse hits (not by the map passes); it leaks where a
+        /// splat's texture-space neighbourhood is hidden from the generator. Needs the device's geometryShader feature
+        /// (gl_PrimitiveID in fragment shaders)
+        caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light, "screen" => CausticSpace::Screen, "texture" => CausticSpace::Texture];
+        /// caustic_space=texture: edge of the receivers' light map (one atlas for every diffuse mesh, one texel size for the whole
+        /// scene, 16 bytes a texel)
+        light_map_size: u32 = 1024, count(64..=8192, "texels");
         /// caustics: a dielectric generator's photons follow both Fresnel branches, each its own photon image (the reflected one is
         /// weak and wide: 4 % at normal incidence), or only the refracted one; mirrors reflect either way. `exact`: photons traced
         /// in the original geometry through Vulkan ray queries (§6.1.1): every specular bounce to the first diffuse hit, a
@@ -82,6 +89,9 @@ pub enum CausticSpace {
     /// Screen space (LC04, WD06b): photons splatted onto the camera's image of the
     /// receivers; only what the camera sees directly gets them.
     Screen,
+    /// Texture space (SKALP05): photons splatted into a light map at their receiver's
+    /// light-map coordinates.
+    Texture,
 }
 
 /// How caustics are rendered (survey §6.3).

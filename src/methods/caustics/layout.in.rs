@@ -51,7 +51,11 @@ gpu_structs! {
         /// caustic_paths=exact through graded media: the most a photon turns per RK4 step
         /// [rad] (the medium_turn knob)
         medium_turn: float,
-        pad: uint,
+        /// caustic_space=texture: `vec4`s of `caustic_atlas` before its triangles (four a mesh)
+        atlas_meshes: uint,
+        /// caustic_space=texture: edge of the light map (texels)
+        light_map_size: uint,
+        pad: [uint; 3],
     }
 }
 
@@ -73,6 +77,9 @@ gpu_consts! {
     /// `CausticParams.flags`: caustic_paths=surface (§6.4): a solid generator's photons go
     /// from their refraction at its surface straight to the receivers.
     CAUSTIC_SURFACE_PATHS: uint = 16;
+    /// `CausticParams.flags`: caustic_space=texture (SKALP05): photons land in the receivers'
+    /// light map; the camera's diffuse surfaces and the ray tracers' diffuse hits read it.
+    CAUSTIC_TEXTURE_SPACE: uint = 32;
     /// `Push.flags` of the photon pass: the caustic cube's index `(flags >> CAUSTIC_CUBE_SHIFT)
     /// & 0xff` and the light's `flags >> CAUSTIC_LIGHT_SHIFT`.
     CAUSTIC_CUBE_SHIFT: uint = 8;
@@ -84,6 +91,9 @@ gpu_consts! {
     /// Caustic triangles whose corners' distances from the reference point differ by more
     /// than this fraction land on different surfaces (§6.3.2) and are dropped.
     CAUSTIC_GAP: float = 0.1;
+    /// caustic_space=texture: the largest splat radius in light-map texels (the atlas's
+    /// charts lie this far apart and two texels more).
+    TEXTURE_SPLAT_MAX: float = 8.0;
 }
 
 flag_bits! {
@@ -131,5 +141,17 @@ descriptor_sets! {
         /// caustic_space=screen: the caustic's irradiance per pixel of the camera target, per
         /// unit area across the view (caustics.screen splats the photons there).
         CAUSTIC_SCREEN = 21: COMBINED_IMAGE_SAMPLER => "uniform sampler2D caustic_screen";
+        /// caustic_space=texture: the receivers' light-map atlas (src/methods/caustics/atlas.rs):
+        /// per mesh four vec4 (world-to-object rows, then its first triangle's index as bits,
+        /// its texel's world area, 1 for a receiver), then per triangle of the scene's list four
+        /// (the rows to light-map coordinates, its chart's rectangle, the chart's object-space
+        /// normal with the mesh's index as bits).
+        CAUSTIC_ATLAS = 24: STORAGE_BUFFER => "readonly buffer CausticAtlas { vec4 caustic_atlas[]; }";
+        /// caustic_space=texture: the light map, irradiance (W/m², rgb) per texel of the
+        /// receivers' charts; a: the signed luminance, + for photons on the chart's front.
+        CAUSTIC_LIGHT_MAP = 25: COMBINED_IMAGE_SAMPLER => "uniform sampler2D caustic_light_map";
+        /// caustic_space=texture: per caustic cube, the receiver triangle (its index in the
+        /// scene's list + 1, as a float; 0 or FAR: none) in each direction from its centre.
+        CAUSTIC_RECEIVER_IDS = 26: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_receiver_ids";
     }
 }

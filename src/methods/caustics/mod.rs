@@ -24,6 +24,7 @@
 //!   straight into a camera-sized irradiance image, depth-tested against the camera's depth
 //!   of everything; only the camera's own diffuse surfaces read it (no light cube maps).
 
+pub mod atlas;
 pub mod knobs;
 pub mod project;
 pub mod slots;
@@ -59,6 +60,7 @@ impl CausticsPlan {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
         v.push(match self.filter {
             _ if self.space == CausticSpace::Screen => "caustics.screen",
+            _ if self.space == CausticSpace::Texture => "caustics.light_map",
             Caustics::Splat => "caustics.splat",
             Caustics::PhotonMap => "caustics.photon_map",
             _ => "caustics.triangles",
@@ -70,9 +72,10 @@ impl CausticsPlan {
     }
 
     /// Whether it keeps light cube maps (splats and caustic triangles go there; the photon
-    /// map's gather reads the photons themselves, screen space splats into the camera's view).
+    /// map's gather reads the photons themselves, screen space splats into the camera's view,
+    /// texture space into the receivers' light map).
     pub fn light_cubes(&self) -> bool {
-        self.filter != Caustics::PhotonMap && self.space != CausticSpace::Screen
+        self.filter != Caustics::PhotonMap && !matches!(self.space, CausticSpace::Screen | CausticSpace::Texture)
     }
 
     /// Every photon of every layer (photons² a layer): what `caustics.photons` traces, and
@@ -341,12 +344,19 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
     let photon_map = if p.filter == Caustics::PhotonMap { p.photon_count(q) * 36 + p.grid_cells(q) as u64 * 16 } else { 0 };
     // The stage renders its cubes in six passes (src/methods/caustics/stage.rs): one depth layer.
     let triangles = if p.filter == Caustics::Triangles { p.photon_layers as u64 * 2 * (n - 1) * (n - 1) * (64 + 24) } else { 0 };
-    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles + photon_map
+    // Texture space: the light map (RGBA32F) and a receiver-triangle cube beside each receiver
+    // distance cube (R32F); the atlas's table is counted by the stage that builds it.
+    let texture = if p.space == CausticSpace::Texture { (q.caustics.light_map_size as u64).pow(2) * 16 + g * 6 * s * s * 4 } else { 0 };
+    g * 6 * s * s * (4 + 16 * light_cubes) + p.photon_layers as u64 * n * n * 32 + n * n * 4 + s * s * 4 + triangles + photon_map + texture
 }
 
 /// What `specula plan` says of it.
 pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
-    let store = if p.light_cubes() {
+    let store = if p.space == CausticSpace::Texture {
+        format!("a {}² RGBA32F light map of the receivers' charts", q.caustics.light_map_size)
+    } else if p.space == CausticSpace::Screen {
+        "a camera-sized RGBA32F irradiance image".to_string()
+    } else if p.light_cubes() {
         format!(
             "{} light cube(s) 6×{}² RGBA32F{}",
             p.cubes.len(),
@@ -372,6 +382,7 @@ pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
         match p.space {
             CausticSpace::Light => "light",
             CausticSpace::Screen => "screen",
+            CausticSpace::Texture => "texture",
             CausticSpace::Cube => "cube-map",
         },
         q.caustics.photons,

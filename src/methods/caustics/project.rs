@@ -27,7 +27,11 @@ impl CausticsProject {
             &GraphicsDesc {
                 name: "caustics.project",
                 vertex: "scene/mesh.vert",
-                fragment: if photon_map(init) { "caustics/project.frag#CAUSTICS_PHOTON_MAP" } else { "caustics/project.frag" },
+                fragment: match init.plan.caustics.as_ref() {
+                    _ if photon_map(init) => "caustics/project.frag#CAUSTICS_PHOTON_MAP",
+                    Some(c) if c.space == crate::quality::CausticSpace::Texture => "caustics/project.frag#CAUSTICS_TEXTURE",
+                    _ => "caustics/project.frag",
+                },
                 vertex_input: VertexInput::Mesh,
                 color_formats: &[TARGET_FORMAT],
                 depth_format: Some(DEPTH_FORMAT),
@@ -56,7 +60,8 @@ impl Stage for CausticsProject {
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         let mut pass = rec.pass("caustics.project").writes(io.target, Access::ColorAttachment).writes(io.depth, Access::DepthAttachment);
-        let maps = [&super::slots::CAUSTIC_DISTANCES, &super::slots::CAUSTIC_MAPS, &super::slots::CAUSTIC_SCREEN].map(|s| io.maps.image(s));
+        use super::slots::{CAUSTIC_DISTANCES, CAUSTIC_LIGHT_MAP, CAUSTIC_MAPS, CAUSTIC_SCREEN};
+        let maps = [&CAUSTIC_DISTANCES, &CAUSTIC_MAPS, &CAUSTIC_SCREEN, &CAUSTIC_LIGHT_MAP].map(|s| io.maps.image(s));
         for img in io.scene_images.iter().copied().chain(maps.into_iter().flatten()) {
             pass = pass.reads(img, Access::FragmentSampled);
         }

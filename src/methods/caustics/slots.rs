@@ -38,6 +38,14 @@ pub const PHOTON_COARSE: Slot = Slot::buffer("caustics.photon_coarse", 0, bindin
 /// diffuse surfaces are shaded.
 pub const CAUSTIC_SCREEN: Slot = Slot { shading: true, ..Slot::image("caustics.screen", 0, binding::CAUSTIC_SCREEN, Sampler::Nearest) };
 
+/// caustic_space=texture (SKALP05): the receivers' atlas, their light map (read where the
+/// camera's and the ray tracers' diffuse surfaces are shaded) and the receiver triangles seen
+/// from each caustic cube's centre (the splats read them).
+pub const CAUSTIC_ATLAS: Slot = Slot::buffer("caustics.atlas", 0, binding::CAUSTIC_ATLAS);
+pub const CAUSTIC_LIGHT_MAP: Slot =
+    Slot { shading: true, ..Slot::image("caustics.light_map", 0, binding::CAUSTIC_LIGHT_MAP, Sampler::Linear) };
+pub const CAUSTIC_RECEIVER_IDS: Slot = Slot::image("caustics.receiver_ids", 0, binding::CAUSTIC_RECEIVER_IDS, Sampler::Nearest);
+
 pub const SLOTS: &[Slot] = &[
     CAUSTIC_DISTANCES,
     CAUSTIC_MAPS,
@@ -51,6 +59,9 @@ pub const SLOTS: &[Slot] = &[
     PHOTON_LIST,
     PHOTON_COARSE,
     CAUSTIC_SCREEN,
+    CAUSTIC_ATLAS,
+    CAUSTIC_LIGHT_MAP,
+    CAUSTIC_RECEIVER_IDS,
 ];
 
 impl crate::frame::maps::Maps {

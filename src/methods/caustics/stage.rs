@@ -6,16 +6,17 @@
 
 use ash::vk;
 
+use super::atlas::Atlas;
 use super::slots::{
-    CAUSTICS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_SCREEN, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID,
-    PHOTON_HITS, PHOTON_LIST, PHOTON_POWER,
+    CAUSTICS, CAUSTIC_ATLAS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_LIGHT_MAP, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_RECEIVER_IDS,
+    CAUSTIC_SCREEN, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID, PHOTON_HITS, PHOTON_LIST, PHOTON_POWER,
 };
 use super::CausticsPlan;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{
     CAUSTIC_BRANCH_SHIFT, CAUSTIC_CUBE_SHIFT, CAUSTIC_DISTANCE_TEST, CAUSTIC_LIGHT_SHIFT, CAUSTIC_ORIENTATION, CAUSTIC_PHOTON_MAP,
-    CAUSTIC_SCREEN_SPACE, CAUSTIC_SURFACE_PATHS,
+    CAUSTIC_SCREEN_SPACE, CAUSTIC_SURFACE_PATHS, CAUSTIC_TEXTURE_SPACE,
 };
 use crate::frame::shadow::FAR;
 use crate::frame::shadow::{SHADOW_CUBES, SHADOW_PLANES};
@@ -53,6 +54,10 @@ pub struct CausticsStage {
     /// against it (caustics/screen_depth.frag, caustics/splat.vert#SCREEN), and that depth.
     screen: [vk::Pipeline; 2],
     screen_depth: Image,
+    /// caustic_space=texture (SKALP05): the receivers' atlas (followed as objects move), and
+    /// the splats into its light map (caustics/splat.vert#TEXTURE).
+    atlas: Option<Atlas>,
+    light_map_splat: vk::Pipeline,
     layout: vk::PipelineLayout,
     /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
     exact: Option<SceneRays>,
@@ -70,7 +75,8 @@ pub fn table(
         | if q.caustics.caustic_orientation { CAUSTIC_ORIENTATION } else { 0 }
         | if plan.filter == Caustics::PhotonMap { CAUSTIC_PHOTON_MAP } else { 0 }
         | if plan.space == CausticSpace::Screen { CAUSTIC_SCREEN_SPACE } else { 0 }
-        | if q.caustics.caustic_paths == CausticPaths::Surface { CAUSTIC_SURFACE_PATHS } else { 0 };
+        | if q.caustics.caustic_paths == CausticPaths::Surface { CAUSTIC_SURFACE_PATHS } else { 0 }
+        | if plan.space == CausticSpace::Texture { CAUSTIC_TEXTURE_SPACE } else { 0 };
     let diag = scene.bounds().diagonal();
     let diag = if diag.is_finite() && diag > 0.0 { diag } else { 1.0 };
     let params = GpuCausticParams {
@@ -89,7 +95,9 @@ pub fn table(
         screen_width: width,
         screen_height: height,
         medium_turn: q.frame.medium_turn,
-        pad: 0,
+        atlas_meshes: 4 * scene.meshes.len() as u32,
+        light_map_size: q.caustics.light_map_size,
+        pad: [0; 3],
     };
     let cubes = plan
         .cubes
@@ -142,6 +150,8 @@ impl CausticsStage {
             photon_places: 0,
             screen: [vk::Pipeline::null(); 2],
             screen_depth: Image::placeholder(),
+            atlas: None,
+            light_map_splat: vk::Pipeline::null(),
             layout: init.layout,
             exact: None,
         };
@@ -150,12 +160,34 @@ impl CausticsStage {
 
     fn init(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
         let (ctx, layout, q) = (init.ctx, init.layout, &init.plan.quality);
-        if self.plan.space == CausticSpace::Screen && self.plan.filter != Caustics::Splat {
+        let splatted = match self.plan.space {
+            CausticSpace::Screen => Some("screen: photons are splatted onto the camera's image"),
+            CausticSpace::Texture => Some("texture: photons are splatted into the receivers' light map"),
+            _ => None,
+        };
+        if let (Some(what), false) = (splatted, self.plan.filter == Caustics::Splat) {
             let filter = if self.plan.filter == Caustics::PhotonMap { "photon-map" } else { "triangles" };
             return Err(crate::Error::invalid(
                 "knob caustic_space",
-                format!("screen: photons are splatted onto the camera's image (caustics=splat); caustics={filter} keeps them elsewhere (caustic_space=cube or light)"),
+                format!("{what} (caustics=splat); caustics={filter} keeps them elsewhere (caustic_space=cube or light)"),
             ));
+        }
+        if self.plan.space == CausticSpace::Texture {
+            if !ctx.geometry_shader {
+                return Err(crate::Error::Unsupported(format!(
+                    "caustic_space=texture reads gl_PrimitiveID in fragment shaders, which needs the geometryShader feature: {} {} (caustic_space=cube)",
+                    ctx.device_name,
+                    if !ctx.owns_device() { "is the host's device, whose enabled features are not known" } else { "does not have it" }
+                )));
+            }
+            // Triangle indices travel as floats (exact below 2²⁴).
+            let triangles = init.scene.triangle_count();
+            if triangles >= 1 << 24 {
+                return Err(crate::Error::invalid(
+                    "knob caustic_space",
+                    format!("texture: {triangles} triangles; texture space names a receiver triangle by a float, exact below 2^24 (caustic_space=cube)"),
+                ));
+            }
         }
         let (s, n) = (q.cube.cube_size, q.caustics.photons);
         let cubes = self.plan.cubes.len() as u32;
@@ -246,6 +278,9 @@ impl CausticsStage {
         if self.plan.space == CausticSpace::Screen {
             return self.init_screen(init, maps);
         }
+        if self.plan.space == CausticSpace::Texture {
+            return self.init_texture(init, maps);
+        }
         let (vs, fs) = match self.plan.filter {
             Caustics::Splat => ("caustics/splat.vert", "caustics/splat.frag"),
             _ => ("caustics/triangles.vert", "caustics/triangles.frag"),
@@ -270,6 +305,85 @@ impl CausticsStage {
                 &desc("caustics.filter", "scene/sky.vert", "caustics/filter.frag", VertexInput::None, &light, false, mask, Blend::Replace),
             )?;
         }
+        Ok(())
+    }
+
+    /// caustic_space=texture (SKALP05): the receivers' atlas and light map, the receiver
+    /// triangles beside each receiver distance cube, the receivers' pipeline that writes both
+    /// and the splats'.
+    fn init_texture(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let (ctx, q) = (init.ctx, &init.plan.quality);
+        let atlas = Atlas::build(init.scene, q.caustics.light_map_size, super::atlas::gutter())?;
+        let (words, _) = atlas.gpu_words();
+        maps.set_buffer(
+            &CAUSTIC_ATLAS,
+            Buffer::with_data(ctx, "caustics.atlas", bytemuck::cast_slice::<[f32; 4], u8>(&words), vk::BufferUsageFlags::STORAGE_BUFFER)?,
+        );
+        self.atlas = Some(atlas);
+        let n = q.caustics.light_map_size;
+        let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
+        maps.set_image(
+            &CAUSTIC_LIGHT_MAP,
+            Image::new(
+                ctx,
+                &ImageDesc { name: "caustics.light_map", format: LIGHT_FORMAT, width: n, height: n, kind: ImageKind::D2, usage },
+            )?,
+        );
+        let s = q.cube.cube_size;
+        let cubes = ImageKind::CubeArray { cubes: self.plan.cubes.len() as u32 };
+        maps.set_image(
+            &CAUSTIC_RECEIVER_IDS,
+            Image::new(
+                ctx,
+                &ImageDesc { name: "caustics.receiver_ids", format: vk::Format::R32_SFLOAT, width: s, height: s, kind: cubes, usage },
+            )?,
+        );
+        let desc = |name, vertex, fragment, vertex_input, formats, depth_format, blend| GraphicsDesc {
+            name,
+            vertex,
+            fragment,
+            vertex_input,
+            color_formats: formats,
+            depth_format,
+            depth_test: depth_format.is_some(),
+            depth_write: depth_format.is_some(),
+            view_mask: 0,
+            cull: vk::CullModeFlags::NONE,
+            multisample: Multisample::OFF,
+            blend,
+            depth_op: crate::vk::pipeline::DepthOp::Nearer,
+        };
+        let two = [vk::Format::R32_SFLOAT, vk::Format::R32_SFLOAT];
+        let old = std::mem::replace(
+            &mut self.receivers,
+            graphics_pipeline(
+                ctx,
+                self.layout,
+                &desc(
+                    "caustics.receivers",
+                    "scene/mesh.vert",
+                    "caustics/receivers.frag",
+                    VertexInput::Mesh,
+                    &two,
+                    Some(DEPTH_FORMAT),
+                    Blend::Replace,
+                ),
+            )?,
+        );
+        destroy_pipelines(ctx, &mut [old]);
+        self.light_map_splat = graphics_pipeline(
+            ctx,
+            self.layout,
+            &desc(
+                "caustics.light_map",
+                "caustics/splat.vert#TEXTURE",
+                "caustics/splat.frag",
+                VertexInput::None,
+                &[LIGHT_FORMAT],
+                None,
+                Blend::Add,
+            ),
+        )?;
         Ok(())
     }
 
@@ -403,6 +517,41 @@ impl CausticsStage {
         );
     }
 
+    /// Texture space: the receiver distance cubes and the receiver triangles beside them, six
+    /// passes a cube of two attachments (both cleared to FAR: no receiver).
+    fn receivers_with_triangles(&mut self, rec: &Recorder, f: &FrameInputs, distances: &Image, ids: &Image, cube_views: &[u32]) {
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        for (k, cube) in self.plan.cubes.iter().enumerate() {
+            let mesh = self.plan.generators[cube.generator].mesh;
+            for face in 0..6u32 {
+                rec.barrier(&mut self.cube_depth, Access::DepthAttachment);
+                let layer = 6 * k as u32 + face;
+                let colors = [distances.layer_view(layer), ids.layer_view(layer)];
+                let target = Target {
+                    clear_color: [FAR, 0.0, 0.0, 0.0],
+                    ..Target::cleared(&colors, Some(self.cube_depth.view), distances.width, distances.width)
+                };
+                begin_rendering(ctx, cmd, &target);
+                f.bind(ctx, cmd, self.receivers);
+                for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh && d.index_count > 0) {
+                    f.draw(ctx, cmd, cube_views[k] + face, d);
+                }
+                unsafe { ctx.device.cmd_end_rendering(cmd) };
+            }
+        }
+    }
+
+    /// Every photon layer's splats into one target seen from `view` (screen and texture
+    /// space), push.flags naming the layer's caustic cube.
+    fn draw_splats(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32) {
+        for c in 0..self.plan.cubes.len() {
+            for layer in cube_layers(&self.plan, c) {
+                f.push_flags(ctx, cmd, view, layer, c as u32);
+                unsafe { ctx.device.cmd_draw(cmd, self.vertices(), 1, 0, 0) };
+            }
+        }
+    }
+
     /// Vertices of one photon layer's splat draw (a quad per photon).
     fn vertices(&self) -> u32 {
         6 * self.photons * self.photons
@@ -464,13 +613,28 @@ impl Stage for CausticsStage {
         if let Some(b) = maps.buffer_mut(&CAUSTICS) {
             b.write(&table_bytes(&self.plan, &init.plan.quality, init))?;
         }
+        // Texture space: the charts follow their objects (the per-mesh rows).
+        if let (Some(atlas), Some(b)) = (self.atlas.as_mut(), maps.buffer_mut(&CAUSTIC_ATLAS)) {
+            atlas.follow(init.scene);
+            let (words, lead) = atlas.gpu_words();
+            b.write(bytemuck::cast_slice::<[f32; 4], u8>(&words[..lead as usize]))?;
+        }
         Ok(())
     }
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
         // Taken out of the frame's maps while recorded (several are written at once), put
         // back after.
-        let own = [&CAUSTIC_DISTANCES, &PHOTON_HITS, &PHOTON_POWER, &CAUSTIC_MAPS, &CAUSTIC_RAW, &CAUSTIC_SCREEN];
+        let own = [
+            &CAUSTIC_DISTANCES,
+            &PHOTON_HITS,
+            &PHOTON_POWER,
+            &CAUSTIC_MAPS,
+            &CAUSTIC_RAW,
+            &CAUSTIC_SCREEN,
+            &CAUSTIC_LIGHT_MAP,
+            &CAUSTIC_RECEIVER_IDS,
+        ];
         let mut images = own.map(|s| io.maps.take_image(s));
         self.record_images(rec, f, io, &mut images);
         for (slot, image) in own.into_iter().zip(images) {
@@ -489,6 +653,7 @@ impl Stage for CausticsStage {
         destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
         destroy_pipelines(ctx, &mut self.grid);
         destroy_pipelines(ctx, &mut self.screen);
+        destroy_pipelines(ctx, &mut [self.light_map_splat]);
         self.screen_depth.destroy(ctx);
     }
 }
@@ -497,10 +662,10 @@ impl CausticsStage {
     /// Records the passes into the caustics' own images: receiver distances, photon hits
     /// and power, light cube maps and their unfiltered twins, the screen's irradiance (`own` in
     /// `record`'s order).
-    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 6]) {
+    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 8]) {
         let ctx = rec.ctx;
         let maps = &*io.maps;
-        let [distances, hits, power, light_image, raw_image, screen_image] = images;
+        let [distances, hits, power, light_image, raw_image, screen_image, light_map, receiver_ids] = images;
         let (Some(distances), Some(hits), Some(power)) = (distances.as_mut(), hits.as_mut(), power.as_mut()) else {
             return;
         };
@@ -508,18 +673,35 @@ impl CausticsStage {
         let (cubes, photons) = (first(super::CUBE_VIEWS), first(super::PHOTON_VIEWS));
         let cube_views: Vec<u32> = (0..self.plan.cubes.len() as u32).map(|k| cubes + 6 * k).collect();
 
-        // The receivers: everything but the generator, from its reference point.
-        let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
-        for (k, cube) in self.plan.cubes.iter().enumerate() {
-            let mesh = self.plan.generators[cube.generator].mesh;
-            render_cube_faces(rec, distances, &mut self.cube_depth, k as u32, cube_views[k], self.mode, [FAR, 0.0, 0.0, 0.0], |cmd, v| {
-                f.bind(ctx, cmd, self.receivers);
-                for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh && d.index_count > 0) {
-                    f.draw(ctx, cmd, v, d);
-                }
-            });
+        // The receivers: everything but the generator, from its reference point (texture
+        // space: with the receiver triangles beside their distances).
+        if let Some(ids) = receiver_ids.as_mut() {
+            let open =
+                rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).writes(ids, Access::ColorAttachment).begin();
+            self.receivers_with_triangles(rec, f, distances, ids, &cube_views);
+            rec.end(open);
+        } else {
+            let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
+            for (k, cube) in self.plan.cubes.iter().enumerate() {
+                let mesh = self.plan.generators[cube.generator].mesh;
+                render_cube_faces(
+                    rec,
+                    distances,
+                    &mut self.cube_depth,
+                    k as u32,
+                    cube_views[k],
+                    self.mode,
+                    [FAR, 0.0, 0.0, 0.0],
+                    |cmd, v| {
+                        f.bind(ctx, cmd, self.receivers);
+                        for d in f.scene.draws.iter().filter(|d| d.mesh as usize != mesh && d.index_count > 0) {
+                            f.draw(ctx, cmd, v, d);
+                        }
+                    },
+                );
+            }
+            rec.end(open);
         }
-        rec.end(open);
 
         // Exact photons: the structures they trace through, built where this frame needs them.
         if let Some(e) = self.exact.as_mut() {
@@ -579,12 +761,24 @@ impl CausticsStage {
                 f.draw(ctx, cmd, io.views.camera, d);
             }
             f.bind(ctx, cmd, self.screen[1]);
-            for c in 0..self.plan.cubes.len() {
-                for layer in cube_layers(&self.plan, c) {
-                    f.push_flags(ctx, cmd, io.views.camera, layer, c as u32);
-                    unsafe { ctx.device.cmd_draw(cmd, self.vertices(), 1, 0, 0) };
-                }
-            }
+            self.draw_splats(ctx, cmd, f, io.views.camera);
+            unsafe { ctx.device.cmd_end_rendering(cmd) };
+            rec.end(open);
+            return;
+        }
+        // Texture space (SKALP05): every photon's splat at its receiver's light-map coordinates.
+        if let (Some(map), Some(ids)) = (light_map.as_mut(), receiver_ids.as_ref()) {
+            let open = rec
+                .pass("caustics.light_map")
+                .writes(map, Access::ColorAttachment)
+                .reads(hits, Access::VertexSampled)
+                .reads(power, Access::VertexSampled)
+                .reads(ids, Access::VertexSampled)
+                .begin();
+            let colors = [map.view];
+            begin_rendering(ctx, cmd, &Target::cleared(&colors, None, map.width, map.height));
+            f.bind(ctx, cmd, self.light_map_splat);
+            self.draw_splats(ctx, cmd, f, io.views.camera);
             unsafe { ctx.device.cmd_end_rendering(cmd) };
             rec.end(open);
             return;
