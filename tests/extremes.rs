@@ -122,8 +122,12 @@ fn glass_of_index_almost_one_is_invisible() {
 ///   it could not fail while this holds, and was dropped). This test caught an absolute
 ///   1e-4 m slack in the point-light shadow test: at 1 mm it lit a floor pixel in the box's
 ///   shadow (0.003 → 0.52, 43 dB) once the demo's light moved to the room's middle;
-/// - reference (1 spp): measured RMSE 1.6e-7 and 2.9e-7 (f32 rounding of the scaled
-///   vertices); asserted ≤ 1e-5 (100 dB, 30 dB under the measured 131 dB).
+/// - reference (1 spp): with the kernel estimate measured RMSE 1.6e-7 and 2.9e-7 (f32
+///   rounding of the scaled vertices); with the progressive estimate (the default since
+///   2026-12-07) 4.9e-5 at 1e-3 (one pixel off by 0.0046, every other within 1e-6: the
+///   estimate counts photons within a shrinking radius, and a photon on its boundary falls in
+///   or out with the rounding) and 1.7e-7 at 1e3; asserted RMSE ≤ 1e-4 and the 99th
+///   percentile of |Δ| ≤ 1e-5 (a scale-dependent term would move every caustic pixel).
 #[test]
 fn scaled_scenes_render_the_same_image() {
     let ctx = common::gpu();
@@ -141,7 +145,7 @@ fn scaled_scenes_render_the_same_image() {
         let cpu = render_reference(&scaled, &q, (64, 64)).unwrap();
         let e = errors(&cpu, &ref1);
         println!("reference, scale {s:e}: {e} (RMSE {:e})", e.rmse);
-        assert!(e.rmse <= 1e-5, "reference at scale {s:e}: {e}");
+        assert!(e.rmse <= 1e-4 && e.p99_abs <= 1e-5, "reference at scale {s:e}: {e}");
     }
     common::assert_clean(&ctx);
 }

@@ -14,7 +14,7 @@ knobs! {
         /// pass's photons, at most that)
         caustic_radius: Option<f32> = auto, auto_metres();
         /// CPU reference: the caustics' density estimate: one photon map with the fixed caustic_radius kernel, or progressive photon mapping (Hachisuka et al. 2008: reference_photons split into ppm_passes passes, each camera hit point's radius shrinking from caustic_radius as photons arrive, α 0.7), which converges to the sharp caustic
-        caustic_estimate: CausticEstimate = "kernel", one_of()["kernel" => CausticEstimate::Kernel, "progressive" => CausticEstimate::Progressive];
+        caustic_estimate: CausticEstimate = "progressive", one_of()["kernel" => CausticEstimate::Kernel, "progressive" => CausticEstimate::Progressive];
         /// CPU reference, caustic_estimate=progressive: photon passes (each of reference_photons / ppm_passes photons per light and generator)
         ppm_passes: u32 = 16, count(1..=4096, "passes");
     }

@@ -437,10 +437,20 @@ struct Surface {
     material: usize,
 }
 
+/// The camera paths' diffuse hits the progressive estimate keeps at once (about 120 bytes
+/// each: 512 MiB); a larger image is gathered in bands of rows, each band tracing the passes'
+/// photons again.
+const HIT_POINT_BUDGET: usize = 1 << 22;
+
 /// Renders `scene` exactly at `width`×`height` (camera: the scene's, or the default one
 /// that frames it, as the GPU renderer takes it) with `quality.reference.spp` samples per pixel and
 /// `quality.frame.depth` specular bounces. Linear radiance RGBA32F, alpha 1.
-pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32, u32)) -> Result<ImageData> {
+pub fn render_reference(scene: &Scene, quality: &Quality, size: (u32, u32)) -> Result<ImageData> {
+    render_in_bands(scene, quality, size, HIT_POINT_BUDGET)
+}
+
+/// `render_reference` with the progressive estimate's hit points at most about `budget`.
+fn render_in_bands(scene: &Scene, quality: &Quality, (width, height): (u32, u32), budget: usize) -> Result<ImageData> {
     if width == 0 || height == 0 || width > 16384 || height > 16384 {
         return Err(Error::invalid("size", format!("{width}x{height} is outside 1..=16384")));
     }
@@ -453,33 +463,42 @@ pub fn render_reference(scene: &Scene, quality: &Quality, (width, height): (u32,
     let tracer = Tracer::new(scene, quality)?;
     let rays = CameraRays::new(&camera, width, height);
     let mut data = vec![0f32; (width * height * 4) as usize];
-    // Progressive photon mapping: each row's camera paths record their diffuse hits.
-    let mut rows: Vec<Vec<ppm::HitPoint>> = (0..height).map(|_| Vec::new()).collect();
-    data.par_chunks_mut(width as usize * 4).zip(rows.par_iter_mut()).enumerate().for_each(|(y, (row, points))| {
-        let y = y as u32;
-        for x in 0..width {
-            let mut c = DVec3::ZERO;
-            for s in 0..spp {
-                let (jx, jy) = sample_offset(x, y, s, spp);
-                let (o, d, t_min) = rays.ray(x as f64 + jx, y as f64 + jy);
-                let mut sink = HitSink { points: &mut *points, pixel: y * width + x, scale: 1.0 / spp as f64 };
-                let sink = tracer.progressive.then_some(&mut sink);
-                c += tracer.trace(Ray { o, d, t_min, skip: None, medium: None }, tracer.depth, DVec3::ONE, sink);
+    // Progressive photon mapping: each row's camera paths record their diffuse hits, gathered
+    // band by band of rows so that the hit points stay within HIT_POINT_BUDGET (about 120
+    // bytes each); every band's passes trace the same photons (the R2 sequence), so the
+    // image is the same whatever the bands.
+    let band = if tracer.progressive { (budget / (2 * width as usize * spp as usize)).clamp(1, height as usize) } else { height as usize };
+    let row_len = width as usize * 4;
+    for (b, chunk) in data.chunks_mut(band * row_len).enumerate() {
+        let first_row = (b * band) as u32;
+        let mut rows: Vec<Vec<ppm::HitPoint>> = (0..chunk.len() / row_len).map(|_| Vec::new()).collect();
+        chunk.par_chunks_mut(row_len).zip(rows.par_iter_mut()).enumerate().for_each(|(dy, (row, points))| {
+            let y = first_row + dy as u32;
+            for x in 0..width {
+                let mut c = DVec3::ZERO;
+                for s in 0..spp {
+                    let (jx, jy) = sample_offset(x, y, s, spp);
+                    let (o, d, t_min) = rays.ray(x as f64 + jx, y as f64 + jy);
+                    let mut sink = HitSink { points: &mut *points, pixel: y * width + x, scale: 1.0 / spp as f64 };
+                    let sink = tracer.progressive.then_some(&mut sink);
+                    c += tracer.trace(Ray { o, d, t_min, skip: None, medium: None }, tracer.depth, DVec3::ONE, sink);
+                }
+                c /= spp as f64;
+                let px = &mut row[4 * x as usize..4 * x as usize + 4];
+                px.copy_from_slice(&[c.x as f32, c.y as f32, c.z as f32, 1.0]);
             }
-            c /= spp as f64;
-            let px = &mut row[4 * x as usize..4 * x as usize + 4];
-            px.copy_from_slice(&[c.x as f32, c.y as f32, c.z as f32, 1.0]);
-        }
-    });
-    if tracer.progressive {
-        let mut points: Vec<ppm::HitPoint> = rows.into_iter().flatten().collect();
-        ppm::gather(&tracer, quality, &mut points)?;
-        let passes = quality.reference.ppm_passes.max(1);
-        for p in &points {
-            let c = p.weight * p.irradiance(passes);
-            let px = &mut data[4 * p.pixel as usize..4 * p.pixel as usize + 3];
-            for k in 0..3 {
-                px[k] += c[k] as f32;
+        });
+        if tracer.progressive {
+            let mut points: Vec<ppm::HitPoint> = rows.into_iter().flatten().collect();
+            ppm::gather(&tracer, quality, &mut points)?;
+            let passes = quality.reference.ppm_passes.max(1);
+            let first = first_row as usize * width as usize;
+            for p in &points {
+                let c = p.weight * p.irradiance(passes);
+                let at = 4 * (p.pixel as usize - first);
+                for k in 0..3 {
+                    chunk[at + k] += c[k] as f32;
+                }
             }
         }
     }
