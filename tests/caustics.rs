@@ -1707,6 +1707,12 @@ fn a_mirror_and_a_glass_ball_chain_their_caustics() {
         near(&light_cube_on_floor(&ctx, &scene, &q, "panel"))
     };
     let (exact, both) = (gpu("exact"), gpu("both"));
+    // `specula plan` says where the sampled paths stop.
+    let chains = |paths: &str| {
+        let q = quality(&["caustics=splat", &format!("caustic_paths={paths}")]);
+        specula::plan::table(&plan(&scene, specula::methods::REFRACTOR_MAP, &q), &scene).contains("caustic_paths=exact follows it")
+    };
+    assert!(chains("both") && !chains("exact"), "the plan names the chain's remedy");
     eprintln!(
         "the chain's caustic at {focus:.3}: light tracer {truth:.4} W within 0.15 m (of {total:.4} W on three bounces or more), GPU exact {exact:.4} W, both {both:.4} W"
     );

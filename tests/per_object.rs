@@ -274,7 +274,10 @@ fn auto_is_as_good_as_the_best_single_method() {
     thin.meshes.iter_mut().find(|m| m.name == "mirror").unwrap().material = pane;
     let demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     // Each scene with auto's measured PSNR (72×48, cube_size 64).
-    let scenes = [("mirror", keep("glass"), 42.26), ("thin", thin, 40.83), ("mirror+glass", full, 36.29), ("demo", demo, 31.25)];
+    // The demo's 31.25 became 26.06 when the reference's caustics converged (progressive photon
+    // mapping, 2026-12-07): its focus, sharp at one sample a pixel, is where every method's
+    // light cube is blurred (refractor-map 26.05, the methods within 0.74 dB of each other).
+    let scenes = [("mirror", keep("glass"), 42.26), ("thin", thin, 40.83), ("mirror+glass", full, 36.29), ("demo", demo, 26.06)];
     for (name, scene, measured) in &scenes {
         let reference = render_reference(scene, &quality(&["spp=1"]), (w, h)).unwrap();
         let psnr = |img: &ImageData| metrics::compare(img, &reference).unwrap().psnr;
@@ -304,7 +307,7 @@ fn auto_is_as_good_as_the_best_single_method() {
         // Measured (72×48, cube_size 64) with the rule-based planner of issue 14: mirror 42.26
         // = proxy-box (the room is its own proxy box; distance 42.05); glass 41.31 =
         // refractor-map; thin 40.83 = proxy-box; mirror+glass 36.29 vs refractor-map 33.54;
-        // demo 31.25 = refractor-map. The measuring planner (issue 31) ray traces each of
+        // demo 31.25 = refractor-map (26.06 = 26.05 against the converged caustics). The measuring planner (issue 31) ray traces each of
         // them on lavapipe: at least those floors.
         assert!(auto >= best.1 - 0.5, "{name}: auto {auto} vs best {best:?}");
         // auto's own floor, 1 dB under its measured PSNR (tests/README.md rule 1).

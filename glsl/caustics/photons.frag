@@ -24,7 +24,8 @@
 // reflected (R), k ≥ 2: refracted in, k − 1 internal reflections, refracted out (T·Rᵏ⁻¹·T),
 // each interface weighted by its Fresnel factor (total internal reflection by 1, and a
 // branch that would transmit there carries nothing); then every specular surface it meets
-// (mirrors reflect, dielectrics transmit, or reflect totally) up to EXACT_BOUNCES, to the
+// (mirrors reflect, dielectrics transmit, or reflect totally) up to the recursion depth
+// (caustic.exact_bounces, the depth knob, as the reference's photons), to the
 // first diffuse hit.
 #include "distance/refractor/trace.glsl"
 #include "caustics/photon_map.glsl"
@@ -55,8 +56,6 @@ float photon_ior(Material m) {
 #ifdef EXACT_PATHS
 #include "raytrace/ray_query.glsl"
 
-// Specular surfaces a photon passes after its generator before it is given up.
-const uint EXACT_BOUNCES = 8u;
 
 // The shading normal and material (and its index) at hit h of a ray along d.
 void exact_surface(RayHit h, vec3 d, out vec3 n, out Material m, out uint material) {
@@ -201,7 +200,7 @@ void main() {
         }
     }
     // On to the first diffuse surface, through every specular one on the way.
-    for (uint bounce = 0u; bounce <= EXACT_BOUNCES; ++bounce) {
+    for (uint bounce = 0u; bounce <= caustic.exact_bounces; ++bounce) {
         if (all(lessThan(w, vec3(1e-6)))) return;
         float len;
         RayHit h = photon_next(pos, dir, skip, medium, len);

@@ -11,8 +11,9 @@ knobs! {
         /// edge of each shadow distance map face
         shadow_size: u32 = 512, count(16..=4096, "texels");
         /// specular recursion depth R of the exact renderers (the reference, ray tracing) and of the planar views of planar-mirror
-        /// and planar-refraction (mirrors in mirrors, a face's refraction in, internal reflections, refraction out): paths still
-        /// specular after R bounces end black; the default is converged for glass
+        /// and planar-refraction (mirrors in mirrors, a face's refraction in, internal reflections, refraction out), and of
+        /// caustic_paths=exact's photons after their generator (chains: light → mirror → glass → floor): paths still specular
+        /// after R bounces end black; the default is converged for glass
         depth: u32 = 16, count(1..=64, "bounces");
         /// graded media (survey §6.5: a dielectric whose index varies, `extras.specula.graded_index`): the most a ray turns in one
         /// RK4 step of the ray equation through it, in the ray tracers and caustic_paths=exact's photons (the chords between steps

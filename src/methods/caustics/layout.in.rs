@@ -55,7 +55,10 @@ gpu_structs! {
         atlas_meshes: uint,
         /// caustic_space=texture: edge of the light map (texels)
         light_map_size: uint,
-        pad: [uint; 3],
+        /// caustic_paths=exact: the specular surfaces a photon passes after its generator
+        /// before it is given up (the depth knob, as the reference's photons)
+        exact_bounces: uint,
+        pad: [uint; 2],
     }
 }
 

@@ -403,6 +403,13 @@ pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
             .collect();
         s += &format!("\n  generator  {} lit by {}", g.name, lights.join(", "));
     }
+    // Chains (light → mirror → glass → floor): the sampled paths end at the first surface of
+    // the receivers' distance map, specular or not.
+    let specular = scene.meshes.iter().filter(|m| !m.hidden && scene.materials[m.material].kind.is_specular()).count();
+    if specular > 1 && q.caustics.caustic_paths != CausticPaths::Exact {
+        s += "\n  chains     a photon that meets another specular object after its generator stops there (sampled paths); \
+              caustic_paths=exact follows it through every specular surface up to the depth knob";
+    }
     s
 }
 

@@ -97,7 +97,8 @@ pub fn table(
         medium_turn: q.frame.medium_turn,
         atlas_meshes: 4 * scene.meshes.len() as u32,
         light_map_size: q.caustics.light_map_size,
-        pad: [0; 3],
+        exact_bounces: q.frame.depth,
+        pad: [0; 2],
     };
     let cubes = plan
         .cubes
