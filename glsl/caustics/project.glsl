@@ -16,6 +16,20 @@
 #include "caustics/photon_map.glsl"
 #endif
 
+// caustic_space=texture: the scene triangle (its index in the scene's list) the fragment being
+// shaded lies on, set by CAUSTIC_TRIANGLE_HERE in the CAUSTICS_TEXTURE variants of the passes
+// that draw the surface they shade (gl_PrimitiveID: the geometryShader feature, which texture
+// space needs); none elsewhere, where caustic_irradiance then gives none.
+const uint NO_CAUSTIC_TRIANGLE = 0xffffffffu;
+uint caustic_triangle = NO_CAUSTIC_TRIANGLE;
+#ifdef CAUSTICS_TEXTURE
+#define CAUSTIC_TRIANGLE_HERE() caustic_triangle = floatBitsToUint(caustic_atlas[4u * push.object + 3u].x) + uint(gl_PrimitiveID)
+#else
+#define CAUSTIC_TRIANGLE_HERE()
+#endif
+
+vec3 caustic_texture_irradiance(uint tri, vec3 p, vec3 towards);
+
 // n: the receiver's normal on the side it is seen from.
 vec3 caustic_irradiance(vec3 p, vec3 n) {
     vec3 e = vec3(0.0);
@@ -27,8 +41,11 @@ vec3 caustic_irradiance(vec3 p, vec3 n) {
     if ((caustic.flags & CAUSTIC_PHOTON_MAP) != 0u) return e;  // gathered by the camera's passes only
 #endif
     // Screen space: only the camera's own surfaces (caustic_screen_irradiance) get caustics;
-    // texture space: the camera's and the ray tracers' (caustic_texture_irradiance).
-    if ((caustic.flags & (CAUSTIC_SCREEN_SPACE | CAUSTIC_TEXTURE_SPACE)) != 0u) return e;
+    // texture space: the surfaces whose triangle the pass knows.
+    if ((caustic.flags & CAUSTIC_TEXTURE_SPACE) != 0u) {
+        return caustic_triangle == NO_CAUSTIC_TRIANGLE ? e : caustic_texture_irradiance(caustic_triangle, p, n);
+    }
+    if ((caustic.flags & CAUSTIC_SCREEN_SPACE) != 0u) return e;
     float texel = 2.0 / float(caustic.cube_size);
     for (uint g = 0u; g < count; ++g) {
         vec3 w = p - cubes[g].centre.xyz;

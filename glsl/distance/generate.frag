@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: INTER_OBJECT PLANAR
+// variants: INTER_OBJECT PLANAR CAUSTICS_TEXTURE INTER_OBJECT_TEXTURE PLANAR_TEXTURE
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
 // the reference point (not window-space z); also image-based reflections' captures (§3.3)
 // and (PLANAR: the depth along an orthographic view's direction) displacement-mapped
@@ -10,7 +10,15 @@
 // refracted in their refractor map (§4.4). The inter-object paths are compiled only into
 // the INTER_OBJECT variant, which the frames that run inter-object cycles use: the other
 // maps see the environment map alone, and their pipeline compiles in a small part of the
-// time (the searches of every other object's maps are most of the shader).
+// time (the searches of every other object's maps are most of the shader). The *_TEXTURE
+// variants (caustic_space=texture) also read the receivers' light map at the fragment's triangle.
+#if defined(INTER_OBJECT_TEXTURE)
+#define INTER_OBJECT
+#define CAUSTICS_TEXTURE
+#elif defined(PLANAR_TEXTURE)
+#define PLANAR
+#define CAUSTICS_TEXTURE
+#endif
 #include "distance/refractor/trace.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -20,6 +28,7 @@ layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_radiance_distance;
 
 void main() {
+    CAUSTIC_TRIANGLE_HERE();
     Object o = objects[push.object];
     Material m = materials[o.material];
     vec3 n = normalize(in_normal);

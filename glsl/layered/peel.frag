@@ -1,12 +1,14 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: CAUSTICS_TEXTURE
 // layered.peel (survey §4.5, UPSK07): layer k of the multi-layer distance map, the k-th
 // surface along each texel's ray from the map's reference point, by depth peeling
 // (Everitt): a fragment survives only behind the previous layer's depth at its texel.
 // A texel holds the Euclidean distance from the reference point and the normal; a diffuse
 // surface its reflected radiance (the shading every map uses, shadows included), a
 // specular one its material (index + 1: Fresnel from ν, κ per channel or the dielectric's
-// ν), so that the search can continue the ray there.
+// ν), so that the search can continue the ray there. CAUSTICS_TEXTURE (caustic_space=texture):
+// diffuse surfaces read the receivers' light map at their triangle.
 #include "common/shading.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -23,6 +25,7 @@ void main() {
         // Reversed-Z: nearer is greater; keep what lies behind the previous layer.
         if (!(gl_FragCoord.z < previous * (1.0 - LAYERED_PEEL_EPSILON))) discard;
     }
+    CAUSTIC_TRIANGLE_HERE();
     Object o = objects[push.object];
     Material m = materials[o.material];
     vec3 n = normalize(in_normal);

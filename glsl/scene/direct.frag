@@ -1,8 +1,11 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
+// variants: CAUSTICS_TEXTURE
 // scene.direct: non-specular surfaces (emission + Lambertian direct light with shadows).
 // The same shader fills environment maps, where specular objects other than the map's
 // owner have no map of their own yet: they reflect and refract the environment map.
+// CAUSTICS_TEXTURE (caustic_space=texture, for the environment maps): diffuse surfaces read
+// the receivers' light map at their triangle.
 #include "common/specular.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -12,6 +15,7 @@ layout(location = 3) flat in uint in_view;
 layout(location = 0) out vec4 out_color;
 
 void main() {
+    CAUSTIC_TRIANGLE_HERE();
     Object o = objects[push.object];
     Material m = materials[o.material];
     vec3 n = normalize(in_normal);

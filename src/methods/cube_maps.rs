@@ -161,11 +161,17 @@ impl CubeMaps {
             maps.push_image(self.kind.slot(), image);
         }
         self.depth = cube_depth(ctx, &format!("{base}.depth"), size, self.mode)?;
-        let (sky, surface) = match self.kind {
-            MapKind::Radiance => ("scene/sky.frag", "scene/direct.frag"),
-            MapKind::Distance if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
-            MapKind::Distance | MapKind::Captures => ("distance/sky.frag", "distance/generate.frag"),
-            MapKind::Relief => ("distance/sky.frag", "distance/generate.frag#PLANAR"),
+        // caustic_space=texture: the variants that read the receivers' light map.
+        let texture = crate::methods::caustics::project::texture_space(plan);
+        let (sky, surface) = match (self.kind, texture) {
+            (MapKind::Radiance, false) => ("scene/sky.frag", "scene/direct.frag"),
+            (MapKind::Radiance, true) => ("scene/sky.frag", "scene/direct.frag#CAUSTICS_TEXTURE"),
+            (MapKind::Distance, false) if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
+            (MapKind::Distance, true) if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT_TEXTURE"),
+            (MapKind::Distance | MapKind::Captures, false) => ("distance/sky.frag", "distance/generate.frag"),
+            (MapKind::Distance | MapKind::Captures, true) => ("distance/sky.frag", "distance/generate.frag#CAUSTICS_TEXTURE"),
+            (MapKind::Relief, false) => ("distance/sky.frag", "distance/generate.frag#PLANAR"),
+            (MapKind::Relief, true) => ("distance/sky.frag", "distance/generate.frag#PLANAR_TEXTURE"),
         };
         let formats = [format];
         let desc = |name: &'static str, vertex, fragment, vertex_input, depth_test| GraphicsDesc {

@@ -40,7 +40,7 @@ knobs! {
         /// space (LC04, WD06b; caustics=splat): splatted straight onto the camera's image of the receivers, depth-tested against
         /// it, so that caustics seen in mirrors or through glass are missing; or in texture space (SKALP05; caustics=splat): each
         /// photon splatted at its receiver's light-map coordinates (an atlas of charts the library cuts, light_map_size²), read
-        /// back by the camera's diffuse surfaces and the ray tracers' diffuse hits (not by the map passes); it leaks where a
+        /// back wherever a pass draws or hits a diffuse surface (not by the curved reflector's virtual objects); it leaks where a
         /// splat's texture-space neighbourhood is hidden from the generator. Needs the device's geometryShader feature
         /// (gl_PrimitiveID in fragment shaders)
         caustic_space: CausticSpace = "cube", one_of()["cube" => CausticSpace::Cube, "light" => CausticSpace::Light, "screen" => CausticSpace::Screen, "texture" => CausticSpace::Texture];

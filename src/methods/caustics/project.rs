@@ -29,7 +29,7 @@ impl CausticsProject {
                 vertex: "scene/mesh.vert",
                 fragment: match init.plan.caustics.as_ref() {
                     _ if photon_map(init) => "caustics/project.frag#CAUSTICS_PHOTON_MAP",
-                    Some(c) if c.space == crate::quality::CausticSpace::Texture => "caustics/project.frag#CAUSTICS_TEXTURE",
+                    _ if texture_space(init.plan) => "caustics/project.frag#CAUSTICS_TEXTURE",
                     _ => "caustics/project.frag",
                 },
                 vertex_input: VertexInput::Mesh,
@@ -80,6 +80,12 @@ impl Stage for CausticsProject {
         destroy_pipelines(ctx, &mut [self.pipeline]);
         self.pipeline = vk::Pipeline::null();
     }
+}
+
+/// Whether the plan's caustics are stored in texture space (SKALP05), which the passes that
+/// shade diffuse surfaces read in their `CAUSTICS_TEXTURE` variants.
+pub fn texture_space(plan: &crate::plan::types::Plan) -> bool {
+    plan.caustics.as_ref().is_some_and(|c| c.space == crate::quality::CausticSpace::Texture)
 }
 
 /// Whether the plan's caustics are the photon map, whose gather only the passes' variants

@@ -124,7 +124,11 @@ impl LayeredMaps {
             &GraphicsDesc {
                 name: "layered.peel",
                 vertex: "scene/mesh.vert",
-                fragment: "layered/peel.frag",
+                fragment: if crate::methods::caustics::project::texture_space(init.plan) {
+                    "layered/peel.frag#CAUSTICS_TEXTURE"
+                } else {
+                    "layered/peel.frag"
+                },
                 vertex_input: VertexInput::Mesh,
                 color_formats: &formats,
                 depth_format: Some(DEPTH_FORMAT),
