@@ -610,6 +610,12 @@ fn texture_space_leaks_under_the_plate() {
     assert!(under.len() >= 40 && c.abs() < 1e-3, "cube space keeps the shadow dark: {c}");
     assert!(leaks[0] > 0.2736 / 1.122 && leaks[2].abs() < 1e-3, "texture space leaks at 64² texels, not at 1024²: {leaks:?}");
 
+    // `specula plan` says what the light map holds: the floor's and the plate's charts.
+    let text = specula::plan::table(
+        &plan(&scene, specula::methods::REFRACTOR_MAP, &quality(&["caustics=splat", "caustic_space=texture"])),
+        &scene,
+    );
+    assert!(text.contains("light map of the receivers' 2 chart(s)"), "{text}");
     // The charts follow their objects: the plate moved and turned over two frames renders as
     // a fresh renderer of the moved scene does (the light map's charts in object space).
     let q = quality(&["caustics=splat", "caustic_space=texture"]);

@@ -353,7 +353,14 @@ pub fn bytes(p: &CausticsPlan, q: &Quality) -> u64 {
 /// What `specula plan` says of it.
 pub fn describe(p: &CausticsPlan, q: &Quality, scene: &Scene) -> String {
     let store = if p.space == CausticSpace::Texture {
-        format!("a {}² RGBA32F light map of the receivers' charts", q.caustics.light_map_size)
+        // The atlas the stage builds: its texel is how far a splat's leak reaches.
+        match atlas::Atlas::build(scene, q.caustics.light_map_size, atlas::gutter()) {
+            Ok(a) => format!(
+                "a {}² RGBA32F light map of the receivers' {} chart(s), a texel {:.3e} object units",
+                q.caustics.light_map_size, a.charts, a.texel
+            ),
+            Err(e) => format!("a {}² RGBA32F light map: {e}", q.caustics.light_map_size),
+        }
     } else if p.space == CausticSpace::Screen {
         "a camera-sized RGBA32F irradiance image".to_string()
     } else if p.light_cubes() {
