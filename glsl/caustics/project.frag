@@ -6,8 +6,7 @@
 // map-generation passes project inside their own shading (common/shading.glsl).
 //
 // CAUSTICS_TEXTURE (caustic_space=texture, SKALP05): the light map at the fragment's
-// triangle (its mesh's first in the scene's list + gl_PrimitiveID: the stage's device has
-// the geometryShader feature).
+// triangle (CAUSTIC_TRIANGLE_HERE, caustics/project.glsl).
 #include "common/shading.glsl"
 
 layout(location = 0) in vec3 in_position;
@@ -23,8 +22,8 @@ void main() {
     if (dot(n, v) < 0.0) n = -n;  // two-sided, as shade_diffuse
     // Screen space: the camera's view (view 0) reads its pixel; a mirrored view gets none.
 #ifdef CAUSTICS_TEXTURE
-    uint first = floatBitsToUint(caustic_atlas[4u * push.object + 3u].x);
-    vec3 e = caustic_texture_irradiance(first + uint(gl_PrimitiveID), in_position, v);
+    CAUSTIC_TRIANGLE_HERE();
+    vec3 e = caustic_texture_irradiance(caustic_triangle, in_position, v);
 #else
     vec3 e = (caustic.flags & CAUSTIC_SCREEN_SPACE) == 0u ? caustic_irradiance(in_position, n)
            : in_view == 0u                          ? caustic_screen_irradiance(ivec2(gl_FragCoord.xy), n, normalize(v))

@@ -127,7 +127,17 @@ impl Atlas {
 
     /// The `vec4`s of `CausticAtlas` (the module's comment), and how many lead (4 a mesh).
     pub fn gpu_words(&self) -> (Vec<[f32; 4]>, u32) {
-        let mut out = Vec::with_capacity(4 * (self.meshes.len() + self.triangles.len()));
+        let mut out = self.mesh_words();
+        out.reserve(4 * self.triangles.len());
+        for t in &self.triangles {
+            out.extend_from_slice(t);
+        }
+        (out, 4 * self.meshes.len() as u32)
+    }
+
+    /// The leading `vec4`s alone (four a mesh: what a move rewrites).
+    pub fn mesh_words(&self) -> Vec<[f32; 4]> {
+        let mut out = Vec::with_capacity(4 * self.meshes.len());
         for e in &self.meshes {
             let inv = object_space(e.world);
             let rows = inv.transpose();
@@ -141,10 +151,7 @@ impl Atlas {
             let area = (self.texel * scale).powi(2) as f32;
             out.push([f32::from_bits(e.first), area, if e.receiver { 1.0 } else { 0.0 }, 0.0]);
         }
-        for t in &self.triangles {
-            out.extend_from_slice(t);
-        }
-        (out, 4 * self.meshes.len() as u32)
+        out
     }
 
     /// Bytes the GPU copy holds.

@@ -617,8 +617,7 @@ impl Stage for CausticsStage {
         // Texture space: the charts follow their objects (the per-mesh rows).
         if let (Some(atlas), Some(b)) = (self.atlas.as_mut(), maps.buffer_mut(&CAUSTIC_ATLAS)) {
             atlas.follow(init.scene);
-            let (words, lead) = atlas.gpu_words();
-            b.write(bytemuck::cast_slice::<[f32; 4], u8>(&words[..lead as usize]))?;
+            b.write(bytemuck::cast_slice::<[f32; 4], u8>(&atlas.mesh_words()))?;
         }
         Ok(())
     }
