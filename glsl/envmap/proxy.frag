@@ -7,6 +7,7 @@
 // up in the direction of the proxy hit.
 #include "common/specular.glsl"
 #include "envmap/proxy.glsl"
+#include "envmap/cube.glsl"
 
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
@@ -35,11 +36,10 @@ void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
-    float layer = float(o.envmap_layer);
-    vec3 c = s.fr * textureLod(envmaps, vec4(proxy_direction(o, in_position, s.r), layer), 0.0).rgb;
+    vec3 c = s.fr * own_cube(o, proxy_direction(o, in_position, s.r));
     vec3 refracted;
     REFRACTED_RADIANCE(refracted, m, s,
-                       chord_transmittance(o, m, in_position, normalize(in_normal), dir) * textureLod(envmaps, vec4(proxy_direction(o, in_position, dir), layer), 0.0).rgb);
+                       chord_transmittance(o, m, in_position, normalize(in_normal), dir) * own_cube(o, proxy_direction(o, in_position, dir)));
     c += refracted;
     out_color = vec4(c, 1.0);
 }

@@ -3,8 +3,10 @@
 // variants: PER_SAMPLE
 // envmap.shade: classic environment mapping (survey §3, §3.1). The reflected and the
 // refracted direction look the object's cube map up, ignoring the ray origin; the
-// radiances are weighted by the Fresnel function (survey eq. 1).
+// radiances are weighted by the Fresnel function (survey eq. 1). The cube is the object's
+// radiance cube, or its distance map where composition draws it so (envmap/cube.glsl).
 #include "common/specular.glsl"
+#include "envmap/cube.glsl"
 
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
@@ -16,10 +18,9 @@ void main() {
     Object o = objects[push.object];
     Material m = materials[o.material];
     SpecularSplit s = specular_split(m, in_position, normalize(in_normal), views[in_view].eye.xyz);
-    float layer = float(o.envmap_layer);
-    vec3 c = s.fr * textureLod(envmaps, vec4(s.r, layer), 0.0).rgb;
+    vec3 c = s.fr * own_cube(o, s.r);
     vec3 refracted;
-    REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, normalize(in_normal), dir) * textureLod(envmaps, vec4(dir, layer), 0.0).rgb);
+    REFRACTED_RADIANCE(refracted, m, s, chord_transmittance(o, m, in_position, normalize(in_normal), dir) * own_cube(o, dir));
     c += refracted;
     out_color = vec4(c, 1.0);
 }

@@ -45,6 +45,12 @@ knobs! {
         /// frames over time: regenerate a map only when the objects, materials or lights it depends on changed, or every frame
         /// (benchmarks)
         map_updates_always as map_updates: bool = "on_change", one_of()["on_change" => false, "always" => true];
+        /// how each specular object of a per-object plan shows in the other objects' maps: on, by its own method's maps (traced
+        /// in a distance map of its own, self refracted through its refractor map, an environment-mapped object's cube drawn as
+        /// a distance map), with the inter-object cycles that needs (`specula plan` names the shading per pair of objects in
+        /// view); off, as a reflection of the environment map alone (no map or cycle for it: black in a closed room). A
+        /// whole-scene method keeps its own behaviour either way
+        compose: bool = "on", one_of()["on" => true, "off" => false];
         /// test knob (never for images): flip_reflection breaks the distance method on purpose (and distance-multi, which shares
         /// its camera pass distance.search, §4.2), the pass tracing the reflected ray's opposite direction, so that tests can check
         /// that the per-object errors see a broken method and the rest of the image does not move (issue 15); the C ABI's string

@@ -196,6 +196,12 @@ pub struct Family {
     /// reflectors: their environment's specular objects), so that composition gives those
     /// objects maps as it does beside a distance-mapped object.
     pub shows_others_by_maps: &'static [Method],
+    /// Its methods whose one map per object is a radiance cube that composition draws as a
+    /// distance map instead (environment mapping, §3: radiance with the distance beside it,
+    /// drawn in the inter-object cycles of §4.3, the other specular objects shown in it by
+    /// their own maps and the object traced in it where the others' maps show it); their
+    /// camera passes read it there (`MapShading` other than `Sky` says so).
+    pub cubes_compose: &'static [Method],
     /// Its methods that trace rays curved through graded media (survey §6.5: the ray
     /// equation marched through the medium, `scene::medium`): the only ones that serve a
     /// graded-index object.
@@ -210,8 +216,9 @@ pub struct Family {
     pub frame_part: Option<CreateFramePart>,
 }
 
-/// Which objects of a mixed plan (their methods, in order) a family composes into its maps.
-pub type Composes = fn(&[Method]) -> Vec<bool>;
+/// Which objects of a mixed plan (their methods, in order; and per object the positions of
+/// the others it sees, `plan::facts::SceneFacts::sight`) a family composes into its maps.
+pub type Composes = fn(&[Method], &[Vec<usize>]) -> Vec<bool>;
 
 /// A family's blocks of views for a plan: (name, count), in table order.
 pub type ViewBlocks = fn(&Plan) -> Vec<(&'static str, u32)>;
@@ -232,6 +239,7 @@ impl Family {
         push_words: None,
         composes: None,
         shows_others_by_maps: &[],
+        cubes_compose: &[],
         curved_rays: &[],
         describe: None,
         frame_part: None,

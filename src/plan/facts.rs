@@ -590,6 +590,13 @@ impl ObjectFacts {
 pub const MIN_COVERAGE: f32 = 0.02;
 
 impl SceneFacts {
+    /// Per object the positions (in `objects`) of the other objects it sees
+    /// (`ObjectFacts::sees`): composition's input (`registry::Composes`).
+    pub fn sight(&self) -> Vec<Vec<usize>> {
+        let sees = |f: &ObjectFacts, j: usize| self.objects[j].mesh != f.mesh && f.sees(self.objects[j].mesh);
+        self.objects.iter().map(|f| (0..self.objects.len()).filter(|&j| sees(f, j)).collect()).collect()
+    }
+
     /// Facts of every specular object. `deep`: also convexity and mutual visibility (ray
     /// casting; the planner needs them, a fixed method does not).
     pub fn new(scene: &Scene, quality: &Quality, deep: bool) -> SceneFacts {

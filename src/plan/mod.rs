@@ -27,6 +27,13 @@ impl Plan {
         self.objects.iter().find(|o| o.mesh == mesh)
     }
 
+    /// Per object (in `objects`' order) the positions of the other objects it sees
+    /// (`ObjectPlan::sees`): composition's input (`registry::Composes`).
+    pub fn sight(&self) -> Vec<Vec<usize>> {
+        let at = |m: &usize| self.objects.iter().position(|o| o.mesh == *m);
+        self.objects.iter().map(|o| o.sees.iter().filter_map(at).collect()).collect()
+    }
+
     /// The map pass named `name`, if planned.
     pub fn map(&self, name: &str) -> Option<&MapPlan> {
         self.stages.iter().find_map(|s| match s {
@@ -485,6 +492,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
             maps: Vec::new(),
             passes: Vec::new(),
             knobs: method.knobs.iter().map(|k| (*k, quality.get(k))).collect(),
+            sees: scene_facts.objects.iter().filter(|g| g.mesh != f.mesh && f.sees(g.mesh)).map(|g| g.mesh).collect(),
         });
     }
     let mut p = Plan {
@@ -524,8 +532,9 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
     // choices compose through inter-object cycles where an object's map sees a
     // self-refracting one over at least `facts::MIN_COVERAGE` of its directions.
     let self_refracting = |o: &ObjectPlan| o.method.gpu.is_some_and(|g| g.map_shading == MapShading::Refractor);
-    let composes =
-        !whole_scene && p.objects.iter().filter(|o| self_refracting(o)).any(|o| scene_facts.objects.iter().any(|f| f.sees(o.mesh)));
+    let composes = !whole_scene
+        && p.quality.frame.compose
+        && p.objects.iter().filter(|o| self_refracting(o)).any(|o| scene_facts.objects.iter().any(|f| f.sees(o.mesh)));
     // Layered maps (§4.5): one map of the whole scene, shared by the objects that take it.
     for f in FAMILIES {
         if let Some(h) = f.plan_objects {

@@ -71,6 +71,11 @@ pub struct ObjectPlan {
     pub passes: Vec<&'static str>,
     /// The knobs its method reads, with their values in force.
     pub knobs: Vec<(&'static str, String)>,
+    /// The other specular objects it sees over at least `facts::MIN_COVERAGE` of its
+    /// directions (empty for a whole-scene method, planned without mutual visibility):
+    /// composition's input (who must show right in whose map).
+    #[serde(skip)]
+    pub sees: Vec<usize>,
 }
 
 /// A map pass over all the objects that need that map.
@@ -445,6 +450,25 @@ impl PlanStages {
         });
         self.maps[k].objects.push(object.mesh);
         object.passes.push(info.name);
+    }
+
+    /// Takes map pass `pass` from `objects[k]` (composition draws its map in another pass):
+    /// the later layers of that pass move down one, the pass goes when it has no object left.
+    pub fn remove_map(&mut self, objects: &mut [ObjectPlan], k: usize, pass: &str) {
+        let Some(i) = self.maps.iter().position(|m| m.name == pass) else { return };
+        let mesh = objects[k].mesh;
+        self.maps[i].objects.retain(|&m| m != mesh);
+        objects[k].maps.retain(|m| m.pass != pass);
+        objects[k].passes.retain(|p| *p != pass);
+        for o in objects.iter_mut() {
+            let layer = self.maps[i].objects.iter().position(|&m| m == o.mesh);
+            if let (Some(m), Some(layer)) = (o.maps.iter_mut().find(|m| m.pass == pass), layer) {
+                m.layer = layer as u32;
+            }
+        }
+        if self.maps[i].objects.is_empty() {
+            self.maps.remove(i);
+        }
     }
 }
 

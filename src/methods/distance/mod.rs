@@ -170,12 +170,40 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     ..crate::methods::registry::Family::NONE
 };
 
+/// Whether `m` draws the other specular objects by their own maps: distance maps (§4.3),
+/// or a curved reflector's virtual objects (`Family::shows_others_by_maps`).
+fn shows_by_maps(m: &Method) -> bool {
+    let distance = m.gpu.is_some_and(|g| g.maps.iter().any(|i| i.name == DISTANCE_CUBES.name));
+    distance || crate::methods::FAMILIES.iter().any(|f| f.shows_others_by_maps.contains(m))
+}
+
+/// The objects of a mixed plan whose radiance cube composition draws as a distance map
+/// (`Family::cubes_compose`: environment mapping): those in view of another specular object
+/// either way — it sees one (its cube must show that object by the object's own map), or an
+/// object that shows the others by their maps sees it (it must show there by its own cube,
+/// traced in it). A converted cube shows the others by their maps, so the set grows to a
+/// fixed point. `sight[i]`: the positions of the objects that object i sees.
+pub fn cubes_converted(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
+    let cubes = |m: &Method| crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m));
+    let mut out: Vec<bool> = methods.iter().zip(sight).map(|(m, s)| cubes(m) && !s.is_empty()).collect();
+    loop {
+        let shows: Vec<bool> = methods.iter().zip(&out).map(|(m, &c)| c || shows_by_maps(m)).collect();
+        let seen = |i: usize| sight.iter().enumerate().any(|(j, s)| j != i && shows[j] && s.contains(&i));
+        let grow: Vec<usize> = (0..methods.len()).filter(|&i| !out[i] && cubes(&methods[i]) && seen(i)).collect();
+        if grow.is_empty() {
+            return out;
+        }
+        grow.into_iter().for_each(|i| out[i] = true);
+    }
+}
+
 /// The objects of `methods` that composition gives maps of their own (or shades by the
 /// distance map it keeps): a method that shades its object as the sky in maps — with no
 /// cube map of its own, or with a distance map of its own (distance, image-space
 /// refraction: single-bounce methods) — not drawn by planar views, where another object's
-/// method keeps distance maps or is a curved reflector (which shows them by their maps).
-fn composed(methods: &[Method]) -> Vec<bool> {
+/// method keeps distance maps, is a curved reflector (which shows them by their maps) or
+/// has its radiance cube drawn as a distance map (`cubes_converted`).
+fn composed(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
     let gpu = |m: &Method| m.gpu.expect("GPU method");
     let distance = |m: &Method| gpu(m).maps.iter().any(|i| i.name == DISTANCE_CUBES.name);
     let needs = |m: &Method| {
@@ -183,10 +211,8 @@ fn composed(methods: &[Method]) -> Vec<bool> {
         let own_cube = g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap));
         (!own_cube || distance(m)) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
-    // Curved reflectors show the specular objects of their environment by those objects'
-    // own maps too (`Family::shows_others_by_maps`).
-    let shows = |m: &Method| distance(m) || crate::methods::FAMILIES.iter().any(|f| f.shows_others_by_maps.contains(m));
-    let mapped: Vec<bool> = methods.iter().map(shows).collect();
+    let converted = cubes_converted(methods, sight);
+    let mapped: Vec<bool> = methods.iter().zip(&converted).map(|(m, &c)| c || shows_by_maps(m)).collect();
     let count = mapped.iter().filter(|&&d| d).count();
     // Another object than itself keeps distance maps (or draws the others by theirs).
     methods.iter().zip(&mapped).map(|(m, &d)| needs(m) && count > usize::from(d)).collect()
@@ -200,20 +226,36 @@ fn composed(methods: &[Method]) -> Vec<bool> {
 /// single-bounce method keeps one already, `distance` or `image-space-refraction`, uses
 /// that one: it showed as the sky there, black beside a mirror on distance-multi) — traced in it
 /// (a solid dielectric: refracted through its own refractor map first), as distance-multi's
-/// objects are — with the inter-object cycles that needs. Planar mirrors are drawn into the
-/// maps by their mirrored views instead (geometry family); objects with radiance cubes of
-/// their own (environment mapping) keep reflecting the sky there. A whole-scene method keeps
-/// its own behaviour, fallbacks included (what `tradeoff` and the planner's corpus measure
-/// of it): only per-object choices compose.
+/// objects are — with the inter-object cycles that needs. An environment-mapped object in
+/// view of another specular object has its radiance cube drawn as a distance map instead
+/// (`cubes_converted`: the same texels, radiance with the distance beside it), in the same
+/// cycles, so that its cube shows the others by their maps and it is traced in its cube in
+/// theirs. Planar mirrors are drawn into the maps by their mirrored views instead (geometry
+/// family). A whole-scene method keeps its own behaviour, fallbacks included (what `tradeoff`
+/// and the planner's corpus measure of it): only per-object choices compose; `compose=off`
+/// keeps every object as the environment's reflection in the others' maps.
 fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::PlanStages) {
     let whole_scene = matches!(p.choice, crate::plan::ids::Choice::Method(_)) && p.overrides.is_empty();
-    if whole_scene {
+    if whole_scene || !p.quality.frame.compose {
         return;
     }
     let methods: Vec<Method> = p.objects.iter().map(|o| o.method).collect();
-    let chosen = composed(&methods);
+    let sight = p.sight();
+    let converted = cubes_converted(&methods, &sight);
+    let chosen = composed(&methods, &sight);
     let q = p.quality.clone();
     let mut composed = false;
+    for k in (0..p.objects.len()).filter(|&k| converted[k]) {
+        for info in p.objects[k].method.gpu.map_or(&[][..], |g| g.maps) {
+            st.remove_map(&mut p.objects, k, info.name);
+        }
+        let o = &mut p.objects[k];
+        st.add_map(o, DISTANCE_CUBES.kind(), describe_cube(&q) + " (its cube, with distances: inter-object cycles)");
+        o.map_shading = MapShading::Traced;
+        o.leaves_out = LeavesOut::Itself;
+        o.reason += " · its cube drawn as a distance map in the inter-object cycles: the others shown in it by their maps, itself traced in it in theirs (§4.3)";
+        composed = true;
+    }
     for (o, _) in p.objects.iter_mut().zip(chosen).filter(|(_, c)| *c) {
         let solid = o.class == ObjectClass::SolidDielectric;
         if solid {

@@ -96,6 +96,7 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
         relief::push_words(q, layout, w);
     }),
     describe: Some(captures::describe),
+    cubes_compose: &[ENVMAP, PROXY_SPHERE, PROXY_BOX],
     ..crate::methods::registry::Family::NONE
 };
 

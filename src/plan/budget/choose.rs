@@ -43,13 +43,13 @@ pub fn choose_with(
         // (variant, whole-scene method or None for mixed, picks, rank)
         let mut best: Option<Best> = None;
         for (k, v) in variants.iter().enumerate() {
-            let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts };
+            let timing = Timing { base: v.base, quality: variant_quality(quality, &v.knobs)?, facts, sight: facts.sight() };
             let idx = search(budget, &|p| timing.frame_ms(p, false), &v.per_object);
             let mixed: Vec<Candidate> = idx.iter().zip(&v.per_object).map(|(&i, c)| c[i].clone()).collect();
             let options = std::iter::once((None, v.base, mixed)).chain(v.wholes.iter().map(|(m, b, list)| (Some(*m), *b, list.clone())));
             for (whole, base, picks) in options {
                 let refs: Vec<&Candidate> = picks.iter().collect();
-                let t = Timing { base, quality: timing.quality.clone(), facts };
+                let t = Timing { base, quality: timing.quality.clone(), facts, sight: timing.sight.clone() };
                 let r = rank(budget, t.frame_ms(&refs, whole.is_some()), &refs);
                 if best.as_ref().is_none_or(|b| better(r, b.4)) {
                     best = Some((k, whole, base, picks, r));
@@ -59,7 +59,7 @@ pub fn choose_with(
         let Some((k, whole, base, picks, r)) = best else { continue };
         let v = &variants[k];
         let q = variant_quality(quality, &v.knobs)?;
-        let timing = Timing { base, quality: q.clone(), facts };
+        let timing = Timing { base, quality: q.clone(), facts, sight: facts.sight() };
         let refs: Vec<&Candidate> = picks.iter().collect();
         let objects: Vec<ObjectPrediction> = facts
             .objects

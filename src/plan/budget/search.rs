@@ -16,6 +16,8 @@ pub(super) struct Timing<'a> {
     pub(super) base: f64,
     pub(super) quality: Quality,
     pub(super) facts: &'a SceneFacts,
+    /// `facts.sight()`: per object the positions of the others it sees.
+    pub(super) sight: Vec<Vec<usize>>,
 }
 
 impl Timing<'_> {
@@ -31,11 +33,13 @@ impl Timing<'_> {
         }
         let gpu = |m: Method| m.gpu.expect("GPU method");
         let own = picks.iter().map(|c| (gpu(c.method).cycles)(&self.quality)).max().unwrap_or(1).max(1);
-        let composes = picks
+        let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
+        let sees_refractor = picks
             .iter()
             .zip(&self.facts.objects)
-            .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)))
-            || Self::composed(picks).contains(&true);
+            .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
+        let converts = crate::methods::distance::cubes_converted(&methods, &self.sight).contains(&true);
+        let composes = self.quality.frame.compose && (sees_refractor || converts || self.composed(picks).contains(&true));
         let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
         if latency {
             1
@@ -69,7 +73,7 @@ impl Timing<'_> {
     }
 
     pub(super) fn frame_ms(&self, picks: &[&Candidate], whole: bool) -> f64 {
-        let composed = Self::composed(picks);
+        let composed = self.composed(picks);
         (0..picks.len()).map(|i| self.own_ms(picks, i, whole, &composed)).sum::<f64>()
             + self.base
             + self.kernels(picks, whole).iter().map(|(_, s)| s).sum::<f64>()
@@ -78,14 +82,14 @@ impl Timing<'_> {
     /// The picks that a mixed choice composes into another family's maps (maps of their own,
     /// `registry::Family::composes`); none when one method serves every object (planned as
     /// that whole-scene method, which keeps its own behaviour).
-    fn composed(picks: &[&Candidate]) -> Vec<bool> {
+    fn composed(&self, picks: &[&Candidate]) -> Vec<bool> {
         let mut out = vec![false; picks.len()];
-        if Self::uniform(picks) {
+        if Self::uniform(picks) || !self.quality.frame.compose {
             return out;
         }
         let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
         for f in crate::methods::FAMILIES.iter().filter_map(|f| f.composes) {
-            out.iter_mut().zip(f(&methods)).for_each(|(o, c)| *o |= c);
+            out.iter_mut().zip(f(&methods, &self.sight)).for_each(|(o, c)| *o |= c);
         }
         out
     }
@@ -122,7 +126,7 @@ impl Timing<'_> {
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
         let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
         let maps = c.fixed * self.scale(picks, c, whole);
-        (maps, self.own_ms(picks, i, whole, &Self::composed(picks)) - maps + shared / users)
+        (maps, self.own_ms(picks, i, whole, &self.composed(picks)) - maps + shared / users)
     }
 }
 
