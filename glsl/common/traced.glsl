@@ -23,6 +23,14 @@ SearchResult search_ray(vec3 x, vec3 dir) {
     return linear_search(x, dir, int(push_search_linear_steps()), int(push_search_binary_steps()), int(push_search_secant_steps()), push_search_tolerance());
 }
 
+// Object o as it shows in the other objects' maps: its cube in the distance maps at
+// shown_layer where composition gave it one apart from its own maps (image-based captures,
+// relief height maps), else at envmap_layer.
+Object as_shown(Object o) {
+    if (o.shown_layer >= 0) o.envmap_layer = o.shown_layer;
+    return o;
+}
+
 // Radiance arriving at world point p from direction dir, traced in the distance map of
 // object o (whose reference point is the map's origin).
 vec3 traced_radiance(Object o, vec3 p, vec3 dir) {

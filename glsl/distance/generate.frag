@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: INTER_OBJECT PLANAR CAUSTICS_TEXTURE INTER_OBJECT_TEXTURE PLANAR_TEXTURE
+// variants: INTER_OBJECT PLANAR CAUSTICS_TEXTURE INTER_OBJECT_TEXTURE PLANAR_TEXTURE PLANAR_INTER_OBJECT PLANAR_INTER_OBJECT_TEXTURE
 // distance.generate: a distance map (survey §4): radiance and the Euclidean distance from
 // the reference point (not window-space z); also image-based reflections' captures (§3.3)
 // and (PLANAR: the depth along an orthographic view's direction) displacement-mapped
@@ -12,12 +12,21 @@
 // maps see the environment map alone, and their pipeline compiles in a small part of the
 // time (the searches of every other object's maps are most of the shader). The *_TEXTURE
 // variants (caustic_space=texture) also read the receivers' light map at the fragment's triangle.
+// Image-based captures and relief height maps of a plan with inter-object cycles take the
+// INTER_OBJECT variants too, drawn after the cycles from the last one's distance maps.
 #if defined(INTER_OBJECT_TEXTURE)
 #define INTER_OBJECT
 #define CAUSTICS_TEXTURE
 #elif defined(PLANAR_TEXTURE)
 #define PLANAR
 #define CAUSTICS_TEXTURE
+#elif defined(PLANAR_INTER_OBJECT_TEXTURE)
+#define PLANAR
+#define INTER_OBJECT
+#define CAUSTICS_TEXTURE
+#elif defined(PLANAR_INTER_OBJECT)
+#define PLANAR
+#define INTER_OBJECT
 #endif
 #include "distance/refractor/trace.glsl"
 
@@ -39,6 +48,7 @@ void main() {
     } else {
         SpecularSplit s = specular_split(m, in_position, n, eye);
 #ifdef INTER_OBJECT
+        o = as_shown(o);
         bool inter = (push.flags & FLAG_INTER_OBJECT) != 0u && o.map_shading != MAP_SHADING_SKY;
         if (inter && (push.flags & FLAG_FIRST_CYCLE) != 0u) {
             c = vec3(0.0);

@@ -33,7 +33,7 @@ void main() {
         float den = 2.0 * (dot(d, d) + dot(d, ep));
         float t = abs(den) > 1e-30 ? (dot(d, d) - dot(ep, ep)) / den : 1.0;
         eye += clamp(t, 0.0, 1.0) * d;
-        Object o = objects[push.object];
+        Object o = as_shown(objects[push.object]);
         SpecularSplit s = specular_split(m, in_position, n, eye);
         bool own = o.map_shading != MAP_SHADING_SKY && o.envmap_layer >= 0;
         if (own && o.map_shading == MAP_SHADING_REFRACTOR && o.refractor_layer >= 0) {

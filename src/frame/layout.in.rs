@@ -70,6 +70,11 @@ gpu_structs! {
         /// how it looks in other objects' distance maps: MAP_SHADING_* (`MapShading::code()`
         /// of its method)
         map_shading: uint,
+        /// cube index in the distance maps of the map composition gives an object whose own maps
+        /// are not that one cube (image-based captures, relief height maps), for how it shows in
+        /// the other objects' maps (`LayerField::Shown`); -1: none (`envmap_layer` is that cube)
+        shown_layer: int,
+        pad: [uint; 3],
         /// xyz; w: proxy sphere radius (§3.2)
         reference_point: vec4,
         /// proxy box (§3.2), world space

@@ -59,4 +59,7 @@ pub enum LayerField {
     Envmap,
     /// `refractor_layer`: the refractor maps (set 1, binding 1).
     Refractor,
+    /// `shown_layer`: the distance cube composition gives an object whose own maps are not
+    /// that cube (image-based captures, relief height maps), for how it shows in the others'.
+    Shown,
 }

@@ -68,6 +68,10 @@ pub struct CubeMaps {
     cycles: u32,
     frame_latency: bool,
     inter_object: bool,
+    /// Captures and height maps of a plan with inter-object cycles (after the distance maps):
+    /// the other specular objects drawn by their own maps, read from the last cycle's
+    /// distance maps (composition, §4.3 across families).
+    shows_by_maps: bool,
     /// Frames recorded so far (frame-latency mode reads the previous frame's maps).
     frames: u64,
     /// Mesh draws the last frame recorded per cube face (per-face culling), over all cubes.
@@ -122,6 +126,7 @@ impl CubeMaps {
             cycles: plan.cycles.max(1),
             frame_latency: plan.frame_latency && inter_object,
             inter_object,
+            shows_by_maps: matches!(kind, MapKind::Captures | MapKind::Relief) && plan.inter_object,
             frames: 0,
             face_draws: [0; 6],
             deps: crate::frame::cube_deps::FaceDeps::new(objects.len()).leaving_out(
@@ -168,6 +173,10 @@ impl CubeMaps {
             (MapKind::Radiance, true) => ("scene/sky.frag", "scene/direct.frag#CAUSTICS_TEXTURE"),
             (MapKind::Distance, false) if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
             (MapKind::Distance, true) if self.inter_object => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT_TEXTURE"),
+            (MapKind::Captures, false) if self.shows_by_maps => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT"),
+            (MapKind::Captures, true) if self.shows_by_maps => ("distance/sky.frag", "distance/generate.frag#INTER_OBJECT_TEXTURE"),
+            (MapKind::Relief, false) if self.shows_by_maps => ("distance/sky.frag", "distance/generate.frag#PLANAR_INTER_OBJECT"),
+            (MapKind::Relief, true) if self.shows_by_maps => ("distance/sky.frag", "distance/generate.frag#PLANAR_INTER_OBJECT_TEXTURE"),
             (MapKind::Distance | MapKind::Captures, false) => ("distance/sky.frag", "distance/generate.frag"),
             (MapKind::Distance | MapKind::Captures, true) => ("distance/sky.frag", "distance/generate.frag#CAUSTICS_TEXTURE"),
             (MapKind::Relief, false) => ("distance/sky.frag", "distance/generate.frag#PLANAR"),
@@ -303,7 +312,9 @@ impl Stage for CubeMaps {
         if self.frame_latency && seen {
             self.frames = 0;
         }
-        if self.every_face() {
+        if self.every_face() || (self.shows_by_maps && seen) {
+            // Maps that show the others by the distance maps: whatever changed may have
+            // changed those.
             self.deps.all();
         } else if self.kind == MapKind::Relief {
             // Height maps: orthographic views over the whole box, every face of a layer that
@@ -341,8 +352,10 @@ impl Stage for CubeMaps {
             pass = pass.writes(m, Access::ColorAttachment);
         }
         // Distance maps bind the generation sets: what they hold besides these images.
-        let generation = io.maps.generation_reads().filter(|_| self.kind == MapKind::Distance);
-        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(generation) {
+        let generation = io.maps.generation_reads().filter(|_| self.kind == MapKind::Distance || self.shows_by_maps);
+        // Captures and height maps shown by maps read the last cycle's distance maps.
+        let last_cycle = io.maps.image(MapKind::Distance.slot()).filter(|_| self.shows_by_maps);
+        for img in io.scene_images.iter().copied().chain(io.maps.shadow_reads()).chain(generation).chain(last_cycle) {
             pass = pass.reads(img, Access::FragmentSampled);
         }
         let open = pass.begin();
@@ -360,14 +373,25 @@ impl Stage for CubeMaps {
             let read = (write + 1) % count;
             // The first cycle ever (or of this frame, without latency) has no maps to read.
             let first = if self.frame_latency { self.frames == 0 } else { cycle == 0 };
-            let flags = if self.inter_object { FLAG_INTER_OBJECT | if first { FLAG_FIRST_CYCLE } else { 0 } } else { 0 };
+            let flags = if self.inter_object {
+                FLAG_INTER_OBJECT | if first { FLAG_FIRST_CYCLE } else { 0 }
+            } else if self.shows_by_maps {
+                FLAG_INTER_OBJECT
+            } else {
+                0
+            };
             if self.inter_object && !first {
                 rec.barrier(&mut images[read], Access::FragmentSampled);
             }
             rec.barrier(&mut images[write], Access::ColorAttachment);
             let (target, depth) = (&images[write], &mut self.depth);
-            let read_set =
-                if self.inter_object && !first { io.sets.generate.get(read).copied().unwrap_or(io.sets.empty) } else { io.sets.empty };
+            let read_set = if self.inter_object && !first {
+                io.sets.generate.get(read).copied().unwrap_or(io.sets.empty)
+            } else if self.shows_by_maps {
+                io.sets.generate.get(io.maps.latest).copied().unwrap_or(io.sets.empty)
+            } else {
+                io.sets.empty
+            };
             let uses_maps = self.kind != MapKind::Radiance;
             let clear = [0.0, 0.0, 0.0, if uses_maps { 1e30 } else { 0.0 }];
             let block = self.view_block.and_then(|b| io.views.first(b));

@@ -684,11 +684,59 @@ pub fn table(p: &Plan, scene: &Scene) -> String {
         let knobs: Vec<String> = o.knobs.iter().map(|(k, v)| format!("{k}={v}")).collect();
         let _ = writeln!(s, "  knobs      {}", if knobs.is_empty() { "-".into() } else { knobs.join(" ") });
     }
+    let pairs = in_view(p, scene);
+    if !pairs.is_empty() {
+        let _ = writeln!(s, "\nin view (how each object shows in the view of another that sees it):");
+        for l in &pairs {
+            let _ = writeln!(s, "  {l}");
+        }
+    }
     for d in FAMILIES.iter().filter_map(|f| f.describe).filter_map(|h| h(p, scene)) {
         let _ = writeln!(s, "\n{d}");
     }
     let _ = writeln!(s, "\nmaps: {:.2} MiB", p.map_bytes() as f64 / (1 << 20) as f64);
     s
+}
+
+/// Per pair of objects where one sees the other (`ObjectPlan::sees`), how the seen one
+/// shows in the viewer's view and why (issue 33's contract): traced by the viewer's rays,
+/// drawn by its own method in the viewer's mirrored views, found in the shared layered map,
+/// or — in the viewer's maps — by its map shading.
+pub fn in_view(p: &Plan, scene: &Scene) -> Vec<String> {
+    let whole_scene = matches!(p.choice, Choice::Method(_)) && p.overrides.is_empty();
+    let mut out = Vec::new();
+    for a in &p.objects {
+        for b in a.sees.iter().filter_map(|&m| p.object(m)) {
+            let g = a.method.gpu;
+            let graded = scene.materials[scene.meshes[b.mesh].material].graded.is_some();
+            let how = if g.is_none() || a.method.family == "raytrace" {
+                "traced by its rays, exactly (the ray pipeline)".to_string()
+            } else if g.is_some_and(|g| (g.views)(&p.quality) > 0) {
+                format!("drawn by its own method ({}) in the mirrored views", b.method.name)
+            } else if g.is_some_and(|g| g.leaves_out == LeavesOut::Nothing) {
+                "found in the shared layered map (the whole scene, peeled), shaded there as the environment's reflection".to_string()
+            } else {
+                let by_map = match b.map_shading {
+                    MapShading::Sky if whole_scene => "as the environment map's reflection (a whole-scene method keeps its own behaviour)",
+                    MapShading::Sky if !p.quality.frame.compose => "as the environment map's reflection (compose=off)",
+                    MapShading::Sky if p.map_mirrors.contains(&b.mesh) => "by its mirrored view inside the map (one reflection deep)",
+                    MapShading::Sky => "as the environment map's reflection (no map of its own planned)",
+                    MapShading::Traced => "traced in its own distance map of the previous cycle (§4.3)",
+                    MapShading::Refractor => "refracted through its refractor map, then traced in its distance map (§4.4, §4.3)",
+                };
+                format!("in its maps {by_map}")
+            };
+            let straight =
+                if graded { "; its graded index as a uniform one (straight rays inside: maps do not march the ray equation)" } else { "" };
+            out.push(format!(
+                "{} shows {}: {how}{}",
+                a.name,
+                b.name,
+                if g.is_none() || a.method.family == "raytrace" { "" } else { straight }
+            ));
+        }
+    }
+    out
 }
 
 impl Planner {

@@ -477,6 +477,41 @@ mod tests {
     use super::*;
     use glam::{Mat4, Quat};
 
+    /// Taking a map from one object moves the later layers of that pass down and drops a
+    /// pass with no object left.
+    #[test]
+    fn removing_a_map_renumbers_its_layers() {
+        let kind = crate::methods::envmap::RADIANCE_CUBES.kind();
+        let mut st = PlanStages { maps: Vec::new(), stages: Vec::new(), shades_scene: false };
+        let object = |mesh: usize| ObjectPlan {
+            mesh,
+            name: format!("o{mesh}"),
+            class: ObjectClass::Mirror,
+            method: crate::methods::ENVMAP,
+            reason: String::new(),
+            reference_point: Vec3::ZERO,
+            own_reference_point: Vec3::ZERO,
+            reference_note: None,
+            map_shading: MapShading::Sky,
+            leaves_out: LeavesOut::Itself,
+            maps: Vec::new(),
+            passes: Vec::new(),
+            knobs: Vec::new(),
+            sees: Vec::new(),
+        };
+        let mut objects: Vec<ObjectPlan> = (0..3).map(object).collect();
+        for o in &mut objects {
+            st.add_map(o, kind, String::new());
+        }
+        st.remove_map(&mut objects, 0, kind.name);
+        assert_eq!(st.maps[0].objects, [1, 2]);
+        assert!(objects[0].maps.is_empty() && objects[0].passes.is_empty());
+        assert_eq!((objects[1].maps[0].layer, objects[2].maps[0].layer), (0, 1));
+        st.remove_map(&mut objects, 2, kind.name);
+        st.remove_map(&mut objects, 1, kind.name);
+        assert!(st.maps.is_empty());
+    }
+
     /// The view's motion from an anchor: a camera step as a fraction of the distance to the
     /// object, an object's turn in radians, its move over its distance; infinite when the
     /// objects change.

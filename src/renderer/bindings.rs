@@ -151,6 +151,8 @@ pub(super) fn object_table(scene: &Scene, plan: &Plan) -> Vec<GpuObject> {
                 material: m.material as u32,
                 envmap_layer: -1,
                 refractor_layer: -1,
+                shown_layer: -1,
+                pad: [0; 3],
                 map_shading: MAP_SHADING_SKY,
                 reference_point: [0.0; 4],
                 map_centre: [0.0; 4],
@@ -171,6 +173,7 @@ pub(super) fn object_table(scene: &Scene, plan: &Plan) -> Vec<GpuObject> {
             match m.layer_field {
                 Some(LayerField::Envmap) => g.envmap_layer = m.layer as i32,
                 Some(LayerField::Refractor) => g.refractor_layer = m.layer as i32,
+                Some(LayerField::Shown) => g.shown_layer = m.layer as i32,
                 None => {}
             }
         }

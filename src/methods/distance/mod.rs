@@ -199,17 +199,18 @@ pub fn cubes_converted(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
 
 /// The objects of `methods` that composition gives maps of their own (or shades by the
 /// distance map it keeps): a method that shades its object as the sky in maps — with no
-/// cube map of its own, or with a distance map of its own (distance, image-space
-/// refraction: single-bounce methods) — not drawn by planar views, where another object's
+/// cube map of its own, with a distance map of its own (distance, image-space refraction:
+/// single-bounce methods), or with maps that are not one cube (image-based captures, relief
+/// height maps: the distance map then goes to `shown_layer`) — not drawn by planar views,
+/// where another object's
 /// method keeps distance maps, is a curved reflector (which shows them by their maps) or
 /// has its radiance cube drawn as a distance map (`cubes_converted`).
 fn composed(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
     let gpu = |m: &Method| m.gpu.expect("GPU method");
-    let distance = |m: &Method| gpu(m).maps.iter().any(|i| i.name == DISTANCE_CUBES.name);
+    let cubes = |m: &Method| crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m));
     let needs = |m: &Method| {
         let g = gpu(m);
-        let own_cube = g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap));
-        (!own_cube || distance(m)) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
+        !cubes(m) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
     let converted = cubes_converted(methods, sight);
     let mapped: Vec<bool> = methods.iter().zip(&converted).map(|(m, &c)| c || shows_by_maps(m)).collect();
@@ -261,7 +262,17 @@ fn compose(_: &crate::scene::Scene, p: &mut Plan, st: &mut crate::plan::types::P
         if solid {
             st.add_map(o, REFRACTOR_CUBES.kind(), describe_cube(&q) + " (normal, distance) for the other objects' maps");
         }
-        st.add_map(o, DISTANCE_CUBES.kind(), describe_cube(&q) + " for the other objects' maps");
+        // Maps of its own that hold its envmap_layer and are not this cube (captures, height
+        // maps): the cube goes to shown_layer.
+        let apart =
+            o.method.gpu.is_some_and(|g| g.maps.iter().any(|i| i.layer_field == Some(LayerField::Envmap) && i.name != DISTANCE_CUBES.name));
+        let field = if apart { Some(LayerField::Shown) } else { DISTANCE_CUBES.layer_field };
+        let what = describe_cube(&q) + " for the other objects' maps";
+        match o.maps.iter_mut().find(|m| m.pass == DISTANCE_CUBES.name) {
+            // A distance map it keeps for itself (relief_source=distance) serves.
+            Some(m) if apart => m.layer_field = field,
+            _ => st.add_map(o, crate::plan::types::MapKind { layer_field: field, ..DISTANCE_CUBES.kind() }, what),
+        }
         o.map_shading = if solid { MapShading::Refractor } else { MapShading::Traced };
         o.leaves_out = LeavesOut::Itself;
         o.reason += " · in the other objects' distance maps: traced in a distance map of its own (§4.3)";
@@ -384,3 +395,27 @@ pub const IMAGE_SPACE_REFRACTION_INFO: &MethodInfo = &MethodInfo {
     needs: crate::methods::registry::DeviceNeeds::Nothing,
 };
 pub const IMAGE_SPACE_REFRACTION: Method = Method(IMAGE_SPACE_REFRACTION_INFO.name);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::methods::{BVH, ENVMAP, PROXY_BOX, REFRACTOR_MAP};
+
+    /// Which environment-mapped objects composition draws as distance maps: in view either
+    /// way of another specular object, grown to a fixed point through converted ones; and
+    /// what the others get beside them.
+    #[test]
+    fn environment_mapped_cubes_compose_where_in_view() {
+        // 0 envmap sees nothing and nobody sees it; 1 envmap sees the bvh object 2; 3
+        // proxy-box is seen by 1 only (a converted cube), 4 refractor-map sees nothing.
+        let methods = [ENVMAP, ENVMAP, BVH, PROXY_BOX, REFRACTOR_MAP];
+        let sight = vec![vec![], vec![2, 3], vec![0], vec![], vec![]];
+        assert_eq!(cubes_converted(&methods, &sight), [false, true, false, true, false]);
+        // The bvh object gets a distance map of its own (converted cubes show it), the
+        // converted ones none (their cube is one), the refractor-mapped glass none (it
+        // shades itself in maps).
+        assert_eq!(composed(&methods, &sight), [false, false, true, false, false]);
+        // Seen by a ray tracer only: nothing to convert (the rays trace it).
+        assert_eq!(cubes_converted(&[ENVMAP, BVH], &[vec![], vec![0]]), [false, false]);
+    }
+}

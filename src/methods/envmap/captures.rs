@@ -26,10 +26,11 @@ use crate::scene::Scene;
 pub const VIEWS: &str = "envmap.captures";
 
 /// `envmap.captures`: per object `captures`³ cube maps, radiance and distance (the distance
-/// maps' shaders, §4), the object left out.
+/// maps' shaders, §4), the object left out; after the distance maps, whose last cycle shows
+/// the other specular objects in them where the plan composes (`cube_maps::CubeMaps`).
 pub const CAPTURE_CUBES: MapInfo = MapInfo {
     name: "envmap.captures",
-    order: order::ENVIRONMENT_MAPS,
+    order: order::ENVIRONMENT_MAPS + 1,
     cube: true,
     layer_field: Some(LayerField::Envmap),
     create: create_captures,

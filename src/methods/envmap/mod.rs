@@ -97,6 +97,8 @@ pub const FAMILY: crate::methods::registry::Family = crate::methods::registry::F
     }),
     describe: Some(captures::describe),
     cubes_compose: &[ENVMAP, PROXY_SPHERE, PROXY_BOX],
+    // Captures and height maps are drawn after the inter-object cycles, from their last maps.
+    shows_others_by_maps: &[IMAGE_BASED, PROXY_RELIEF],
     ..crate::methods::registry::Family::NONE
 };
 
