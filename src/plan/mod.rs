@@ -714,7 +714,7 @@ pub fn in_view(p: &Plan, scene: &Scene) -> Vec<String> {
             } else if g.is_some_and(|g| (g.views)(&p.quality) > 0) {
                 format!("drawn by its own method ({}) in the mirrored views", b.method.name)
             } else if g.is_some_and(|g| g.leaves_out == LeavesOut::Nothing) {
-                "found in the shared layered map (the whole scene, peeled), shaded there as the environment's reflection".to_string()
+                "found in the shared layered map (the whole scene, peeled) and traced on through its layers (§4.5)".to_string()
             } else {
                 let by_map = match b.map_shading {
                     MapShading::Sky if whole_scene => "as the environment map's reflection (a whole-scene method keeps its own behaviour)",
