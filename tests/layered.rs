@@ -247,24 +247,31 @@ fn figure_28_thin_objects_need_fine_steps_and_hidden_surfaces_need_layers() {
     assert!(steps[1].1.rmse > steps[2].1.rmse * 1.206, "8 → 32 linear steps: {steps:?}");
     assert!(steps[2].1.psnr > 21.98, "32 linear steps: {steps:?}");
     // Layers below the depth complexity lose what the missing layers hold (the rod, the
-    // bowl and the floor behind the ball); at the full count the error is gone.
+    // bowl and the floor behind the ball); such a cut peel gets one more layer holding the
+    // farthest surfaces (`layered.far_layer`), so that rays past the peeled layers meet the
+    // room's walls instead of the sky; at the full count no extra layer.
     let (full, full_img, stats) = run(&[]);
     let l = stat(&stats, "layered.layers") as u32;
+    assert_eq!(stat(&stats, "layered.far_layer"), 0.0, "a full peel needs no farthest layer");
     let mut by_layers = Vec::new();
     for n in 1..l {
         let (e, _, st) = run(&[&format!("layers={n}")]);
-        assert_eq!(stat(&st, "layered.layers"), n as f64);
+        assert_eq!((stat(&st, "layered.layers"), stat(&st, "layered.far_layer")), (n as f64, 1.0));
         eprintln!("rod: layers {n}: {e}");
         by_layers.push(e);
     }
     eprintln!("rod: layers auto ({l}): {full}");
-    // Measured: RMSE 0.1267 / 0.0971 / 0.0853 at 1 / 2 / 3 layers, 0.0814 at 4 (PSNR
-    // 21.79 dB): ratios 1.305, 1.138, 1.049, bounds a factor 1.122 under (the last, under
-    // 1.122, at 1.03); the floor at 4 layers 1 dB under.
+    // Measured: RMSE 0.1039 / 0.0872 / 0.0738 at 1 / 2 / 3 layers (each with the farthest
+    // surfaces' layer; without it 0.1267 / 0.0971 / 0.0853), 0.0814 at 4 (PSNR 21.79 dB):
+    // ratios 1.192 and 1.182, bounds a factor 1.122 under; the farthest layer at 1 layer a
+    // factor 1.22 under the bare peel's error, bound 1.122 (0.1129); 3 peeled + farthest is
+    // within 1 dB of the full peel (it measured 0.85 dB above: the peel's epsilon drops a
+    // near-coincident surface the farthest layer keeps); the floor at 4 layers 1 dB under.
     assert_eq!(by_layers.len(), 3, "the rod scene has 4 layers");
-    assert!(by_layers[0].rmse > by_layers[1].rmse * 1.164, "1 → 2 layers: {by_layers:?}");
-    assert!(by_layers[1].rmse > by_layers[2].rmse * 1.015, "2 → 3 layers: {by_layers:?}");
-    assert!(by_layers[2].rmse > full.rmse * 1.03, "the last layer matters: {by_layers:?} vs {full}");
+    assert!(by_layers[0].rmse < 0.1267 / 1.122, "the farthest layer at 1 layer: {by_layers:?}");
+    assert!(by_layers[0].rmse > by_layers[1].rmse * 1.062, "1 → 2 layers: {by_layers:?}");
+    assert!(by_layers[1].rmse > by_layers[2].rmse * 1.054, "2 → 3 layers: {by_layers:?}");
+    assert!(by_layers[2].psnr > full.psnr - 1.0, "3 layers and the farthest: {by_layers:?} vs {full}");
     assert!(full.psnr > 20.79, "all layers: {full}");
     let (_, exact_img, _) = run(&[&format!("layers={l}")]);
     assert_eq!(exact_img.data, full_img.data, "layers=auto is layers={l}");

@@ -268,7 +268,7 @@ impl CubeMaps {
 
 /// Clears the depth attachment of the rendering in progress (a `size`² cube face, every
 /// view of a multiview pass) to `depth`.
-fn clear_depth(ctx: &Context, cmd: vk::CommandBuffer, size: u32, depth: f32) {
+pub(crate) fn clear_depth(ctx: &Context, cmd: vk::CommandBuffer, size: u32, depth: f32) {
     let attachment = vk::ClearAttachment {
         aspect_mask: vk::ImageAspectFlags::DEPTH,
         color_attachment: 0,

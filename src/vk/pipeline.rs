@@ -231,6 +231,9 @@ pub enum DepthOp {
     NearerOrEqual,
     /// Always: a mask written into the depth buffer (planar mirrors in cube maps).
     Always,
+    /// Strictly farther (over a depth cleared to the nearest): the farthest surface
+    /// (layered maps' last layer where the peel is cut).
+    Farther,
 }
 
 /// Colour blending of a pipeline's attachments.
@@ -336,6 +339,7 @@ fn make_graphics_pipeline(ctx: &Context, layout: vk::PipelineLayout, desc: &Grap
             DepthOp::Nearer => vk::CompareOp::GREATER,
             DepthOp::NearerOrEqual => vk::CompareOp::GREATER_OR_EQUAL,
             DepthOp::Always => vk::CompareOp::ALWAYS,
+            DepthOp::Farther => vk::CompareOp::LESS,
         });
     let blend: Vec<_> = desc
         .color_formats

@@ -37,7 +37,10 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
             .layered
             .layers
             .map_or(format!("auto (the depth complexity, at most {MAX_LAYERS}; memory counted at {MAX_LAYERS})"), |l| l.to_string());
-        format!("one map of the whole scene, shared: layers {layers}, each {}", peel::describe_layer(q))
+        format!(
+            "one map of the whole scene, shared: layers {layers} (one more, the farthest surfaces, where they are fewer than the depth complexity), each {}",
+            peel::describe_layer(q)
+        )
     },
     shared: true,
 };

@@ -10,7 +10,12 @@
 //! additive blending and the largest count is read back (on the library's own queue; a
 //! host's device without one is counted on the CPU along the same texel rays). A scene
 //! that needs 3 layers allocates 3; the count is taken again when objects move, and the
-//! layers are reallocated when it changes.
+//! layers are reallocated when it changes. Where the layers are fewer than the depth
+//! complexity (a `layers` knob under it, or more than `MAX_LAYERS` surfaces), the peel is
+//! cut: one more layer then holds the *farthest* surface along each texel's ray (depth test
+//! reversed over a depth cleared to the nearest), so that a ray that passes behind the
+//! peeled layers meets the scene's outermost surface — in a closed room its walls, as one
+//! distance map would show them — instead of leaving for the sky (black in a room).
 
 use ash::vk;
 use glam::{DVec3, Vec3};
@@ -47,10 +52,12 @@ const HALF_MATERIALS: usize = 2048;
 
 pub struct LayeredMaps {
     layers: u32,
-    /// The depth complexity counted (`layers=auto`), and whether the GPU counted it.
+    /// The depth complexity counted, and whether the GPU counted it.
     measured: Option<(u32, bool)>,
     depth: Vec<Image>,
     peel: vk::Pipeline,
+    /// The last layer's pipeline where the peel is cut: the farthest surface.
+    far: vk::Pipeline,
     nearest: vk::Sampler,
     /// Set-1 sets sampling depth buffer 0 and 1 as the previous layer.
     sets: Vec<(vk::DescriptorPool, vk::DescriptorSet)>,
@@ -65,6 +72,7 @@ pub fn create(init: &StageInit, _objects: &[usize], maps: &mut Maps) -> Result<B
         measured: None,
         depth: Vec::new(),
         peel: vk::Pipeline::null(),
+        far: vk::Pipeline::null(),
         nearest: vk::Sampler::null(),
         sets: Vec::new(),
         mode: init.plan.quality.cube.cube_mode,
@@ -117,40 +125,29 @@ impl LayeredMaps {
             }
             crate::vk::pipeline::write_buffer(ctx, set, binding::THICKNESS, vk::DescriptorType::STORAGE_BUFFER, vk::Buffer::null());
         }
-        let formats = [radiance_format(q.cube.cube_precision), normal_format(q, init.scene.materials.len())];
-        self.peel = graphics_pipeline(
-            ctx,
-            init.layout,
-            &GraphicsDesc {
-                name: "layered.peel",
-                vertex: "scene/mesh.vert",
-                fragment: if crate::methods::caustics::project::texture_space(init.plan) {
-                    "layered/peel.frag#CAUSTICS_TEXTURE"
-                } else {
-                    "layered/peel.frag"
-                },
-                vertex_input: VertexInput::Mesh,
-                color_formats: &formats,
-                depth_format: Some(DEPTH_FORMAT),
-                depth_test: true,
-                depth_write: true,
-                view_mask: crate::frame::view_mask(q.cube.cube_mode),
-                cull: vk::CullModeFlags::NONE,
-                multisample: Multisample::OFF,
-                blend: Blend::Replace,
-                depth_op: DepthOp::Nearer,
-            },
-        )?;
+        self.peel = peel_pipeline(init, DepthOp::Nearer)?;
+        if self.cut() {
+            self.far = peel_pipeline(init, DepthOp::Farther)?;
+        }
         Ok(())
     }
 
+    /// Whether the peeled layers are fewer than the surfaces along some texel's ray: one
+    /// more layer then holds the farthest surface.
+    fn cut(&self) -> bool {
+        self.measured.is_some_and(|(count, _)| count > self.layers)
+    }
+
+    /// The layers allocated: those peeled, and the farthest surface's where the peel is cut.
+    fn allocated(&self) -> u32 {
+        self.layers + u32::from(self.cut())
+    }
+
     /// The knob, or the depth complexity counted now (at least one layer).
+    /// The knob, or the depth complexity counted now (at least one layer); counted under a
+    /// knob too, to know whether the peel is cut (`cut`).
     fn layer_count(&mut self, init: &StageInit) -> Result<u32> {
         let q = &init.plan.quality;
-        if let Some(l) = q.layered.layers {
-            self.measured = None;
-            return Ok(l);
-        }
         let centre = self.centre(init);
         let (count, gpu) = if init.ctx.queue.is_some() {
             (count_on_gpu(init, centre)?, true)
@@ -158,14 +155,14 @@ impl LayeredMaps {
             (count_on_cpu(init.scene, centre, q.cube.cube_size.min(64)), false)
         };
         self.measured = Some((count, gpu));
-        Ok(count.clamp(1, MAX_LAYERS))
+        Ok(q.layered.layers.unwrap_or(count.clamp(1, MAX_LAYERS)))
     }
 
     /// The layers' two images, `layers` cubes each, into the frame's maps.
     fn allocate(&mut self, init: &StageInit, maps: &mut Maps) -> Result<()> {
         let (ctx, q) = (init.ctx, &init.plan.quality);
         let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
-        let kind = ImageKind::CubeArray { cubes: self.layers };
+        let kind = ImageKind::CubeArray { cubes: self.allocated() };
         let s = q.cube.cube_size;
         let radiance =
             ImageDesc { name: "layered.cubes", format: radiance_format(q.cube.cube_precision), width: s, height: s, kind, usage };
@@ -175,6 +172,33 @@ impl LayeredMaps {
         maps.set_image(&LAYERED_NORMALS, Image::new(ctx, &normals)?);
         Ok(())
     }
+}
+
+/// `layered.peel`'s pipeline: the nearest surface behind the previous layer, or
+/// (`DepthOp::Farther`, `layered.peel_far`) the farthest surface.
+fn peel_pipeline(init: &StageInit, depth_op: DepthOp) -> Result<vk::Pipeline> {
+    let q = &init.plan.quality;
+    let formats = [radiance_format(q.cube.cube_precision), normal_format(q, init.scene.materials.len())];
+    let desc = GraphicsDesc {
+        name: if depth_op == DepthOp::Farther { "layered.peel_far" } else { "layered.peel" },
+        vertex: "scene/mesh.vert",
+        fragment: if crate::methods::caustics::project::texture_space(init.plan) {
+            "layered/peel.frag#CAUSTICS_TEXTURE"
+        } else {
+            "layered/peel.frag"
+        },
+        vertex_input: VertexInput::Mesh,
+        color_formats: &formats,
+        depth_format: Some(DEPTH_FORMAT),
+        depth_test: true,
+        depth_write: true,
+        view_mask: crate::frame::view_mask(q.cube.cube_mode),
+        cull: vk::CullModeFlags::NONE,
+        multisample: Multisample::OFF,
+        blend: Blend::Replace,
+        depth_op,
+    };
+    graphics_pipeline(init.ctx, init.layout, &desc)
 }
 
 fn normal_format(q: &Quality, materials: usize) -> vk::Format {
@@ -314,12 +338,15 @@ impl Stage for LayeredMaps {
         let size = radiance.width;
         let six = self.mode == CubeMode::SixPasses;
         let eyes = io.view_eyes;
-        for k in 0..self.layers {
+        let cut = self.cut();
+        for k in 0..self.allocated() {
             let (cur, prev) = ((k % 2) as usize, ((k + 1) % 2) as usize);
             rec.barrier(&mut self.depth[cur], Access::DepthAttachment);
             // Layer 0 samples nothing, but its set names the other buffer all the same.
             rec.barrier(&mut self.depth[prev], Access::FragmentSampled);
-            let first = if k == 0 { LAYERED_FIRST } else { 0 };
+            // A cut peel's extra layer: the farthest surface, peeling nothing.
+            let far = cut && k == self.layers;
+            let first = if k == 0 || far { LAYERED_FIRST } else { 0 };
             let faces: &[u32] = if six { &[0, 1, 2, 3, 4, 5] } else { &[0] };
             for &face in faces {
                 let (colors, depth, mask) = if six {
@@ -338,7 +365,10 @@ impl Stage for LayeredMaps {
                     clear: true,
                 };
                 begin_rendering(ctx, cmd, &t);
-                f.bind(ctx, cmd, self.peel);
+                if far {
+                    crate::methods::cube_maps::clear_depth(ctx, cmd, size, 1.0);
+                }
+                f.bind(ctx, cmd, if far { self.far } else { self.peel });
                 f.bind_maps(ctx, cmd, self.sets[prev].1);
                 let v = view + face;
                 let eye = eyes.get(v as usize).copied().unwrap_or_default();
@@ -366,28 +396,34 @@ impl Stage for LayeredMaps {
             s.push(("layered.depth_complexity".into(), count as f64));
             s.push(("layered.counted_on_gpu".into(), if gpu { 1.0 } else { 0.0 }));
         }
+        // 1 where the peel is cut and one more layer holds the farthest surfaces.
+        s.push(("layered.far_layer".into(), if self.cut() { 1.0 } else { 0.0 }));
         s
     }
 
-    /// Objects moved: with `layers=auto` the depth complexity is counted again, and the
-    /// layers are reallocated when it changed (the renderer rewrites the descriptors).
+    /// Objects moved: the depth complexity is counted again (under a `layers` knob too:
+    /// whether the peel is cut), and the layers are reallocated when what they need changed
+    /// (the renderer rewrites the descriptors).
     fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
-        if changes.moved.is_empty() || init.plan.quality.layered.layers.is_some() {
+        if changes.moved.is_empty() {
             return Ok(());
         }
-        let layers = self.layer_count(init)?;
-        if layers != self.layers {
+        let allocated = self.allocated();
+        self.layers = self.layer_count(init)?;
+        if self.allocated() != allocated {
             for i in [maps.take_image(&LAYERED), maps.take_image(&LAYERED_NORMALS)].iter_mut().flatten() {
                 i.destroy(init.ctx);
             }
-            self.layers = layers;
             self.allocate(init, maps)?;
+        }
+        if self.cut() && self.far == vk::Pipeline::null() {
+            self.far = peel_pipeline(init, DepthOp::Farther)?;
         }
         Ok(())
     }
 
     fn destroy(&mut self, ctx: &Context) {
-        destroy_pipelines(ctx, &mut [self.peel]);
+        destroy_pipelines(ctx, &mut [self.peel, self.far]);
         for d in &mut self.depth {
             d.destroy(ctx);
         }
