@@ -1,6 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: PER_SAMPLE
+// variants: PER_SAMPLE COUNT_FALLBACKS COUNT_FALLBACKS_PER_SAMPLE
+#ifdef COUNT_FALLBACKS_PER_SAMPLE
+#define COUNT_FALLBACKS
+#define PER_SAMPLE
+#endif
 // geometry.mirror: a planar mirror (survey §5, DB97/MBGN00). Its reflection is the scene
 // rendered from the camera mirrored through its plane, which lands on the mirror's own
 // pixels: the pixel's texel of that view, weighted by the mirror's Fresnel reflectance at
@@ -12,6 +16,13 @@
 #include "common/sky.glsl"
 #include "common/traced.glsl"
 
+#ifdef COUNT_FALLBACKS
+// The fallback is counted per fragment that survives the depth test (geometry.fallback_pixels).
+layout(early_fragment_tests) in;
+#define COUNT_FALLBACK() atomicAdd(fallbacks[push.object], 1u)
+#else
+#define COUNT_FALLBACK()
+#endif
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
 layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
@@ -28,6 +39,8 @@ void main() {
         reflected = texelFetch(mirror_views, texel, 0).rgb;
     } else if (o.envmap_layer >= 0 && (push.flags & FLAG_MIRROR_DEPTH_END) == 0u) {
         reflected = traced_radiance(o, in_position, s.r);
+        // The image's own fragments (not the mirrored views'): geometry.fallback_pixels.
+        if (push.view < push_extra_view_base()) COUNT_FALLBACK();
     } else {
         reflected = sky_radiance(s.r);
     }

@@ -1,6 +1,10 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// variants: PER_SAMPLE
+// variants: PER_SAMPLE COUNT_FALLBACKS COUNT_FALLBACKS_PER_SAMPLE
+#ifdef COUNT_FALLBACKS_PER_SAMPLE
+#define COUNT_FALLBACKS
+#define PER_SAMPLE
+#endif
 // geometry.refract: a flat-faced dielectric (survey §5, GS04/Sch03), or a thin-walled
 // pane. Each face the view sees has up to two child views, laid onto the face's own
 // pixels: its reflection (the view mirrored through the face, exact) and its refraction
@@ -25,6 +29,13 @@ vec3 fallback(Object o, Material m, vec3 p, vec3 dir, bool inside) {
     return traced_radiance(o, p, dir);
 }
 
+#ifdef COUNT_FALLBACKS
+// Fallbacks are counted per fragment that survives the depth test (geometry.fallback_pixels).
+layout(early_fragment_tests) in;
+#define COUNT_FALLBACK() atomicAdd(fallbacks[push.object], 1u)
+#else
+#define COUNT_FALLBACK()
+#endif
 layout(location = 0) SAMPLE_INTERP in vec3 in_position;
 layout(location = 1) SAMPLE_INTERP in vec3 in_normal;
 layout(location = 2) SAMPLE_INTERP in vec2 in_uv;
@@ -60,6 +71,8 @@ void main() {
     }
     bool fallback_absorbs = !eye_inside && solid && o.envmap_layer >= 0 && (push.flags & FLAG_MIRROR_DEPTH_END) == 0u;
     if (!fallback_absorbs && !eye_inside) refracted *= chord_transmittance(o, m, in_position, n, s.t);
+    // Which branches a child view serves: the others took the fallback.
+    bool viewed_r = false, viewed_t = false;
     if ((push.flags & FLAG_MIRROR_VIEW) != 0u) {
         // The face's plane, towards the eye; its child views keep that side (reflection)
         // or the other (refraction), `dir.w` beyond the plane.
@@ -83,10 +96,15 @@ void main() {
             vec3 texel = texelFetch(mirror_views, ivec3(ivec2(gl_FragCoord.xy), int(layer)), 0).rgb;
             if (facing > 0.0) {
                 reflected = texel;
+                viewed_r = true;
             } else {
                 refracted = texel;
+                viewed_t = true;
             }
         }
     }
+    // The image's own fragments (not the views') whose branch the budget cut.
+    bool maps = o.envmap_layer >= 0 && (push.flags & FLAG_MIRROR_DEPTH_END) == 0u && push.view < push_extra_view_base();
+    if (maps && (!viewed_r || (!viewed_t && any(greaterThan(s.ft, vec3(0.0)))))) COUNT_FALLBACK();
     out_color = vec4(absorbed * (s.fr * reflected + s.ft * refracted), 1.0);
 }

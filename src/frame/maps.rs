@@ -58,6 +58,8 @@ pub struct Slot {
     pub needs_pair: bool,
     /// Its presence needs the set-1 sets (some pass binds them when it is there).
     pub needs_sets: bool,
+    /// A buffer of per-mesh counters the frame reports (`Maps::counts`): `<name>.<object>`.
+    pub counts: bool,
 }
 
 impl Slot {
@@ -75,6 +77,7 @@ impl Slot {
             ping_pong: false,
             needs_pair: false,
             needs_sets: false,
+            counts: false,
         }
     }
 
@@ -204,6 +207,13 @@ impl Maps {
     /// §6.3.3).
     pub fn shadow_reads(&self) -> impl Iterator<Item = &Image> {
         self.all_slots().filter(|s| s.shading).filter_map(|s| self.image(s))
+    }
+
+    /// Every counter slot's words (`Slot::counts`), as the last completed frame left them.
+    pub fn counts(&self) -> Vec<(&'static str, Vec<u32>)> {
+        let words =
+            |b: &Buffer| b.read().map(|bytes| bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect());
+        self.all_slots().filter(|s| s.counts).filter_map(|s| Some((s.name, words(self.buffer(s)?).ok()?))).collect()
     }
 
     /// What map generation samples through a generation set besides the ping-pong images

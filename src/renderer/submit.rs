@@ -89,6 +89,12 @@ impl Renderer {
             stats.push(("profiler.untimed_passes".into(), self.profiler.untimed() as f64));
         }
         stats.extend(self.parts.iter().flat_map(|p| p.stats()));
+        // Per-object counters (`Slot::counts`): the objects' non-zero ones.
+        for (name, words) in self.maps.counts() {
+            for o in self.plan.objects.iter().filter(|o| words.get(o.mesh).is_some_and(|&n| n > 0)) {
+                stats.push((format!("{name}.{}", o.name), words[o.mesh] as f64));
+            }
+        }
         let object_ids = self.ids.as_ref().map(|i| i.read()).transpose()?;
         let map_updates = self.updates.recorded().to_vec();
         Ok(Frame { image, passes, memory: ctx.memory.snapshot(), stats, map_updates, object_ids })

@@ -184,6 +184,9 @@ pub struct Context {
     /// The device was created with `geometryShader`: fragment shaders may read
     /// gl_PrimitiveID (caustic_space=texture needs it). Only the library's own devices.
     pub geometry_shader: bool,
+    /// The device was created with `fragmentStoresAndAtomics`: fragment shaders may write
+    /// storage buffers (the planar objects' fallback counters). Only the library's own devices.
+    pub fragment_stores: bool,
     /// Vulkan's ray-tracing API (acceleration structures and ray queries), where the device
     /// has it and it was enabled; else why not (the `ray-query` method's fallback reason).
     pub ray_query: std::result::Result<RayQueryDevice, String>,
@@ -394,10 +397,12 @@ impl Context {
         let supported = unsafe { instance_ref.get_physical_device_features(physical) };
         let sample_rate_shading = supported.sample_rate_shading == vk::TRUE;
         let geometry_shader = supported.geometry_shader == vk::TRUE;
+        let fragment_stores = supported.fragment_stores_and_atomics == vk::TRUE;
         let features = vk::PhysicalDeviceFeatures::default()
             .image_cube_array(true)
             .sample_rate_shading(sample_rate_shading)
-            .geometry_shader(geometry_shader);
+            .geometry_shader(geometry_shader)
+            .fragment_stores_and_atomics(fragment_stores);
         let mut f11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true).maintenance4(true);
         let mut robust = vk::PhysicalDeviceRobustness2FeaturesEXT::default().null_descriptor(true);
@@ -448,6 +453,7 @@ impl Context {
         ctx.owned = true;
         ctx.sample_rate_shading = sample_rate_shading;
         ctx.geometry_shader = geometry_shader;
+        ctx.fragment_stores = fragment_stores;
         ctx.callbacks = alloc;
         Ok(ctx)
     }
@@ -568,6 +574,7 @@ impl Context {
             owned,
             sample_rate_shading: false,
             geometry_shader: false,
+            fragment_stores: false,
             ray_query,
             callbacks: None,
             pipelines: Default::default(),

@@ -76,6 +76,12 @@ descriptor_sets! {
         /// renders into a scratch target while it samples its children here, and is copied
         /// into its layer afterwards.
         MIRROR_VIEWS = 9: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray mirror_views";
+        /// Per mesh, the camera's fragments (pixels, or samples with per-sample shading)
+        /// whose branch a view budget cut and the object's own maps served instead
+        /// (`geometry.mirror`, `geometry.refract`; branches cut inside the mirrored views are
+        /// counted by plane, `geometry.mirror_fallbacks`); zeroed each frame, reported as
+        /// `geometry.fallback_pixels.<object>`.
+        FALLBACKS = 27: STORAGE_BUFFER => "buffer Fallbacks { uint fallbacks[]; }";
     }
 
     /// Curved reflectors by geometry transformation (survey §5, EMD*05/EMDT06), set 4 of

@@ -106,7 +106,7 @@ pub const MIRROR_PASS: CameraPass = CameraPass {
     fragment: "geometry/mirror.frag",
     flags: 0,
     order: order::CAMERA,
-    create: None,
+    create: Some(views::counting_pass),
     profiled: PROFILED,
 };
 
@@ -134,7 +134,7 @@ pub const REFRACT_PASS: CameraPass = CameraPass {
     fragment: "geometry/refract.frag",
     flags: 0,
     order: order::CAMERA,
-    create: None,
+    create: Some(views::counting_pass),
     profiled: PROFILED,
 };
 

@@ -227,7 +227,44 @@ pub fn create_frame_part(init: &StageInit, maps: &mut Maps) -> Result<Option<Box
         return Ok(None);
     }
     let mirrors = MirrorViews::new(init.ctx, plan, (init.width, init.height), init.multisample, init.layout, maps)?;
+    if counts_fallbacks(init) {
+        let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+        let bytes = 4 * init.scene.meshes.len().max(1) as u64;
+        let counts = crate::vk::Buffer::new(init.ctx, "geometry.fallback_pixels", bytes, usage, crate::vk::MemoryLocation::GpuToCpu)?;
+        maps.set_buffer(&super::slots::FALLBACKS, counts);
+    }
     Ok(Some(Box::new(PlanarViews { mirrors })))
+}
+
+/// Whether the frame counts the planar objects' fallback fragments: some planar object's
+/// views the budget can cut (the plan gave it maps of its own for the branches it leaves
+/// out, `super::plan_fallback_maps`), and the device lets fragment shaders write.
+fn counts_fallbacks(init: &StageInit) -> bool {
+    let planar = [super::PLANAR_MIRROR, super::PLANAR_REFRACTION];
+    let own_maps = |o: &crate::plan::types::ObjectPlan| o.maps.iter().any(|m| m.pass == crate::methods::distance::DISTANCE_CUBES.name);
+    init.ctx.fragment_stores && init.plan.objects.iter().any(|o| planar.contains(&o.method) && own_maps(o))
+}
+
+/// `geometry.mirror` / `geometry.refract`: the plain camera pass, or where the fallbacks are
+/// counted (`create_frame_part` made the counters: the plan gives the objects maps for the
+/// branches the budget cuts, and the device lets fragment shaders write) its COUNT_FALLBACKS
+/// variant.
+pub fn counting_pass(init: &StageInit, plan: &crate::plan::types::CameraPlan) -> Result<Box<dyn crate::frame::stage::Stage>> {
+    let variant = counts_fallbacks(init).then_some("COUNT_FALLBACKS");
+    Ok(Box::new(crate::frame::camera::CameraShade::with_extra(init.ctx, init.layout, plan, init.multisample, variant, None)?))
+}
+
+/// Zeroes the fallback counters (where planned) before the frame's first camera pass.
+fn clear_fallbacks(rec: &mut Recorder, maps: &Maps) {
+    let Some(b) = maps.buffer(&super::slots::FALLBACKS) else { return };
+    let (ctx, cmd) = (rec.ctx, rec.cmd);
+    unsafe { ctx.device.cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, 0) };
+    let barrier = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+        .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE)];
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
 }
 
 impl FramePart for PlanarViews {
@@ -264,6 +301,7 @@ impl FramePart for PlanarViews {
         maps: &mut Maps,
         camera_stages: &mut dyn FnMut(&mut Recorder, ViewPass),
     ) -> bool {
+        clear_fallbacks(rec, maps);
         let Some(mv) = self.mirrors.as_mut() else { return false };
         let first = layout.first(EXTRA_VIEWS).expect("planar mirrors declare their views");
         rec.scope = Some("geometry.mirror_view");
