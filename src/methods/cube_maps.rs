@@ -192,7 +192,7 @@ impl CubeMaps {
             depth_format: Some(DEPTH_FORMAT),
             depth_test,
             depth_write: depth_test,
-            view_mask: view_mask(q.cube.cube_mode),
+            view_mask: view_mask(self.mode),
             cull: vk::CullModeFlags::NONE,
             multisample: Multisample::OFF,
             blend: crate::vk::pipeline::Blend::Replace,
