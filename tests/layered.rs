@@ -291,6 +291,12 @@ fn the_map_models_only_the_layers_the_scene_needs() {
     let layer = 6 * 32 * 32 * 8;
     assert!(bytes("layered.cubes") >= 3 * layer && bytes("layered.cubes") < 4 * layer, "{:?}", f.memory);
     assert!(bytes("layered.normals") >= 3 * layer && bytes("layered.normals") < 4 * layer);
+    // The plan budgets what the stage allocates (the depth complexity counted when planning,
+    // not the most there can be): its map's bytes are the frame's layered memory.
+    let plan = specula::plan::plan_with(&s, &specula::plan::Choices::all(specula::methods::LAYERED), &q).unwrap();
+    let planned = plan.map("layered.peel").map(|m| m.bytes).unwrap();
+    let allocated: u64 = f.memory.iter().filter(|(n, _)| n.starts_with("layered.")).map(|(_, b)| *b).sum();
+    assert_eq!(planned, allocated, "plan {planned} B, frame {:?}", f.memory);
     // Without a layered object, nothing of it.
     let f = specula::render(&ctx, &s, specula::methods::REFRACTOR_MAP, &q, (16, 16), (0, 1)).unwrap();
     assert!(f.passes.iter().all(|p| !p.name.starts_with("layered")));

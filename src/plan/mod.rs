@@ -66,8 +66,19 @@ impl Plan {
                 .map(|o| (o.map_shading, o.leaves_out, o.maps.iter().map(|m| (m.pass, m.layer)).collect::<Vec<_>>()))
                 .collect::<Vec<_>>()
         };
+        // The stages as a structure: a map's bytes may follow the geometry (the layered map's
+        // depth complexity) without changing what the frame records.
+        let structure = |p: &Plan| {
+            p.stages
+                .iter()
+                .map(|s| match s {
+                    StageSpec::Map(m) => StageSpec::Map(MapPlan { bytes: 0, ..m.clone() }),
+                    s => s.clone(),
+                })
+                .collect::<Vec<_>>()
+        };
         let same = |fresh: &Plan| {
-            fresh.stages == self.stages
+            structure(fresh) == structure(self)
                 && (fresh.inter_object, fresh.cycles, fresh.frame_latency) == (self.inter_object, self.cycles, self.frame_latency)
                 && shading(fresh) == shading(self)
                 && fresh.shadow_cubes == self.shadow_cubes
@@ -119,7 +130,7 @@ impl Plan {
             }
         }
         if !same(&fresh) {
-            let what = match fresh.stages.iter().zip(&self.stages).find(|(a, b)| a != b) {
+            let what = match structure(&fresh).iter().zip(&structure(self)).find(|(a, b)| a != b) {
                 Some((a, b)) => format!("{} was {b:?}, now {a:?}", a.name()),
                 None if fresh.cycles != self.cycles || fresh.inter_object != self.inter_object => {
                     format!("inter-object cycles {} → {}", self.cycles * self.inter_object as u32, fresh.cycles * fresh.inter_object as u32)
@@ -142,6 +153,8 @@ impl Plan {
             e.reference_point = f.reference_point;
         }
         self.layered_centre = fresh.layered_centre;
+        self.layered_depth = fresh.layered_depth;
+        self.stages = fresh.stages;
         self.captures = fresh.captures;
         for f in FAMILIES {
             if let Some(h) = f.refresh {
@@ -274,6 +287,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         objects: Vec::new(),
         envmaps: Vec::new(),
         layered_centre: None,
+        layered_depth: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: vec![REFERENCE_PASS],
@@ -507,6 +521,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         objects,
         envmaps: Vec::new(),
         layered_centre: None,
+        layered_depth: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: Vec::new(),

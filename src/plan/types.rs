@@ -236,6 +236,11 @@ pub struct Plan {
     /// The shared layered map's centre (§4.5), when an object takes `layered`: its six
     /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
     pub layered_centre: Option<Vec3>,
+    /// The scene's depth complexity around `layered_centre`, counted on the CPU along the
+    /// texel rays of six faces of at most 64² (`layered::peel::count_on_cpu`): the layers the
+    /// plan budgets (the stage counts again on the GPU at the map's own size).
+    #[serde(skip)]
+    pub layered_depth: Option<u32>,
     /// Image-based reflections' captures (§3.3): per object that takes the method, in the
     /// order of its layers in `envmap.captures`, the centres of its cube maps.
     pub captures: Vec<CaptureSet>,

@@ -31,12 +31,9 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
     cube: true,
     layer_field: None,
     create: peel::create,
-    bytes: |p, objects, _| if objects == 0 { 0 } else { peel::bytes(&p.quality, planned_layers(&p.quality)) },
+    bytes: |p, objects, _| if objects == 0 { 0 } else { peel::bytes(&p.quality, planned_layers(p)) },
     describe: |q, _| {
-        let layers = q
-            .layered
-            .layers
-            .map_or(format!("auto (the depth complexity, at most {MAX_LAYERS}; memory counted at {MAX_LAYERS})"), |l| l.to_string());
+        let layers = q.layered.layers.map_or(format!("auto (the depth complexity, at most {MAX_LAYERS})"), |l| l.to_string());
         format!(
             "one map of the whole scene, shared: layers {layers} (one more, the farthest surfaces, where they are fewer than the depth complexity), each {}",
             peel::describe_layer(q)
@@ -45,10 +42,14 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
     shared: true,
 };
 
-/// The layers the plan budgets: the knob, or for `auto` the most there can be (the stage
-/// allocates what it measured; `layered.layers` in the frame's stats).
-pub fn planned_layers(q: &Quality) -> u32 {
-    q.layered.layers.unwrap_or(MAX_LAYERS)
+/// The layers the plan budgets: the knob or (`auto`) the depth complexity counted when the
+/// plan was made (at most `MAX_LAYERS`; without a count, that most), and one more for the
+/// farthest surfaces where they are fewer than the complexity (`peel`). The stage allocates
+/// what it counts on the GPU (`layered.layers` in the frame's stats).
+pub fn planned_layers(p: &Plan) -> u32 {
+    let depth = p.layered_depth;
+    let layers = p.quality.layered.layers.unwrap_or_else(|| depth.map_or(MAX_LAYERS, |d| d.clamp(1, MAX_LAYERS)));
+    layers + u32::from(depth.is_some_and(|d| d > layers))
 }
 
 const fn one(_: &Quality) -> u32 {
@@ -145,6 +146,7 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
     }
     let c = centre(scene, &p.quality, &meshes);
     p.layered_centre = Some(c);
+    p.layered_depth = Some(peel::count_on_cpu(scene, c, p.quality.cube.cube_size.min(64)));
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
         o.reference_note = Some(if p.quality.cube.ref_point.is_some() {
