@@ -398,6 +398,7 @@ fn plan_command_prints_per_object_methods() {
         assert!(o["maps"].as_array().is_some_and(|m| !m.is_empty() && m[0]["bytes"].as_u64().unwrap() > 0), "{o}");
     }
     let json: serde_json::Value = serde_json::from_str(&run(&["plan", scene, "--json"])).unwrap();
+    assert!(json["in_view"].is_array(), "the pairs in view: {json}");
     assert!(json["objects"].as_array().unwrap().iter().all(|o| o["reason"].as_str().unwrap().starts_with("auto: predicted")), "{json}");
     // --candidates: each object's Pareto set of predictions.
     let candidates = run(&["plan", scene, "--candidates"]);

@@ -13,7 +13,10 @@ pub fn run(args: &RenderArgs, json: bool, candidates: bool, budget: &BudgetArgs)
     let prediction = crate::budget::apply(&mut job, &args.scene, budget)?;
     let p = job.plan(&job.quality)?;
     if json {
-        let value = serde_json::json!({ "plan": &p, "prediction": &prediction });
+        // The plan, with how each object shows in the view of another that sees it.
+        let mut plan = serde_json::to_value(&p).map_err(|e| specula::Error::invalid("plan", e.to_string()))?;
+        plan["in_view"] = serde_json::json!(specula::plan::in_view(&p, &job.scene));
+        let value = serde_json::json!({ "plan": plan, "prediction": &prediction });
         let text = serde_json::to_string_pretty(if prediction.is_some() { &value } else { &value["plan"] })
             .map_err(|e| specula::Error::invalid("plan", e.to_string()))?;
         println!("{text}");
