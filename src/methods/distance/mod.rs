@@ -202,9 +202,9 @@ pub fn cubes_converted(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
 /// cube map of its own, with a distance map of its own (distance, image-space refraction:
 /// single-bounce methods), or with maps that are not one cube (image-based captures, relief
 /// height maps: the distance map then goes to `shown_layer`) — not drawn by planar views,
-/// where another object's
-/// method keeps distance maps, is a curved reflector (which shows them by their maps) or
-/// has its radiance cube drawn as a distance map (`cubes_converted`).
+/// where another object's method keeps distance maps, draws the others by their maps
+/// (curved reflectors, captures, height maps) or has its radiance cube drawn as a distance
+/// map (`cubes_converted`).
 fn composed(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
     let gpu = |m: &Method| m.gpu.expect("GPU method");
     let cubes = |m: &Method| crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m));

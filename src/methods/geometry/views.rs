@@ -258,6 +258,13 @@ pub fn counting_pass(init: &StageInit, plan: &crate::plan::types::CameraPlan) ->
 fn clear_fallbacks(rec: &mut Recorder, maps: &Maps) {
     let Some(b) = maps.buffer(&super::slots::FALLBACKS) else { return };
     let (ctx, cmd) = (rec.ctx, rec.cmd);
+    // After the last frame's counting (and its host read), before this frame's.
+    let before = [vk::MemoryBarrier2::default()
+        .src_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
+        .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
+        .dst_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+        .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)];
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&before)) };
     unsafe { ctx.device.cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, 0) };
     let barrier = [vk::MemoryBarrier2::default()
         .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
