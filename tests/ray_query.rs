@@ -300,6 +300,18 @@ fn hybrid_search_traces_only_what_the_map_cannot_answer() {
     assert!(rim.iter().all(|&i| black(&hybrid, i) && black(&confirm, i)), "the hybrids show something where the ball meets itself");
     assert!(!rim.iter().any(|&i| black(&plain, i)), "plain distance maps see the room there");
     common::assert_clean(&ctx);
+    // A device whose fragment shaders may not write storage (a host's, whose enabled features
+    // are not known): the counter-free variant renders the same image and reports no counts.
+    let mut bare = Context::new(&DeviceOptions { validation: true, device_filter: None, ..Default::default() }).unwrap();
+    bare.fragment_stores = false;
+    let mut q = Quality::default();
+    for p in ["depth=1", "caustics=off", "spp=1", "hybrid=rays"] {
+        q.set_pair(p).unwrap();
+    }
+    let uncounted = specula::render(&bare, &scene, distance, &q, (64, 64), (0, 1)).unwrap();
+    assert!(uncounted.image.data == hybrid.image.data, "the counters change no pixel");
+    assert!(uncounted.stats.iter().all(|(n, _)| !n.starts_with("distance.hybrid")), "{:?}", uncounted.stats);
+    common::assert_clean(&bare);
 }
 
 /// The exact caustic photons and the hybrid search keep their structures in step with moving

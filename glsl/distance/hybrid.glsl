@@ -3,6 +3,14 @@
 // define SPECULA_RAY_QUERY and enable GL_EXT_ray_query first.
 #ifndef DISTANCE_HYBRID_GLSL
 #define DISTANCE_HYBRID_GLSL
+// The per-object ray counters (`distance.hybrid.*` in the frame's stats) are storage writes
+// from a fragment shader: the HYBRID_UNCOUNTED variants leave them out where the device was
+// not created with fragmentStoresAndAtomics (a host's device: its features are not known).
+#ifdef HYBRID_NO_COUNTS
+#define RQ_COUNT(k)
+#else
+#define RQ_COUNT(k) atomicAdd(rq_counts[k], 1u)
+#endif
 #include "common/specular.glsl"
 #include "common/traced.glsl"
 #include "raytrace/ray_query.glsl"
@@ -78,7 +86,7 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     SearchResult s = search_ray(x, dir);
     vec4 texel = textureLod(distance_maps, vec4(s.dir, search_layer), 0.0);
     bool resolved = hybrid_resolved(s, x, dir, texel.a, textureGather(distance_maps, vec4(s.dir, search_layer), 3));
-    atomicAdd(rq_counts[2u * push.object], 1u);
+    RQ_COUNT(2u * push.object);
     // Off the surface by 10⁻⁵ of its distance from the reference point (f32 rounding of p).
     float t_min = 1e-5 * length(x) + 1e-30;
     RayHit h = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
@@ -89,7 +97,7 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
         h = rq_trace_mesh(p, dir, max(s.d - w, t_min), s.d + w, push.object, false);
     }
     if (h.triangle == RAY_NO_TRIANGLE) {
-        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        RQ_COUNT(2u * push.object + 1u);
         h = rq_trace_mesh(p, dir, t_min, RQ_T_MAX, push.object, false);
     }
     return hybrid_shade(o, p, dir, h);
@@ -108,8 +116,8 @@ vec3 hybrid_ng = vec3(0.0);
 vec3 hybrid_reflected(Object o, vec3 p, vec3 r) {
     if (!(dot(r, hybrid_ng) < 0.0) || materials[o.material].kind != KIND_MIRROR) return hybrid_radiance(o, p, r);
     search_layer = float(o.envmap_layer);
-    atomicAdd(rq_counts[2u * push.object], 1u);
-    atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+    RQ_COUNT(2u * push.object);
+    RQ_COUNT(2u * push.object + 1u);
     RayHit h = rq_trace_mesh(p, r, 1e-5 * length(p - o.reference_point.xyz) + 1e-30, RQ_T_MAX, RQ_EVERY_MESH, false);
     if (h.triangle != RAY_NO_TRIANGLE && floatBitsToUint(rq_shading[h.triangle].uv2.z) == push.object) return vec3(0.0);
     return hybrid_shade(o, p, r, h);
@@ -151,8 +159,8 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w) {
     vec3 times = w;
     if ((push.flags & FLAG_HYBRID_REENTERS) != 0u) {
         float t_min = 1e-5 * length(p - o.reference_point.xyz) + 1e-30;
-        atomicAdd(rq_counts[2u * push.object], 1u);
-        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        RQ_COUNT(2u * push.object);
+        RQ_COUNT(2u * push.object + 1u);
         RayHit own = rq_trace_mesh(p, d, t_min, RQ_T_MAX, push.object, true);
         if (own.triangle != RAY_NO_TRIANGLE && rq_trace_mesh(p, d, t_min, own.t, push.object, false).triangle == RAY_NO_TRIANGLE) {
             vec3 q = p + d * own.t;
@@ -184,7 +192,7 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     SearchResult h = search_ray(x, dir);
     vec4 texel = textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0);
     vec4 around = textureGather(refractor_maps, vec4(h.dir, search_layer), 3);
-    atomicAdd(rq_counts[2u * push.object], 1u);
+    RQ_COUNT(2u * push.object);
     float t_min = 1e-5 * length(pos - ref) + 1e-30;
     RayHit r = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (hybrid_resolved(h, x, dir, texel.w, around)) {
@@ -199,7 +207,7 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
         r = rq_trace_mesh(pos, dir, max(eps + h.d - w, t_min), eps + h.d + w, push.object, true);
     }
     if (r.triangle == RAY_NO_TRIANGLE) {
-        atomicAdd(rq_counts[2u * push.object + 1u], 1u);
+        RQ_COUNT(2u * push.object + 1u);
         r = rq_trace_mesh(pos, dir, t_min, RQ_T_MAX, push.object, true);
     }
     if (r.triangle == RAY_NO_TRIANGLE) return false;  // an open refractor: the ray is out

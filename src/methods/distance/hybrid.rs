@@ -26,6 +26,8 @@ pub struct HybridRays {
     rays: SceneRays,
     /// (mesh, name) of the pass's objects, for the statistics.
     objects: Vec<(usize, String)>,
+    /// The pass counts its rays (the device lets fragment shaders write storage).
+    counted: bool,
 }
 
 impl HybridRays {
@@ -35,7 +37,7 @@ impl HybridRays {
             e => e,
         })?;
         let objects = plan.objects.iter().map(|&(m, _)| (m, init.scene.meshes[m].name.clone())).collect();
-        Ok(HybridRays { rays, objects })
+        Ok(HybridRays { rays, objects, counted: init.ctx.fragment_stores })
     }
 }
 
@@ -58,8 +60,12 @@ impl PassExtra for HybridRays {
     }
 
     /// Per object the fraction of its search's rays that were traced
-    /// (`distance.hybrid.traced.<object>`), and the rays searched.
+    /// (`distance.hybrid.traced.<object>`), and the rays searched; nothing where the pass
+    /// could not count them (a host's device, HYBRID_UNCOUNTED).
     fn stats(&self) -> Vec<(String, f64)> {
+        if !self.counted {
+            return Vec::new();
+        }
         let counts = self.rays.counts();
         let mut out = Vec::new();
         for (m, name) in &self.objects {

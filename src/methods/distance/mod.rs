@@ -135,12 +135,15 @@ fn create_hybrid_or_plain(init: &StageInit, c: &CameraPlan) -> Result<Box<dyn St
                 *f |= crate::frame::layout::FLAG_HYBRID_REENTERS;
             }
         }
+        // Counting the rays writes storage from the fragment shader: only where the device
+        // was created with fragmentStoresAndAtomics (the library's own, where present).
+        let variant = if init.ctx.fragment_stores { "HYBRID" } else { "HYBRID_UNCOUNTED" };
         return Ok(Box::new(crate::frame::camera::CameraShade::with_extra(
             init.ctx,
             init.layout,
             &c,
             init.multisample,
-            Some("HYBRID"),
+            Some(variant),
             Some(Box::new(extra)),
         )?));
     }
