@@ -724,7 +724,8 @@ pub fn in_view(p: &Plan, scene: &Scene) -> Vec<String> {
         for b in a.sees.iter().filter_map(|&m| p.object(m)) {
             let g = a.method.gpu;
             let graded = scene.materials[scene.meshes[b.mesh].material].graded.is_some();
-            let how = if g.is_none() || a.method.family == "raytrace" {
+            let rays = g.is_none() || a.method.family == "raytrace";
+            let how = if rays {
                 "traced by its rays, exactly (the ray pipeline)".to_string()
             } else if g.is_some_and(|g| (g.views)(&p.quality) > 0) {
                 format!("drawn by its own method ({}) in the mirrored views", b.method.name)
@@ -743,12 +744,7 @@ pub fn in_view(p: &Plan, scene: &Scene) -> Vec<String> {
             };
             let straight =
                 if graded { "; its graded index as a uniform one (straight rays inside: maps do not march the ray equation)" } else { "" };
-            out.push(format!(
-                "{} shows {}: {how}{}",
-                a.name,
-                b.name,
-                if g.is_none() || a.method.family == "raytrace" { "" } else { straight }
-            ));
+            out.push(format!("{} shows {}: {how}{}", a.name, b.name, if rays { "" } else { straight }));
         }
     }
     out

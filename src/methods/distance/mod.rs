@@ -180,6 +180,11 @@ fn shows_by_maps(m: &Method) -> bool {
     distance || crate::methods::FAMILIES.iter().any(|f| f.shows_others_by_maps.contains(m))
 }
 
+/// Whether composition may draw `m`'s radiance cube as a distance map (`Family::cubes_compose`).
+fn cube_composes(m: &Method) -> bool {
+    crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m))
+}
+
 /// The objects of a mixed plan whose radiance cube composition draws as a distance map
 /// (`Family::cubes_compose`: environment mapping): those in view of another specular object
 /// either way — it sees one (its cube must show that object by the object's own map), or an
@@ -187,12 +192,11 @@ fn shows_by_maps(m: &Method) -> bool {
 /// traced in it). A converted cube shows the others by their maps, so the set grows to a
 /// fixed point. `sight[i]`: the positions of the objects that object i sees.
 pub fn cubes_converted(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
-    let cubes = |m: &Method| crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m));
-    let mut out: Vec<bool> = methods.iter().zip(sight).map(|(m, s)| cubes(m) && !s.is_empty()).collect();
+    let mut out: Vec<bool> = methods.iter().zip(sight).map(|(m, s)| cube_composes(m) && !s.is_empty()).collect();
     loop {
         let shows: Vec<bool> = methods.iter().zip(&out).map(|(m, &c)| c || shows_by_maps(m)).collect();
         let seen = |i: usize| sight.iter().enumerate().any(|(j, s)| j != i && shows[j] && s.contains(&i));
-        let grow: Vec<usize> = (0..methods.len()).filter(|&i| !out[i] && cubes(&methods[i]) && seen(i)).collect();
+        let grow: Vec<usize> = (0..methods.len()).filter(|&i| !out[i] && cube_composes(&methods[i]) && seen(i)).collect();
         if grow.is_empty() {
             return out;
         }
@@ -210,10 +214,9 @@ pub fn cubes_converted(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
 /// map (`cubes_converted`).
 fn composed(methods: &[Method], sight: &[Vec<usize>]) -> Vec<bool> {
     let gpu = |m: &Method| m.gpu.expect("GPU method");
-    let cubes = |m: &Method| crate::methods::FAMILIES.iter().any(|f| f.cubes_compose.contains(m));
     let needs = |m: &Method| {
         let g = gpu(m);
-        !cubes(m) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
+        !cube_composes(m) && g.map_shading == MapShading::Sky && m.shape != crate::methods::registry::Shape::Planar
     };
     let converted = cubes_converted(methods, sight);
     let mapped: Vec<bool> = methods.iter().zip(&converted).map(|(m, &c)| c || shows_by_maps(m)).collect();

@@ -20,43 +20,61 @@ pub(super) struct Timing<'a> {
     pub(super) sight: Vec<Vec<usize>>,
 }
 
+/// A choice's composition (`Timing::composition`).
+struct Composition {
+    /// Per pick: maps of its own in another family's maps.
+    composed: Vec<bool>,
+    /// The inter-object cycles the frame runs.
+    cycles: u32,
+}
+
 impl Timing<'_> {
     /// Whether every object has the same method (planned as that whole-scene method).
     pub(super) fn uniform(picks: &[&Candidate]) -> bool {
         picks.windows(2).all(|w| w[0].method == w[1].method)
     }
 
-    /// The inter-object cycles `plan_with` runs for these per-object methods.
-    fn cycles(&self, picks: &[&Candidate]) -> u32 {
+    /// How `plan_with` composes these per-object methods, computed once per choice: which
+    /// picks get maps of their own in another family's maps (`registry::Family::composes`;
+    /// none when one method serves every object: planned as that whole-scene method, which
+    /// keeps its own behaviour), and the inter-object cycles the frame runs.
+    fn composition(&self, picks: &[&Candidate]) -> Composition {
         if Self::uniform(picks) {
-            return picks.first().map_or(1, |c| c.cycles);
+            return Composition { composed: vec![false; picks.len()], cycles: picks.first().map_or(1, |c| c.cycles) };
+        }
+        let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
+        let mut composed = vec![false; picks.len()];
+        if self.quality.frame.compose {
+            for f in crate::methods::FAMILIES.iter().filter_map(|f| f.composes) {
+                composed.iter_mut().zip(f(&methods, &self.sight)).for_each(|(o, c)| *o |= c);
+            }
         }
         let gpu = |m: Method| m.gpu.expect("GPU method");
         let own = picks.iter().map(|c| (gpu(c.method).cycles)(&self.quality)).max().unwrap_or(1).max(1);
-        let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
         let sees_refractor = picks
             .iter()
             .zip(&self.facts.objects)
             .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
-        let converts = crate::methods::distance::cubes_converted(&methods, &self.sight).contains(&true);
-        let composes = self.quality.frame.compose && (sees_refractor || converts || self.composed(picks).contains(&true));
+        let converts = || crate::methods::distance::cubes_converted(&methods, &self.sight).contains(&true);
+        let composes = self.quality.frame.compose && (sees_refractor || composed.contains(&true) || converts());
         let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
-        if latency {
+        let cycles = if latency {
             1
         } else if composes {
             own.max(2)
         } else {
             own
-        }
+        };
+        Composition { composed, cycles }
     }
 
     /// The scale of each object's map share: the frame's cycles over its calibration's (1 for
     /// a whole-scene row, which runs as measured).
-    fn scale(&self, picks: &[&Candidate], c: &Candidate, whole: bool) -> f64 {
+    fn scale(c: &Candidate, whole: bool, how: &Composition) -> f64 {
         if whole {
             1.0
         } else {
-            self.cycles(picks) as f64 / c.cycles as f64
+            how.cycles as f64 / c.cycles as f64
         }
     }
 
@@ -73,32 +91,17 @@ impl Timing<'_> {
     }
 
     pub(super) fn frame_ms(&self, picks: &[&Candidate], whole: bool) -> f64 {
-        let composed = self.composed(picks);
-        (0..picks.len()).map(|i| self.own_ms(picks, i, whole, &composed)).sum::<f64>()
+        let how = self.composition(picks);
+        (0..picks.len()).map(|i| self.own_ms(picks, i, whole, &how)).sum::<f64>()
             + self.base
             + self.kernels(picks, whole).iter().map(|(_, s)| s).sum::<f64>()
     }
 
-    /// The picks that a mixed choice composes into another family's maps (maps of their own,
-    /// `registry::Family::composes`); none when one method serves every object (planned as
-    /// that whole-scene method, which keeps its own behaviour).
-    fn composed(&self, picks: &[&Candidate]) -> Vec<bool> {
-        let mut out = vec![false; picks.len()];
-        if Self::uniform(picks) || !self.quality.frame.compose {
-            return out;
-        }
-        let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
-        for f in crate::methods::FAMILIES.iter().filter_map(|f| f.composes) {
-            out.iter_mut().zip(f(&methods, &self.sight)).for_each(|(o, c)| *o |= c);
-        }
-        out
-    }
-
     /// Object `i`'s maps and camera work, its camera work repeated in the others' views.
-    fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool, composed: &[bool]) -> f64 {
+    fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool, how: &Composition) -> f64 {
         let c = picks[i];
-        let compose = if !whole && composed[i] { c.compose_fixed } else { 0.0 };
-        (c.fixed + compose) * self.scale(picks, c, whole) + c.screen * (1.0 + self.views(picks, Some(i), whole))
+        let compose = if !whole && how.composed[i] { c.compose_fixed } else { 0.0 };
+        (c.fixed + compose) * Self::scale(c, whole, how) + c.screen * (1.0 + self.views(picks, Some(i), whole))
     }
 
     /// Per method its whole-screen kernels, once, repeated in the views of objects of other
@@ -125,8 +128,9 @@ impl Timing<'_> {
         let c = picks[i];
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
         let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
-        let maps = c.fixed * self.scale(picks, c, whole);
-        (maps, self.own_ms(picks, i, whole, &self.composed(picks)) - maps + shared / users)
+        let how = self.composition(picks);
+        let maps = c.fixed * Self::scale(c, whole, &how);
+        (maps, self.own_ms(picks, i, whole, &how) - maps + shared / users)
     }
 }
 
