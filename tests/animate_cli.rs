@@ -1,6 +1,7 @@
 //! `specula animate` and `render --time`: the demo scene's animated mirror sphere as a frame
 //! sequence (PNG + EXR per frame, frames.csv with the maps each frame rebuilt, an animated
-//! GIF), with the validation layer on; bad `--fps`, `--duration` and `--time` are refused.
+//! GIF), with the validation layer on; `--slide` moves any object; bad `--fps`, `--duration`,
+//! `--time` and `--slide` are refused.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -52,6 +53,16 @@ fn animate_writes_frames_timings_and_a_preview() {
     let (ok, out) = specula(&args);
     assert!(ok, "{out}");
     assert!(std::fs::read(&posed).unwrap() == b, "render --time 1 equals the animation's frame at t = 1");
+    // --slide moves any object, --freeze holds the scene's own animation: the box moves
+    // alone, and frames.csv says what its move rebuilt.
+    let slid = dir.join("slid");
+    let mut args = vec!["animate", SCENE, "--fps", "2", "--duration", "1", "--freeze", "--slide", "box/0=0.2,0,0"];
+    args.extend(["--out", slid.to_str().unwrap()]);
+    args.extend(small);
+    let (ok, out) = specula(&args);
+    assert!(ok, "{out}");
+    let csv = std::fs::read_to_string(slid.join("frames.csv")).unwrap();
+    assert!(csv.contains("moved 'box/0'") && !csv.contains("mirror_sphere"), "{csv}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
@@ -64,6 +75,8 @@ fn bad_animation_arguments_are_refused() {
         (vec!["animate", SCENE, "--duration=-1", "--out", out_dir], "--duration"),
         (vec!["render", SCENE, "--time=-2", "--out", "x.png"], "--time"),
         (vec!["animate", SCENE, "--method", "reference", "--out", out_dir], "--method"),
+        (vec!["animate", SCENE, "--slide", "nobox=1,0,0", "--out", out_dir], "no object named 'nobox'"),
+        (vec!["animate", SCENE, "--slide", "box/0=1,x,0", "--out", out_dir], "--slide"),
     ] {
         let (ok, out) = specula(&args);
         assert!(!ok && out.contains(want), "{args:?}: {out}");

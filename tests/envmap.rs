@@ -258,13 +258,14 @@ fn only_what_the_scene_requires_is_planned_and_allocated() {
     q.set("cube_size", "64").unwrap();
     let f = specula::render(&ctx, &scene, specula::methods::ENVMAP, &q, (16, 16), (0, 1)).unwrap();
     let names: Vec<_> = f.passes.iter().map(|p| p.name.as_str()).collect();
-    // The lit mirror over the floor is a caustic generator (§6): its four passes.
+    // The lit mirror over the floor is a caustic generator (§6): its five passes.
     assert_eq!(
         names,
         [
             "shadow.generate",
             "caustics.receivers",
             "caustics.photons",
+            "caustics.reach",
             "caustics.triangles",
             "caustics.filter",
             "envmap.generate",

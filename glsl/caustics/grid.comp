@@ -37,7 +37,7 @@ void main() {
     ivec3 tc = ivec3(int(i % n), int(i / n), int(push.object));
     vec4 hit = texelFetch(photon_hits, tc, 0);
     vec4 power = texelFetch(photon_power, tc, 0);
-    if (hit.w == 0.0 || all(lessThanEqual(power.rgb, vec3(0.0)))) return;
+    if (!(hit.w > 0.0) || all(lessThanEqual(power.rgb, vec3(0.0)))) return;
     vec3 p = cubes[push.flags].centre.xyz + hit.xyz;
     if (any(isnan(p)) || any(isinf(p))) return;
     uint b = photon_bucket(photon_cell(p));

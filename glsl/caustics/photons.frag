@@ -273,7 +273,12 @@ void main() {
     search_layer = float(cube);
     vec3 x = pos - centre;
     SearchResult h = search_ray(x, dir);
-    if (h.escaped) return;
+    if (h.escaped) {
+        // No receiver: w −1 says so (caustics/reach.comp: its region has no bound); every
+        // other pass takes only w > 0.
+        out_hit = vec4(dir, -1.0);
+        return;
+    }
     if ((caustic.flags & CAUSTIC_SURFACE_PATHS) != 0u && m.kind == KIND_DIELECTRIC && m.thin == 0u && branch == 0u) {
         w *= volume_transmittance(m, h.d * length(dir));  // absorbed inside on the way there
     }

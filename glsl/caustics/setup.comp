@@ -41,7 +41,7 @@ void main() {
     for (int j = 0; j < 3; ++j) {
         ivec3 tc = ivec3(base + CORNERS[first + j], layer);
         vec4 hit = texelFetch(photon_hits, tc, 0);
-        ok = ok && hit.w != 0.0;
+        ok = ok && hit.w > 0.0;
         h[j] = hit.xyz;
         float len = length(hit.xyz);
         lo = min(lo, len);

@@ -48,7 +48,7 @@ void main() {
     vec2 uv;
     vec3 normal;
     float area;
-    bool lands = hit.w != 0.0 && id >= 1.0 && id < 16777217.0 && any(greaterThan(power, vec3(0.0)))
+    bool lands = hit.w > 0.0 && id >= 1.0 && id < 16777217.0 && any(greaterThan(power, vec3(0.0)))
               && caustic_texture_point(uint(id) - 1u, cubes[cube].centre.xyz + hit.xyz, uv, normal, area) && area > 0.0;
     if (!lands) {
         out_scale = vec4(0.0);
@@ -67,7 +67,7 @@ void main() {
 #elif defined(SCREEN)
     vec3 p = cubes[push.flags].centre.xyz + hit.xyz;
     vec4 clip = v.view_proj * vec4(p, 1.0);
-    if (hit.w == 0.0 || clip.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
+    if (!(hit.w > 0.0) || clip.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
         out_scale = vec4(0.0);
         gl_Position = vec4(0.0, 0.0, 0.0, -1.0);
         return;
@@ -83,7 +83,7 @@ void main() {
     vec4 near = v.view_proj * vec4(p + normalize(v.eye.xyz - p) * 2.0 * max(px, py), 1.0);
     gl_Position = vec4((ndc.xy + corner * (2.0 * r / screen)) * near.w, near.z, near.w);
 #else
-    if (hit.w == 0.0 || c.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
+    if (!(hit.w > 0.0) || c.w <= 0.0 || all(lessThanEqual(power, vec3(0.0)))) {
         out_scale = vec4(0.0);
         gl_Position = vec4(0.0, 0.0, 0.0, -1.0);  // outside every clip volume: no quad
         return;

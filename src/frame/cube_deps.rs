@@ -4,8 +4,9 @@
 //! that moved was inside it before or is now, or the shadow it casts from a shadowed light
 //! (the volume behind it, clipped to the scene's bounds) was or is; when a material of an
 //! object inside it changed; when its centre moved (its own object moved); on any light
-//! change (every face is lit); with caustics, on any move or material change (the light a
-//! generator focuses may land anywhere); and — with inter-object cycles, where a face shows
+//! change (every face is lit); where the caustics this frame redoes may have changed the
+//! light on its surfaces (`CausticReach`: within the boxes the caustics stage worked out, or
+//! anywhere after a generator moved); and — with inter-object cycles, where a face shows
 //! the other objects traced in their own maps — when it sees an object whose map is drawn
 //! again. A face that shows a planar mirror (its mirrored view sees anywhere) is drawn
 //! again on any move. Everything else keeps what it holds.
@@ -26,27 +27,42 @@ pub enum ShadowFrom {
     Directional(Vec3),
 }
 
+/// Where the caustics this frame redoes may have changed the light on the maps' surfaces
+/// (set by the caustics stage's update, `methods::caustics::reach`, before the maps' own).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum CausticReach {
+    /// No caustic the maps show is redone.
+    #[default]
+    Unchanged,
+    /// Within these boxes.
+    Within(Vec<(Vec3, Vec3)>),
+    /// Anywhere (a generator moved, a light changed, a photon escaped …).
+    Anywhere,
+}
+
 /// What else a face's content depends on besides what lies in it.
 #[derive(Clone, Debug, Default)]
 pub struct Lighting {
     /// The lights whose shadows the maps show.
     pub shadows: Vec<ShadowFrom>,
-    /// Caustics are projected onto what the maps show.
-    pub caustics: bool,
+    /// Where the caustics projected onto what the maps show changed.
+    pub caustics: CausticReach,
 }
 
 impl Lighting {
-    /// What a plan's maps show of the lights: the shadow-mapped lights' shadows, caustics.
-    pub fn of(scene: &Scene, plan: &crate::plan::types::Plan) -> Lighting {
+    /// What a plan's maps show of the lights: the shadow-mapped lights' shadows, and where
+    /// this frame's caustics changed (`maps.caustic_reach`).
+    pub fn of(scene: &Scene, plan: &crate::plan::types::Plan, maps: &crate::frame::maps::Maps) -> Lighting {
         let point = plan.shadow_cubes.iter().filter_map(|&i| scene.lights.get(i)).map(|l| ShadowFrom::Point(l.position));
         let directional = plan.shadow_planes.iter().filter_map(|&i| scene.lights.get(i)).map(|l| ShadowFrom::Directional(l.direction));
-        Lighting { shadows: point.chain(directional).collect(), caustics: plan.caustics.is_some() }
+        let caustics = if plan.caustics.is_some() { maps.caustic_reach.clone() } else { CausticReach::Unchanged };
+        Lighting { shadows: point.chain(directional).collect(), caustics }
     }
 }
 
 /// The bounds of the shadow box (lo, hi) casts from `light` within the scene's bounds
 /// `scene` (the box itself included); None where the light is inside it (everywhere).
-fn shadow_bounds(light: ShadowFrom, (lo, hi): (Vec3, Vec3), (slo, shi): (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
+pub(crate) fn shadow_bounds(light: ShadowFrom, (lo, hi): (Vec3, Vec3), (slo, shi): (Vec3, Vec3)) -> Option<(Vec3, Vec3)> {
     if !(lo.is_finite() && hi.is_finite() && slo.is_finite() && shi.is_finite()) {
         return None;
     }
@@ -146,7 +162,8 @@ impl FaceDeps {
     ) {
         let known = self.eyes.len() == objects.len() && self.bounds.len() == draws.len() && eyes.len() == objects.len();
         let changed = !changes.moved.is_empty() || !changes.materials.is_empty();
-        if !known || !changes.lights.is_empty() || (inter_object && !changes.materials.is_empty()) || (lighting.caustics && changed) {
+        let caustics_anywhere = lighting.caustics == CausticReach::Anywhere && changed;
+        if !known || !changes.lights.is_empty() || (inter_object && !changes.materials.is_empty()) || caustics_anywhere {
             self.all();
             return;
         }
@@ -176,6 +193,11 @@ impl FaceDeps {
         let sees = |k: usize, f: usize, (lo, hi): (Vec3, Vec3)| face_sees_box(f, eyes[k], lo, hi);
         let changed_material = |m: usize| scene.meshes.get(m).is_some_and(|mesh| changes.materials.contains(&mesh.material));
         let any_move = !changes.moved.is_empty();
+        // Where redone caustics may have changed the light on what the faces show.
+        let caustic_boxes: &[(Vec3, Vec3)] = match &lighting.caustics {
+            CausticReach::Within(b) => b,
+            _ => &[],
+        };
         for (k, eye) in eyes.iter().enumerate() {
             if self.eyes[k] != *eye {
                 self.faces[k] = ALL_FACES;
@@ -185,7 +207,8 @@ impl FaceDeps {
                 let own = self.left_out.get(k).copied().flatten();
                 let hit = reached.iter().any(|&(m, r)| (m.is_none() || m != own) && r.is_none_or(|b| sees(k, f, b)))
                     || (0..draws.len()).any(|m| changed_material(m) && sees(k, f, now(m)))
-                    || (any_move && mirrors.iter().any(|&m| sees(k, f, now(m))));
+                    || (any_move && mirrors.iter().any(|&m| sees(k, f, now(m))))
+                    || caustic_boxes.iter().any(|&b| sees(k, f, b));
                 if hit {
                     self.faces[k] |= 1 << f;
                 }
@@ -281,12 +304,20 @@ mod tests {
         d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &Lighting::default());
         assert_eq!(d.faces, vec![1], "unshadowed: the box's face only");
         d.drawn(vec![eye], &[floor, before]);
-        let light = Lighting { shadows: vec![ShadowFrom::Point(Vec3::new(2.0, 3.0, 0.0))], caustics: false };
+        let light = Lighting { shadows: vec![ShadowFrom::Point(Vec3::new(2.0, 3.0, 0.0))], caustics: CausticReach::Unchanged };
         d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &light);
         assert!(d.faces[0] & 1 != 0 && d.faces[0] & (1 << 3) != 0, "the box and its shadow below: {:#08b}", d.faces[0]);
         // Caustics: every face.
         d.drawn(vec![eye], &[floor, before]);
-        d.mark(&scene, &[9], &[eye], &[floor, after], &moved, (false, &[]), &Lighting { shadows: Vec::new(), caustics: true });
+        d.mark(
+            &scene,
+            &[9],
+            &[eye],
+            &[floor, after],
+            &moved,
+            (false, &[]),
+            &Lighting { shadows: Vec::new(), caustics: CausticReach::Anywhere },
+        );
         assert_eq!(d.count(), (6, 6));
 
         // A cube that leaves the box out (its own object, as image-based's fixed captures): the

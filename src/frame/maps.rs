@@ -105,6 +105,9 @@ pub struct Maps {
     pub latest: usize,
     /// How many times an image or a buffer was put into a slot (`changes`).
     puts: u64,
+    /// Where the caustics this frame redoes may change the light on the maps' surfaces (the
+    /// caustics stage's update sets it before the maps' updates read it).
+    pub caustic_reach: crate::frame::cube_deps::CausticReach,
 }
 
 impl Maps {

@@ -37,6 +37,9 @@ pub enum Deps {
     /// materials of the stage's own objects (the receivers' albedo is applied when they are
     /// shaded).
     LitObjects,
+    /// A light effect in the camera's view (caustic_space=screen): as `LitObjects`, and the
+    /// camera.
+    LitView,
     /// Maps around objects (environment, distance, refractor): everything they see, which
     /// is the whole scene's geometry, materials and lights, but not the camera.
     World,

@@ -41,6 +41,10 @@ pub trait Stage {
     fn redraw(&self) -> Option<(u32, u32)> {
         None
     }
+    /// What `redraw` counts, said in the frame's map-update list (None: "k of n faces").
+    fn redraw_note(&self) -> Option<String> {
+        None
+    }
     /// Flags `scene.direct` shades with because this stage exists (e.g. a pass of its own
     /// projects the caustics: `FLAG_CAUSTICS_APART`).
     fn direct_flags(&self) -> u32 {

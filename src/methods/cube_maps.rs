@@ -307,7 +307,7 @@ impl Stage for CubeMaps {
     /// With frame latency the inter-object cycles run one per frame on the previous frame's
     /// maps: after a change they start again from the sky, like a fresh renderer's, so that
     /// no bounce keeps the old scene.
-    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, _maps: &mut Maps) -> Result<()> {
+    fn update(&mut self, init: &StageInit, changes: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
         let seen = !changes.moved.is_empty() || !changes.materials.is_empty() || !changes.lights.is_empty();
         if self.frame_latency && seen {
             self.frames = 0;
@@ -320,8 +320,8 @@ impl Stage for CubeMaps {
             // Height maps: orthographic views over the whole box, every face of a layer that
             // sees the change: a light or material, another object's move, or its own
             // object's where its shadows or caustics fall on what the layer draws.
-            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
-            let casts = !lighting.shadows.is_empty() || lighting.caustics;
+            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan, maps);
+            let casts = !lighting.shadows.is_empty() || lighting.caustics != crate::frame::cube_deps::CausticReach::Unchanged;
             let global = !changes.lights.is_empty() || !changes.materials.is_empty();
             for (k, &own) in self.objects.iter().enumerate() {
                 if global || changes.moved.iter().any(|&m| m != own || casts) {
@@ -330,7 +330,7 @@ impl Stage for CubeMaps {
             }
         } else {
             let eyes = self.eyes(init.plan);
-            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan);
+            let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan, maps);
             self.deps.mark(init.scene, &self.objects, &eyes, &init.gpu.draws, changes, (self.inter_object, &self.map_mirrors), &lighting);
         }
         Ok(())

@@ -13,8 +13,9 @@ use crate::vk::Context;
 
 use super::{bindings, stage_init, Renderer};
 
-/// `Stage::redraw`: (faces to draw, faces in all), or None for the whole stage.
-type Redraw = Option<(u32, u32)>;
+/// `Stage::redraw`: (faces to draw, faces in all), or None for the whole stage, with
+/// `Stage::redraw_note`.
+type Redraw = (Option<(u32, u32)>, Option<String>);
 
 /// A map stage the frame recorded, and why: its first frame, `map_updates=always`, or what
 /// it depends on that changed.
@@ -97,6 +98,7 @@ impl Updates {
                     Deps::Shadows => (geometry, false, !c.lights.is_empty(), false),
                     Deps::Geometry => (geometry, false, false, false),
                     Deps::LitObjects => (geometry, own_materials(), !c.lights.is_empty(), false),
+                    Deps::LitView => (geometry, own_materials(), !c.lights.is_empty(), c.camera),
                     Deps::World => (geometry, !c.materials.is_empty(), !c.lights.is_empty(), false),
                     Deps::CameraMap => (geometry, false, false, c.camera),
                 };
@@ -113,9 +115,10 @@ impl Updates {
                     why.push("camera".to_string());
                 }
                 // A stage that tracks what each face saw draws only the faces that saw it.
-                match redraw.get(i).copied().flatten() {
+                let (count, note) = redraw.get(i).cloned().unwrap_or_default();
+                match count {
                     Some((0, _)) if !cam => why.clear(),
-                    Some((k, n)) if k < n && !why.is_empty() => why.push(format!("{k} of {n} faces")),
+                    Some((k, n)) if k < n && !why.is_empty() => why.push(note.unwrap_or_else(|| format!("{k} of {n} faces"))),
                     _ => {}
                 }
             }
@@ -248,7 +251,7 @@ impl Renderer {
             }
         }
         let names: Vec<&'static str> = self.stages.iter().map(|s| s.name()).collect();
-        let redraw: Vec<Redraw> = self.stages.iter().map(|s| s.redraw()).collect();
+        let redraw: Vec<Redraw> = self.stages.iter().map(|s| (s.redraw(), s.redraw_note())).collect();
         self.updates.invalidate(&self.plan, &self.deps, (&names, &redraw), c);
         Ok(())
     }

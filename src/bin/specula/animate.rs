@@ -10,7 +10,37 @@ use std::path::Path;
 
 use crate::args::{context, prepare, write_image, RenderArgs};
 
-pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, out: &Path) -> specula::Result<()> {
+/// An object moved at a constant velocity (`--slide OBJECT=DX,DY,DZ`).
+struct Slide {
+    mesh: usize,
+    velocity: glam::Vec3,
+    world: glam::Mat4,
+}
+
+/// Parses `--slide OBJECT=DX,DY,DZ` against the scene's object names.
+fn slides(scene: &specula::scene::Scene, specs: &[String]) -> specula::Result<Vec<Slide>> {
+    specs
+        .iter()
+        .map(|spec| {
+            let bad = |why: String| specula::Error::invalid("--slide", format!("'{spec}': {why}"));
+            let (name, v) = spec.rsplit_once('=').ok_or_else(|| bad("expected OBJECT=DX,DY,DZ".into()))?;
+            let mesh = scene.meshes.iter().position(|m| m.name == name).ok_or_else(|| {
+                let names: Vec<&str> = scene.meshes.iter().map(|m| m.name.as_str()).collect();
+                bad(format!("no object named '{name}' (objects: {})", names.join(", ")))
+            })?;
+            let parts: Vec<f32> =
+                v.split(',').map(|p| p.trim().parse::<f32>()).collect::<Result<_, _>>().map_err(|e| bad(e.to_string()))?;
+            match parts[..] {
+                [x, y, z] if x.is_finite() && y.is_finite() && z.is_finite() => {
+                    Ok(Slide { mesh, velocity: glam::Vec3::new(x, y, z), world: scene.meshes[mesh].world })
+                }
+                _ => Err(bad(format!("expected three finite numbers, got '{v}'"))),
+            }
+        })
+        .collect()
+}
+
+pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, (slide, freeze): (&[String], bool), out: &Path) -> specula::Result<()> {
     if !(fps > 0.0 && fps <= 240.0) {
         return Err(specula::Error::invalid("--fps", format!("must be in (0, 240], got {fps}")));
     }
@@ -29,9 +59,14 @@ pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, out: &Path) -> sp
     if !(duration > 0.0 && duration <= 3600.0) {
         return Err(specula::Error::invalid("--duration", format!("must be in (0, 3600] seconds, got {duration}")));
     }
-    if job.scene.animation.is_none() {
+    if job.scene.animation.is_none() && slide.is_empty() {
         eprintln!("specula: note: {} has no animations: every frame is the same pose", args.scene.display());
     }
+    let slides = {
+        let mut first = job.scene.clone();
+        first.set_time(0.0)?;
+        slides(&first, slide)?
+    };
     let frames = ((duration * fps).round() as u32).max(1);
     std::fs::create_dir_all(out).map_err(|e| specula::Error::io(out, e))?;
     let ctx = context(args.validate, &args.device)?;
@@ -46,7 +81,10 @@ pub fn run(args: &RenderArgs, fps: f32, duration: Option<f32>, out: &Path) -> sp
     let result = (|| -> specula::Result<()> {
         for k in 0..frames {
             let t = k as f32 / fps;
-            scene.set_time(t)?;
+            scene.set_time(if freeze { 0.0 } else { t })?;
+            for s in &slides {
+                scene.set_object_transform(s.mesh, glam::Mat4::from_translation(s.velocity * t) * s.world)?;
+            }
             let mut replanned = None;
             if let Err(e) = r.update(&scene) {
                 // The pose changed the plan's structure (say, objects came into each other's

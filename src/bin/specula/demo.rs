@@ -119,7 +119,7 @@ pub fn run(outdir: &Path, size: &str, validate: bool, device: &Option<String>) -
         warmup: 0,
         frames: 1,
     };
-    crate::animate::run(&anim, 12.0, None, &outdir.join("animation"))
+    crate::animate::run(&anim, 12.0, None, (&[], false), &outdir.join("animation"))
 }
 
 /// The mirror scene (`assets/mirrors/`): images and a timing table into `outdir`; the

@@ -221,6 +221,14 @@ enum Command {
         /// Seconds to render; default: the animation's duration (2 s without animations).
         #[arg(long)]
         duration: Option<f32>,
+        /// Moves an object from its first pose at a constant velocity (units per second),
+        /// e.g. `--slide box/0=0.2,0,0` (repeatable; it replaces that object's own animation):
+        /// frames over time for any object, for profiling what a move rebuilds.
+        #[arg(long = "slide", value_name = "OBJECT=DX,DY,DZ")]
+        slides: Vec<String>,
+        /// Holds the scene's own animations at their first pose (only `--slide` moves).
+        #[arg(long)]
+        freeze: bool,
         #[arg(long, default_value = "animation")]
         out: PathBuf,
     },
@@ -317,7 +325,7 @@ fn run(cmd: Command) -> specula::Result<()> {
     match cmd {
         Command::Render { args, out, profile, budget } => render::run(&args, &out, profile.as_deref(), &budget),
         Command::Info { scene } => info::run(&scene),
-        Command::Animate { args, fps, duration, out } => animate::run(&args, fps, duration, &out),
+        Command::Animate { args, fps, duration, slides, freeze, out } => animate::run(&args, fps, duration, (&slides, freeze), &out),
         Command::Plan { args, json, candidates, budget } => plan::run(&args, json, candidates, &budget),
         Command::Knobs => knobs::run(),
         Command::Demo { outdir, size, validate, device } => demo::run(&outdir, &size, validate, &device),

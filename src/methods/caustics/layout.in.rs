@@ -116,7 +116,8 @@ descriptor_sets! {
         /// caustic as seen from its centre, the projection's input.
         CAUSTIC_MAPS = 11: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_maps";
         /// Caustics: photon hit location images, one layer per light view of a generator:
-        /// xyz the hit relative to its cube's centre, w 1 for a photon.
+        /// xyz the hit relative to its cube's centre, w 1 for a photon (more: an exact hit's
+        /// code), −1 with xyz its direction for one that escaped the receivers, 0 for none.
         PHOTON_HITS = 12: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_hits";
         /// Caustics: the photons' power (rgb, W).
         PHOTON_POWER = 13: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_power";
@@ -156,5 +157,11 @@ descriptor_sets! {
         /// caustic_space=texture: per caustic cube, the receiver triangle (its index in the
         /// scene's list + 1, as a float; 0 or FAR: none) in each direction from its centre.
         CAUSTIC_RECEIVER_IDS = 26: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_receiver_ids";
+        /// Caustics: where each caustic cube's photons went in its last record (issue 33 item
+        /// 4; caustics/reach.comp), eight words a cube: the terminal hits' world bounds (min xyz,
+        /// max xyz, as order-preserving uints: `reach_key`), 1 if a photon escaped the receivers,
+        /// the photons that landed. Read back by the stage to decide which generators a later
+        /// change reaches.
+        CAUSTIC_REACH = 28: STORAGE_BUFFER => "buffer CausticReach { uint caustic_reach[]; }";
     }
 }

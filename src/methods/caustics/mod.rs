@@ -27,6 +27,7 @@
 pub mod atlas;
 pub mod knobs;
 pub mod project;
+pub mod reach;
 pub mod slots;
 pub mod stage;
 
@@ -58,6 +59,10 @@ impl CausticsPlan {
     /// The profiled passes it records, in order.
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
+        // Where the photons went (issue 33 item 4): all but exact photons, which any move reaches.
+        if q.caustics.caustic_paths != CausticPaths::Exact {
+            v.push("caustics.reach");
+        }
         v.push(match self.filter {
             _ if self.space == CausticSpace::Screen => "caustics.screen",
             _ if self.space == CausticSpace::Texture => "caustics.light_map",
@@ -69,6 +74,13 @@ impl CausticsPlan {
             v.push("caustics.filter");
         }
         v
+    }
+
+    /// Whether the maps around objects show these caustics (light cube maps and the texture
+    /// space's light map; the photon map's gather and the screen's splats are the camera's
+    /// alone).
+    pub fn shown_in_maps(&self) -> bool {
+        self.light_cubes() || self.space == CausticSpace::Texture
     }
 
     /// Whether it keeps light cube maps (splats and caustic triangles go there; the photon
@@ -140,7 +152,9 @@ fn plan_stages(scene: &Scene, p: &mut Plan, st: &mut PlanStages) {
         }
     }
     let generators: Vec<usize> = c.generators.iter().map(|g| g.mesh).collect();
-    st.stages.push(STAGE.stage(p, generators.clone()));
+    // Screen space splats into the camera's view: the camera's moves redo it.
+    let stage = if c.space == CausticSpace::Screen { EffectInfo { deps: Deps::LitView, ..STAGE } } else { STAGE };
+    st.stages.push(stage.stage(p, generators.clone()));
     // A whole-scene ray tracer shades every pixel itself (its kernel projects them).
     if !st.shades_scene {
         st.stages.push(PROJECT.stage(p, generators));

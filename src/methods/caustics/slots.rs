@@ -46,6 +46,10 @@ pub const CAUSTIC_LIGHT_MAP: Slot =
     Slot { shading: true, ..Slot::image("caustics.light_map", 0, binding::CAUSTIC_LIGHT_MAP, Sampler::Linear) };
 pub const CAUSTIC_RECEIVER_IDS: Slot = Slot::image("caustics.receiver_ids", 0, binding::CAUSTIC_RECEIVER_IDS, Sampler::Nearest);
 
+/// Where each caustic cube's photons went in its last record (caustics/reach.comp), read
+/// back by the stage after the frame (`super::reach`).
+pub const CAUSTIC_REACH: Slot = Slot::buffer("caustics.reach", 0, binding::CAUSTIC_REACH);
+
 pub const SLOTS: &[Slot] = &[
     CAUSTIC_DISTANCES,
     CAUSTIC_MAPS,
@@ -62,11 +66,12 @@ pub const SLOTS: &[Slot] = &[
     CAUSTIC_ATLAS,
     CAUSTIC_LIGHT_MAP,
     CAUSTIC_RECEIVER_IDS,
+    CAUSTIC_REACH,
 ];
 
 impl crate::frame::maps::Maps {
     /// Caustics: the photon hit location images (xyz hit relative to the reference point,
-    /// w 1 for a photon) and the photons' power, one layer per light view.
+    /// w > 0 for a photon, −1 for one that escaped) and the photons' power, one layer per light view.
     pub fn photon_images(&self) -> Option<(&crate::vk::Image, &crate::vk::Image)> {
         self.image(&PHOTON_HITS).zip(self.image(&PHOTON_POWER))
     }

@@ -7,11 +7,13 @@
 use ash::vk;
 
 use super::atlas::Atlas;
+use super::reach::Tracker;
 use super::slots::{
-    CAUSTICS, CAUSTIC_ATLAS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_LIGHT_MAP, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_RECEIVER_IDS,
-    CAUSTIC_SCREEN, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID, PHOTON_HITS, PHOTON_LIST, PHOTON_POWER,
+    CAUSTICS, CAUSTIC_ATLAS, CAUSTIC_DISTANCES, CAUSTIC_FACES, CAUSTIC_LIGHT_MAP, CAUSTIC_MAPS, CAUSTIC_RAW, CAUSTIC_REACH,
+    CAUSTIC_RECEIVER_IDS, CAUSTIC_SCREEN, CAUSTIC_TRIANGLES, PHOTON_COARSE, PHOTON_GRID, PHOTON_HITS, PHOTON_LIST, PHOTON_POWER,
 };
 use super::CausticsPlan;
+use crate::frame::cube_deps::ShadowFrom;
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{GpuCausticCube, GpuCausticParams};
 use crate::frame::layout::{
@@ -61,6 +63,12 @@ pub struct CausticsStage {
     layout: vk::PipelineLayout,
     /// caustic_paths=exact: what the photons' ray queries trace through (§6.1.1).
     exact: Option<SceneRays>,
+    /// Where each cube's photons went (caustics/reach.comp; none with exact paths).
+    reach: vk::Pipeline,
+    /// Which generators the next record redoes (issue 33 item 4, `super::reach`).
+    tracker: Tracker,
+    /// map_updates=always: every record redoes every generator.
+    always: bool,
 }
 
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene` and a
@@ -155,6 +163,9 @@ impl CausticsStage {
             light_map_splat: vk::Pipeline::null(),
             layout: init.layout,
             exact: None,
+            reach: vk::Pipeline::null(),
+            tracker: Tracker::new(0, 0, Vec::new(), (false, true)),
+            always: q.frame.map_updates_always,
         };
         Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
     }
@@ -211,6 +222,17 @@ impl CausticsStage {
         maps.set_image(&PHOTON_POWER, photon("caustics.photon_power")?);
         let bytes = table_bytes(&self.plan, q, init);
         maps.set_buffer(&CAUSTICS, Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
+        // Where the photons went, read back to decide what a later change reaches (exact
+        // photons bounce off every specular surface: any move may reach them, nothing to read).
+        let tracks = q.caustics.caustic_paths != CausticPaths::Exact;
+        let bounds = init.gpu.draws.iter().map(|d| (d.lo, d.hi)).collect();
+        self.tracker = Tracker::new(self.plan.generators.len(), cubes as usize, bounds, (tracks, !self.plan.light_cubes()));
+        if tracks {
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let words = Buffer::new(ctx, "caustics.reach", 32 * cubes as u64, usage, crate::vk::MemoryLocation::GpuToCpu)?;
+            maps.set_buffer(&CAUSTIC_REACH, words);
+            self.reach = crate::vk::pipeline::compute_pipeline(ctx, layout, "caustics/reach.comp")?;
+        }
         self.cube_depth = cube_depth(ctx, "caustics.depth", s, self.mode)?;
         self.photon_depth = Image::new(
             ctx,
@@ -469,14 +491,7 @@ impl CausticsStage {
     /// previous frame's reads are behind the pass's opening barrier.)
     fn build_photon_grid(&self, rec: &mut Recorder, f: &FrameInputs, grid: vk::Buffer) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let barrier = |src: vk::PipelineStageFlags2, src_access, dst: vk::PipelineStageFlags2, dst_access| {
-            let b = [vk::MemoryBarrier2::default()
-                .src_stage_mask(src)
-                .src_access_mask(src_access)
-                .dst_stage_mask(dst)
-                .dst_access_mask(dst_access)];
-            unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
-        };
+        let barrier = |src, src_access, dst, dst_access| memory_barrier(ctx, cmd, (src, src_access), (dst, dst_access));
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
         let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         unsafe { ctx.device.cmd_fill_buffer(cmd, grid, 0, vk::WHOLE_SIZE, 0) };
@@ -542,6 +557,41 @@ impl CausticsStage {
         }
     }
 
+    /// `caustics.reach`: where the redone cubes' photons went (caustics/reach.comp), their
+    /// words cleared first (bounds empty, nothing escaped, none landed); the stage reads them
+    /// back at the next change (`Stage::update`).
+    fn record_reach(&self, rec: &mut Recorder, f: &FrameInputs, maps: &Maps, hits: &Image, redo: &[bool]) {
+        let Some(words) = maps.buffer(&CAUSTIC_REACH).map(|b| b.raw) else { return };
+        let open = rec.pass("caustics.reach").reads(hits, Access::ComputeSampled).begin();
+        let (ctx, cmd) = (rec.ctx, rec.cmd);
+        let barrier = |src, src_access, dst, dst_access| memory_barrier(ctx, cmd, (src, src_access), (dst, dst_access));
+        let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
+        let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        let transfer = vk::PipelineStageFlags2::ALL_TRANSFER;
+        // After the last record's kernel (and the host's read, behind the frame's fence).
+        barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, transfer, vk::AccessFlags2::TRANSFER_WRITE);
+        for k in (0..redo.len()).filter(|&k| redo[k]) {
+            let at = 32 * k as u64;
+            unsafe {
+                ctx.device.cmd_fill_buffer(cmd, words, at, 12, u32::MAX);
+                ctx.device.cmd_fill_buffer(cmd, words, at + 12, 20, 0);
+            }
+        }
+        barrier(transfer, vk::AccessFlags2::TRANSFER_WRITE, compute, storage);
+        unsafe {
+            ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.reach);
+            ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
+        }
+        let (x, y) = spread_groups((self.photons as u64 * self.photons as u64).div_ceil(64));
+        for c in (0..self.plan.cubes.len()).filter(|&c| redo[c]) {
+            for layer in cube_layers(&self.plan, c) {
+                f.push_flags(ctx, cmd, 0, layer, c as u32);
+                unsafe { ctx.device.cmd_dispatch(cmd, x, y, 1) };
+            }
+        }
+        rec.end(open);
+    }
+
     /// Every photon layer's splats into one target seen from `view` (screen and texture
     /// space), push.flags naming the layer's caustic cube.
     fn draw_splats(&self, ctx: &Context, cmd: vk::CommandBuffer, f: &FrameInputs, view: u32) {
@@ -561,7 +611,7 @@ impl CausticsStage {
     /// Caustic triangles (§6.3.2): sets up every photon layer's triangles once, each flagged
     /// for the faces of its cube it may reach. (The previous frame's reads of the buffers
     /// are behind the pass's opening barrier.)
-    fn setup_triangles(&self, rec: &mut Recorder, f: &FrameInputs, views: &crate::frame::stage::ViewLayout) {
+    fn setup_triangles(&self, rec: &mut Recorder, f: &FrameInputs, views: &crate::frame::stage::ViewLayout, redo: &[bool]) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         unsafe {
             ctx.device.cmd_bind_pipeline(cmd, vk::PipelineBindPoint::COMPUTE, self.setup);
@@ -569,7 +619,7 @@ impl CausticsStage {
         }
         let per_layer = 2 * (self.photons - 1) * (self.photons - 1);
         let cubes = views.first(super::CUBE_VIEWS).expect("caustics declare their views");
-        for c in 0..self.plan.cubes.len() {
+        for c in (0..self.plan.cubes.len()).filter(|&c| redo[c]) {
             let first_view = cubes + 6 * c as u32;
             for layer in cube_layers(&self.plan, c) {
                 f.push_flags(ctx, cmd, first_view, layer, 0);
@@ -604,8 +654,48 @@ impl Stage for CausticsStage {
         v
     }
 
-    /// Reference points follow their objects; the table is rewritten before the frame.
-    fn update(&mut self, init: &StageInit, _: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
+    /// Reference points follow their objects; the table is rewritten before the frame. Which
+    /// generators the change reaches (`super::reach`: where their photons went at their last
+    /// record, read back now) and where their light may land (`Maps::caustic_reach`, for the
+    /// maps' faces).
+    fn update(&mut self, init: &StageInit, c: &crate::scene::update::Changes, maps: &mut Maps) -> Result<()> {
+        if let Some(words) = maps.buffer(&CAUSTIC_REACH).map(Buffer::read).transpose()? {
+            let words: Vec<u32> = words.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect();
+            self.tracker.read(&words);
+        }
+        let q = &init.plan.quality;
+        let scene = init.scene;
+        let from = |l: usize| match scene.lights[l].kind {
+            crate::scene::LightKind::Directional => ShadowFrom::Directional(scene.lights[l].direction),
+            _ => ShadowFrom::Point(scene.lights[l].position),
+        };
+        let (_, cubes) = table(&self.plan, q, scene, (init.width, init.height));
+        let gens: Vec<_> = self
+            .plan
+            .generators
+            .iter()
+            .enumerate()
+            .map(|(g, gen)| {
+                let ids: Vec<usize> = gen.lights.iter().map(|lv| lv.light).collect();
+                let own: Vec<(usize, glam::Vec3)> = (0..self.plan.cubes.len())
+                    .filter(|&k| self.plan.cubes[k].generator == g)
+                    .map(|k| (k, glam::Vec3::from_slice(&cubes[k].centre[..3])))
+                    .collect();
+                super::reach::GeneratorSpec { mesh: gen.mesh, lights: ids.iter().map(|&l| from(l)).collect(), light_ids: ids, cubes: own }
+            })
+            .collect();
+        let materials = |m: usize| scene.meshes.get(m).is_some_and(|mesh| c.materials.contains(&mesh.material));
+        let now = init.gpu.draws.iter().map(|d| (d.lo, d.hi)).collect();
+        // The margin: a twentieth of the region's size (the search's step past a hit), and
+        // the splats' and the filter's texels.
+        let texels = q.caustics.splat_size + self.filter as f32 + 2.0;
+        let name = |m: usize| scene.meshes.get(m).map_or_else(|| format!("mesh {m}"), |mesh| mesh.name.clone());
+        let changed = super::reach::Changed { moved: &c.moved, materials: &materials, lights: &c.lights, name: &name };
+        let reach = self.tracker.change(&gens, &changed, now, (0.05, texels, q.cube.cube_size));
+        if c.camera && self.plan.space == CausticSpace::Screen {
+            self.tracker.all("camera");
+        }
+        maps.caustic_reach = if self.plan.shown_in_maps() { reach } else { crate::frame::cube_deps::CausticReach::Unchanged };
         if let Some(p) = init.plan.caustics.as_ref() {
             for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
                 g.reference_point = fresh.reference_point;
@@ -622,7 +712,28 @@ impl Stage for CausticsStage {
         Ok(())
     }
 
+    /// The generators the next record redoes, of all.
+    fn redraw(&self) -> Option<(u32, u32)> {
+        Some(self.tracker.count())
+    }
+
+    /// Which generators, and why.
+    fn redraw_note(&self) -> Option<String> {
+        let names: Vec<String> = self
+            .plan
+            .generators
+            .iter()
+            .zip(&self.tracker.dirty)
+            .filter_map(|(g, d)| d.as_ref().map(|why| format!("'{}': {why}", g.name)))
+            .collect();
+        let (k, n) = self.tracker.count();
+        Some(format!("{k} of {n} generators ({})", names.join(", ")))
+    }
+
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
+        if self.always {
+            self.tracker.all("map_updates=always");
+        }
         // Taken out of the frame's maps while recorded (several are written at once), put
         // back after.
         let own = [
@@ -636,7 +747,10 @@ impl Stage for CausticsStage {
             &CAUSTIC_RECEIVER_IDS,
         ];
         let mut images = own.map(|s| io.maps.take_image(s));
-        self.record_images(rec, f, io, &mut images);
+        // The cubes of the generators this record redoes; the others keep what they hold.
+        let redo: Vec<bool> = self.plan.cubes.iter().map(|c| self.tracker.dirty[c.generator].is_some()).collect();
+        self.record_images(rec, f, io, &mut images, &redo);
+        self.tracker.recorded(&redo);
         for (slot, image) in own.into_iter().zip(images) {
             if let Some(image) = image {
                 io.maps.set_image(slot, image);
@@ -650,7 +764,7 @@ impl Stage for CausticsStage {
         }
         self.cube_depth.destroy(ctx);
         self.photon_depth.destroy(ctx);
-        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup]);
+        destroy_pipelines(ctx, &mut [self.receivers, self.photon, self.accumulate, self.box_filter, self.setup, self.reach]);
         destroy_pipelines(ctx, &mut self.grid);
         destroy_pipelines(ctx, &mut self.screen);
         destroy_pipelines(ctx, &mut [self.light_map_splat]);
@@ -662,7 +776,9 @@ impl CausticsStage {
     /// Records the passes into the caustics' own images: receiver distances, photon hits
     /// and power, light cube maps and their unfiltered twins, the screen's irradiance (`own` in
     /// `record`'s order).
-    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 8]) {
+    /// `redo`: per caustic cube, whether its generator is redone (in the spaces that record
+    /// every generator at once, all or none).
+    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 8], redo: &[bool]) {
         let ctx = rec.ctx;
         let maps = &*io.maps;
         let [distances, hits, power, light_image, raw_image, screen_image, light_map, receiver_ids] = images;
@@ -682,7 +798,7 @@ impl CausticsStage {
             rec.end(open);
         } else {
             let open = rec.pass("caustics.receivers").writes(distances, Access::ColorAttachment).begin();
-            for (k, cube) in self.plan.cubes.iter().enumerate() {
+            for (k, cube) in self.plan.cubes.iter().enumerate().filter(|&(k, _)| redo[k]) {
                 let mesh = self.plan.generators[cube.generator].mesh;
                 render_cube_faces(
                     rec,
@@ -717,7 +833,7 @@ impl CausticsStage {
         }
         let open = pass.begin();
         let cmd = rec.cmd;
-        for gen in &self.plan.generators {
+        for (_, gen) in self.plan.generators.iter().enumerate().filter(|&(g, _)| self.tracker.dirty[g].is_some()) {
             for lv in &gen.lights {
                 for (branch, face) in (0..lv.branches).flat_map(|b| (0..lv.faces).map(move |f| (b, f))) {
                     let layer = lv.first_layer + branch * lv.faces + face;
@@ -743,6 +859,7 @@ impl CausticsStage {
             }
         }
         rec.end(open);
+        self.record_reach(rec, f, maps, hits, redo);
 
         // Screen space (LC04, WD06b): the camera's depth of everything, then every photon's
         // splat at its pixel, depth-tested against it, in one rendering.
@@ -810,12 +927,12 @@ impl CausticsStage {
         let open = rec.pass(name).writes(target, Access::ColorAttachment).reads(hits, photon_access).reads(power, photon_access).begin();
         let triangles = self.plan.filter == Caustics::Triangles;
         if triangles {
-            self.setup_triangles(rec, f, io.views);
+            self.setup_triangles(rec, f, io.views, redo);
         }
         // A photon layer's quads (splat) or triangles (the faces skip those not flagged).
         let vertices = if triangles { 6 * (self.photons - 1) * (self.photons - 1) } else { self.vertices() };
         let plan = &self.plan;
-        for (k, &first_view) in cube_views.iter().enumerate().take(plan.cubes.len()) {
+        for (k, &first_view) in cube_views.iter().enumerate().take(plan.cubes.len()).filter(|&(k, _)| redo[k]) {
             render_cube_faces(rec, target, &mut self.cube_depth, k as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                 f.bind(ctx, cmd, self.accumulate);
                 for layer in cube_layers(plan, k) {
@@ -830,7 +947,7 @@ impl CausticsStage {
         if filtering {
             let (Some(light), Some(raw)) = (light_image.as_mut(), raw_image.as_ref()) else { return };
             let open = rec.pass("caustics.filter").writes(light, Access::ColorAttachment).reads(raw, Access::FragmentSampled).begin();
-            for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.cubes.len()) {
+            for (g, &first_view) in cube_views.iter().enumerate().take(self.plan.cubes.len()).filter(|&(k, _)| redo[k]) {
                 render_cube_faces(rec, light, &mut self.cube_depth, g as u32, first_view, self.mode, [0.0; 4], |cmd, v| {
                     f.bind(ctx, cmd, self.box_filter);
                     f.push(ctx, cmd, v, g as u32);
@@ -856,6 +973,17 @@ fn within_storage_range(ctx: &Context, what: &str, bytes: u64, photons: u32, lay
             ctx.device_name
         ),
     ))
+}
+
+/// A memory barrier from the (stages, accesses) `src` to `dst`.
+fn memory_barrier(
+    ctx: &Context,
+    cmd: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
+    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
 }
 
 /// Workgroups (x, y) covering `groups`: at most 32768 along x (every device allows 65535 an
