@@ -794,6 +794,21 @@ fn caustics_redo_only_the_generators_a_change_reaches() {
     let _ = a;
     r.destroy(&ctx);
 
+    // Screen-space caustics splat into the camera's view: a camera move redoes them.
+    for k in ["caustics=splat", "caustic_space=screen"] {
+        let (key, value) = k.split_once('=').unwrap();
+        q.set(key, value).unwrap();
+    }
+    let mut r = renderer(&ctx, &s, specula::methods::DISTANCE, &q);
+    r.render(&ctx).unwrap();
+    let mut cam = s.camera.unwrap();
+    cam.position += Vec3::new(0.3, 0.0, 0.0);
+    cam.world_from_camera = Mat4::from_translation(Vec3::new(0.3, 0.0, 0.0)) * cam.world_from_camera;
+    s.camera = Some(cam);
+    let u = updates(&mut r, &s, &q, "screen-space camera");
+    assert_eq!(reason(&u, "caustics").as_deref(), Some("camera"), "{u:?}");
+    r.destroy(&ctx);
+
     // The demo: the mirror sphere's light reaches every wall, so the box's move reaches it.
     let mut demo = specula::scene::load(std::path::Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/assets/demo/demo.gltf"))).unwrap();
     let q = quality();
