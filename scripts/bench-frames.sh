@@ -5,13 +5,16 @@
 #   2. the animated demo (the mirror sphere on its path), mean GPU frame with on_change vs always;
 #   3. aa=off|msaa4|ssaa2|ssaa4 at 512² with bvh, distance and envmap (msaa4 with per-sample
 #      and per-pixel shading of the specular passes): GPU ms and PSNR / mean FLIP against the
-#      16-spp reference.
-# Usage: scripts/bench-frames.sh [OUTDIR] [SECTIONS]   (SECTIONS: e.g. 3, default 123; needs a
+#      16-spp reference;
+#   4. what a move reaches (issue 33 item 4): a box slides across builtin:caustic-room (two glass
+#      balls focusing a lamp's light, refracted caustic paths) and across the demo (its mirror
+#      sphere held still), mean GPU frame with on_change vs always.
+# Usage: scripts/bench-frames.sh [OUTDIR] [SECTIONS]   (SECTIONS: e.g. 3, default 1234; needs a
 # release build: cargo build --release)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-bench-frames}
-sections=${2:-123}
+sections=${2:-1234}
 mkdir -p "$out"
 . scripts/bench-lib.sh
 scene=assets/demo/demo.gltf
@@ -31,7 +34,7 @@ fi
 if [[ $sections == *2* ]]; then
 echo
 echo "## Animated demo (mirror sphere on its path), 256x256, 12 fps x 4 s: mean GPU ms per frame"
-echo "(caustics off: the maps redraw only the cube faces that see what moved; with caustics every face)"
+echo "(the mirror sphere is a caustic generator whose light reaches every wall: with caustics every face)"
 echo "| method | caustics | on_change | always |"
 echo "|---|---|---:|---:|"
 for m in envmap distance distance-multi bvh; do
@@ -60,5 +63,23 @@ for run in "bvh off sample" "bvh msaa4 sample" "bvh ssaa2 sample" "bvh ssaa4 sam
   psnr=$(awk '/^PSNR/ {print $2}' <<< "$errors")
   flip=$(awk '/^mean FLIP/ {print $3}' <<< "$errors")
   echo "| $m | $aa | $sh | $ms | $psnr dB | $flip |"
+done
+fi
+
+if [[ $sections == *4* ]]; then
+echo
+echo "## A box slides (0.2 m/s, 12 fps x 2 s), 256x256: mean GPU ms per frame"
+echo "| scene | method | caustics | on_change | always | on_change / always |"
+echo "|---|---|---|---:|---:|---:|"
+for run in "builtin:caustic-room box refracted" "assets/demo/demo.gltf box/0 both"; do
+  read -r s obj paths <<< "$run"
+  for m in envmap distance bvh; do
+    for c in triangles off; do
+      args=(animate "$s" --method $m --size 256x256 --fps 12 --duration 2 --freeze --slide "$obj=0.2,0,0" -q caustics=$c -q caustic_paths=$paths --out "$out/slide_$m")
+      a=$($bin "${args[@]}" -q map_updates=on_change 2>/dev/null | sed -n 's/.*mean \([0-9.]*\) ms.*/\1/p')
+      b=$($bin "${args[@]}" -q map_updates=always 2>/dev/null | sed -n 's/.*mean \([0-9.]*\) ms.*/\1/p')
+      echo "| ${s#*/} | $m | $c | $a | $b | $(awk -v a="$a" -v b="$b" 'BEGIN { printf "%.2f", a / b }') |"
+    done
+  done
 done
 fi

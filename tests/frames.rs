@@ -731,29 +731,10 @@ fn a_move_that_changes_the_plan_reconfigures_a_standalone_c_context() {
 /// box's move reaches both generators (and equals a fresh render too).
 #[test]
 fn caustics_redo_only_the_generators_a_change_reaches() {
-    use specula::scene::{shapes, Light, LightKind, Material};
     let ctx = common::gpu();
-    let mut s = Scene::new();
-    let white = s.add_material(Material { name: "white".into(), ..Default::default() }).unwrap();
-    let glass = s
-        .add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })
-        .unwrap();
-    for m in shapes::quadrant_room(Vec3::new(0.0, 1.5, 0.0), 1.5, 1, |_, _| white) {
-        s.add_mesh(m).unwrap();
-    }
-    let a = s.add_mesh(shapes::uv_sphere("glass_a", Vec3::new(-1.1, 0.6, -0.5), 0.3, 16, 8, glass)).unwrap();
-    let b = s.add_mesh(shapes::uv_sphere("glass_b", Vec3::new(1.1, 0.6, -0.5), 0.3, 16, 8, glass)).unwrap();
-    let cube = s.add_mesh(shapes::cuboid("box", Vec3::new(0.0, 0.15, 1.0), Vec3::splat(0.15), white)).unwrap();
-    s.add_light(Light {
-        name: "lamp".into(),
-        kind: LightKind::Point,
-        position: Vec3::new(0.0, 2.8, -0.5),
-        direction: Vec3::NEG_Y,
-        intensity: Vec3::splat(8.0),
-        range: None,
-    })
-    .unwrap();
-    s.camera = Some(specula::scene::Camera::look_at(Vec3::new(0.0, 1.6, 2.9), Vec3::new(0.0, 0.5, 0.0), 1.2));
+    let mut s = specula::scenes::caustic_room().unwrap();
+    let index = |s: &Scene, name: &str| s.meshes.iter().position(|m| m.name == name).unwrap();
+    let (b, cube) = (index(&s, "glass_b"), index(&s, "box"));
     let mut q = quality();
     for k in ["caustic_paths=refracted", "photons=48", "cube_size=64"] {
         let (key, value) = k.split_once('=').unwrap();
@@ -791,7 +772,6 @@ fn caustics_redo_only_the_generators_a_change_reaches() {
     let u = updates(&mut r, &s, &q, "b moved");
     let why = reason(&u, "caustics").expect("b's caustic follows it");
     assert!(why.contains("1 of 2 generators ('glass_b': it moved)"), "{why}");
-    let _ = a;
     r.destroy(&ctx);
 
     // Screen-space caustics splat into the camera's view: a camera move redoes them.

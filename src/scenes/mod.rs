@@ -59,6 +59,7 @@ pub const BUILTIN: &[&str] = &[
     "flat-glass",
     "convex-mirror",
     "caustic-ball",
+    "caustic-room",
     "mirage",
     "grin-lens",
     "pool",
@@ -66,7 +67,7 @@ pub const BUILTIN: &[&str] = &[
 
 /// A scene built in code by its name (`builtin:NAME` on the command line): `corner-mirror`,
 /// `concave-occluder`, `glass-1.1`, `glass-1.5`, `flat-glass`, `convex-mirror`,
-/// `caustic-ball`, `mirage`, `grin-lens`, `pool`; `None` for another name.
+/// `caustic-ball`, `caustic-room`, `mirage`, `grin-lens`, `pool`; `None` for another name.
 pub fn builtin(name: &str) -> Option<Result<Scene>> {
     if let Some(i) = name.strip_prefix("corpus-").and_then(|n| n.parse::<usize>().ok()).filter(|&i| i < 10_000) {
         return Some(corpus::scene(i));
@@ -79,6 +80,7 @@ pub fn builtin(name: &str) -> Option<Result<Scene>> {
         "flat-glass" => flat_glass(),
         "convex-mirror" => convex_mirror(),
         "caustic-ball" => caustic_ball(),
+        "caustic-room" => caustic_room(),
         "mirage" => media::mirage(),
         "grin-lens" => media::grin_lens(),
         "pool" => water::pool(),
@@ -235,6 +237,33 @@ pub fn convex_mirror() -> Result<Scene> {
 /// lit directly stays under radiance 0.3, so only the caustic is bright: what the photon
 /// count, the light cube's filter and the splatting or triangle accumulation change shows
 /// there.
+/// Two glass balls (ν 1.5) under a lamp in a closed white room of 3 m, each focusing its
+/// light onto the floor and walls beside it, and a box on the floor between them: frames over
+/// time where a moving object reaches few of the maps (`specula animate builtin:caustic-room
+/// --slide box=…`; issue 33 item 4).
+pub fn caustic_room() -> Result<Scene> {
+    let mut s = Scene::new();
+    let white = s.add_material(Material { name: "white".into(), ..Default::default() })?;
+    let glass =
+        s.add_material(Material { name: "glass".into(), kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() })?;
+    for m in shapes::quadrant_room(Vec3::new(0.0, 1.5, 0.0), 1.5, 1, |_, _| white) {
+        s.add_mesh(m)?;
+    }
+    s.add_mesh(shapes::uv_sphere("glass_a", Vec3::new(-1.1, 0.6, -0.5), 0.3, 16, 8, glass))?;
+    s.add_mesh(shapes::uv_sphere("glass_b", Vec3::new(1.1, 0.6, -0.5), 0.3, 16, 8, glass))?;
+    s.add_mesh(shapes::cuboid("box", Vec3::new(0.0, 0.15, 1.0), Vec3::splat(0.15), white))?;
+    s.add_light(crate::scene::Light {
+        name: "lamp".into(),
+        kind: crate::scene::LightKind::Point,
+        position: Vec3::new(0.0, 2.8, -0.5),
+        direction: Vec3::NEG_Y,
+        intensity: Vec3::splat(8.0),
+        range: None,
+    })?;
+    s.camera = Some(Camera::look_at(Vec3::new(0.0, 1.6, 2.9), Vec3::new(0.0, 0.5, 0.0), 1.2));
+    Ok(s)
+}
+
 pub fn caustic_ball() -> Result<Scene> {
     let mut s = Scene::new();
     let floor = s.add_material(Material { name: "floor".into(), base_color: Vec3::splat(0.7), ..Default::default() })?;

@@ -13,7 +13,7 @@ use specula::{Choice, Method, Quality, Scene};
 #[derive(clap::Args, Clone)]
 pub struct RenderArgs {
     /// glTF 2.0 scene (.gltf or .glb), or builtin:NAME (corner-mirror, concave-occluder,
-    /// glass-1.1, glass-1.5, flat-glass, convex-mirror, caustic-ball, mirage, grin-lens, pool).
+    /// glass-1.1, glass-1.5, flat-glass, convex-mirror, caustic-ball, caustic-room, mirage, grin-lens, pool).
     pub scene: PathBuf,
     /// Rendering method of every specular object, or `auto`: the planner picks one per
     /// object (`specula knobs` lists methods and knobs).
@@ -61,7 +61,7 @@ pub struct RenderArgs {
 #[derive(clap::Args, Clone)]
 pub struct TradeoffArgs {
     /// glTF 2.0 scene (.gltf or .glb), or builtin:NAME (corner-mirror, concave-occluder,
-    /// glass-1.1, glass-1.5, flat-glass, convex-mirror, caustic-ball, mirage, grin-lens, pool).
+    /// glass-1.1, glass-1.5, flat-glass, convex-mirror, caustic-ball, caustic-room, mirage, grin-lens, pool).
     pub scene: PathBuf,
     /// Output size WIDTHxHEIGHT.
     #[arg(long, default_value = "256x256")]
