@@ -253,14 +253,23 @@ fn figure_28_thin_objects_need_fine_steps_and_hidden_surfaces_need_layers() {
     let (full, full_img, stats) = run(&[]);
     let l = stat(&stats, "layered.layers") as u32;
     assert_eq!(stat(&stats, "layered.far_layer"), 0.0, "a full peel needs no farthest layer");
+    // The pixels whose path met the farthest layer, per object (issue 33 item 2): none
+    // without one; with one, some of the image's pixels, fewer as more layers are peeled.
+    let far_pixels =
+        |st: &[(String, f64)]| -> f64 { st.iter().filter(|(k, _)| k.starts_with("layered.far_layer_pixels.")).map(|(_, v)| v).sum() };
+    assert_eq!(far_pixels(&stats), 0.0, "{stats:?}");
     let mut by_layers = Vec::new();
+    let mut far = Vec::new();
     for n in 1..l {
         let (e, _, st) = run(&[&format!("layers={n}")]);
         assert_eq!((stat(&st, "layered.layers"), stat(&st, "layered.far_layer")), (n as f64, 1.0));
+        far.push(far_pixels(&st));
         eprintln!("rod: layers {n}: {e}");
         by_layers.push(e);
     }
-    eprintln!("rod: layers auto ({l}): {full}");
+    eprintln!("rod: layers auto ({l}): {full}; pixels that met the farthest layer at 1.. layers: {far:?}");
+    assert!(far.iter().all(|&p| p > 0.0 && p <= (SIZE * SIZE) as f64), "{far:?}");
+    assert!(far.windows(2).all(|w| w[1] <= w[0]), "{far:?}");
     // Measured: RMSE 0.1039 / 0.0872 / 0.0738 at 1 / 2 / 3 layers (each with the farthest
     // surfaces' layer; without it 0.1267 / 0.0971 / 0.0853), 0.0814 at 4 (PSNR 21.79 dB):
     // ratios 1.192 and 1.182, bounds a factor 1.122 under; the farthest layer at 1 layer a

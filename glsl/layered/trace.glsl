@@ -10,6 +10,9 @@
 #include "common/sky.glsl"
 
 int layered_layer = 0;
+// Whether a path met a surface in the last layer (the farthest surface, where the peel is
+// cut; layered/search.frag's COUNT_FAR counts such pixels).
+bool layered_met_last = false;
 
 float layered_distance(vec3 dir) {
     return textureLod(layered_maps, vec4(dir, float(layered_layer)), 0.0).a;
@@ -124,6 +127,7 @@ vec3 layered_radiance(vec3 centre, Material m, vec3 p, vec3 n, vec3 eye, uint le
             c += r.weight * sky_radiance(r.dir);
             continue;
         }
+        layered_met_last = layered_met_last || h.layer == textureSize(layered_maps, 0).z - 1;
         vec4 texel = textureLod(layered_maps, vec4(h.dir, float(h.layer)), 0.0);
         vec4 surface = textureLod(layered_normals, vec4(h.dir, float(h.layer)), 0.0);
         if (surface.w < 0.5) {

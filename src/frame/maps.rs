@@ -212,6 +212,31 @@ impl Maps {
         self.all_slots().filter(|s| s.shading).filter_map(|s| self.image(s))
     }
 
+    /// Zeroes every counter slot (`Slot::counts`) before the frame's views and camera passes
+    /// count again (after the last frame's counting, whose host read the frame's fence
+    /// ordered).
+    pub fn clear_counts(&self, rec: &mut crate::vk::Recorder) {
+        let counters: Vec<vk::Buffer> = self.all_slots().filter(|s| s.counts).filter_map(|s| self.buffer(s)).map(|b| b.raw).collect();
+        if counters.is_empty() {
+            return;
+        }
+        let transfer = vk::PipelineStageFlags2::ALL_TRANSFER;
+        let fragment = vk::PipelineStageFlags2::FRAGMENT_SHADER;
+        rec.memory_barrier((fragment, vk::AccessFlags2::SHADER_STORAGE_WRITE), (transfer, vk::AccessFlags2::TRANSFER_WRITE));
+        for b in counters {
+            unsafe { rec.ctx.device.cmd_fill_buffer(rec.cmd, b, 0, vk::WHOLE_SIZE, 0) };
+        }
+        let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
+        rec.memory_barrier((transfer, vk::AccessFlags2::TRANSFER_WRITE), (fragment, storage));
+    }
+
+    /// Takes a slot's buffer out (the descriptors must be written again: `changes`).
+    pub fn take_buffer(&mut self, slot: &Slot) -> Option<Buffer> {
+        let b = self.buffers.remove(&slot.key());
+        self.puts += u64::from(b.is_some());
+        b
+    }
+
     /// Every counter slot's words (`Slot::counts`), as the last completed frame left them.
     pub fn counts(&self) -> Vec<(&'static str, Vec<u32>)> {
         let words =

@@ -336,6 +336,8 @@ impl Renderer {
             }
         };
         let mut views_ran = false;
+        // The per-object counters the views and camera passes add to (`Slot::counts`).
+        self.maps.clear_counts(&mut rec);
         for p in &mut self.parts {
             views_ran |= p.record_views(&mut rec, &f, &self.views, &mut self.maps, &mut camera_stages);
         }

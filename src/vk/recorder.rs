@@ -148,6 +148,13 @@ impl<'a> Recorder<'a> {
         }
     }
 
+    /// A global memory barrier from the (stages, accesses) `src` to `dst` (buffers written by
+    /// one kernel or transfer and read by the next).
+    pub fn memory_barrier(&self, src: (vk::PipelineStageFlags2, vk::AccessFlags2), dst: (vk::PipelineStageFlags2, vk::AccessFlags2)) {
+        let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
+        unsafe { self.ctx.device.cmd_pipeline_barrier2(self.cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
+    }
+
     pub fn end(&mut self, pass: OpenPass) {
         let (d, cmd) = (&self.ctx.device, self.cmd);
         if pass.index == u32::MAX {

@@ -491,7 +491,7 @@ impl CausticsStage {
     /// previous frame's reads are behind the pass's opening barrier.)
     fn build_photon_grid(&self, rec: &mut Recorder, f: &FrameInputs, grid: vk::Buffer) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let barrier = |src, src_access, dst, dst_access| memory_barrier(ctx, cmd, (src, src_access), (dst, dst_access));
+        let barrier = |src, src_access, dst, dst_access| rec.memory_barrier((src, src_access), (dst, dst_access));
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
         let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         unsafe { ctx.device.cmd_fill_buffer(cmd, grid, 0, vk::WHOLE_SIZE, 0) };
@@ -564,7 +564,7 @@ impl CausticsStage {
         let Some(words) = maps.buffer(&CAUSTIC_REACH).map(|b| b.raw) else { return };
         let open = rec.pass("caustics.reach").reads(hits, Access::ComputeSampled).begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
-        let barrier = |src, src_access, dst, dst_access| memory_barrier(ctx, cmd, (src, src_access), (dst, dst_access));
+        let barrier = |src, src_access, dst, dst_access| rec.memory_barrier((src, src_access), (dst, dst_access));
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
         let storage = vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE;
         let transfer = vk::PipelineStageFlags2::ALL_TRANSFER;
@@ -973,17 +973,6 @@ fn within_storage_range(ctx: &Context, what: &str, bytes: u64, photons: u32, lay
             ctx.device_name
         ),
     ))
-}
-
-/// A memory barrier from the (stages, accesses) `src` to `dst`.
-fn memory_barrier(
-    ctx: &Context,
-    cmd: vk::CommandBuffer,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
-) {
-    let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&b)) };
 }
 
 /// Workgroups (x, y) covering `groups`: at most 32768 along x (every device allows 65535 an

@@ -254,26 +254,6 @@ pub fn counting_pass(init: &StageInit, plan: &crate::plan::types::CameraPlan) ->
     Ok(Box::new(crate::frame::camera::CameraShade::with_extra(init.ctx, init.layout, plan, init.multisample, variant, None)?))
 }
 
-/// Zeroes the fallback counters (where planned) before the frame's first camera pass.
-fn clear_fallbacks(rec: &mut Recorder, maps: &Maps) {
-    let Some(b) = maps.buffer(&super::slots::FALLBACKS) else { return };
-    let (ctx, cmd) = (rec.ctx, rec.cmd);
-    // After the last frame's counting (and its host read), before this frame's.
-    let before = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
-        .src_access_mask(vk::AccessFlags2::SHADER_STORAGE_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-        .dst_access_mask(vk::AccessFlags2::TRANSFER_WRITE)];
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&before)) };
-    unsafe { ctx.device.cmd_fill_buffer(cmd, b.raw, 0, vk::WHOLE_SIZE, 0) };
-    let barrier = [vk::MemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-        .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::FRAGMENT_SHADER)
-        .dst_access_mask(vk::AccessFlags2::SHADER_STORAGE_READ | vk::AccessFlags2::SHADER_STORAGE_WRITE)];
-    unsafe { ctx.device.cmd_pipeline_barrier2(cmd, &vk::DependencyInfo::default().memory_barriers(&barrier)) };
-}
-
 impl FramePart for PlanarViews {
     fn write_views(&mut self, fr: &ViewFrame, table: &mut [GpuView]) {
         if let Some(m) = self.mirrors.as_mut() {
@@ -308,7 +288,6 @@ impl FramePart for PlanarViews {
         maps: &mut Maps,
         camera_stages: &mut dyn FnMut(&mut Recorder, ViewPass),
     ) -> bool {
-        clear_fallbacks(rec, maps);
         let Some(mv) = self.mirrors.as_mut() else { return false };
         let first = layout.first(EXTRA_VIEWS).expect("planar mirrors declare their views");
         rec.scope = Some("geometry.mirror_view");

@@ -41,4 +41,10 @@ descriptor_sets! {
         /// `layered.peel`: the previous layer's depth, six faces (only the peel's own sets).
         LAYERED_PREVIOUS = 6: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray layered_previous";
     }
+    BINDINGS = set 0 {
+        /// Layered maps (§4.5) cut short of the depth complexity: per mesh, the pixels whose
+        /// path met a surface in the farthest layer (the fallback past the peeled layers;
+        /// `layered.far_layer_pixels`), zeroed every frame. Only where the peel is cut.
+        LAYERED_FAR = 29: STORAGE_BUFFER => "buffer LayeredFar { uint layered_far[]; }";
+    }
 }

@@ -17,7 +17,7 @@ pub mod slots;
 
 use glam::Vec3;
 
-use crate::frame::stage::{order, FramePart, MapInfo, ViewFrame};
+use crate::frame::stage::{order, FramePart, MapInfo, StageInit, ViewFrame};
 use crate::methods::registry::{CameraPass, GpuSpec, LeavesOut, MapShading, Method, MethodInfo, Profiled, Shape};
 use crate::methods::EVERY_CLASS;
 use crate::plan::types::Plan;
@@ -62,9 +62,17 @@ pub const SEARCH: CameraPass = CameraPass {
     fragment: "layered/search.frag",
     flags: 0,
     order: order::CAMERA,
-    create: None,
+    create: Some(search_pass),
     profiled: Profiled::OWN,
 };
+
+/// `layered.search`: where the device lets fragment shaders write, its COUNT_FAR variant,
+/// which counts per object the pixels whose path met the farthest layer of a cut peel
+/// (`layered.far_layer_pixels.<object>`; the counters exist only while the peel is cut).
+fn search_pass(init: &StageInit, plan: &crate::plan::types::CameraPlan) -> crate::Result<Box<dyn crate::frame::stage::Stage>> {
+    let variant = init.ctx.fragment_stores.then_some("COUNT_FAR");
+    Ok(Box::new(crate::frame::camera::CameraShade::with_extra(init.ctx, init.layout, plan, init.multisample, variant, None)?))
+}
 
 pub const LAYERED_INFO: &MethodInfo = &MethodInfo {
     name: "layered",

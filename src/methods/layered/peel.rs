@@ -20,7 +20,7 @@
 use ash::vk;
 use glam::{DVec3, Vec3};
 
-use super::slots::{LAYERED, LAYERED_NORMALS};
+use super::slots::{LAYERED, LAYERED_FAR, LAYERED_NORMALS};
 use crate::frame::direct::DEPTH_FORMAT;
 use crate::frame::layout::{LAYERED_FACE_SHIFT, LAYERED_FIRST};
 use crate::frame::stage::{cube_texel_bytes, describe_cube, FrameIo, Maps, Stage, StageInit};
@@ -28,7 +28,7 @@ use crate::frame::{destroy_pipelines, FrameInputs};
 use crate::methods::cube_maps::radiance_format;
 use crate::quality::{CubeMode, Precision, Quality, MAX_LAYERS};
 use crate::vk::pipeline::{allocate_set, graphics_pipeline, sampler, write_image, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
-use crate::vk::{begin_rendering, build, Access, Context, Image, ImageDesc, ImageKind, Owner, Recorder, Target};
+use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, MemoryLocation, Owner, Recorder, Target};
 use crate::Result;
 
 /// Device memory of `layers` layers (both images) and the two peeling depth buffers.
@@ -128,6 +128,25 @@ impl LayeredMaps {
         self.peel = peel_pipeline(init, DepthOp::Nearer)?;
         if self.cut() {
             self.far = peel_pipeline(init, DepthOp::Farther)?;
+        }
+        self.far_counters(init, maps)
+    }
+
+    /// The counters of the pixels whose path met the farthest layer (`LAYERED_FAR`): there
+    /// while the peel is cut and the device lets the camera pass count (its COUNT_FAR
+    /// variant, `super::search_pass`), else absent (the pass's adds go to a null descriptor).
+    fn far_counters(&self, init: &StageInit, maps: &mut Maps) -> Result<()> {
+        let wanted = self.cut() && init.ctx.fragment_stores;
+        if wanted == maps.has(&LAYERED_FAR) {
+            return Ok(());
+        }
+        if let Some(mut b) = maps.take_buffer(&LAYERED_FAR) {
+            b.destroy(init.ctx);
+        }
+        if wanted {
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let bytes = 4 * init.scene.meshes.len().max(1) as u64;
+            maps.set_buffer(&LAYERED_FAR, Buffer::new(init.ctx, "layered.far_layer_pixels", bytes, usage, MemoryLocation::GpuToCpu)?);
         }
         Ok(())
     }
@@ -419,7 +438,7 @@ impl Stage for LayeredMaps {
         if self.cut() && self.far == vk::Pipeline::null() {
             self.far = peel_pipeline(init, DepthOp::Farther)?;
         }
-        Ok(())
+        self.far_counters(init, maps)
     }
 
     fn destroy(&mut self, ctx: &Context) {

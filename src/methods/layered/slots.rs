@@ -18,4 +18,8 @@ pub const LAYERED_NORMALS: Slot =
 /// never filled in the frame's (null there).
 pub const LAYERED_PREVIOUS: Slot = Slot::image("layered.previous", 1, binding::LAYERED_PREVIOUS, Sampler::Nearest);
 
-pub const SLOTS: &[Slot] = &[LAYERED, LAYERED_NORMALS, LAYERED_PREVIOUS];
+/// Per mesh, the pixels whose path met the farthest layer of a cut peel (counted where the
+/// device lets fragment shaders write; `layered.far_layer_pixels.<object>` in the stats).
+pub const LAYERED_FAR: Slot = Slot { counts: true, ..Slot::buffer("layered.far_layer_pixels", 0, binding::LAYERED_FAR) };
+
+pub const SLOTS: &[Slot] = &[LAYERED, LAYERED_NORMALS, LAYERED_PREVIOUS, LAYERED_FAR];
