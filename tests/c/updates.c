@@ -153,7 +153,10 @@ int main(void) {
     expect(ctx, "recolour the floor", specula_context_set_material(ctx, m_white, &white), SPECULA_SUCCESS);
     expect(ctx, "frame 5", specula_context_render(ctx, SPECULA_PIXEL_RGBA32F, before, sizeof before), SPECULA_SUCCESS);
     updates(ctx, u, sizeof u);
-    check("a material rebuilds the distance maps only", strcmp(u, "distance.generate(material 'material0')") == 0, u);
+    /* (the faces that see the floor: "; 5 of 6 faces"; the caustics keep theirs: their light
+       does not depend on what it falls on) */
+    check("a material rebuilds the distance maps only",
+          strncmp(u, "distance.generate(material 'material0'", 38) == 0 && !strstr(u, "shadow.generate") && !strstr(u, "caustics"), u);
 
     /* Hiding the mirror changes the image and rebuilds the maps; showing it restores frame 5. */
     expect(ctx, "hide the mirror", specula_context_set_object_visible(ctx, mirror_id, 0), SPECULA_SUCCESS);
