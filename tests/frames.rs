@@ -736,7 +736,7 @@ fn caustics_redo_only_the_generators_a_change_reaches() {
     let index = |s: &Scene, name: &str| s.meshes.iter().position(|m| m.name == name).unwrap();
     let (b, cube) = (index(&s, "glass_b"), index(&s, "box"));
     let mut q = quality();
-    for k in ["caustic_paths=refracted", "photons=48", "cube_size=64"] {
+    for k in ["caustic_paths=refracted", "photons=48", "cube_size=128"] {
         let (key, value) = k.split_once('=').unwrap();
         q.set(key, value).unwrap();
     }
@@ -774,7 +774,8 @@ fn caustics_redo_only_the_generators_a_change_reaches() {
     assert!(why.contains("1 of 2 generators ('glass_b': it moved)"), "{why}");
     r.destroy(&ctx);
 
-    // Screen-space caustics splat into the camera's view: a camera move redoes them.
+    // Screen-space caustics splat into the camera's view, depth-tested against everything: a
+    // camera move redoes them, and so does any move.
     for k in ["caustics=splat", "caustic_space=screen"] {
         let (key, value) = k.split_once('=').unwrap();
         q.set(key, value).unwrap();
@@ -787,6 +788,9 @@ fn caustics_redo_only_the_generators_a_change_reaches() {
     s.camera = Some(cam);
     let u = updates(&mut r, &s, &q, "screen-space camera");
     assert_eq!(reason(&u, "caustics").as_deref(), Some("camera"), "{u:?}");
+    shift(&mut s, cube, Vec3::new(0.0, 0.0, 0.1));
+    let u = updates(&mut r, &s, &q, "screen-space box");
+    assert!(reason(&u, "caustics").is_some(), "{u:?}");
     r.destroy(&ctx);
 
     // The demo: the mirror sphere's light reaches every wall, so the box's move reaches it.

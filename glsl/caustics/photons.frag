@@ -282,7 +282,9 @@ void main() {
     if ((caustic.flags & CAUSTIC_SURFACE_PATHS) != 0u && m.kind == KIND_DIELECTRIC && m.thin == 0u && branch == 0u) {
         w *= volume_transmittance(m, h.d * length(dir));  // absorbed inside on the way there
     }
-    out_hit = vec4(x + dir * h.d, 1.0);
+    // w: 1/(1 + the ray's length from where it left the generator), in (0, 1]: a photon
+    // (w > 0), not an exact path's code (> 1.5); caustics/reach.comp recovers the length.
+    out_hit = vec4(x + dir * h.d, 1.0 / (1.0 + h.d * length(dir)));
     out_power = vec4(w * power, photon_direction_code(dir));
 #endif
 }

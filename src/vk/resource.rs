@@ -451,10 +451,19 @@ impl Image {
                 | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE
                 | vk::AccessFlags2::TRANSFER_WRITE,
         );
-        if from.layout == to.layout && !from_writes && !access.writes() {
-            // Read after read: widen the tracked stages so a later write waits on all readers.
+        if from.layout == to.layout && !from_writes && !access.writes() && from.stage.contains(to.stage) {
+            // Read after read at stages the last barrier already reached: widen the tracked
+            // accesses so a later write waits on all readers.
             self.state.set(ImageState { stage: from.stage | to.stage, access: from.access | to.access, layout: from.layout });
             return None;
+        }
+        if from.layout == to.layout && !from_writes && !access.writes() {
+            // A read at a stage the last barrier did not reach (a compute pass sampling what
+            // fragment shaders sampled): a barrier from those readers chains the last write's
+            // (or layout transition's) visibility on to the new stage; both keep reading.
+            let b = self.barrier_to(to);
+            self.state.set(ImageState { stage: from.stage | to.stage, access: from.access | to.access, layout: from.layout });
+            return Some(b);
         }
         Some(self.barrier_to(to))
     }

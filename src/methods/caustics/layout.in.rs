@@ -116,8 +116,9 @@ descriptor_sets! {
         /// caustic as seen from its centre, the projection's input.
         CAUSTIC_MAPS = 11: COMBINED_IMAGE_SAMPLER => "uniform samplerCubeArray caustic_maps";
         /// Caustics: photon hit location images, one layer per light view of a generator:
-        /// xyz the hit relative to its cube's centre, w 1 for a photon (more: an exact hit's
-        /// code), −1 with xyz its direction for one that escaped the receivers, 0 for none.
+        /// xyz the hit relative to its cube's centre, w in (0, 1] for a photon (1/(1 + its
+        /// last segment's length); more than 1.5: an exact hit's code), −1 with xyz its
+        /// direction for one that escaped the receivers, 0 for none.
         PHOTON_HITS = 12: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_hits";
         /// Caustics: the photons' power (rgb, W).
         PHOTON_POWER = 13: COMBINED_IMAGE_SAMPLER => "uniform sampler2DArray photon_power";

@@ -59,8 +59,7 @@ impl CausticsPlan {
     /// The profiled passes it records, in order.
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];
-        // Where the photons went (issue 33 item 4): all but exact photons, which any move reaches.
-        if q.caustics.caustic_paths != CausticPaths::Exact {
+        if self.tracks_reach(q) {
             v.push("caustics.reach");
         }
         v.push(match self.filter {
@@ -74,6 +73,15 @@ impl CausticsPlan {
             v.push("caustics.filter");
         }
         v
+    }
+
+    /// Whether it records where the photons went (`caustics.reach`, issue 33 item 4): not for
+    /// exact photons, which bounce off every specular surface (any move may reach them), nor
+    /// under a search of fewer than 3 linear steps, whose probes near a hit are not bounded
+    /// (caustics/reach.comp), nor without the projection's distance test (the light then falls
+    /// on whatever lies in its directions, near or far).
+    pub fn tracks_reach(&self, q: &Quality) -> bool {
+        q.caustics.caustic_paths != CausticPaths::Exact && q.search.linear_steps >= 3 && q.caustics.caustic_distance_test
     }
 
     /// Whether the maps around objects show these caustics (light cube maps and the texture

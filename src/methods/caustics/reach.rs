@@ -45,6 +45,9 @@ pub struct GeneratorFacts {
     pub region: Option<Bounds>,
     /// Its caustic cubes' centres.
     pub centres: Vec<Vec3>,
+    /// Why it is redone whatever moved (its cube's centre moved, the scene's bounds changed,
+    /// screen space), if so: its light may land anywhere.
+    pub forced: Option<String>,
 }
 
 /// A change as the rule sees it: moved meshes with their boxes before and after, the meshes
@@ -98,11 +101,23 @@ fn reach_of(g: &GeneratorFacts, c: &Change) -> (Option<String>, Option<Vec<Bound
     if let Some(l) = c.lights.iter().find(|l| g.light_ids.contains(l)) {
         return (Some(format!("its light {l}")), None);
     }
+    if let Some(why) = &g.forced {
+        return (Some(why.clone()), None);
+    }
     let mut lands: Vec<Bounds> = Vec::new();
     let mut why = None;
     for &(m, before, after) in c.moved {
-        // Between a light and the generator: photons start or stop there.
-        let shades = |b: Bounds| g.lights.iter().any(|&l| shadow_bounds(l, b, c.world).is_none_or(|s| overlaps(s, g.bounds)));
+        // Between a light and the generator: photons start or stop there (the box grown by
+        // the margin: the shadow map's texels).
+        let shades = |b: Bounds| {
+            g.lights.iter().any(|&l| {
+                let from = match l {
+                    ShadowFrom::Point(p) => p,
+                    ShadowFrom::Directional(_) => b.0,
+                };
+                shadow_bounds(l, grown(b, from, c.margin), c.world).is_none_or(|s| overlaps(s, g.bounds))
+            })
+        };
         if shades(before) || shades(after) {
             return (Some(format!("'{}' between it and its light", (c.name)(m))), None);
         }
@@ -119,10 +134,12 @@ fn reach_of(g: &GeneratorFacts, c: &Change) -> (Option<String>, Option<Vec<Bound
         // generator (the shadows of its corners and its cubes' centres, from which the
         // receiver maps' distances change too).
         for b in [(was, before), (is, after)].into_iter().filter(|&(meets, _)| meets).map(|(_, b)| b) {
-            lands.push(grown(b, g.centres.first().copied().unwrap_or(b.0), c.margin));
+            for &centre in &g.centres {
+                lands.push(grown(b, centre, c.margin));
+            }
             for from in (0..8).map(|k| pick(g.bounds, k)).chain(g.centres.iter().copied()) {
                 match shadow_bounds(ShadowFrom::Point(from), b, c.world) {
-                    Some(s) => lands.push(grown(s, from, c.margin)),
+                    Some(s) => lands.extend(g.centres.iter().map(|&centre| grown(s, centre, c.margin))),
                     None => return (why, None),
                 }
             }
@@ -157,10 +174,11 @@ pub fn union(a: Bounds, b: Bounds) -> Bounds {
     (a.0.min(b.0), a.1.max(b.1))
 }
 
-/// The region a cube's photons' paths lay in: its hits' bounds with the cube's centre and the
-/// generator's box, grown by `grow` of its size (the search's step past a hit, rounding) and
-/// by `texels` × the cube's texel angle at its farthest corner (the splats and the filter
-/// spread a photon that far). None where the hits' bounds are None (a photon escaped).
+/// The region a cube's photons' paths and searches lay in: the bounds caustics/reach.comp read
+/// back (the hits and the receiver surfaces the search's probes read) with the cube's centre
+/// and the generator's box, grown by `grow` of its size (rounding) and by `texels` × the cube's
+/// texel angle at its farthest corner (the splats and the filter spread a photon that far).
+/// None where the hits' bounds are None (a photon escaped, or a probe saw no receiver).
 pub fn region(hits: Option<Option<Bounds>>, centre: Vec3, generator: Bounds, (grow, texels, cube_size): (f32, f32, u32)) -> Option<Bounds> {
     let hits = hits?;
     let mut b = union(generator, (centre, centre));
@@ -190,13 +208,16 @@ pub fn hits_of(words: &[u32]) -> Option<Option<Bounds>> {
 }
 
 /// A generator as the tracker is told it: its mesh, its lights (where from, and their
-/// indices) and its caustic cubes with their centres.
+/// indices), its caustic cubes with their centres, and why it is redone regardless.
 #[derive(Clone, Debug)]
 pub struct GeneratorSpec {
     pub mesh: usize,
     pub lights: Vec<ShadowFrom>,
     pub light_ids: Vec<usize>,
+    /// Its caustic cubes with their centres when they were last recorded.
     pub cubes: Vec<(usize, Vec3)>,
+    /// `GeneratorFacts::forced`.
+    pub forced: Option<String>,
 }
 
 /// A scene change as the tracker is told it: the moved meshes, whether a mesh's material
@@ -269,14 +290,15 @@ impl Tracker {
             .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |w, &b| union(w, b));
         let facts: Vec<GeneratorFacts> = gens
             .iter()
-            .map(|GeneratorSpec { mesh, lights: from, light_ids: ids, cubes }| {
+            .map(|GeneratorSpec { mesh, lights: from, light_ids: ids, cubes, forced }| {
                 let bounds = before(*mesh);
                 let region = cubes.iter().try_fold(None::<Bounds>, |acc, &(k, centre)| {
                     let r = region(self.hits.get(k).copied().flatten(), centre, bounds, margin)?;
                     Some(Some(acc.map_or(r, |a| union(a, r))))
                 });
                 let centres = cubes.iter().map(|&(_, c)| c).collect();
-                GeneratorFacts { mesh: *mesh, bounds, lights: from.clone(), light_ids: ids.clone(), region: region.flatten(), centres }
+                let (lights, light_ids, region) = (from.clone(), ids.clone(), region.flatten());
+                GeneratorFacts { mesh: *mesh, bounds, lights, light_ids, region, centres, forced: forced.clone() }
             })
             .collect();
         let (why, reach) = reached(&facts, &Change { moved: &moved, materials, lights, world, name, margin });
@@ -337,6 +359,7 @@ mod tests {
             light_ids: vec![0],
             region,
             centres: vec![Vec3::new(0.0, 1.0, 0.0)],
+            forced: None,
         };
         let world = (Vec3::new(-5.0, 0.0, -5.0), Vec3::new(5.0, 4.0, 5.0));
         let none = |_: usize| false;
@@ -378,6 +401,12 @@ mod tests {
             &Change { moved: &[], materials: &none, lights: &[0], world, name: &named, margin: (0.0, 0.0, 64) },
         );
         assert!(why[0].is_some());
+        // Forced (its cube's centre moved, the scene's bounds changed, screen space): any
+        // move reaches it, anywhere.
+        let forced = GeneratorFacts { forced: Some("its caustic cube's centre moved".into()), ..g.clone() };
+        let (why, reach) =
+            reached(&[forced], &Change { moved: &side, materials: &none, lights: &[], world, name: &named, margin: (0.0, 0.0, 64) });
+        assert!(why[0].as_deref() == Some("its caustic cube's centre moved") && reach == CausticReach::Anywhere);
         // An unknown region (an escaped photon): any move reaches it.
         let open = GeneratorFacts { region: None, ..g.clone() };
         let (why, reach) =

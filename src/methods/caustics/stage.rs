@@ -5,6 +5,7 @@
 //! triangle shaders read them through the frame's set.
 
 use ash::vk;
+use glam::Vec3;
 
 use super::atlas::Atlas;
 use super::reach::Tracker;
@@ -69,6 +70,8 @@ pub struct CausticsStage {
     tracker: Tracker,
     /// map_updates=always: every record redoes every generator.
     always: bool,
+    /// The scene's bounds when the last change was taken.
+    scene_bounds: Option<(Vec3, Vec3)>,
 }
 
 /// The cube table the shaders read (`Caustics`, set 0), for the lights of `scene` and a
@@ -166,6 +169,7 @@ impl CausticsStage {
             reach: vk::Pipeline::null(),
             tracker: Tracker::new(0, 0, Vec::new(), (false, true)),
             always: q.frame.map_updates_always,
+            scene_bounds: None,
         };
         Ok(Box::new(build(init.ctx, me, |me| me.init(init, maps))?))
     }
@@ -224,9 +228,11 @@ impl CausticsStage {
         maps.set_buffer(&CAUSTICS, Buffer::with_data(ctx, "caustics.generators", &bytes, vk::BufferUsageFlags::STORAGE_BUFFER)?);
         // Where the photons went, read back to decide what a later change reaches (exact
         // photons bounce off every specular surface: any move may reach them, nothing to read).
-        let tracks = q.caustics.caustic_paths != CausticPaths::Exact;
+        let tracks = self.plan.tracks_reach(q);
         let bounds = init.gpu.draws.iter().map(|d| (d.lo, d.hi)).collect();
         self.tracker = Tracker::new(self.plan.generators.len(), cubes as usize, bounds, (tracks, !self.plan.light_cubes()));
+        let b = init.scene.bounds();
+        self.scene_bounds = Some((b.min, b.max));
         if tracks {
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             let words = Buffer::new(ctx, "caustics.reach", 32 * cubes as u64, usage, crate::vk::MemoryLocation::GpuToCpu)?;
@@ -560,9 +566,12 @@ impl CausticsStage {
     /// `caustics.reach`: where the redone cubes' photons went (caustics/reach.comp), their
     /// words cleared first (bounds empty, nothing escaped, none landed); the stage reads them
     /// back at the next change (`Stage::update`).
-    fn record_reach(&self, rec: &mut Recorder, f: &FrameInputs, maps: &Maps, hits: &Image, redo: &[bool]) {
+    /// `reads`: the photon hits and power and the receiver distances.
+    fn record_reach(&self, rec: &mut Recorder, f: &FrameInputs, maps: &Maps, reads: [&Image; 3], redo: &[bool]) {
         let Some(words) = maps.buffer(&CAUSTIC_REACH).map(|b| b.raw) else { return };
-        let open = rec.pass("caustics.reach").reads(hits, Access::ComputeSampled).begin();
+        let [hits, power, distances] = reads;
+        let pass = rec.pass("caustics.reach").reads(hits, Access::ComputeSampled).reads(power, Access::ComputeSampled);
+        let open = pass.reads(distances, Access::ComputeSampled).begin();
         let (ctx, cmd) = (rec.ctx, rec.cmd);
         let barrier = |src, src_access, dst, dst_access| rec.memory_barrier((src, src_access), (dst, dst_access));
         let compute = vk::PipelineStageFlags2::COMPUTE_SHADER;
@@ -669,7 +678,24 @@ impl Stage for CausticsStage {
             crate::scene::LightKind::Directional => ShadowFrom::Directional(scene.lights[l].direction),
             _ => ShadowFrom::Point(scene.lights[l].position),
         };
-        let (_, cubes) = table(&self.plan, q, scene, (init.width, init.height));
+        // The cubes' centres at their last record, and now (reference points follow their
+        // objects; one may move away from what blocks it without its object moving).
+        let centres = |plan: &CausticsPlan| -> Vec<Vec3> {
+            table(plan, q, scene, (init.width, init.height)).1.iter().map(|c| Vec3::from_slice(&c.centre[..3])).collect()
+        };
+        let before = centres(&self.plan);
+        if let Some(p) = init.plan.caustics.as_ref() {
+            for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
+                g.reference_point = fresh.reference_point;
+            }
+        }
+        let after = centres(&self.plan);
+        let bounds = scene.bounds();
+        let bounds = (bounds.min, bounds.max);
+        // The scene's bounds size the shadow planes of directional lights (the photons'
+        // visibility) and the photon map's cells: a change there reaches every generator.
+        let world_changed = self.scene_bounds.is_some_and(|b| b != bounds);
+        self.scene_bounds = Some(bounds);
         let gens: Vec<_> = self
             .plan
             .generators
@@ -677,30 +703,33 @@ impl Stage for CausticsStage {
             .enumerate()
             .map(|(g, gen)| {
                 let ids: Vec<usize> = gen.lights.iter().map(|lv| lv.light).collect();
-                let own: Vec<(usize, glam::Vec3)> = (0..self.plan.cubes.len())
-                    .filter(|&k| self.plan.cubes[k].generator == g)
-                    .map(|k| (k, glam::Vec3::from_slice(&cubes[k].centre[..3])))
-                    .collect();
-                super::reach::GeneratorSpec { mesh: gen.mesh, lights: ids.iter().map(|&l| from(l)).collect(), light_ids: ids, cubes: own }
+                let own: Vec<(usize, Vec3)> =
+                    (0..self.plan.cubes.len()).filter(|&k| self.plan.cubes[k].generator == g).map(|k| (k, before[k])).collect();
+                let forced = if world_changed {
+                    Some("the scene's bounds changed".to_string())
+                } else if own.iter().any(|&(k, c)| c != after[k]) {
+                    Some("its caustic cube's centre moved".to_string())
+                } else if self.plan.space == CausticSpace::Screen && !c.moved.is_empty() {
+                    Some("moved in the camera's view".to_string())
+                } else {
+                    None
+                };
+                let lights = ids.iter().map(|&l| from(l)).collect();
+                super::reach::GeneratorSpec { mesh: gen.mesh, lights, light_ids: ids, cubes: own, forced }
             })
             .collect();
         let materials = |m: usize| scene.meshes.get(m).is_some_and(|mesh| c.materials.contains(&mesh.material));
         let now = init.gpu.draws.iter().map(|d| (d.lo, d.hi)).collect();
-        // The margin: a twentieth of the region's size (the search's step past a hit), and
-        // the splats' and the filter's texels.
-        let texels = q.caustics.splat_size + self.filter as f32 + 2.0;
+        // The margin: 2 % of the region's size (rounding), and the splats' and the filter's
+        // texels and one more.
+        let texels = q.caustics.splat_size + self.filter as f32 + 1.0;
         let name = |m: usize| scene.meshes.get(m).map_or_else(|| format!("mesh {m}"), |mesh| mesh.name.clone());
         let changed = super::reach::Changed { moved: &c.moved, materials: &materials, lights: &c.lights, name: &name };
-        let reach = self.tracker.change(&gens, &changed, now, (0.05, texels, q.cube.cube_size));
+        let reach = self.tracker.change(&gens, &changed, now, (0.02, texels, q.cube.cube_size));
         if c.camera && self.plan.space == CausticSpace::Screen {
             self.tracker.all("camera");
         }
         maps.caustic_reach = if self.plan.shown_in_maps() { reach } else { crate::frame::cube_deps::CausticReach::Unchanged };
-        if let Some(p) = init.plan.caustics.as_ref() {
-            for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
-                g.reference_point = fresh.reference_point;
-            }
-        }
         if let Some(b) = maps.buffer_mut(&CAUSTICS) {
             b.write(&table_bytes(&self.plan, &init.plan.quality, init))?;
         }
@@ -859,7 +888,7 @@ impl CausticsStage {
             }
         }
         rec.end(open);
-        self.record_reach(rec, f, maps, hits, redo);
+        self.record_reach(rec, f, maps, [hits, power, distances], redo);
 
         // Screen space (LC04, WD06b): the camera's depth of everything, then every photon's
         // splat at its pixel, depth-tested against it, in one rendering.
