@@ -22,7 +22,7 @@ layout(local_size_x = 64) in;
 #include "common/scene.glsl"
 #include "caustics/photon_map.glsl"
 
-const int REACH_PROBES = 8;
+const int REACH_PROBES = 4;
 
 // An order-preserving key of a float: a < b ⇔ reach_key(a) < reach_key(b) (unsigned).
 uint reach_key(float f) {

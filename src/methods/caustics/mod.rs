@@ -79,9 +79,13 @@ impl CausticsPlan {
     /// exact photons, which bounce off every specular surface (any move may reach them), nor
     /// under a search of fewer than 3 linear steps, whose probes near a hit are not bounded
     /// (caustics/reach.comp), nor without the projection's distance test (the light then falls
-    /// on whatever lies in its directions, near or far).
+    /// on whatever lies in its directions, near or far); nor under `map_updates=always`, which
+    /// redoes every generator every frame anyway.
     pub fn tracks_reach(&self, q: &Quality) -> bool {
-        q.caustics.caustic_paths != CausticPaths::Exact && q.search.linear_steps >= 3 && q.caustics.caustic_distance_test
+        !q.frame.map_updates_always
+            && q.caustics.caustic_paths != CausticPaths::Exact
+            && q.search.linear_steps >= 3
+            && q.caustics.caustic_distance_test
     }
 
     /// Whether the maps around objects show these caustics (light cube maps and the texture
