@@ -17,7 +17,9 @@
 // where t exceeds the last sample, |x|(n − 1), the far end's bracket looks past the hit in
 // directions on the arc from h's to R's, and its last undershoot lies beyond that sample;
 // where the first sample already overshoots, the bracket's other end is x itself. The
-// surfaces the map holds in REACH_PROBES directions of each stretch are added.
+// surfaces the map holds in REACH_PROBES directions of each stretch are added, and those around
+// the hit's direction as far as its splat and the filter spread it (past a silhouette they
+// light a farther receiver).
 layout(local_size_x = 64) in;
 #include "common/scene.glsl"
 #include "caustics/photon_map.glsl"
@@ -80,6 +82,19 @@ void main() {
                 bool far_end = len >= last * 0.999;
                 vec3 past = far_end ? dir : normalize(hit.xyz + dir * ((k - 1.0) * len));
                 float before = far_end ? max(len - last, len * (1.0 - 1.0 / k)) : len * (1.0 - 1.0 / k);
+                // Around the hit: the splat's radius and the filter's, in texels of the cube.
+                float spread = (caustic.splat_size + float(caustic.filter_radius) + 1.0) * 2.0 / float(caustic.cube_size);
+                vec3 t1 = normalize(cross(at, abs(at.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+                vec3 t2 = cross(at, t1);
+                for (int j = 0; j < 4; ++j) {
+                    vec3 d = normalize(at + spread * (j < 2 ? t1 : t2) * (j % 2 == 0 ? 1.0 : -1.0));
+                    float s = textureLod(caustic_distances, vec4(d, float(push.flags)), 0.0).r;
+                    if (s >= 1e30) {
+                        atomicOr(escaped, 1u);
+                    } else {
+                        reach_include(c.centre.xyz + d * s);
+                    }
+                }
                 if (len * (steps - 1.0) <= length(x) * 1.001) {
                     // The first sample overshoots: the bracket's start is x.
                     float s = textureLod(caustic_distances, vec4(normalize(x), float(push.flags)), 0.0).r;
