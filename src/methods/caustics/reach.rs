@@ -247,6 +247,10 @@ pub struct Tracker {
     /// Whether one record covers every generator at once (the photon map, screen and texture
     /// spaces): any generator reached redoes them all.
     pub whole: bool,
+    /// Per generator: its own object moved at the last change. One that moved at the last two
+    /// is moving: its next record measures no region (`measures`), which its next move would
+    /// make stale anyway; its region is then unknown until a record while it stands still.
+    moving: Vec<(bool, bool)>,
 }
 
 impl Tracker {
@@ -260,7 +264,14 @@ impl Tracker {
             bounds,
             tracks,
             whole,
+            moving: vec![(false, false); generators],
         }
+    }
+
+    /// Per generator: whether its next record measures where its photons go (it is tracked and
+    /// not moving every frame).
+    pub fn measures(&self) -> Vec<bool> {
+        self.moving.iter().map(|&(last, now)| self.tracks && !(last && now)).collect()
     }
 
     /// Takes the words the last record wrote (`CAUSTIC_REACH`, eight a cube) for the cubes it
@@ -302,6 +313,9 @@ impl Tracker {
             })
             .collect();
         let (why, reach) = reached(&facts, &Change { moved: &moved, materials, lights, world, name, margin });
+        for (m, g) in self.moving.iter_mut().zip(gens) {
+            *m = (m.1, moved.iter().any(|&(k, _, _)| k == g.mesh));
+        }
         for (d, w) in self.dirty.iter_mut().zip(why) {
             if d.is_none() {
                 *d = w;
@@ -328,11 +342,15 @@ impl Tracker {
         (self.dirty.iter().filter(|d| d.is_some()).count() as u32, self.dirty.len() as u32)
     }
 
-    /// The record redid the generators `redone` with the caustic cubes `cubes`: their words
-    /// are to be read back; nothing is left to redo.
-    pub fn recorded(&mut self, cubes: &[bool]) {
-        for (u, &c) in self.unread.iter_mut().zip(cubes) {
-            *u |= c;
+    /// The record redid the caustic cubes `redone` and measured `measured` of them: their
+    /// words are to be read back; the others redone are not known; nothing is left to redo.
+    pub fn recorded(&mut self, redone: &[bool], measured: &[bool]) {
+        for (k, (&r, &m)) in redone.iter().zip(measured).enumerate() {
+            if r && !m {
+                self.hits[k] = None;
+                self.unread[k] = false;
+            }
+            self.unread[k] |= r && m;
         }
         self.dirty.iter_mut().for_each(|d| *d = None);
     }
@@ -412,6 +430,46 @@ mod tests {
         let (why, reach) =
             reached(&[open], &Change { moved: &side, materials: &none, lights: &[], world, name: &named, margin: (0.0, 0.0, 64) });
         assert!(why[0].is_some() && reach == CausticReach::Anywhere);
+    }
+
+    /// A generator that moves every frame is not measured (its region would be stale at its
+    /// next move); once it stands still, the next record measures it again, and until then
+    /// any move reaches it.
+    #[test]
+    fn a_moving_generator_is_measured_once_it_stands_still() {
+        let g = |x: f32| (Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 1.0, 1.0));
+        let spec = GeneratorSpec { mesh: 0, lights: Vec::new(), light_ids: Vec::new(), cubes: vec![(0, Vec3::splat(0.5))], forced: None };
+        let none = |_: usize| false;
+        let name = |m: usize| format!("mesh{m}");
+        let mut t = Tracker::new(1, 1, vec![g(0.0), g(5.0)], (true, false));
+        let step = |t: &mut Tracker, moved: &[usize], now: Vec<Bounds>| {
+            let c = Changed { moved, materials: &none, lights: &[], name: &name };
+            t.change(std::slice::from_ref(&spec), &c, now, (0.0, 0.0, 64))
+        };
+        assert_eq!(t.measures(), [true]);
+        t.recorded(&[true], &[true]);
+        // A region read back: a move far from it reaches nothing.
+        let words = |b: Bounds| {
+            let key = |f: f32| if f.to_bits() & 0x8000_0000 != 0 { !f.to_bits() } else { f.to_bits() | 0x8000_0000 };
+            vec![key(b.0.x), key(b.0.y), key(b.0.z), key(b.1.x), key(b.1.y), key(b.1.z), 0, 10]
+        };
+        t.read(&words(g(0.0)));
+        assert_eq!(step(&mut t, &[1], vec![g(0.0), g(6.0)]), CausticReach::Unchanged);
+        // It moves twice: redone both times, measured the first only.
+        step(&mut t, &[0], vec![g(0.1), g(6.0)]);
+        assert_eq!(t.measures(), [true]);
+        t.recorded(&[true], &[true]);
+        step(&mut t, &[0], vec![g(0.2), g(6.0)]);
+        assert_eq!(t.measures(), [false]);
+        t.recorded(&[true], &[false]);
+        t.read(&words(g(0.0)));
+        // Standing still: the other's far move now reaches it (its region is not known) …
+        assert_eq!(step(&mut t, &[1], vec![g(0.2), g(7.0)]), CausticReach::Anywhere);
+        assert_eq!(t.measures(), [true]);
+        t.recorded(&[true], &[true]);
+        t.read(&words(g(0.2)));
+        // … and once measured again, no longer.
+        assert_eq!(step(&mut t, &[1], vec![g(0.2), g(8.0)]), CausticReach::Unchanged);
     }
 
     /// The words caustics/reach.comp writes decode to the hits' bounds; escaped and empty

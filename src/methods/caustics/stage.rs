@@ -563,11 +563,11 @@ impl CausticsStage {
         }
     }
 
-    /// `caustics.reach`: where the redone cubes' photons went (caustics/reach.comp), their
+    /// `caustics.reach`: where the measured cubes' photons went (caustics/reach.comp), their
     /// words cleared first (bounds empty, nothing escaped, none landed); the stage reads them
     /// back at the next change (`Stage::update`).
     /// `reads`: the photon hits and power and the receiver distances.
-    fn record_reach(&self, rec: &mut Recorder, f: &FrameInputs, maps: &Maps, reads: [&Image; 3], redo: &[bool]) {
+    fn record_reach(&self, rec: &mut Recorder, f: &FrameInputs, maps: &Maps, reads: [&Image; 3], measure: &[bool]) {
         let Some(words) = maps.buffer(&CAUSTIC_REACH).map(|b| b.raw) else { return };
         let [hits, power, distances] = reads;
         let pass = rec.pass("caustics.reach").reads(hits, Access::ComputeSampled).reads(power, Access::ComputeSampled);
@@ -579,7 +579,7 @@ impl CausticsStage {
         let transfer = vk::PipelineStageFlags2::ALL_TRANSFER;
         // After the last record's kernel (and the host's read, behind the frame's fence).
         barrier(compute, vk::AccessFlags2::SHADER_STORAGE_WRITE, transfer, vk::AccessFlags2::TRANSFER_WRITE);
-        for k in (0..redo.len()).filter(|&k| redo[k]) {
+        for k in (0..measure.len()).filter(|&k| measure[k]) {
             let at = 32 * k as u64;
             unsafe {
                 ctx.device.cmd_fill_buffer(cmd, words, at, 12, u32::MAX);
@@ -592,7 +592,7 @@ impl CausticsStage {
             ctx.device.cmd_bind_descriptor_sets(cmd, vk::PipelineBindPoint::COMPUTE, self.layout, 0, &[f.set], &[]);
         }
         let (x, y) = spread_groups((self.photons as u64 * self.photons as u64).div_ceil(64));
-        for c in (0..self.plan.cubes.len()).filter(|&c| redo[c]) {
+        for c in (0..self.plan.cubes.len()).filter(|&c| measure[c]) {
             for layer in cube_layers(&self.plan, c) {
                 f.push_flags(ctx, cmd, 0, layer, c as u32);
                 unsafe { ctx.device.cmd_dispatch(cmd, x, y, 1) };
@@ -778,8 +778,11 @@ impl Stage for CausticsStage {
         let mut images = own.map(|s| io.maps.take_image(s));
         // The cubes of the generators this record redoes; the others keep what they hold.
         let redo: Vec<bool> = self.plan.cubes.iter().map(|c| self.tracker.dirty[c.generator].is_some()).collect();
-        self.record_images(rec, f, io, &mut images, &redo);
-        self.tracker.recorded(&redo);
+        // Measured where the photons go: the redone cubes of generators not moving every frame.
+        let measures = self.tracker.measures();
+        let measure: Vec<bool> = self.plan.cubes.iter().zip(&redo).map(|(c, &r)| r && measures[c.generator]).collect();
+        self.record_images(rec, f, io, &mut images, (&redo, &measure));
+        self.tracker.recorded(&redo, &measure);
         for (slot, image) in own.into_iter().zip(images) {
             if let Some(image) = image {
                 io.maps.set_image(slot, image);
@@ -806,8 +809,15 @@ impl CausticsStage {
     /// and power, light cube maps and their unfiltered twins, the screen's irradiance (`own` in
     /// `record`'s order).
     /// `redo`: per caustic cube, whether its generator is redone (in the spaces that record
-    /// every generator at once, all or none).
-    fn record_images(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo, images: &mut [Option<Image>; 8], redo: &[bool]) {
+    /// every generator at once, all or none); `measure`: whether `caustics.reach` measures it.
+    fn record_images(
+        &mut self,
+        rec: &mut Recorder,
+        f: &FrameInputs,
+        io: &mut FrameIo,
+        images: &mut [Option<Image>; 8],
+        (redo, measure): (&[bool], &[bool]),
+    ) {
         let ctx = rec.ctx;
         let maps = &*io.maps;
         let [distances, hits, power, light_image, raw_image, screen_image, light_map, receiver_ids] = images;
@@ -888,7 +898,7 @@ impl CausticsStage {
             }
         }
         rec.end(open);
-        self.record_reach(rec, f, maps, [hits, power, distances], redo);
+        self.record_reach(rec, f, maps, [hits, power, distances], measure);
 
         // Screen space (LC04, WD06b): the camera's depth of everything, then every photon's
         // splat at its pixel, depth-tested against it, in one rendering.
