@@ -56,6 +56,13 @@ impl CausticsPlan {
         }
     }
 
+    /// Where cube `c` is in `scene`: its light's position, or its generator's reference point
+    /// (`centre`, from the scene's lights rather than the frame's table).
+    pub fn scene_centre(&self, c: usize, scene: &Scene) -> Vec3 {
+        let cube = &self.cubes[c];
+        cube.light.map_or(self.generators[cube.generator].reference_point, |l| scene.lights[l].position)
+    }
+
     /// The profiled passes it records, in order.
     pub fn passes(&self, q: &Quality) -> Vec<&'static str> {
         let mut v = vec!["caustics.receivers", "caustics.photons"];

@@ -432,6 +432,34 @@ mod tests {
         assert!(why[0].is_some() && reach == CausticReach::Anywhere);
     }
 
+    /// The reach is measured (`caustics.reach` planned and recorded) except for exact photons,
+    /// fewer than 3 linear steps, no distance test and `map_updates=always`.
+    #[test]
+    fn what_is_tracked() {
+        use crate::quality::{CausticSpace, Caustics, Quality};
+        let plan = crate::plan::types::CausticsPlan {
+            filter: Caustics::Triangles,
+            generators: Vec::new(),
+            cubes: Vec::new(),
+            space: CausticSpace::Cube,
+            photon_layers: 0,
+            bytes: 0,
+        };
+        let tracked = |knobs: &[(&str, &str)]| {
+            let mut q = Quality::default();
+            for (k, v) in knobs {
+                q.set(k, v).unwrap();
+            }
+            assert_eq!(plan.passes(&q).contains(&"caustics.reach"), plan.tracks_reach(&q));
+            plan.tracks_reach(&q)
+        };
+        assert!(tracked(&[]));
+        assert!(tracked(&[("linear_steps", "3")]));
+        for knob in [("caustic_paths", "exact"), ("linear_steps", "2"), ("caustic_distance_test", "off"), ("map_updates", "always")] {
+            assert!(!tracked(&[knob]), "{knob:?}");
+        }
+    }
+
     /// A generator that moves every frame is not measured (its region would be stale at its
     /// next move); once it stands still, the next record measures it again, and until then
     /// any move reaches it.

@@ -114,9 +114,11 @@ pub fn table(
     let cubes = plan
         .cubes
         .iter()
-        .map(|c| {
-            let centre = c.light.map_or(plan.generators[c.generator].reference_point, |l| scene.lights[l].position);
-            GpuCausticCube { centre: centre.extend(0.0).to_array(), mesh: plan.generators[c.generator].mesh as u32, pad: [0; 3] }
+        .enumerate()
+        .map(|(k, c)| GpuCausticCube {
+            centre: plan.scene_centre(k, scene).extend(0.0).to_array(),
+            mesh: plan.generators[c.generator].mesh as u32,
+            pad: [0; 3],
         })
         .collect();
     (params, cubes)
@@ -680,9 +682,7 @@ impl Stage for CausticsStage {
         };
         // The cubes' centres at their last record, and now (reference points follow their
         // objects; one may move away from what blocks it without its object moving).
-        let centres = |plan: &CausticsPlan| -> Vec<Vec3> {
-            table(plan, q, scene, (init.width, init.height)).1.iter().map(|c| Vec3::from_slice(&c.centre[..3])).collect()
-        };
+        let centres = |plan: &CausticsPlan| -> Vec<Vec3> { (0..plan.cubes.len()).map(|k| plan.scene_centre(k, scene)).collect() };
         let before = centres(&self.plan);
         if let Some(p) = init.plan.caustics.as_ref() {
             for (g, fresh) in self.plan.generators.iter_mut().zip(&p.generators) {
