@@ -368,22 +368,34 @@ fn curved_reflector_wins_in_a_deep_finely_tessellated_environment_and_auto_is_no
     let on_sphere = |i: &ImageData| specula::metrics::masked_error(i, &smooth, &mask, "sphere").unwrap().unwrap().psnr;
     let mut msaa = q.clone();
     msaa.set("aa", "msaa4").unwrap();
-    let others: Vec<f64> = images
-        .iter()
-        .map(on_sphere)
-        .chain(
-            [specula::methods::CURVED_REFLECTOR, specula::methods::DISTANCE, specula::methods::PROXY_BOX]
-                .map(|m| on_sphere(&gpu(&ctx, &s, m, &msaa).image)),
-        )
+    // Each frame's GPU time (the median of 3 after one warm-up), in this run.
+    let timed = |choice: specula::Choice, q: &Quality| {
+        let f = specula::render(&ctx, &s, choice, q, SIZE, (1, 3)).unwrap();
+        (on_sphere(&f.image), f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>())
+    };
+    let rivals = [specula::methods::CURVED_REFLECTOR, specula::methods::DISTANCE, specula::methods::PROXY_BOX];
+    let others: Vec<(String, f64, f64)> = [("", &q), (" msaa4", &msaa)]
+        .into_iter()
+        .flat_map(|(aa, q)| rivals.map(|m| (m, aa, q)))
+        .map(|(m, aa, q)| {
+            let (db, ms) = timed(m.into(), q);
+            (format!("{m}{aa}"), db, ms)
+        })
         .collect();
-    let auto = on_sphere(&specula::render(&ctx, &s, specula::Choice::Auto, &q, SIZE, (0, 1)).unwrap().image);
-    println!(
-        "cluttered, the sphere against 16 samples a pixel: auto {auto:.2} dB; curved, distance, proxy-box (aa off, msaa4) {others:.2?}"
-    );
-    // Measured: auto (ray-query, msaa4) 33.41 dB; the best of the others 29.28 (distance,
-    // msaa4); the exact tracer without anti-aliasing 25.24 (its error measured on the sphere
-    // by the planner: 24.78 dB, and 32.02 with msaa4).
-    assert!(others.iter().all(|&o| auto >= o - 0.5), "auto {auto:.2} dB");
+    let (auto, auto_ms) = timed(specula::Choice::Auto, &q);
+    println!("cluttered, the sphere against 16 samples a pixel: auto {auto:.2} dB in {auto_ms:.1} ms; {others:.2?}");
+    // Measured with the calibration of 2026-12-07: auto (bvh: within its default budget, the
+    // exact tracer's frame, multisampling does not fit) 25.24 dB; curved-reflector 25.89 /
+    // 26.33 (msaa4), distance 24.33 / 29.28, proxy-box 21.16 / 22.48 — the better ones
+    // slower (with the calibration before it, whose multisamples were nearly free, auto took
+    // ray-query with msaa4: 33.41 dB). Auto is never dominated (issue 31): no rival both
+    // faster beyond the noise (1.12×) and more accurate by over 0.5 dB.
+    for (name, db, ms) in &others {
+        assert!(
+            !(*db > auto + 0.5 && *ms * 1.12 < auto_ms),
+            "{name} ({db:.2} dB, {ms:.1} ms) dominates auto ({auto:.2} dB, {auto_ms:.1} ms)"
+        );
+    }
 
     let hall = hall_scene();
     let plan = specula::plan(&hall, specula::Choice::Auto, &q);
@@ -568,13 +580,18 @@ fn moved_objects_equal_a_fresh_render() {
     common::assert_clean(&ctx);
 }
 
-/// Two separate balls in one mesh: every edge bends the convex way, so the planner's
-/// convexity test lets it through, yet a vertex may have a reflection point on each ball —
-/// several minima, which the search's check counts (`geometry.curved_multiple_minima`).
+/// Two separate balls in one mesh: every edge bends the convex way, so the convexity test
+/// lets it through, yet an environment vertex may have a reflection point on each ball —
+/// several minima (survey §5). The planner's check (`plan::reflection_points`, on the CPU
+/// from the camera) refuses it by name: an explicit per-object choice is an error, the
+/// whole-scene method gives it the fallback. The GPU search's own check counts the
+/// second points (`geometry.curved_multiple_minima`) where a plan made before brings such
+/// a mesh to it: the plan of one ball, rendered with the pair.
 #[test]
-fn several_minima_are_counted() {
+fn several_minima_are_refused_and_counted() {
     let ctx = common::gpu();
-    let s = room(
+    let camera = (Vec3::new(0.0, 0.3, 1.9), Vec3::new(0.0, -0.3, 0.0));
+    let pair = room(
         |m| {
             let mut a = shapes::uv_sphere("pair", Vec3::new(-0.5, -0.3, 0.0), 0.4, 32, 16, m);
             let b = shapes::uv_sphere("pair", Vec3::new(0.5, -0.3, 0.0), 0.4, 32, 16, m);
@@ -587,15 +604,33 @@ fn several_minima_are_counted() {
             a.indices.extend(b.indices.iter().map(|i| i + base));
             a
         },
-        (Vec3::new(0.0, 0.3, 1.9), Vec3::new(0.0, -0.3, 0.0)),
+        camera,
     );
     let q = quality();
-    let plan = specula::plan(&s, specula::methods::CURVED_REFLECTOR, &q);
-    assert_eq!(plan.objects[0].method, specula::methods::CURVED_REFLECTOR, "{}", plan.objects[0].reason);
-    let f = gpu(&ctx, &s, specula::methods::CURVED_REFLECTOR, &q);
+    let facts = specula::plan::facts::SceneFacts::new(&pair, &q, false);
+    let mirror = facts.objects.iter().find(|f| pair.meshes[f.mesh].name == "pair").unwrap();
+    let (found, checked) = mirror.reflection_points;
+    println!("two balls in one mesh: the planner finds a second reflection point for {found} of {checked} sampled vertices");
+    assert_eq!(mirror.curvature, specula::plan::facts::Curvature::Convex);
+    let choices =
+        specula::plan::Choices { method: specula::Choice::Auto, objects: vec![("pair".into(), specula::methods::CURVED_REFLECTOR)] };
+    let e = specula::plan::plan_with(&pair, &choices, &q).unwrap_err().to_string();
+    println!("{e}");
+    assert!(e.contains("'pair'") && e.contains("second one") && e.contains("several minima") && e.contains("unsupported"), "{e}");
+    let plan = specula::plan(&pair, specula::methods::CURVED_REFLECTOR, &q);
+    let o = plan.objects.iter().find(|o| o.name == "pair").unwrap();
+    assert_eq!(o.method, specula::methods::DISTANCE, "{}", o.reason);
+    assert!(o.reason.contains("several-minima"), "{}", o.reason);
+
+    // One ball where the pair's first ball is: accepted (no second point), its plan then
+    // drawn with the pair's mesh in its place.
+    let one = room(|m| shapes::uv_sphere("pair", Vec3::new(-0.5, -0.3, 0.0), 0.4, 32, 16, m), camera);
+    let single = specula::plan(&one, specula::methods::CURVED_REFLECTOR, &q);
+    assert!(single.objects.iter().any(|o| o.name == "pair" && o.method == specula::methods::CURVED_REFLECTOR));
+    let f = specula::render_plan(&ctx, &pair, single, SIZE, (0, 1)).unwrap();
     let (found, checked) = (stat(&f, "geometry.curved_multiple_minima"), stat(&f, "geometry.curved_checked"));
-    let reference = specula::reference::render_reference(&s, &q, SIZE).unwrap();
-    println!("two balls in one mesh: {found} of {checked} checked vertices with several minima, {:.2} dB", psnr(&f.image, &reference));
+    let reference = specula::reference::render_reference(&pair, &q, SIZE).unwrap();
+    println!("drawn anyway: the GPU finds {found} of {checked} checked vertices with several minima, {:.2} dB", psnr(&f.image, &reference));
     // Counts (tests/README.md): measured 648 of 2475 (the convex sphere and the bowl: 0),
     // the bound a factor 1.122 under it.
     assert!(found >= 577.0, "{found} of {checked}");

@@ -121,7 +121,8 @@ fn set(c: &mut SpeculaContext, index: usize, method: SpeculaMethod) -> FfiResult
             format!("object '{name}': method '{}' cannot serve a {} (it serves: {})", m.name, class.label(), serves.join(", ")),
         );
     }
-    // Its shape: judged from the mesh as the planner judges it (rigid and affine moves keep it).
+    // Its shape: judged as the planner judges it, from the mesh (rigid and affine moves keep its
+    // curvature) and, for a curved mirror, its reflection points seen from the camera.
     let facts = crate::plan::facts::SceneFacts::new(&c.scene, &c.quality, false);
     if let Some(f) = facts.objects.iter().find(|f| f.mesh == index).filter(|f| !m.fits(f)) {
         return fail(
@@ -129,9 +130,9 @@ fn set(c: &mut SpeculaContext, index: usize, method: SpeculaMethod) -> FfiResult
             format!(
                 "object '{name}': method '{}' cannot serve {} {}: {}",
                 m.name,
-                m.shape.misfit(),
+                m.shape.misfit_of(f),
                 f.class.label(),
-                m.shape.requirement()
+                m.shape.refusal(f)
             ),
         );
     }

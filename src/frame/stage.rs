@@ -262,6 +262,10 @@ pub struct MapInfo {
     pub create: CreateStage,
     /// Device memory of its images for `objects` objects at a `width`×`height` camera.
     pub bytes: fn(&Plan, u32, (u32, u32)) -> u64,
+    /// Texels it draws for one object (for a shared map, the whole map) under these knobs,
+    /// with `layers` layers where it peels (`layered::planned_layers`), at a `width`×`height`
+    /// camera: the map work the planner's cost model counts (`plan::predict::features`).
+    pub texels: fn(&Quality, u32, (u32, u32)) -> f64,
     /// What one object's map is, for `specula plan` (e.g. "cube 6×256² RGBA16F").
     pub describe: fn(&Quality, (u32, u32)) -> String,
     /// One map for all the objects that take it (a layered map of the whole scene): its
@@ -287,6 +291,11 @@ impl PartialEq for MapInfo {
     fn eq(&self, o: &MapInfo) -> bool {
         self.name == o.name
     }
+}
+
+/// Texels of one cube map at `q`'s `cube_size` (`MapInfo::texels` of a cube map per object).
+pub fn cube_texels(q: &Quality, _layers: u32, _size: (u32, u32)) -> f64 {
+    6.0 * (q.cube.cube_size as f64).powi(2)
 }
 
 /// Bytes per texel of the cube maps at a precision.

@@ -134,7 +134,33 @@ impl Shape {
                 ObjectClass::ThinDielectric => f.planar,
                 ObjectClass::Mirror => false,
             },
-            Shape::ConvexOrConcave => f.curvature != crate::plan::facts::Curvature::Saddle,
+            Shape::ConvexOrConcave => {
+                f.curvature != crate::plan::facts::Curvature::Saddle && !crate::plan::reflection_points::refused(f.reflection_points)
+            }
+        }
+    }
+
+    /// Why object `f` misses the shape (what [`Shape::requirement`] says, with the
+    /// measured reflection points where several were found).
+    pub fn refusal(self, f: &ObjectFacts) -> String {
+        match self {
+            Shape::ConvexOrConcave if f.curvature != crate::plan::facts::Curvature::Saddle => {
+                let (found, checked) = f.reflection_points;
+                format!(
+                    "reflectors with one reflection point per environment point only: seen from the camera, {found} of {checked} sampled environment vertices have a second one on this mesh (several minima of the reflection-point search, survey §5; e.g. separate surfaces in one mesh): unsupported"
+                )
+            }
+            _ => self.requirement().to_string(),
+        }
+    }
+
+    /// [`Shape::misfit`] for object `f`.
+    pub fn misfit_of(self, f: &ObjectFacts) -> &'static str {
+        match self {
+            Shape::ConvexOrConcave if f.curvature != crate::plan::facts::Curvature::Saddle => {
+                "a several-minima (more than one reflection point per environment point, unsupported)"
+            }
+            _ => self.misfit(),
         }
     }
 

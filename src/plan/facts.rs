@@ -33,6 +33,10 @@ pub struct ObjectFacts {
     /// Convex, concave (towards its normals), flat or neither (saddle-shaped): the
     /// reflection-point search of curved reflectors (§5) has one minimum on the first three.
     pub curvature: Curvature,
+    /// A curved mirror's reflection points (survey §5): of the environment vertices sampled
+    /// with one on it seen from the camera, those with a second one — (found, checked)
+    /// (`reflection_points::several`; (0, 0) for other objects, planar, saddle-shaped).
+    pub reflection_points: (u32, u32),
     /// Farthest over nearest distance of the surfaces around the reference point (2048 rays;
     /// 1 without deep facts): the environment's depth variation.
     pub depth_ratio: f32,
@@ -626,6 +630,12 @@ impl SceneFacts {
                     faceted: mf.faceted,
                     watertight: mf.watertight,
                     curvature: mf.curvature,
+                    reflection_points: match (class, mf.planar, mf.curvature) {
+                        (ObjectClass::Mirror, false, Curvature::Convex | Curvature::Concave) => {
+                            super::reflection_points::several(scene, i, scene.camera_or_default().position)
+                        }
+                        _ => (0, 0),
+                    },
                     depth_ratio,
                     near_ratio: if radius > 0.0 { nearest / radius } else { 0.0 },
                     edge_angle: if bvh.is_some() { edge_angle(scene, i, reference_point) } else { 0.0 },

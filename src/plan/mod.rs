@@ -9,6 +9,7 @@ pub mod facts;
 pub mod ids;
 pub mod knobs;
 pub mod predict;
+pub mod reflection_points;
 pub mod types;
 
 use glam::Vec3;
@@ -323,7 +324,7 @@ fn choose(
                 format!("method '{}' cannot serve a graded-index medium, whose rays curve (survey §6.5): {}", m.name, curved()),
             ))
         } else if m.can_serve(class) && !m.shape.fits(facts) {
-            Err(Error::invalid(format!("object '{}'", mesh.name), format!("method '{}' serves {}", m.name, m.shape.requirement())))
+            Err(Error::invalid(format!("object '{}'", mesh.name), format!("method '{}' serves {}", m.name, m.shape.refusal(facts))))
         } else if m.can_serve(class) {
             Ok((m, format!("{source}: {}", m.name)))
         } else {
@@ -349,7 +350,8 @@ fn choose(
             ));
         }
         if let Some(f) = m.fallback.filter(|f| f.fits(facts)) {
-            let what = if m.can_serve(class) { format!("{} {}", m.shape.misfit(), class.label()) } else { format!("a {}", class.label()) };
+            let what =
+                if m.can_serve(class) { format!("{} {}", m.shape.misfit_of(facts), class.label()) } else { format!("a {}", class.label()) };
             return Ok((f, format!("--method {} does not serve {what}: its fallback {}", m.name, f.name)));
         }
         return check(m, "--method");

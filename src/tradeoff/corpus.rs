@@ -7,7 +7,7 @@
 
 use crate::error::Result;
 use crate::methods::{Choice, Method, BVH};
-use crate::plan::predict::features::{error_features, workload};
+use crate::plan::predict::features::{error_features, workload, MapWork};
 use crate::plan::predict::samples::{Corpus, FrameSample, Sample, PSNR_CAP};
 use crate::plan::{plan_with, Choices};
 use crate::quality::Quality;
@@ -139,7 +139,8 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                         let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
                         let pixels = object_pixels[mesh + 1];
                         let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
-                        let work = workload(f, &scene, &q, size, pixels as f64, &frame);
+                        let maps = MapWork::of(o.method, &q, crate::methods::layered::planned_layers(&plan), size);
+                        let work = workload(f, &scene, &q, maps, size, pixels as f64, &frame);
                         any = Some(work);
                         let dup = out.samples.iter().any(|s| {
                             s.scene == i && s.object == o.name && s.method == o.method.name && s.knobs == *v && s.work.screen == work.screen

@@ -28,6 +28,7 @@ pub const DISTANCE_CUBES: MapInfo = MapInfo {
     layer_field: Some(LayerField::Envmap),
     create: create_distance,
     bytes: distance_bytes,
+    texels: crate::frame::stage::cube_texels,
     describe: |q, _| describe_cube(q),
     shared: false,
 };
@@ -52,6 +53,7 @@ pub const REFRACTOR_CUBES: MapInfo = MapInfo {
         let s = p.quality.cube.cube_size as u64;
         6 * s * s * cube_texel_bytes(&p.quality) * n as u64
     },
+    texels: crate::frame::stage::cube_texels,
     describe: |q, _| describe_cube(q) + " (normal, distance)",
     shared: false,
 };
@@ -64,6 +66,7 @@ pub const BACKFACES: MapInfo = MapInfo {
     layer_field: None,
     create: image_space::create,
     bytes: |_, _, (w, h)| w as u64 * h as u64 * 16,
+    texels: |_, _, (w, h)| w as f64 * h as f64,
     describe: |_, _| "camera-sized RGBA32F back-face normals and depths + per-vertex thickness".into(),
     shared: false,
 };

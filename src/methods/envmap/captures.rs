@@ -38,6 +38,7 @@ pub const CAPTURE_CUBES: MapInfo = MapInfo {
         let s = p.quality.cube.cube_size as u64;
         6 * s * s * cube_texel_bytes(&p.quality) * objects as u64 * per_object(&p.quality) as u64
     },
+    texels: |q, l, size| crate::frame::stage::cube_texels(q, l, size) * per_object(q) as f64,
     describe: |q, _| {
         format!(
             "{} captures ({} per axis, in the {}'s box), each a {} with distance",

@@ -26,6 +26,7 @@ pub const RADIANCE_CUBES: MapInfo = MapInfo {
     layer_field: Some(LayerField::Envmap),
     create: crate::methods::cube_maps::create_radiance,
     bytes: radiance_bytes,
+    texels: crate::frame::stage::cube_texels,
     describe: |q, _| describe_cube(q),
     shared: false,
 };

@@ -42,6 +42,7 @@ pub const RELIEF_MAPS: MapInfo = MapInfo {
         let s = p.quality.envmap.relief_size as u64;
         6 * s * s * crate::frame::stage::cube_texel_bytes(&p.quality) * objects as u64
     },
+    texels: |q, _, _| 6.0 * (q.envmap.relief_size as f64).powi(2),
     describe: |q, _| {
         format!(
             "six height maps {}² (one per face of the scene's box: radiance and depth, {}, {})",

@@ -32,6 +32,7 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
     layer_field: None,
     create: peel::create,
     bytes: |p, objects, _| if objects == 0 { 0 } else { peel::bytes(&p.quality, planned_layers(p)) },
+    texels: |q, layers, size| crate::frame::stage::cube_texels(q, layers, size) * layers as f64,
     describe: |q, _| {
         let layers = q.layered.layers.map_or(format!("auto (the depth complexity, at most {MAX_LAYERS})"), |l| l.to_string());
         format!(
@@ -47,8 +48,12 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
 /// farthest surfaces where they are fewer than the complexity (`peel`). The stage allocates
 /// what it counts on the GPU (`layered.layers` in the frame's stats).
 pub fn planned_layers(p: &Plan) -> u32 {
-    let depth = p.layered_depth;
-    let layers = p.quality.layered.layers.unwrap_or_else(|| depth.map_or(MAX_LAYERS, |d| d.clamp(1, MAX_LAYERS)));
+    layers_for(&p.quality, p.layered_depth)
+}
+
+/// [`planned_layers`] under `q` where the depth complexity counted is `depth`.
+pub fn layers_for(q: &Quality, depth: Option<u32>) -> u32 {
+    let layers = q.layered.layers.unwrap_or_else(|| depth.map_or(MAX_LAYERS, |d| d.clamp(1, MAX_LAYERS)));
     layers + u32::from(depth.is_some_and(|d| d > layers))
 }
 

@@ -27,8 +27,10 @@ use crate::error::{Error, Result};
 /// triangle. `MethodCost::under`, the under-prediction margin, came later without a new
 /// format: a file without it reads as margin 1. 4: light terms (lit cube texels, shadow
 /// rays, caustic cubes read, the caustics themselves in the frame's base), a constant per
-/// object in the camera work, and the whole-screen kernels' term per scene triangle gone.)
-pub const FORMAT: &str = "specula-costs 4";
+/// object in the camera work, and the whole-screen kernels' term per scene triangle gone.
+/// 5: a method's own maps' texels, not one cube's; its maps of the whole scene and the
+/// layers its search reads as terms of their own.)
+pub const FORMAT: &str = "specula-costs 5";
 
 /// The quantile of a method's measured-over-predicted frame times that [`MethodCost::under`]
 /// keeps, frames weighted by their measured time: the median, the fit's bias on the method's

@@ -119,6 +119,38 @@ pub struct Workload {
     /// calibration scene is a closed room.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub covered: Option<f64>,
+    /// Texels the method's own maps draw for the object (`MapInfo::texels` summed: a
+    /// refractor map and a distance map are two cubes, image-based captures `captures³`,
+    /// relief height maps `6 · relief_size²`); `None` (measured before it): one cube map.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub map_texels: Option<f64>,
+    /// Texels of the method's maps of the whole scene, drawn once a frame for all its
+    /// objects (the layered map's layers: `MapInfo::shared`); 0 for none.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub shared_texels: f64,
+    /// Layers its camera search reads per pixel (a layered map's; 1 else).
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub layers: f64,
+}
+
+/// What a method's maps draw for one object: its own maps' texels, its maps of the whole
+/// scene's, and the layers its search reads.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapWork {
+    pub texels: f64,
+    pub shared_texels: f64,
+    pub layers: f64,
+}
+
+impl MapWork {
+    /// `m`'s maps under `q` at a `size` camera, `layers` the layers a layered map peels
+    /// (`methods::layered::layers_for`; any for methods that peel none).
+    pub fn of(m: crate::plan::Method, q: &Quality, layers: u32, size: (u32, u32)) -> MapWork {
+        let maps = m.gpu.as_ref().map_or(&[][..], |g| g.maps);
+        let sum = |shared: bool| maps.iter().filter(|i| i.shared == shared).map(|i| (i.texels)(q, layers, size)).sum::<f64>();
+        let peels = maps.iter().any(|i| i.name == crate::methods::layered::LAYERED_CUBES.name);
+        MapWork { texels: sum(false), shared_texels: sum(true), layers: if peels { layers.max(1) as f64 } else { 1.0 } }
+    }
 }
 
 /// What a frame does beyond its objects' own work, the same for each of them: its caustics
@@ -148,6 +180,14 @@ fn one() -> f64 {
     1.0
 }
 
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
+fn is_one(x: &f64) -> bool {
+    *x == 1.0
+}
+
 impl Default for Workload {
     fn default() -> Workload {
         Workload {
@@ -164,6 +204,9 @@ impl Default for Workload {
             caustic_photons: 0.0,
             caustic_texels: 0.0,
             covered: None,
+            map_texels: None,
+            shared_texels: 0.0,
+            layers: 1.0,
         }
     }
 }
@@ -171,14 +214,18 @@ impl Default for Workload {
 /// Names of the per-object map features, in the order [`map_features`] returns them.
 pub const MAP_FEATURES: [&str; 5] = ["object", "cube_raster", "cube_texels", "lit_cube_texels", "caustic_cube_texels"];
 
-/// What an object's maps cost scales with: a constant per object (its passes), cube-map
-/// rasterisation (texels × scene triangles, 1e9), cube texels (1e6), cube texels times
-/// lights (1e6: every texel's diffuse surface shaded with each light's shadow map; on
-/// lavapipe a lit 256² cube costs 3–5× an unlit one) and times the frame's caustic cubes
-/// (1e6: the caustics projected onto them).
+/// What an object's maps cost scales with: a constant per object (its passes), their
+/// rasterisation (texels × scene triangles, 1e9), their texels (1e6), texels times lights
+/// (1e6: every texel's diffuse surface shaded with each light's shadow map; on lavapipe a
+/// lit 256² cube costs 3–5× an unlit one) and times the frame's caustic cubes (1e6: the
+/// caustics projected onto them). The texels are the method's own maps'
+/// ([`Workload::map_texels`]), not one cube's: relief height maps follow `relief_size`, not
+/// `cube_size` (counted as cubes, a calibration's `cube_size=128` variant moved the feature
+/// and not their cost, and an unseen lit scene measured 2.04× its prediction).
 pub fn map_features(w: &Workload) -> Vec<f64> {
-    let t = w.cube_texels / 1e6;
-    vec![1.0, w.cube_texels * w.scene_triangles / 1e9, t, t * w.lights, t * caustic_cubes(w)]
+    let texels = w.map_texels.unwrap_or(w.cube_texels);
+    let t = texels / 1e6;
+    vec![1.0, texels * w.scene_triangles / 1e9, t, t * w.lights, t * caustic_cubes(w)]
 }
 
 /// The frame's caustic cubes (each a light cube map that diffuse shading reads).
@@ -209,15 +256,17 @@ pub const SCREEN_FEATURES: [&str; 8] = [
 /// scene's triangles (log₂ / 16: a traversal per ray), again for a solid dielectric's and a
 /// thin one's (more rays per sample), and a constant per object, again for a dielectric
 /// (its draws and dispatches; a dielectric's rays branch at every hit).
+///
+/// A search through layers (a layered map's) counts its pixels once per layer.
 pub fn screen_features(w: &Workload) -> Vec<f64> {
     let px = w.pixels / 1e4;
     let rays = px * w.samples * depth(w);
     let [msaa, ssaa] = extra(w);
-    vec![px, px * msaa, px * ssaa, rays, rays * w.solid, rays * w.thin, 1.0, w.solid + w.thin]
+    vec![px * w.layers.max(1.0), px * msaa, px * ssaa, rays, rays * w.solid, rays * w.thin, 1.0, w.solid + w.thin]
 }
 
 /// Names of the whole-screen features, in the order [`shared_features`] returns them.
-pub const SHARED_FEATURES: [&str; 7] = [
+pub const SHARED_FEATURES: [&str; 10] = [
     "frame",
     "screen",
     "screen_extra_msaa_samples",
@@ -225,6 +274,9 @@ pub const SHARED_FEATURES: [&str; 7] = [
     "screen_rays",
     "screen_shadow_rays",
     "screen_caustic_rays",
+    "shared_map_raster",
+    "shared_map_texels",
+    "lit_shared_map_texels",
 ];
 
 /// What a method's whole-screen kernels scale with: a constant per frame (its dispatches,
@@ -236,12 +288,27 @@ pub const SHARED_FEATURES: [&str; 7] = [
 /// logarithm: a traversal's frame grows with the hierarchy's depth (survey Table 1 measured,
 /// BENCHMARKS.md: bvh 226 ms at 1.7·10³ triangles, 527 ms at 10⁶); a term linear in
 /// triangles, fitted on six calibration scenes, took their noise and predicted bvh on the
-/// concave mirror 2.5× its measured frame.
+/// concave mirror 2.5× its measured frame. Then its maps of the whole scene (a layered
+/// map's peel, drawn once for all its objects): their rasterisation, texels and lit texels,
+/// as an object's own maps' (without them, layered's frames were fitted as a constant and
+/// measured 4× their prediction on an unseen scene of more layers).
 pub fn shared_features(w: &Workload) -> Vec<f64> {
     let px = w.screen / 1e4;
     let [msaa, ssaa] = extra(w);
     let rays = w.covered.unwrap_or(w.screen).min(w.screen) / 1e4 * w.samples * depth(w);
-    vec![1.0, px, px * msaa, px * ssaa, rays, rays * w.lights, rays * caustic_cubes(w)]
+    let t = w.shared_texels / 1e6;
+    vec![
+        1.0,
+        px,
+        px * msaa,
+        px * ssaa,
+        rays,
+        rays * w.lights,
+        rays * caustic_cubes(w),
+        w.shared_texels * w.scene_triangles / 1e9,
+        t,
+        t * w.lights,
+    ]
 }
 
 /// Samples beyond one per pixel, multisampled and supersampled.
@@ -254,8 +321,9 @@ fn depth(w: &Workload) -> f64 {
     w.scene_triangles.max(2.0).log2() / 16.0
 }
 
-/// The workload of object `f` at `size` covering `pixels` of it, in `frame`.
-pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), pixels: f64, frame: &FrameWork) -> Workload {
+/// The workload of object `f` at `size` covering `pixels` of it, in `frame`, with a
+/// method whose maps do `maps`.
+pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, maps: MapWork, size: (u32, u32), pixels: f64, frame: &FrameWork) -> Workload {
     let visible = |m: &&crate::scene::Mesh| !m.hidden;
     Workload {
         pixels,
@@ -271,6 +339,9 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, size: (u32, u32), p
         caustic_photons: frame.caustic_photons,
         caustic_texels: frame.caustic_texels,
         covered: Some(frame.covered),
+        map_texels: Some(maps.texels),
+        shared_texels: maps.shared_texels,
+        layers: maps.layers,
     }
 }
 
