@@ -1,8 +1,8 @@
 //! Curved reflectors by geometry transformation (survey §5, EMD*05, EMDT06, RHS06). Each
 //! reflector is sampled once into a geometry image — world positions and normals in two
-//! RGBA32F layers, rasterised over its UV parameterisation, or a planar projection along
-//! its mean normal where its UVs overlap or are missing (`geometry.image`, redone only when
-//! it moves). The environment — the scene's triangles, each split into `tessellation`²
+//! RGBA32F layers, rasterised over its UV parameterisation, or where its UVs overlap or are
+//! missing a planar projection along its mean normal, or for a closed surface a cube atlas
+//! around its centre (`geometry.image`, redone only when it moves). The environment — the scene's triangles, each split into `tessellation`²
 //! triangles by a compute pre-pass from the scene's vertex buffer
 //! (`geometry.virtual.tessellate`, redone when an object moves; the grid's indices are
 //! fixed) — is searched every frame: for each of its vertices and every reflector, a compute
@@ -16,9 +16,10 @@
 //!
 //! The search has one minimum only on reflectors that are convex or concave: the planner
 //! classifies each mesh by the sign of its normal curvature along every edge
-//! (`plan::facts::curvature`) and
-//! refuses a saddle-shaped one by name (or gives it the fallback), instead of drawing
-//! garbage. Cost: the search is O(S·D) per frame (S reflectors, D environment vertices),
+//! (`plan::facts::curvature`) and refuses a saddle-shaped one by name (or gives it the
+//! fallback), instead of drawing garbage; likewise a mesh that bends one way along every
+//! edge and still has several reflection points for the environment's vertices seen from the
+//! camera (`plan::reflection_points`: two balls in one mesh). Cost: the search is O(S·D) per frame (S reflectors, D environment vertices),
 //! each search (size/2^levels)² + 25·levels texel reads (survey Table 1: O(S), O(N)).
 
 use ash::vk;
@@ -62,7 +63,7 @@ pub const CURVED_REFLECTOR_INFO: &MethodInfo = &MethodInfo {
     abi: 15,
     section: "§5",
     family: "geometry",
-    summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors are refused",
+    summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors, and those with several reflection points for the environment seen from the camera, are refused",
     serves: &[ObjectClass::Mirror],
     knobs: &[GeometryKnobs::geometry_image, GeometryKnobs::curved_search, GeometryKnobs::tessellation, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
@@ -138,12 +139,13 @@ fn tessellate(m: &Mesh, t: u32, vertices: &mut Vec<GpuCurvedVertex>, indices: &m
     }
 }
 
-/// A reflector's parameterisation into [0,1]² (half a texel of margin at `size`): its own
-/// UVs, rescaled to fill the square, when they are present, span an area and do not overlap
-/// (the triangles' UV areas add up to no more than their bounding box); else the projection
-/// onto the plane across its area-weighted normal (the axis of its smallest extent when that
-/// vanishes, as for a closed surface). Returns the per-vertex coordinates and whether they
-/// are the mesh's own.
+/// A reflector's parameterisation into [0,1]², per triangle corner (`m.indices`' order; half
+/// a texel of margin at `size`): its own UVs, rescaled to fill the square, when they are
+/// present, span an area and do not overlap (the triangles' UV areas add up to no more than
+/// their bounding box); else the projection onto the plane across its area-weighted normal;
+/// where that normal vanishes (a closed surface, which a plane would fold onto itself), a
+/// cube atlas around its centre ([`cube_atlas`]). Returns the coordinates and whether they are
+/// the mesh's own.
 pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
     let tri_area = |a: Vec2, b: Vec2, c: Vec2| 0.5 * ((b - a).perp_dot(c - a)).abs();
     let bbox = |uvs: &[Vec2]| uvs.iter().fold((Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)), |(lo, hi), u| (lo.min(*u), hi.max(*u)));
@@ -153,8 +155,9 @@ pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
         let area: f32 = m.indices.chunks_exact(3).map(|t| tri_area(m.uvs[t[0] as usize], m.uvs[t[1] as usize], m.uvs[t[2] as usize])).sum();
         span.x > 0.0 && span.y > 0.0 && area.is_finite() && area > 0.0 && area <= 1.02 * span.x * span.y
     };
+    let corners = |uv: &[Vec2]| m.indices.iter().map(|&i| uv.get(i as usize).copied().unwrap_or(Vec2::ZERO)).collect::<Vec<Vec2>>();
     let raw: Vec<Vec2> = if usable {
-        m.uvs.clone()
+        corners(&m.uvs)
     } else {
         let p = |i: u32| m.positions[i as usize];
         let mut n = Vec3::ZERO;
@@ -163,21 +166,57 @@ pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
         }
         let b = m.bounds();
         let extent = b.max - b.min;
-        let axis = if n.length() > 1e-3 * extent.length_squared() {
-            n.normalize()
+        if n.length() > 1e-3 * extent.length_squared() {
+            let axis = n.normalize();
+            let u = axis.any_orthonormal_vector();
+            let v = axis.cross(u);
+            corners(&m.positions.iter().map(|q| Vec2::new(q.dot(u), q.dot(v))).collect::<Vec<Vec2>>())
         } else {
-            let k = extent.min_position();
-            Vec3::AXES[k]
-        };
-        let u = axis.any_orthonormal_vector();
-        let v = axis.cross(u);
-        m.positions.iter().map(|q| Vec2::new(q.dot(u), q.dot(v))).collect()
+            cube_atlas(m)
+        }
     };
     let (lo, hi) = bbox(&raw);
     let span = (hi - lo).max(Vec2::splat(f32::MIN_POSITIVE));
     let margin = 0.5 / size as f32;
     let scale = 1.0 - 2.0 * margin;
     (raw.iter().map(|u| Vec2::splat(margin) + (*u - lo) / span * scale).collect(), usable)
+}
+
+/// A closed surface's chart: each triangle projected from the surface's centre (its
+/// area-weighted centroid) onto the face of a cube that its centroid's direction points
+/// through (gnomonic), the six faces side by side in a 3×2 atlas, each face filling 80 % of
+/// its cell so that a triangle straddling a face's edge stays in its own cell. One-to-one
+/// where the surface is star-shaped from its centre (every convex one): no texel holds two
+/// surface points, as a plane's projection of a closed surface would (front and back on one
+/// texel). Per triangle corner, in the atlas's [0,1]².
+fn cube_atlas(m: &Mesh) -> Vec<Vec2> {
+    let p = |i: u32| m.positions[i as usize];
+    let (mut centre, mut area) = (Vec3::ZERO, 0.0f32);
+    for t in m.indices.chunks_exact(3) {
+        let a = 0.5 * (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length();
+        centre += a * (p(t[0]) + p(t[1]) + p(t[2])) / 3.0;
+        area += a;
+    }
+    let centre = if area > 0.0 { centre / area } else { m.bounds().center() };
+    // The face's share of its cell: [-1, 1] maps to the middle 80 %, up to ±1.25 fits.
+    const REACH: f32 = 1.25;
+    let mut uv = Vec::with_capacity(m.indices.len());
+    for t in m.indices.chunks_exact(3) {
+        let d = (p(t[0]) + p(t[1]) + p(t[2])) / 3.0 - centre;
+        let axis = d.abs().max_position();
+        let sign = if d[axis] < 0.0 { -1.0 } else { 1.0 };
+        let face = 2 * axis + usize::from(sign < 0.0);
+        let (u_axis, v_axis) = ((axis + 1) % 3, (axis + 2) % 3);
+        let cell = Vec2::new((face % 3) as f32 / 3.0, (face / 3) as f32 / 2.0);
+        for &i in t {
+            let v = p(i) - centre;
+            let depth = (sign * v[axis]).max(1e-6 * v.length().max(1e-12));
+            let x = (v[u_axis] / depth).clamp(-REACH, REACH);
+            let y = (v[v_axis] / depth).clamp(-REACH, REACH);
+            uv.push(cell + Vec2::new((0.5 + 0.5 * x / REACH) / 3.0, (0.5 + 0.5 * y / REACH) / 2.0));
+        }
+    }
+    uv
 }
 
 /// Every reflector's triangles (three vertices each) with its parameterisation in `uv`,
@@ -189,9 +228,9 @@ fn reflector_vertices(scene: &Scene, reflectors: &[usize], size: u32) -> (Vec<Gp
         let first = vertices.len() as u32;
         let (uv, own) = parameterisation(m, size);
         own_uvs.push(own);
-        for &i in &m.indices {
+        for (&i, &uv) in m.indices.iter().zip(&uv) {
             let i = i as usize;
-            vertices.push(vertex(m.positions[i], m.normals[i], uv[i]));
+            vertices.push(vertex(m.positions[i], m.normals[i], uv));
         }
         ranges.push((first, vertices.len() as u32 - first));
     }
@@ -714,8 +753,34 @@ mod tests {
         cap.uvs.clear();
         let (uv, own) = parameterisation(&cap, 64);
         assert!(!own);
-        assert_eq!(uv.len(), cap.positions.len());
+        assert_eq!(uv.len(), cap.indices.len());
         assert_eq!(curvature(&cap), Curvature::Concave);
+    }
+
+    /// A closed sphere without UVs: the cube atlas gives every triangle its own place — no
+    /// two triangles' charts overlap (sampled at the triangles' centroids and corners pulled
+    /// towards them), where a plane's projection folds the back onto the front.
+    #[test]
+    fn a_closed_uvless_sphere_gets_a_chart_without_overlaps() {
+        let mut s = shapes::uv_sphere("s", Vec3::new(0.3, -0.2, 0.1), 0.7, 24, 12, 0);
+        s.uvs.clear();
+        let (uv, own) = parameterisation(&s, 128);
+        assert!(!own && uv.len() == s.indices.len());
+        assert!(uv.iter().all(|u| u.x > 0.0 && u.x < 1.0 && u.y > 0.0 && u.y < 1.0));
+        let tris: Vec<[Vec2; 3]> =
+            uv.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).filter(|t| (t[1] - t[0]).perp_dot(t[2] - t[0]).abs() > 1e-9).collect();
+        let inside = |t: &[Vec2; 3], q: Vec2| {
+            let s = |a: Vec2, b: Vec2| (b - a).perp_dot(q - a);
+            let (a, b, c) = (s(t[0], t[1]), s(t[1], t[2]), s(t[2], t[0]));
+            (a > 0.0 && b > 0.0 && c > 0.0) || (a < 0.0 && b < 0.0 && c < 0.0)
+        };
+        for (i, t) in tris.iter().enumerate() {
+            let c = (t[0] + t[1] + t[2]) / 3.0;
+            for q in [c, c.lerp(t[0], 0.8), c.lerp(t[1], 0.8), c.lerp(t[2], 0.8)] {
+                let hits = tris.iter().enumerate().filter(|(j, o)| *j != i && inside(o, q)).count();
+                assert_eq!(hits, 0, "triangle {i}'s point {q} lies in {hits} other triangles' charts");
+            }
+        }
     }
 
     /// A spherical cap of radius r and half-angle a around −y, normals towards its centre.
