@@ -450,3 +450,51 @@ fn flat_glass_view_budget_moves_the_faces_error() {
     assert!(faces[1].0 - faces[0].0 >= 2.28 && faces[1].1 - faces[0].1 >= 2.66, "{faces:?}");
     common::assert_clean(&s.ctx);
 }
+
+/// Issue 35's niches on `glass-1.5` at 128²: refractor-map (§4.4) is on the Pareto front of
+/// error against time among every method, the exact tracers included — as accurate as they
+/// are on the ball, in less time — and image-space refraction (§4.4, Wyman) with two Newton
+/// steps is the fastest refraction above 20 dB (refractor-map's accuracy at more time). One
+/// run, frames timed the same way (the median of 3 after one warm-up, GPU ms); a ratio that
+/// misses its bound is measured once more (the machine is shared: noise only slows a frame).
+#[test]
+fn glass_ball_refractions_on_the_front() {
+    const SIZE: (u32, u32) = (128, 128);
+    let ctx = common::gpu();
+    let scene = specula::scenes::builtin("glass-1.5").unwrap().unwrap();
+    let mut base = Quality::default();
+    base.reference.spp = 16;
+    base.set("image_space_iterations", "2").unwrap();
+    let reference = specula::reference::render_reference(&scene, &base, SIZE).unwrap();
+    let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
+    let run = |m: specula::Method| {
+        let f = specula::render(&ctx, &scene, m, &base, SIZE, (1, 3)).unwrap();
+        let ms = f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>();
+        (psnr(&split(&scene, &f.image, &reference, &ids), "specular"), ms)
+    };
+    let methods =
+        [specula::methods::IMAGE_SPACE_REFRACTION, specula::methods::REFRACTOR_MAP, specula::methods::BVH, specula::methods::RAY_QUERY];
+    let measure = || methods.map(run);
+    let mut r = measure();
+    let ok = |r: &[(f64, f64); 4]| {
+        let exact_ms = r[2].1.min(r[3].1);
+        exact_ms >= 1.12 * r[1].1 && r[1].1 >= 1.12 * r[0].1
+    };
+    if !ok(&r) {
+        let again = measure();
+        for (a, b) in r.iter_mut().zip(again) {
+            a.1 = a.1.min(b.1);
+        }
+    }
+    println!("glass-1.5, the ball at 128²: image-space (2 steps), refractor-map, bvh, ray-query (dB, ms): {r:.2?}");
+    let [(image_db, image_ms), (map_db, map_ms), (bvh_db, bvh_ms), (rq_db, rq_ms)] = r;
+    // Measured (BENCHMARKS.md, "Every approximate method against the exact tracers"): 24.40 dB
+    // in 50.4 ms, 31.70 in 69.6, bvh 31.44 in 177.9, ray-query 31.44 in 137.3. Floors 1 dB
+    // under (rule 1); the times as the front needs them: each faster than the next more
+    // accurate one beyond the noise (1.12×; measured 1.39× and 1.97×).
+    assert!(map_db >= 30.70 && map_db >= bvh_db.max(rq_db) - 0.74, "refractor-map {map_db:.2} dB");
+    assert!(image_db >= 23.40, "image-space refraction {image_db:.2} dB");
+    assert!(bvh_ms.min(rq_ms) >= 1.12 * map_ms, "refractor-map {map_ms:.1} ms, exact {bvh_ms:.1} / {rq_ms:.1} ms");
+    assert!(map_ms >= 1.12 * image_ms, "image-space {image_ms:.1} ms, refractor-map {map_ms:.1} ms");
+    common::assert_clean(&ctx);
+}
