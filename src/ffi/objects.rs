@@ -122,7 +122,8 @@ fn set(c: &mut SpeculaContext, index: usize, method: SpeculaMethod) -> FfiResult
         );
     }
     // Its shape: judged as the planner judges it, from the mesh (rigid and affine moves keep its
-    // curvature) and, for a curved mirror, its reflection points seen from the camera.
+    // curvature) and, for a curved mirror, its reflection points seen from the camera (which
+    // moves can change: a later update may then refuse it by name).
     let facts = crate::plan::facts::SceneFacts::new(&c.scene, &c.quality, false);
     if let Some(f) = facts.objects.iter().find(|f| f.mesh == index).filter(|f| !m.fits(f)) {
         return fail(

@@ -119,8 +119,10 @@ pub enum Shape {
     /// Flat faces: a convex solid of planar faces (`ObjectFacts::faceted`), or a planar
     /// thin-walled pane.
     Faceted,
-    /// Convex or concave (or flat), not saddle-shaped (`ObjectFacts::curvature`): where a
-    /// search on the reflector's surface finds one reflection point (survey §5).
+    /// Convex or concave (or flat), not saddle-shaped (`ObjectFacts::curvature`), and without
+    /// several reflection points for the environment seen from the camera
+    /// (`ObjectFacts::reflection_points`): where a search on the reflector's surface finds
+    /// one reflection point (survey §5).
     ConvexOrConcave,
 }
 

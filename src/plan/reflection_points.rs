@@ -13,13 +13,18 @@ use glam::DVec3;
 
 use crate::scene::{Mesh, Scene};
 
-/// Environment vertices sampled (evenly by index over the other visible meshes).
+/// Environment vertices sampled (evenly by index over the other visible meshes), at most;
+/// fewer on large reflectors, so that a check scores at most [`WORK`] vertices in all (the
+/// planner runs it on every plan and every move).
 pub const SAMPLES: usize = 64;
-/// A reflector is refused where more than this share of the sampled environment vertices
-/// that have a reflection point on it have a second one (and at least one does): on the
-/// two-ball mesh of `tests/curved.rs` 26 % of the GPU's checks find one, on a sphere and a
-/// bowl none.
-pub const SHARE: f64 = 0.02;
+const WORK: usize = 1 << 21;
+/// A reflector is refused where at least [`MIN_FOUND`] and more than this share of the
+/// sampled environment vertices that have a reflection point on it have a second one: on
+/// the two-ball mesh of `tests/curved.rs` 26 % of the GPU's checks find one (61 of 61
+/// here), on a sphere and a bowl none. Well above one sample's share, so that a small move
+/// does not flip the verdict.
+pub const SHARE: f64 = 0.10;
+pub const MIN_FOUND: u32 = 3;
 /// Two reflection points count as two when their normals differ by more than this cosine
 /// (the GPU search's `CURVED_MIN_COS`): not the same valley reached twice.
 const APART_COS: f64 = 0.98;
@@ -41,7 +46,8 @@ pub fn several(scene: &Scene, index: usize, eye: glam::Vec3) -> (u32, u32) {
     let eye = eye.as_dvec3();
     let others: Vec<&Mesh> = scene.meshes.iter().enumerate().filter(|(i, m)| *i != index && !m.hidden).map(|(_, m)| m).collect();
     let total: usize = others.iter().map(|m| m.positions.len()).sum();
-    let stride = total.div_ceil(SAMPLES).max(1);
+    let samples = SAMPLES.min(WORK / w.positions.len()).max(4);
+    let stride = total.div_ceil(samples).max(1);
     let samples = others.iter().flat_map(|m| m.positions.iter()).step_by(stride).map(|p| p.as_dvec3());
     let (mut found, mut checked) = (0, 0);
     let mut score = vec![0.0f64; w.positions.len()];
@@ -72,9 +78,10 @@ pub fn several(scene: &Scene, index: usize, eye: glam::Vec3) -> (u32, u32) {
     (found, checked)
 }
 
-/// Whether (found, checked) means several minima: more than [`SHARE`] of the checks, and one.
+/// Whether (found, checked) means several minima: more than [`SHARE`] of the checks, and at
+/// least [`MIN_FOUND`].
 pub fn refused((found, checked): (u32, u32)) -> bool {
-    found > 0 && found as f64 > SHARE * checked as f64
+    found >= MIN_FOUND && found as f64 > SHARE * checked as f64
 }
 
 /// A mesh with coincident vertices (seams, poles) merged, normals averaged: the surface the
@@ -132,15 +139,14 @@ impl Welded {
     }
 
     /// `v` and the vertices within `k` edges of it.
-    fn rings(&self, v: usize, k: usize) -> Vec<usize> {
-        let mut set = vec![v];
+    fn rings(&self, v: usize, k: usize) -> std::collections::HashSet<usize> {
+        let mut set = std::collections::HashSet::from([v]);
         let mut frontier = vec![v];
         for _ in 0..k {
             let mut next = Vec::new();
             for &u in &frontier {
                 for &n in &self.neighbours[u] {
-                    if !set.contains(&(n as usize)) {
-                        set.push(n as usize);
+                    if set.insert(n as usize) {
                         next.push(n as usize);
                     }
                 }

@@ -66,7 +66,10 @@ pub const BACKFACES: MapInfo = MapInfo {
     layer_field: None,
     create: image_space::create,
     bytes: |_, _, (w, h)| w as u64 * h as u64 * 16,
-    texels: |_, _, (w, h)| w as f64 * h as f64,
+    // Camera-sized and of the refractors' back faces only: screen work, not a map of the
+    // scene (counted as texels it was priced as a lit cube of every triangle, 5× a cube at
+    // 1080p).
+    texels: |_, _, _| 0.0,
     describe: |_, _| "camera-sized RGBA32F back-face normals and depths + per-vertex thickness".into(),
     shared: false,
 };

@@ -19,7 +19,7 @@ knobs! {
         /// when the map is; off: the map shows the mirror reflecting the environment only
         map_mirrors: bool = "on", one_of()["on" => true, "off" => false];
         /// curved-reflector (§5, EMD*05): edge of each reflector's geometry image (world positions and normals rasterised over its
-        /// UV parameterisation, or a planar projection where it has none): the reflection points' sampling
+        /// UV parameterisation, or where it has none a planar projection, a cube atlas for a closed surface): the reflection points' sampling
         geometry_image: u32 = 128, count(8..=1024, "texels");
         /// curved-reflector: coarse-to-fine levels of each vertex's reflection-point search in the geometry image: the coarsest
         /// level (every 2^levels-th texel) is searched exhaustively, each finer one in a 5×5 window around the last best, then a

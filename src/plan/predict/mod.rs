@@ -132,6 +132,9 @@ fn models_measured(
     let errors = error_model();
     let px = coverage(scene, target.size);
     let mut out = Vec::new();
+    // The layered map's layers per (count size, reference point, layers knob): the variants
+    // mostly share them, and each count builds a BVH of the scene.
+    let mut counted: Vec<((u32, Option<[u32; 3]>, Option<u32>), u32)> = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
         let (aa, aa_n, per_sample) = (q.get("aa"), features::aa_samples(&q).1, q.frame.msaa_per_sample);
@@ -139,7 +142,15 @@ fn models_measured(
         let mut base = 0.0;
         let meshes: Vec<usize> = facts.objects.iter().map(|f| f.mesh).collect();
         let frame = FrameWork::new(scene, &meshes, &q, px.iter().sum());
-        let layers = layered_layers(scene, facts, &q);
+        let key = (q.cube.cube_size.min(64), q.cube.ref_point.map(|p| p.to_array().map(f32::to_bits)), q.layered.layers);
+        let layers = match counted.iter().find(|(k, _)| *k == key) {
+            Some(&(_, l)) => l,
+            None => {
+                let l = layered_layers(scene, facts, &q);
+                counted.push((key, l));
+                l
+            }
+        };
         for f in &facts.objects {
             let name = &scene.meshes[f.mesh].name;
             let work_of = |m: Method| workload(f, scene, &q, MapWork::of(m, &q, layers, target.size), target.size, px[f.mesh], &frame);
@@ -183,7 +194,9 @@ fn models_measured(
 }
 
 /// GPU methods that the corpus and the calibration measure (error and cost models exist,
-/// `specula corpus --evaluate` reports them) but that `auto` and the budgets do not choose:
+/// `specula corpus --evaluate` reports them) but that the predicted models leave out, so
+/// that `auto` and the budgets over them do not choose them (a scene's own models file,
+/// `specula tradeoff --calibrate`, still may):
 /// their error models, fitted on corpus rooms, mispredict the scenes that make or break them
 /// by more than any tolerance can absorb — image-based reflections predicted at the exact
 /// tracer's 50.7 dB on a thin pane in a box room (capped there, and taken for speed) where

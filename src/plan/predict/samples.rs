@@ -155,8 +155,11 @@ fn check_work(w: &Workload, what: &str) -> Result<()> {
         w.caustic_photons,
         w.caustic_texels,
         w.covered.unwrap_or(0.0),
+        w.map_texels.unwrap_or(0.0),
+        w.shared_texels,
     ];
-    if all.iter().any(|x| !x.is_finite() || *x < 0.0) || !(w.samples.is_finite() && w.samples >= 1.0) {
+    let at_least_one = |x: f64| x.is_finite() && x >= 1.0;
+    if all.iter().any(|x| !x.is_finite() || *x < 0.0) || !at_least_one(w.samples) || !at_least_one(w.layers) {
         return Err(Error::invalid(what.to_string(), format!("{w:?}: every count must be finite and non-negative")));
     }
     Ok(())
