@@ -134,7 +134,8 @@ fn models_measured(
     let mut out = Vec::new();
     // The layered map's layers per (count size, reference point, layers knob): the variants
     // mostly share them, and each count builds a BVH of the scene.
-    let mut counted: Vec<((u32, Option<[u32; 3]>, Option<u32>), u32)> = Vec::new();
+    type Count = (u32, Option<[u32; 3]>, Option<u32>);
+    let mut counted: Vec<(Count, u32)> = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
         let (aa, aa_n, per_sample) = (q.get("aa"), features::aa_samples(&q).1, q.frame.msaa_per_sample);
