@@ -349,6 +349,29 @@ pub fn workload(f: &ObjectFacts, scene: &Scene, q: &Quality, maps: MapWork, size
 mod tests {
     use super::*;
 
+    /// What each method's maps draw: relief height maps follow `relief_size` (not
+    /// `cube_size`), image-based captures count `captures³` cubes, a refractor map and a
+    /// distance map two cubes, the layered peel its layers as a map of the whole scene with
+    /// the search reading each, the ray tracers none.
+    #[test]
+    fn map_work_follows_each_methods_maps() {
+        use crate::methods::*;
+        let mut q = Quality::default();
+        q.set("cube_size", "128").unwrap();
+        q.set("relief_size", "64").unwrap();
+        let cube = 6.0 * 128.0 * 128.0;
+        let of = |m| MapWork::of(m, &q, 3, (64, 64));
+        assert_eq!(of(ENVMAP), MapWork { texels: cube, shared_texels: 0.0, layers: 1.0 });
+        assert_eq!(of(PROXY_RELIEF).texels, 6.0 * 64.0 * 64.0);
+        assert_eq!(of(IMAGE_BASED).texels, cube * q.envmap.captures.pow(3) as f64);
+        assert_eq!(of(REFRACTOR_MAP).texels, 2.0 * cube);
+        assert_eq!(of(LAYERED), MapWork { texels: 0.0, shared_texels: 3.0 * cube, layers: 3.0 });
+        assert_eq!(of(BVH), MapWork { texels: 0.0, shared_texels: 0.0, layers: 1.0 });
+        let w = Workload { pixels: 1e4, map_texels: Some(of(PROXY_RELIEF).texels), cube_texels: cube, ..Workload::default() };
+        assert_eq!(map_features(&w)[2], 6.0 * 64.0 * 64.0 / 1e6);
+        assert_eq!(screen_features(&Workload { layers: 3.0, ..w })[0], 3.0);
+    }
+
     /// A ray tracer's kernels trace rays from the pixels that show geometry: half the screen
     /// covered, half the rays (and their shadow and caustic rays); unknown, the whole screen.
     #[test]
