@@ -155,8 +155,10 @@ SearchResult linear_search(vec3 x, vec3 R, int steps, int binary_steps, int seca
 // only where the ray meets the surface: the refined point, or else the false-position
 // point of the final bracket, must be within `gap` of it (else the bracket spans the gap
 // between two surfaces of the layer, a silhouette, and the march goes on). Not escaped:
-// `d` is the hit.
-SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secant_steps, float tolerance, float gap, int start_side) {
+// `d` is the hit. `bound`: the nearest hit the other layers gave (1e30: none); the march
+// stops at the first step beyond it, whose brackets could give only farther hits.
+SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secant_steps, float tolerance, float gap, int start_side,
+                          float bound) {
     int lookups = 0;
     float len_x = length(x);
     float far_stored = SEARCH_DISTANCE(R);
@@ -172,6 +174,9 @@ SearchResult layer_search(vec3 x, vec3 R, int steps, int binary_steps, int secan
     if (start_side != 0) a_l = start_side > 0 ? 2.0 : 0.0;
     steps = max(steps, 1);
     for (int i = 1; i <= steps; ++i) {
+        // A crossing past the bound is no nearer than a hit already found: the march
+        // stops there (what it would find further is discarded anyway).
+        if (d_l >= bound) return search_result(x, R, 0.0, true, lookups);
         float d, a;
         if (i < steps) {
             float t = float(i) / float(steps);

@@ -55,7 +55,7 @@ LayeredHit layered_hit(vec3 x, vec3 R, vec3 n) {
     for (int k = 0; k < layers; ++k) {
         layered_layer = k;
         SearchResult s = layer_search(x, R, steps, int(push_search_binary_steps()), int(push_search_secant_steps()), push_search_tolerance(),
-                                      LAYERED_GAP, k == origin ? side : 0);
+                                      LAYERED_GAP, k == origin ? side : 0, h.d);
         if (!s.escaped && s.d < h.d) {
             h.escaped = false;
             h.layer = k;

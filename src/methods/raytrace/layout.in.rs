@@ -84,7 +84,7 @@ gpu_structs! {
         /// camera rays per pixel (MSAA samples; 1 without)
         samples: uint,
         /// 1: the ray texture holds the queue's rays in `ray_order` (the ray hierarchy's
-        /// pixel order, raytrace/sort.glsl); 0: texel t is ray t
+        /// direction cell and pixel order, raytrace/sort.glsl); 0: texel t is ray t
         ordered: uint,
         /// graded media (survey §6.5, common/medium.glsl): the most a ray turns per RK4 step
         /// [rad] (the medium_turn knob)
@@ -156,6 +156,9 @@ gpu_consts! {
     /// the bits of the radix sort's digit (16 bins per pass, 8 passes over 32-bit keys).
     LBVH_TILE: uint = 256;
     LBVH_RADIX_BITS: uint = 4;
+    /// The ray hierarchy's ray order: direction cells per side of the octahedral map that
+    /// groups a queue's rays before their pixels (raytrace/sort.glsl).
+    SORT_DIRECTION_CELLS: uint = 4;
     /// `lbvh_parents`: the root's parent.
     LBVH_NONE: uint = 4294967295;
     /// Bins of a queue budget's weight histogram: half an octave each, from 2^16 down to
@@ -227,9 +230,9 @@ descriptor_sets! {
         /// queue (rays, shadow rays) the tile×triangle pairs tested and those kept
         CULL_STATS = 15: STORAGE_BUFFER => "buffer CullStats { uint cull_stats[]; }";
         /// The ray hierarchy's ray order: the ray at each texel of the ray texture, the
-        /// queue's rays by pixel (raytrace/sort.glsl)
+        /// queue's rays by direction cell and pixel (raytrace/sort.glsl)
         RAY_ORDER = 16: STORAGE_BUFFER => "buffer RayOrder { uint ray_order[]; }";
-        /// The ray order's pixel counters, then (scanned) where each pixel's rays start
+        /// The ray order's key counters, then (scanned) where each key's rays start
         SORT_OFFSETS = 17: STORAGE_BUFFER => "buffer SortOffsets { uint sort_offsets[]; }";
         /// Each ray's rank among its pixel's rays
         SORT_RANKS = 18: STORAGE_BUFFER => "buffer SortRanks { uint sort_ranks[]; }";

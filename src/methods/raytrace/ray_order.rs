@@ -6,21 +6,33 @@
 //! the hierarchy culls nothing past the camera rays — and culls differently in every run
 //! (measured on lavapipe at 16², bounce 1: 17 % of the tile × triangle pairs in most runs,
 //! 0.1 % in others). The survey's ray textures keep a secondary ray at its parent's texel;
-//! here a counting sort by pixel (one key per pixel and sample) gives each queue that
-//! order before the tiles' cones are built: slot t holds ray `ray_order[t]`, a pixel's rays
-//! together, the pixels in blocks of tile_size² block by block, and a pixel's few rays
-//! ordered by their query's bits, so that the order is the same in every run; the ray
-//! texture holds the slots tile by tile, so that a tile's rays come from about one block
-//! of the screen (glsl/raytrace/engine.glsl's texel_slot).
+//! here a counting sort gives each queue that order before the tiles' cones are built: slot
+//! t holds ray `ray_order[t]`, a pixel's rays together, the pixels in blocks of tile_size²
+//! block by block, and a pixel's few rays ordered by their query's bits, so that the order
+//! is the same in every run; the ray texture holds the slots tile by tile, so that a tile's
+//! rays come from about one block of the screen (glsl/raytrace/engine.glsl's texel_slot).
 //!
-//! Cost: per queue two passes over its rays, one over the P + 1 pixel counters (a
-//! three-step scan), one scatter and one pass that orders each pixel's rays; memory: one
-//! word per ray for the order and one for the ranks, one per pixel key for the counters.
+//! The method assumes coherent tiles: rays that share origins *and* directions. After a
+//! curved mirror or through glass, the rays of one screen block point everywhere, and a
+//! tile's cone covered everything (bounce 1 of the demo at 48²: 0 % culled). So the rays
+//! (not the shadow rays, whose directions follow their origins towards the lights) are
+//! ordered by direction first: the key is the ray's cell on a 4 × 4 octahedral map of
+//! directions (`SORT_DIRECTION_CELLS`, the cells in Morton order), then its pixel — a key
+//! over direction and origin (the pixel standing for the origin, as the parent's hit
+//! point). Measured on the demo at 256², depth 4 (BENCHMARKS.md, the ray hierarchy's
+//! culling): bounce 1 rays culled 46 → 74 % at tile 8, 14 → 48 % at tile 16; 2 × 2 cells
+//! 64 / 39 %, 8 × 8 cells 62 / 37 % (a cell's rays of a block are then too few for a tile,
+//! which spans blocks).
+//!
+//! Cost: per queue two passes over its rays, one over the K + 1 counters (a three-step
+//! scan; K = the pixel keys × the 16 cells), one scatter and one pass that orders each
+//! key's rays; memory: one word per ray for the order and one for the ranks, one per key
+//! for the counters.
 
 use ash::vk;
 
 use crate::error::Result;
-use crate::frame::layout::binding;
+use crate::frame::layout::{binding, SORT_DIRECTION_CELLS};
 use crate::vk::pipeline::{compute_pipeline, write_buffer};
 use crate::vk::{Buffer, Context, MemoryLocation};
 
@@ -46,15 +58,16 @@ pub(super) struct RayOrder {
     ranks: Buffer,
     blocks: Buffer,
     pipelines: [vk::Pipeline; 6],
-    /// Pixel keys: the frame in whole tile_size² blocks, times the samples
-    /// (glsl/raytrace/sort.glsl's sort_keys).
+    /// Keys: the frame in whole tile_size² blocks, times the samples, times the direction
+    /// cells (glsl/raytrace/sort.glsl's sort_keys).
     keys: u64,
 }
 
 impl RayOrder {
     /// For queues of at most `rays` rays of a `width`×`height` frame of `samples` rays per
     /// pixel, in tiles of `tile`² rays: the pixel keys are the frame padded to whole
-    /// `tile`² blocks, times the samples (glsl/raytrace/sort.glsl's sort_keys).
+    /// `tile`² blocks, times the samples, times the direction cells (glsl/raytrace/sort.glsl's
+    /// sort_keys).
     pub fn new(
         ctx: &Context,
         layout: vk::PipelineLayout,
@@ -62,7 +75,8 @@ impl RayOrder {
         (width, height, samples, tile): (u32, u32, u32, u32),
     ) -> Result<RayOrder> {
         let tile = tile.max(1) as u64;
-        let keys = (width as u64).div_ceil(tile) * (height as u64).div_ceil(tile) * tile * tile * samples as u64;
+        let cells = SORT_DIRECTION_CELLS as u64 * SORT_DIRECTION_CELLS as u64;
+        let keys = (width as u64).div_ceil(tile) * (height as u64).div_ceil(tile) * tile * tile * samples as u64 * cells;
         let mut me = RayOrder {
             order: Buffer::placeholder(),
             offsets: Buffer::placeholder(),

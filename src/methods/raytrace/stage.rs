@@ -148,7 +148,7 @@ pub struct RayTrace {
     engine_depth: Option<Image>,
     /// The ray hierarchy's cone per tile.
     cones: Buffer,
-    /// The ray hierarchy's ray order (each queue's rays by pixel, before its cones).
+    /// The ray hierarchy's ray order (each queue's rays by direction cell and pixel, before its cones).
     order: Option<RayOrder>,
     /// With the ray_stats knob: the hierarchy's culling counts (`cull_stats.comp`).
     cull_stats: Buffer,
@@ -734,7 +734,7 @@ impl RayTrace {
 
     /// The nearest hits of the queue bound in `sets`: the scheme's kernel (indirect, from the
     /// queue's counter), or the ray engine's raster pass over the ray texture and its copy
-    /// into the hit buffer (the ray hierarchy first orders the queue by pixel, then builds its
+    /// into the hit buffer (the ray hierarchy first orders the queue by direction cell and pixel, then builds its
     /// tiles' cones).
     fn intersect(&mut self, rec: &mut Recorder, f: &FrameInputs, sets: [vk::DescriptorSet; 2], at: u64, view: u32, queue: u32) {
         let (ctx, cmd) = (rec.ctx, rec.cmd);
