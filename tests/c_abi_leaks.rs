@@ -226,17 +226,17 @@ fn resident_kib() -> u64 {
     s.lines().find_map(|l| l.strip_prefix("VmRSS:")).and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok()).unwrap_or(0)
 }
 
-/// 40 reconfigures with unchanged settings (issue 37: an engine reconfigures on every
-/// resolution change or settings toggle), 20 each with a fixed method and with `auto` (which
+/// 60 reconfigures with unchanged settings (issue 37: an engine reconfigures on every
+/// resolution change or settings toggle), 30 each with a fixed method and with `auto` (which
 /// also looks up the device's unit costs and the objects' facts), a frame after every 10.
 /// Measured with 100 (lavapipe, validation on): the library's heap grows by about 2 KiB (fixed
 /// method) and 11–17 KiB (auto) once — the same after 30 or 90 reconfigures, i.e. none of it per
-/// reconfigure, 0 B over every second half — and the resident size by 10.4–11.1 MiB over the
+/// reconfigure, 0 B over every later run of 10 — and the resident size by 10.4–11.1 MiB over the
 /// 100 (about 110 KiB a reconfigure: lavapipe's LLVM code memory for the pipelines each
 /// configure compiles again, as in the create/destroy cycles above; the library heap and the C
-/// heap stay flat). The bounds: the library heap's growth over the second half of each run at
-/// most 64 B a reconfigure, and the resident size at most 8 MiB over the 40 (about 4.4 MiB at
-/// the measured rate; the 1.5 MiB a reconfigure the issue measured would be 60 MiB).
+/// heap stay flat). The bounds: the library heap's growth over the second or the third run of
+/// 10 at most 64 B a reconfigure, and the resident size at most 12 MiB over the 60 (about 6.6 MiB
+/// at the measured rate; the 1.5 MiB a reconfigure the issue measured would be 90 MiB).
 #[test]
 fn reconfigures_leak_nothing() {
     let _turn = TURN.lock().unwrap_or_else(|e| e.into_inner());
@@ -260,7 +260,7 @@ fn reconfigures_leak_nothing() {
             let rd = render_desc(method);
             const HALF: isize = 10;
             let mut heap = Vec::new();
-            for _ in 0..2 {
+            for _ in 0..3 {
                 heap.push(LIVE_BYTES.load(Ordering::Relaxed));
                 for _ in 0..HALF {
                     ok(specula_context_configure(ctx, &rd), ctx);
@@ -268,13 +268,20 @@ fn reconfigures_leak_nothing() {
                 ok(specula_context_render(ctx, SPECULA_PIXEL_RGBA8_SRGB, px.as_mut_ptr().cast(), px.len()), ctx);
             }
             heap.push(LIVE_BYTES.load(Ordering::Relaxed));
-            let (first, second) = (heap[1] - heap[0], heap[2] - heap[1]);
-            eprintln!("{label}: library heap {first:+} B over the first {HALF} reconfigures, {second:+} B over the next {HALF}");
-            assert!(second <= 64 * HALF, "{label}: the library's heap grew by {second} B over {HALF} reconfigures with unchanged settings");
+            let grew: Vec<isize> = heap.windows(2).map(|w| w[1] - w[0]).collect();
+            eprintln!("{label}: library heap {:+} B over the first {HALF} reconfigures, then {:+} B and {:+} B", grew[0], grew[1], grew[2]);
+            // A leak grows the heap in every run of reconfigures. Under the whole suite's load
+            // one run grew once by +5696 B where it measures 0 B alone (the counted heap is
+            // the process's: the test harness's threads and the planner's parallel prediction
+            // on rayon's pool, whose queues' blocks are freed through an epoch collector as
+            // the threads are scheduled, count too). So the smaller of the two later runs'
+            // growths is bounded.
+            let second = grew[1].min(grew[2]);
+            assert!(second <= 64 * HALF, "{label}: the library's heap grew by {grew:?} B over runs of {HALF} reconfigures with unchanged settings");
         }
         let rss = resident_kib() as i64 - rss0;
-        eprintln!("resident size {rss:+} KiB over 40 reconfigures");
-        assert!(rss < 8 * 1024, "the resident size grew by {rss} KiB over 40 reconfigures with unchanged settings");
+        eprintln!("resident size {rss:+} KiB over 60 reconfigures");
+        assert!(rss < 12 * 1024, "the resident size grew by {rss} KiB over 60 reconfigures with unchanged settings");
         assert_eq!(specula_context_destroy(ctx), SPECULA_SUCCESS);
     }
 }

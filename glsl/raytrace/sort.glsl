@@ -15,7 +15,8 @@
 #define RAYTRACE_SORT_GLSL
 #include "raytrace/engine.glsl"
 
-// SORT_DIRECTION_CELLS per side of the octahedral map of directions: the rays of a queue
+// trace.direction_cells per side of the octahedral map of directions (at most
+// SORT_DIRECTION_CELLS; fewer where the counters would outgrow their cap): the rays of a queue
 // are grouped by their direction's cell first, then by pixel, so that a tile holds rays of
 // one cell from about one block of the screen — rays whose directions a screen block
 // spreads over the sphere (behind a curved mirror, through glass) no longer share a cone.
@@ -29,7 +30,7 @@ uint sort_pixel_keys() {
 }
 
 uint sort_keys() {
-    return sort_pixel_keys() * SORT_DIRECTION_CELLS * SORT_DIRECTION_CELLS;
+    return sort_pixel_keys() * trace.direction_cells * trace.direction_cells;
 }
 
 // The cell of direction d on the octahedral map, the cells in Morton order (neighbouring
@@ -40,9 +41,10 @@ uint sort_direction_cell(vec3 d) {
     if (!(l1 > 0.0) || isinf(l1)) return 0u;
     vec2 p = d.xy / l1;
     if (d.z < 0.0) p = (1.0 - abs(p.yx)) * vec2(p.x >= 0.0 ? 1.0 : -1.0, p.y >= 0.0 ? 1.0 : -1.0);
-    uvec2 c = uvec2(clamp((p * 0.5 + 0.5) * float(SORT_DIRECTION_CELLS), vec2(0.0), vec2(float(SORT_DIRECTION_CELLS) - 0.5)));
+    float n = float(trace.direction_cells);
+    uvec2 c = uvec2(clamp((p * 0.5 + 0.5) * n, vec2(0.0), vec2(n - 0.5)));
     uint m = 0u;
-    for (uint bit = 0u; (1u << bit) < SORT_DIRECTION_CELLS; ++bit) {
+    for (uint bit = 0u; (1u << bit) < trace.direction_cells; ++bit) {
         m |= ((c.x >> bit) & 1u) << (2u * bit) | ((c.y >> bit) & 1u) << (2u * bit + 1u);
     }
     return m;

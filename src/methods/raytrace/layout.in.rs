@@ -89,7 +89,10 @@ gpu_structs! {
         /// graded media (survey §6.5, common/medium.glsl): the most a ray turns per RK4 step
         /// [rad] (the medium_turn knob)
         medium_turn: float,
-        pad: [uint; 3],
+        /// the ray order's direction cells per side (ray_order.rs's `direction_cells`: at most
+        /// SORT_DIRECTION_CELLS, fewer where the counters would outgrow their cap)
+        direction_cells: uint,
+        pad: [uint; 2],
     }
 
     /// One bounce's budget for a queue (raytrace/trace.glsl's budget_*): which rays the
@@ -156,8 +159,8 @@ gpu_consts! {
     /// the bits of the radix sort's digit (16 bins per pass, 8 passes over 32-bit keys).
     LBVH_TILE: uint = 256;
     LBVH_RADIX_BITS: uint = 4;
-    /// The ray hierarchy's ray order: direction cells per side of the octahedral map that
-    /// groups a queue's rays before their pixels (raytrace/sort.glsl).
+    /// The ray hierarchy's ray order: the most direction cells per side of the octahedral
+    /// map that groups a queue's rays before their pixels (raytrace/sort.glsl).
     SORT_DIRECTION_CELLS: uint = 4;
     /// `lbvh_parents`: the root's parent.
     LBVH_NONE: uint = 4294967295;

@@ -27,7 +27,8 @@
 //! Cost: per queue two passes over its rays, one over the K + 1 counters (a three-step
 //! scan; K = the pixel keys × the 16 cells), one scatter and one pass that orders each
 //! key's rays; memory: one word per ray for the order and one for the ranks, one per key
-//! for the counters.
+//! for the counters — at most `COUNTER_CAP` (32 MiB): a frame with more pixel keys gets 2 × 2
+//! cells or the pixel order alone (512² at 16 samples; 1024² gets 2 × 2).
 
 use ash::vk;
 
@@ -35,6 +36,30 @@ use crate::error::Result;
 use crate::frame::layout::{binding, SORT_DIRECTION_CELLS};
 use crate::vk::pipeline::{compute_pipeline, write_buffer};
 use crate::vk::{Buffer, Context, MemoryLocation};
+
+/// The most bytes the key counters take: where `SORT_DIRECTION_CELLS`² keys per pixel key
+/// would need more (512² at 16 samples), the cells per side halve.
+const COUNTER_CAP: u64 = 32 << 20;
+
+/// Pixel keys of a `width`×`height` frame of `samples` rays per pixel in tiles of `tile`²:
+/// the frame padded to whole blocks, times the samples (glsl/raytrace/sort.glsl's
+/// sort_pixel_keys).
+fn pixel_keys(width: u32, height: u32, samples: u32, tile: u32) -> u64 {
+    let tile = tile.max(1) as u64;
+    (width as u64).div_ceil(tile) * (height as u64).div_ceil(tile) * tile * tile * samples.max(1) as u64
+}
+
+/// Direction cells per side of the ray order's octahedral map (the `direction_cells` of
+/// the trace parameters): `SORT_DIRECTION_CELLS`, halved while the counters (a word per key
+/// and one more) would exceed `COUNTER_CAP`; 1 is the pixel order alone.
+pub(super) fn direction_cells(width: u32, height: u32, samples: u32, tile: u32) -> u32 {
+    let pixels = pixel_keys(width, height, samples, tile);
+    let mut cells = SORT_DIRECTION_CELLS;
+    while cells > 1 && 4 * (pixels * cells as u64 * cells as u64 + 1) > COUNTER_CAP {
+        cells /= 2;
+    }
+    cells
+}
 
 const STORAGE: vk::BufferUsageFlags = vk::BufferUsageFlags::STORAGE_BUFFER;
 /// Counters per scan block (glsl/raytrace/sort.glsl's SCAN_BLOCK).
@@ -74,9 +99,8 @@ impl RayOrder {
         rays: u64,
         (width, height, samples, tile): (u32, u32, u32, u32),
     ) -> Result<RayOrder> {
-        let tile = tile.max(1) as u64;
-        let cells = SORT_DIRECTION_CELLS as u64 * SORT_DIRECTION_CELLS as u64;
-        let keys = (width as u64).div_ceil(tile) * (height as u64).div_ceil(tile) * tile * tile * samples as u64 * cells;
+        let cells = direction_cells(width, height, samples, tile) as u64;
+        let keys = pixel_keys(width, height, samples, tile) * cells * cells;
         let mut me = RayOrder {
             order: Buffer::placeholder(),
             offsets: Buffer::placeholder(),
@@ -159,6 +183,24 @@ impl RayOrder {
         crate::frame::destroy_pipelines(ctx, &mut self.pipelines);
         for b in [&mut self.order, &mut self.offsets, &mut self.ranks, &mut self.blocks] {
             b.destroy(ctx);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cells halve where the counters would pass their cap, and the counters then fit.
+    #[test]
+    fn direction_cells_fit_the_counter_cap() {
+        assert_eq!(direction_cells(48, 48, 1, 8), SORT_DIRECTION_CELLS);
+        assert_eq!(direction_cells(512, 512, 1, 8), 4);
+        assert_eq!(direction_cells(1024, 1024, 1, 8), 2);
+        assert_eq!(direction_cells(512, 512, 16, 8), 1);
+        for (w, h, s, t) in [(48, 48, 1, 8), (512, 512, 1, 8), (1024, 1024, 1, 16), (512, 512, 16, 8), (4096, 4096, 16, 32)] {
+            let c = direction_cells(w, h, s, t) as u64;
+            assert!(c == 1 || 4 * (pixel_keys(w, h, s, t) * c * c + 1) <= COUNTER_CAP, "{w}x{h}x{s}: {c}");
         }
     }
 }

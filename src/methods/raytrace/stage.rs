@@ -485,7 +485,8 @@ impl RayTrace {
                 samples: self.samples,
                 ordered: (tile > 0) as u32,
                 medium_turn: q.frame.medium_turn,
-                pad: [0; 3],
+                direction_cells: super::ray_order::direction_cells(self.width, self.height, self.samples, tile.max(1)),
+                pad: [0; 2],
             };
             let at = (k * self.stride) as usize;
             params[at..at + std::mem::size_of::<GpuTraceParams>()].copy_from_slice(bytemuck::bytes_of(&p));
