@@ -258,9 +258,9 @@ fn host_device_without_ray_queries_gets_the_fallback_and_a_message() {
 /// The hybrid search on survey Figure 21's difficult case (a box between the mirror ball and
 /// its reference point: a single distance map substitutes the box's edge for what lies behind
 /// it): the rays the map cannot answer are traced; with `hybrid=confirm` every answer of the
-/// map is also confirmed by a ray query around its hit and its triangle shaded. The ball's
-/// error falls from distance maps' towards the exact tracer's (not within 1 dB of it: see the
-/// bounds), tracing a small fraction of its rays in full; where the ball's rim reflects into
+/// map is also confirmed by a ray query bounded by its hit and its triangle shaded. The ball's
+/// error falls from distance maps' towards the exact tracer's (`confirm` within 1 dB of it),
+/// tracing a small fraction of its rays in full; where the ball's rim reflects into
 /// the ball itself the hybrid's pixels are black, as the exact tracer's. Depth 1 for all (one
 /// specular bounce, as the distance map's); the reference at 1 spp, pixel centres.
 #[test]
@@ -282,14 +282,16 @@ fn hybrid_search_traces_only_what_the_map_cannot_answer() {
     );
     assert!(hybrid.passes.iter().any(|p| p.name == "raytrace.tlas"), "the hybrid pass builds its TLAS");
     // Measured at 64²: distance 21.66 dB, hybrid=rays 30.94 dB tracing 8.72 % of 1181 rays
-    // (one per ball pixel), hybrid=confirm 31.37 dB tracing 8.72 %, ray-query 40.65 dB. What
-    // remains: rays whose map hit is consistent but not the first surface (a box face hidden
-    // from the reference point: one pixel at 64² is most of confirm's excess), and (rays)
-    // the map's texels. Floors: 1 dB under the hybrids' PSNR; the traced fraction at most
-    // 1.122 × measured.
+    // (one per ball pixel), hybrid=confirm 40.64 dB tracing 8.72 % in full (the others up to
+    // their map hit), ray-query 40.65 dB. hybrid=rays' excess: the map's texels, and rays
+    // whose map hit is consistent but not the first surface (a box face hidden from the
+    // reference point), which confirm's query from the ray's start finds (31.37 dB when it
+    // searched ±1 % around the hit only). Floors: 1 dB under the hybrids' PSNR (confirm: also
+    // within 1 dB of ray-query, the bound); the traced fraction at most 1.122 ×
+    // measured.
     assert_eq!(rays, 1181.0, "one ray per ball pixel: hidden fragments are not shaded");
     assert!(h >= 29.94 && h < e, "hybrid=rays {h:.2} dB (distance {d:.2}, ray-query {e:.2})");
-    assert!(c >= 30.37 && c < e, "hybrid=confirm {c:.2} dB (rays {h:.2}, ray-query {e:.2})");
+    assert!(c >= 39.64 && c >= e - 1.0, "hybrid=confirm {c:.2} dB (rays {h:.2}, ray-query {e:.2})");
     assert!((0.01..=0.098).contains(&traced), "traced fraction {traced}");
     assert!((0.01..=0.098).contains(&confirm_traced), "traced fraction {confirm_traced}");
     // The rim: pixels the exact tracer finds black (the reflected ray goes into the ball past

@@ -27,8 +27,10 @@ layout(early_fragment_tests) in;
 const float HYBRID_TOLERANCE = 0.002;
 const float HYBRID_GAP = 0.1;
 
-// hybrid=confirm (FLAG_HYBRID_CONFIRM): the ray query that confirms a search's hit reaches
-// this fraction of the map's distance either side of it.
+// hybrid=confirm (FLAG_HYBRID_CONFIRM): the ray query that confirms a search's hit runs from
+// the ray's start to this fraction of the map's distance past the hit: the search's hit bounds
+// the query (t_max), and whatever the map cannot see before it — a face hidden from the
+// reference point that the linear search stepped over — is found too.
 const float HYBRID_WINDOW = 0.01;
 
 bool hybrid_confirms() {
@@ -92,9 +94,9 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     RayHit h = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (resolved) {
         if (!hybrid_confirms()) return texel.rgb;
-        // The map's hit confirmed: the nearest triangle in a window around it, shaded.
+        // The map's hit confirmed: the nearest triangle up to just past it, shaded.
         float w = HYBRID_WINDOW * texel.a;
-        h = rq_trace_mesh(p, dir, max(s.d - w, t_min), s.d + w, push.object, false);
+        h = rq_trace_mesh(p, dir, t_min, s.d + w, push.object, false);
     }
     if (h.triangle == RAY_NO_TRIANGLE) {
         RQ_COUNT(2u * push.object + 1u);
@@ -202,9 +204,9 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
             if (dot(n2, dir) < 0.0) n2 = -n2;
             return true;
         }
-        // The map's exit confirmed: the refractor's own triangle in a window around it.
+        // The map's exit confirmed: the refractor's own nearest triangle up to just past it.
         float w = HYBRID_WINDOW * texel.w;
-        r = rq_trace_mesh(pos, dir, max(eps + h.d - w, t_min), eps + h.d + w, push.object, true);
+        r = rq_trace_mesh(pos, dir, t_min, eps + h.d + w, push.object, true);
     }
     if (r.triangle == RAY_NO_TRIANGLE) {
         RQ_COUNT(2u * push.object + 1u);

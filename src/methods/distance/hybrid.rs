@@ -6,9 +6,10 @@
 //! — fires a Vulkan ray query and shades what it meets (`glsl/distance/search.frag`,
 //! HYBRID). Approximate where the map is right, exact where it is wrong; the statistics say
 //! which fraction of each object's rays were traced in full. `hybrid=confirm` also confirms
-//! each answer the map gives by a ray query over a short window around its hit and shades
-//! the triangle there (exact point, normal and texture instead of the map's filtered
-//! radiance). Both modes trace with the object itself a reflected ray that goes into its own
+//! each answer the map gives by a ray query bounded by its hit (from the ray's start to 1 %
+//! past it: the map's answer is the query's t_max, and a face hidden from the reference
+//! point before it is found as well) and shades the triangle there (exact point, normal and
+//! texture instead of the map's filtered radiance). Both modes trace with the object itself a reflected ray that goes into its own
 //! surface (below the fragment's triangle, near a silhouette), which the map cannot see; and
 //! on a solid refractor that is neither convex nor flat, every ray that leaves it is traced
 //! against it first and followed back in where it meets it again.

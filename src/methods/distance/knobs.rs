@@ -31,8 +31,9 @@ knobs! {
         /// distance, distance-multi, refractor-map: the camera pass's searches that the map cannot answer (escaped, or a hit the
         /// map does not hold: a gap behind a silhouette, beyond the search's tolerance; inside a refractor too) are traced through
         /// Vulkan ray queries and their hits shaded (`rays`; needs a device with ray queries), or left to the map (`off`); `confirm`
-        /// also checks every answer the map gives by a ray query over ±1 % of its distance around the map's hit and shades the
-        /// triangle it meets there (exact geometry, normal and texture), tracing the whole ray where the window holds none
+        /// also checks every answer the map gives by a ray query from the ray's start to 1 % of its distance past the map's hit
+        /// (the hit bounds the query; a face hidden from the reference point before it is found too) and shades the triangle it
+        /// meets (exact geometry, normal and texture), tracing the whole ray where that segment holds none
         hybrid: Hybrid = "off", one_of()["off" => Hybrid::Off, "rays" => Hybrid::Rays, "confirm" => Hybrid::Confirm];
         /// image-space-refraction (§4.4): Newton steps that move Wyman's estimated exit point along the refracted ray onto the back
         /// faces' depth where it projects (beyond the paper, whose interpolated distance is far off near the silhouette: a
@@ -49,8 +50,8 @@ pub enum Hybrid {
     Off,
     /// A ray query where the search cannot answer; the map's radiance where it can.
     Rays,
-    /// As `Rays`, and every answer of the map confirmed by a ray query over a short window
-    /// around its hit, whose triangle is shaded.
+    /// As `Rays`, and every answer of the map confirmed by a ray query bounded by its hit
+    /// (from the ray's start to just past it), whose triangle is shaded.
     Confirm,
 }
 
