@@ -212,7 +212,7 @@ pub const RAY_HIERARCHY_INFO: &MethodInfo = &MethodInfo {
     abi: 11,
     section: "§2.2.1",
     family: "raytrace",
-    summary: "the ray engine over tiles of the ray texture, each bounded by a cone built on the GPU from its rays; a tile is rasterised for a triangle only where the cone meets the triangle's bounding sphere (tested in the vertex shader)",
+    summary: "the ray engine over tiles of the ray texture (its rays ordered by direction cell, then pixel, so that a tile's rays are coherent), each bounded by a cone built on the GPU from its rays; a tile is rasterised for a triangle only where the cone meets the triangle's bounding sphere (tested in the vertex shader)",
     serves: EVERY_CLASS,
     knobs: RAY_KNOBS_HIERARCHY,
     gpu: Some(ray_tracer("raytrace.ray-hierarchy", |init, plan| {
