@@ -277,7 +277,10 @@ fn reconfigures_leak_nothing() {
             // the threads are scheduled, count too). So the smaller of the two later runs'
             // growths is bounded.
             let second = grew[1].min(grew[2]);
-            assert!(second <= 64 * HALF, "{label}: the library's heap grew by {grew:?} B over runs of {HALF} reconfigures with unchanged settings");
+            assert!(
+                second <= 64 * HALF,
+                "{label}: the library's heap grew by {grew:?} B over runs of {HALF} reconfigures with unchanged settings"
+            );
         }
         let rss = resident_kib() as i64 - rss0;
         eprintln!("resident size {rss:+} KiB over 60 reconfigures");

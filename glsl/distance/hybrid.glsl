@@ -89,8 +89,9 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     vec4 texel = textureLod(distance_maps, vec4(s.dir, search_layer), 0.0);
     bool resolved = hybrid_resolved(s, x, dir, texel.a, textureGather(distance_maps, vec4(s.dir, search_layer), 3));
     RQ_COUNT(2u * push.object);
-    // Off the surface by 10⁻⁵ of its distance from the reference point (f32 rounding of p).
-    float t_min = 1e-5 * length(x) + 1e-30;
+    // Off the surface by 10⁻⁵ of its distance from the reference point, and by more than
+    // the f32 rounding of p far from the origin.
+    float t_min = max(1e-5 * length(x), 1e-6 * length(p)) + 1e-30;
     RayHit h = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (resolved) {
         if (!hybrid_confirms()) return texel.rgb;
@@ -195,7 +196,7 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     vec4 texel = textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0);
     vec4 around = textureGather(refractor_maps, vec4(h.dir, search_layer), 3);
     RQ_COUNT(2u * push.object);
-    float t_min = 1e-5 * length(pos - ref) + 1e-30;
+    float t_min = max(1e-5 * length(pos - ref), 1e-6 * length(pos)) + 1e-30;
     RayHit r = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (hybrid_resolved(h, x, dir, texel.w, around)) {
         if (!hybrid_confirms()) {

@@ -35,14 +35,18 @@ uint sort_keys() {
 
 // The cell of direction d on the octahedral map, the cells in Morton order (neighbouring
 // cells mostly adjacent in the order, so a tile that spans two spans neighbours).
+// `precise`: the count, scatter and ties kernels each compute a ray's key and must agree to
+// the bit (a ray whose key moved between them would leave a hole in ray_order), so no
+// compiler may fuse or reorder this arithmetic differently in one of the three pipelines.
 uint sort_direction_cell(vec3 d) {
-    vec3 a = abs(d);
-    float l1 = a.x + a.y + a.z;
+    precise vec3 a = abs(d);
+    precise float l1 = a.x + a.y + a.z;
     if (!(l1 > 0.0) || isinf(l1)) return 0u;
-    vec2 p = d.xy / l1;
+    precise vec2 p = d.xy / l1;
     if (d.z < 0.0) p = (1.0 - abs(p.yx)) * vec2(p.x >= 0.0 ? 1.0 : -1.0, p.y >= 0.0 ? 1.0 : -1.0);
     float n = float(trace.direction_cells);
-    uvec2 c = uvec2(clamp((p * 0.5 + 0.5) * n, vec2(0.0), vec2(n - 0.5)));
+    precise vec2 q = (p * 0.5 + 0.5) * n;
+    uvec2 c = uvec2(clamp(q, vec2(0.0), vec2(n - 0.5)));
     uint m = 0u;
     for (uint bit = 0u; (1u << bit) < trace.direction_cells; ++bit) {
         m |= ((c.x >> bit) & 1u) << (2u * bit) | ((c.y >> bit) & 1u) << (2u * bit + 1u);

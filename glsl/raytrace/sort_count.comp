@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Ray order, step 1: each ray's rank among its pixel's rays (raytrace/sort.glsl).
+// Ray order, step 1: each ray's rank among its key's rays (direction cell and pixel) (raytrace/sort.glsl).
 layout(local_size_x = 64) in;
 #include "raytrace/sort.glsl"
 

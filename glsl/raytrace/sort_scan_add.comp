@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Ray order, step 2c: each counter plus its block's offset: sort_offsets[p] is where pixel
-// p's rays start, sort_offsets[P] the total (raytrace/sort.glsl).
+// Ray order, step 2c: each counter plus its block's offset: sort_offsets[k] is where key
+// k's rays start, sort_offsets[K] the total (raytrace/sort.glsl).
 layout(local_size_x = 256) in;
 #include "raytrace/sort.glsl"
 

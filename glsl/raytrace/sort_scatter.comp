@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Ray order, step 3: each ray to its pixel's range, at its rank (raytrace/sort.glsl).
+// Ray order, step 3: each ray to its key's range, at its rank (raytrace/sort.glsl).
 layout(local_size_x = 64) in;
 #include "raytrace/sort.glsl"
 

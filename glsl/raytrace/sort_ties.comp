@@ -1,8 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Ray order, step 4: the rays of each pixel (a handful: children and shadow rays of its
-// earlier rays) by their query's bits, which the atomic ranks left in any order
-// (raytrace/sort.glsl). The invocation at a pixel's first texel sorts its range.
+// Ray order, step 4: the rays of each key (a pixel's rays in one direction cell, a handful:
+// children and shadow rays of its earlier rays) by their query's bits, which the atomic
+// ranks left in any order (raytrace/sort.glsl). The invocation at a key's first texel sorts its range.
 layout(local_size_x = 64) in;
 #include "raytrace/sort.glsl"
 

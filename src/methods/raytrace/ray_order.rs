@@ -25,7 +25,7 @@
 //! which spans blocks).
 //!
 //! Cost: per queue two passes over its rays, one over the K + 1 counters (a three-step
-//! scan; K = the pixel keys × the 16 cells), one scatter and one pass that orders each
+//! scan; K = the pixel keys × the cells, at most 16), one scatter and one pass that orders each
 //! key's rays; memory: one word per ray for the order and one for the ranks, one per key
 //! for the counters — at most `COUNTER_CAP` (32 MiB): a frame with more pixel keys gets 2 × 2
 //! cells or the pixel order alone (512² at 16 samples; 1024² gets 2 × 2).
