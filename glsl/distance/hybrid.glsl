@@ -33,6 +33,10 @@ const float HYBRID_GAP = 0.1;
 // reference point that the linear search stepped over — is found too.
 const float HYBRID_WINDOW = 0.01;
 
+// The most meetings with its own surface that hybrid_outside follows one ray that left a
+// refractor through (the budget of interfaces ends it first: 16 internal bounces + 2).
+const uint HYBRID_MAX_MEETINGS = 18u;
+
 bool hybrid_confirms() {
     return (push.flags & FLAG_HYBRID_CONFIRM) != 0u;
 }
@@ -40,9 +44,11 @@ bool hybrid_confirms() {
 // The nearest triangle along o + t d, t_min ≤ t ≤ t_max, of any object but `mesh` (inside:
 // false; the distance map leaves the object out, its rays' fallback does too), or of `mesh`
 // alone (inside: true; a refractor's own surface); of every object for mesh RQ_EVERY_MESH
-// and inside false.
+// and inside false. Never triangle `skip`: the one the ray leaves, as the exact tracers skip
+// it (RAY_NO_TRIANGLE: none known) — a grazing ray from a point that f32 rounding put just
+// off that triangle's plane meets it again farther than any t_min would cover.
 const uint RQ_EVERY_MESH = 0xffffffffu;
-RayHit rq_trace_mesh(vec3 o, vec3 d, float t_min, float t_max, uint mesh, bool inside) {
+RayHit rq_trace_mesh(vec3 o, vec3 d, float t_min, float t_max, uint mesh, bool inside, uint skip) {
     RayHit best = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     t_max = min(t_max, RQ_T_MAX);
     if (!is_finite(o) || !is_finite(d) || dot(d, d) == 0.0 || !(0.0 <= t_min && t_min <= t_max)) return best;
@@ -50,7 +56,8 @@ RayHit rq_trace_mesh(vec3 o, vec3 d, float t_min, float t_max, uint mesh, bool i
     rayQueryInitializeEXT(rq, tlas, gl_RayFlagsNoOpaqueEXT, 0xffu, o, t_min, d, t_max);
     while (rayQueryProceedEXT(rq)) {
         if (rayQueryGetIntersectionTypeEXT(rq, false) != gl_RayQueryCandidateIntersectionTriangleEXT) continue;
-        if ((floatBitsToUint(rq_shading[RQ_TRIANGLE(rq, false)].uv2.z) == mesh) == inside) rayQueryConfirmIntersectionEXT(rq);
+        uint id = RQ_TRIANGLE(rq, false);
+        if ((floatBitsToUint(rq_shading[id].uv2.z) == mesh) == inside && id != skip) rayQueryConfirmIntersectionEXT(rq);
     }
     if (rayQueryGetIntersectionTypeEXT(rq, true) == gl_RayQueryCommittedIntersectionTriangleEXT) {
         vec2 uv = rayQueryGetIntersectionBarycentricsEXT(rq, true);
@@ -97,11 +104,11 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
         if (!hybrid_confirms()) return texel.rgb;
         // The map's hit confirmed: the nearest triangle up to just past it, shaded.
         float w = HYBRID_WINDOW * texel.a;
-        h = rq_trace_mesh(p, dir, t_min, s.d + w, push.object, false);
+        h = rq_trace_mesh(p, dir, t_min, s.d + w, push.object, false, RAY_NO_TRIANGLE);
     }
     if (h.triangle == RAY_NO_TRIANGLE) {
         RQ_COUNT(2u * push.object + 1u);
-        h = rq_trace_mesh(p, dir, t_min, RQ_T_MAX, push.object, false);
+        h = rq_trace_mesh(p, dir, t_min, RQ_T_MAX, push.object, false, RAY_NO_TRIANGLE);
     }
     return hybrid_shade(o, p, dir, h);
 }
@@ -121,7 +128,7 @@ vec3 hybrid_reflected(Object o, vec3 p, vec3 r) {
     search_layer = float(o.envmap_layer);
     RQ_COUNT(2u * push.object);
     RQ_COUNT(2u * push.object + 1u);
-    RayHit h = rq_trace_mesh(p, r, 1e-5 * length(p - o.reference_point.xyz) + 1e-30, RQ_T_MAX, RQ_EVERY_MESH, false);
+    RayHit h = rq_trace_mesh(p, r, 1e-5 * length(p - o.reference_point.xyz) + 1e-30, RQ_T_MAX, RQ_EVERY_MESH, false, RAY_NO_TRIANGLE);
     if (h.triangle != RAY_NO_TRIANGLE && floatBitsToUint(rq_shading[h.triangle].uv2.z) == push.object) return vec3(0.0);
     return hybrid_shade(o, p, r, h);
 }
@@ -137,47 +144,77 @@ vec3 hybrid_geometric_normal(vec3 p, vec3 eye) {
 
 // A solid refractor that is not convex (FLAG_HYBRID_REENTERS): a ray that leaves it may meet
 // it again, which neither map holds (the distance map leaves the object out). Such rays are
-// traced against the object first; where they meet it, the reflection there is searched and
-// the refracted path queued here, followed inside after the path that found it (a work
-// list instead of recursion; a path that finds the list full is dropped).
+// traced against the object first; where they meet it, the refracted path is queued here,
+// followed inside after the path that found it (a work list instead of recursion; a path
+// that finds the list full is dropped), and the reflected ray goes on the same way.
+//
+// A path's budget counts its interfaces as the exact tracers' `depth` does (the camera's
+// hit, each surface met inside, each meeting from outside): internal_bounces + 2, so that the
+// camera's path inside meets internal_bounces + 1 surfaces, as without the hybrid, and paths
+// that come back in spend the same budget instead of starting a new one. Past it a path
+// still specular ends black, as through the exact tracers.
 const uint HYBRID_PATHS = 4u;
 struct HybridPath {
     vec3 pos;
     vec3 dir;
     vec3 weight;
+    // The interfaces the path has met up to pos (pos's included).
+    uint used;
+    // The triangle at pos (RAY_NO_TRIANGLE: not known).
+    uint from;
 };
 HybridPath hybrid_paths[HYBRID_PATHS];
 uint hybrid_queued = 0u;
 // The index the current inside paths refract with (a channel's under dispersion).
 float hybrid_ior = 1.0;
+// The interfaces the current inside path had met where it started.
+uint hybrid_used = 1u;
+// The refractor's triangle the current inside path is at (where hybrid_exit last found it,
+// RAY_NO_TRIANGLE where a map answered): what its next ray query skips.
+uint hybrid_from = RAY_NO_TRIANGLE;
 
-// What a ray that left refractor o at p along d brings back, times w: hybrid_radiance, or
-// where it meets the refractor again before anything else, the reflection there plus the
-// refracted path queued (refractor/trace.glsl's REFRACTOR_OUT).
-vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w) {
+uint hybrid_budget() {
+    return push_internal_bounces() + 2u;
+}
+
+// What a ray that left refractor o at p along d (p: its `used`-th interface) brings back,
+// times w: hybrid_radiance, or where it meets the refractor again before anything else, the
+// refracted path there queued and the reflected ray followed on (refractor/trace.glsl's
+// REFRACTOR_OUT).
+vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
     // One search at the end whatever the ray met (every call site is a copy of the search
     // in the compiled shader).
     vec3 from = p;
     vec3 along = d;
     vec3 times = w;
+    uint skip = hybrid_from;
     if ((push.flags & FLAG_HYBRID_REENTERS) != 0u) {
-        float t_min = 1e-5 * length(p - o.reference_point.xyz) + 1e-30;
-        RQ_COUNT(2u * push.object);
-        RQ_COUNT(2u * push.object + 1u);
-        RayHit own = rq_trace_mesh(p, d, t_min, RQ_T_MAX, push.object, true);
-        if (own.triangle != RAY_NO_TRIANGLE && rq_trace_mesh(p, d, t_min, own.t, push.object, false).triangle == RAY_NO_TRIANGLE) {
-            vec3 q = p + d * own.t;
-            vec3 n = rq_surface(own, d).n;
-            if (dot(n, d) > 0.0) n = -n;  // against the ray: it comes from outside
-            vec3 f = material_fresnel(materials[o.material], -dot(d, n), hybrid_ior);
+        for (uint k = 0u; k < HYBRID_MAX_MEETINGS; ++k) {
+            float t_min = max(1e-5 * length(from - o.reference_point.xyz), 1e-6 * length(from)) + 1e-30;
+            RQ_COUNT(2u * push.object);
+            RQ_COUNT(2u * push.object + 1u);
+            RayHit own = rq_trace_mesh(from, along, t_min, RQ_T_MAX, push.object, true, skip);
+            if (own.triangle == RAY_NO_TRIANGLE || rq_trace_mesh(from, along, t_min, own.t, push.object, false, RAY_NO_TRIANGLE).triangle != RAY_NO_TRIANGLE) break;
+            skip = own.triangle;
+            // It meets the refractor again: its (used + 1)-th interface.
+            used += 1u;
+            if (used > hybrid_budget()) return vec3(0.0);
+            vec3 q = from + along * own.t;
+            // It comes from outside, entering, unless the interpolated normal faces along the
+            // ray (near a silhouette), where the exact tracers take it as leaving.
+            vec3 n = rq_surface(own, along).n;
+            bool entering = dot(n, along) <= 0.0;
+            if (!entering) n = -n;  // against the ray
+            float eta_t_i = entering ? hybrid_ior : 1.0 / hybrid_ior;
+            vec3 f = material_fresnel(materials[o.material], -dot(along, n), eta_t_i);
             vec3 t;
-            if (hybrid_queued < HYBRID_PATHS && refract_dir(d, n, 1.0 / hybrid_ior, t)) {
-                hybrid_paths[hybrid_queued] = HybridPath(q, t, w * (1.0 - f));
+            if (used < hybrid_budget() && hybrid_queued < HYBRID_PATHS && refract_dir(along, n, 1.0 / eta_t_i, t)) {
+                hybrid_paths[hybrid_queued] = HybridPath(q, t, times * (1.0 - f), used, own.triangle);
                 hybrid_queued += 1u;
             }
             from = q;
-            along = reflect_dir(d, n);
-            times = w * f;
+            along = reflect_dir(along, n);
+            times *= f;
         }
     }
     return times * hybrid_radiance(o, from, along);
@@ -201,22 +238,25 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     if (hybrid_resolved(h, x, dir, texel.w, around)) {
         if (!hybrid_confirms()) {
             hit = pos + dir * (eps + h.d);
+            hybrid_from = RAY_NO_TRIANGLE;
             n2 = normalize(texel.xyz);
             if (dot(n2, dir) < 0.0) n2 = -n2;
             return true;
         }
         // The map's exit confirmed: the refractor's own nearest triangle up to just past it.
         float w = HYBRID_WINDOW * texel.w;
-        r = rq_trace_mesh(pos, dir, t_min, eps + h.d + w, push.object, true);
+        r = rq_trace_mesh(pos, dir, t_min, eps + h.d + w, push.object, true, hybrid_from);
     }
     if (r.triangle == RAY_NO_TRIANGLE) {
         RQ_COUNT(2u * push.object + 1u);
-        r = rq_trace_mesh(pos, dir, t_min, RQ_T_MAX, push.object, true);
+        r = rq_trace_mesh(pos, dir, t_min, RQ_T_MAX, push.object, true, hybrid_from);
     }
     if (r.triangle == RAY_NO_TRIANGLE) return false;  // an open refractor: the ray is out
+    // The interpolated normal as it is: where it faces the ray, the exact tracers take the
+    // ray as entering, and so does refractor_inside_ior.
     n2 = rq_surface(r, dir).n;
-    if (dot(n2, dir) < 0.0) n2 = -n2;
     hit = pos + dir * r.t;
+    hybrid_from = r.triangle;
     return true;
 }
 #endif

@@ -24,7 +24,8 @@
 #include "distance/hybrid.glsl"
 #define REFRACTOR_ENV hybrid_radiance
 #define REFRACTOR_EXIT hybrid_exit
-#define REFRACTOR_OUT hybrid_outside
+#define REFRACTOR_OUT(o, p, d, w, hits) hybrid_outside(o, p, d, w, hybrid_used + (hits))
+#define REFRACTOR_LAST_BOUNCE (hybrid_budget() - 1u - hybrid_used)
 #endif
 #include "distance/refractor/trace.glsl"
 
@@ -33,10 +34,13 @@
 // camera's reflection into the refractor itself): at most twice the list's length of them,
 // each of which may queue more. One call site of the inside search, as below: each is a copy
 // of every search in the compiled shader.
+uint hybrid_camera_triangle = RAY_NO_TRIANGLE;
 vec3 hybrid_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c, float ior) {
     hybrid_ior = ior;
-    HybridPath path = HybridPath(p, dir, weight);
+    HybridPath path = HybridPath(p, dir, weight, 1u, hybrid_camera_triangle);
     for (uint k = 0u; k <= 2u * HYBRID_PATHS; ++k) {
+        hybrid_used = path.used;
+        hybrid_from = path.from;
         c = refractor_inside_ior(o, m, path.pos, path.dir, path.weight, c, ior);
         if (hybrid_queued == 0u) break;
         hybrid_queued -= 1u;
@@ -48,17 +52,26 @@ vec3 hybrid_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3
 
 // refractor_radiance (refractor/trace.glsl) for the hybrid search: the camera's reflection
 // that goes into the refractor's own surface (below its triangle, near a silhouette) goes on
-// inside it, as through the exact tracers; every channel (one, without dispersion) inside
-// through one call site.
+// inside it, as through the exact tracers; on a refractor that is not convex the reflection
+// is traced against it (hybrid_outside), which finds that case as the exact tracers do,
+// without the screen-space normal that a silhouette's pixel quad gets wrong. Every channel
+// (one, without dispersion) inside through one call site.
 vec3 hybrid_refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
     vec3 c = vec3(0.0);
     hybrid_queued = 0u;
-    if (dot(s.r, hybrid_ng) < 0.0) {
-        hybrid_paths[0] = HybridPath(p, s.r, s.fr);
+    hybrid_ior = material_ior(m);
+    // The triangle the camera sees at p (the pass rasterises without triangle ids): the
+    // refractor's nearest along the eye's ray to just past p.
+    float seen = length(p - eye);
+    hybrid_camera_triangle = rq_trace_mesh(eye, (p - eye) / seen, 0.0, seen * (1.0 + 1e-3), push.object, true, RAY_NO_TRIANGLE).triangle;
+    if (dot(s.r, hybrid_ng) < 0.0 && (push.flags & FLAG_HYBRID_REENTERS) == 0u) {
+        hybrid_paths[0] = HybridPath(p, s.r, s.fr, 1u, hybrid_camera_triangle);
         hybrid_queued = 1u;
     } else {
-        c = s.fr * hybrid_radiance(o, p, s.r);
+        // Off a refractor that is not convex, the reflection may meet it again.
+        hybrid_from = hybrid_camera_triangle;
+        c = hybrid_outside(o, p, s.r, s.fr, 1u);
     }
     bool disperses = material_disperses(m);
     for (int k = 0; k < (disperses ? 3 : 1); ++k) {

@@ -36,10 +36,15 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 #ifndef REFRACTOR_EXIT
 #define REFRACTOR_EXIT refractor_exit
 #endif
-// What a ray that left the refractor at p along d brings back, times w (the hybrid search
-// follows it into the refractor again where it meets it).
+// What a ray that left the refractor at p along d brings back, times w; `hits`: the surfaces
+// this inside path has met so far (the hybrid search follows the ray into the refractor again
+// where it meets it, within the path's budget of interfaces).
 #ifndef REFRACTOR_OUT
-#define REFRACTOR_OUT(o, p, d, w) ((w) * REFRACTOR_ENV(o, p, d))
+#define REFRACTOR_OUT(o, p, d, w, hits) ((w) * REFRACTOR_ENV(o, p, d))
+#endif
+// The last internal bounce an inside path takes (the hybrid's: what its budget leaves).
+#ifndef REFRACTOR_LAST_BOUNCE
+#define REFRACTOR_LAST_BOUNCE push_internal_bounces()
 #endif
 
 // c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
@@ -48,24 +53,31 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 // `ior`: the index the ray refracts out with (a channel's under dispersion).
 vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c, float ior) {
     vec3 pos = p;
-    for (uint bounce = 0u; bounce <= push_internal_bounces() && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
+    uint last = REFRACTOR_LAST_BOUNCE;
+    for (uint bounce = 0u; bounce <= last && any(greaterThan(weight, vec3(1e-4))); ++bounce) {
         vec3 hit, n2;
         if (!REFRACTOR_EXIT(o, pos, dir, hit, n2)) {  // an open refractor: the ray is out
-            c += REFRACTOR_OUT(o, pos, dir, weight);
+            c += REFRACTOR_OUT(o, pos, dir, weight, bounce);
             weight = vec3(0.0);
             break;
         }
         weight *= volume_transmittance(m, length(hit - pos));  // absorbed on the way there
+        // Leaving the object where the normal faces along the ray (the map's always does):
+        // ν_i/ν_t = ior, the normal turned to the inside. A triangle's interpolated normal
+        // (the hybrid's exits) may face the ray near a silhouette; the exact tracers then take
+        // the ray as entering (specular_split), and so does this.
         float cos_i = dot(dir, n2);
+        bool leaving = cos_i > 0.0;
+        vec3 against = leaving ? -n2 : n2;
+        float eta_i_t = leaving ? ior : 1.0 / ior;
         vec3 out_dir;
-        // Leaving the object: ν_i/ν_t = ior, the normal faces the inside (−n2).
-        if (refract_dir(dir, -n2, ior, out_dir)) {
-            vec3 f = material_fresnel(m, cos_i, 1.0 / ior);
-            c += REFRACTOR_OUT(o, hit, out_dir, weight * (1.0 - f));
+        if (refract_dir(dir, against, eta_i_t, out_dir)) {
+            vec3 f = material_fresnel(m, abs(cos_i), 1.0 / eta_i_t);
+            c += REFRACTOR_OUT(o, hit, out_dir, weight * (1.0 - f), bounce + 1u);
             weight *= f;
         }
         // Total internal reflection (or the reflected part): on inside the object.
-        dir = reflect_dir(dir, -n2);
+        dir = reflect_dir(dir, against);
         pos = hit;
     }
     return c;
