@@ -193,8 +193,10 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
             float t_min = max(1e-5 * length(from - o.reference_point.xyz), 1e-6 * length(from)) + 1e-30;
             RQ_COUNT(2u * push.object);
             RQ_COUNT(2u * push.object + 1u);
-            RayHit own = rq_trace_mesh(from, along, t_min, RQ_T_MAX, push.object, true, skip);
-            if (own.triangle == RAY_NO_TRIANGLE || rq_trace_mesh(from, along, t_min, own.t, push.object, false, RAY_NO_TRIANGLE).triangle != RAY_NO_TRIANGLE) break;
+            // The nearest triangle of any object: the refractor's own, or the ray goes on to
+            // the search (one query for both questions).
+            RayHit own = rq_trace_mesh(from, along, t_min, RQ_T_MAX, RQ_EVERY_MESH, false, skip);
+            if (own.triangle == RAY_NO_TRIANGLE || floatBitsToUint(rq_shading[own.triangle].uv2.z) != push.object) break;
             skip = own.triangle;
             // It meets the refractor again: its (used + 1)-th interface.
             used += 1u;
