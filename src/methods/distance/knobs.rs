@@ -24,7 +24,9 @@ knobs! {
     pub struct DistanceKnobs {
         /// distance-multi: distance-map generation cycles per frame (§4.3); cycle k shows k specular bounces in the maps
         cycles: u32 = 4, count(1..=16, "cycles");
-        /// refractor-map: total internal reflections followed inside a refractor (§4.4)
+        /// refractor-map: total internal reflections followed inside a refractor (§4.4); with `hybrid`, the budget of
+        /// interfaces a path meets is internal_bounces + 2 as the exact tracers count `depth` (the camera's hit, each surface
+        /// inside, each meeting from outside), shared by the paths that leave a non-convex refractor and come back in
         internal_bounces: u32 = 2, count(0..=16);
         /// distance-multi: one map cycle per frame reusing the previous frame's maps (§4.3)
         frame_latency: bool = "off", one_of()["on" => true, "off" => false];
