@@ -155,6 +155,7 @@ impl Plan {
         }
         self.layered_centre = fresh.layered_centre;
         self.layered_depth = fresh.layered_depth;
+        self.layered_faces = fresh.layered_faces;
         self.stages = fresh.stages;
         self.captures = fresh.captures;
         for f in FAMILIES {
@@ -289,6 +290,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         envmaps: Vec::new(),
         layered_centre: None,
         layered_depth: None,
+        layered_faces: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: vec![REFERENCE_PASS],
@@ -524,6 +526,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         envmaps: Vec::new(),
         layered_centre: None,
         layered_depth: None,
+        layered_faces: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: Vec::new(),

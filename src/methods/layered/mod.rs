@@ -57,6 +57,18 @@ pub fn layers_for(q: &Quality, depth: Option<u32>) -> u32 {
     layers + u32::from(depth.is_some_and(|d| d > layers))
 }
 
+/// The cubes' worth of faces the peel draws under `q` where each face's depth complexity is
+/// `faces` (`peel`: a face peels only the layers its texels reach; the farthest surfaces'
+/// layer, where the peel is cut, draws all six); without counts, every layer's six.
+pub fn drawn_cubes(q: &Quality, faces: Option<[u32; 6]>) -> f64 {
+    let Some(faces) = faces else { return layers_for(q, None) as f64 };
+    let depth = faces.iter().copied().max().unwrap_or(0);
+    // As layers_for: the knob or the depth complexity, and one more where it is cut.
+    let peeled = q.layered.layers.unwrap_or_else(|| depth.clamp(1, MAX_LAYERS));
+    let cut = depth > peeled;
+    faces.iter().map(|&f| f.min(peeled)).sum::<u32>() as f64 / 6.0 + f64::from(u32::from(cut))
+}
+
 const fn one(_: &Quality) -> u32 {
     1
 }
@@ -159,7 +171,9 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
     }
     let c = centre(scene, &p.quality, &meshes);
     p.layered_centre = Some(c);
-    p.layered_depth = Some(peel::count_on_cpu(scene, c, p.quality.cube.cube_size.min(64)));
+    let faces = peel::count_faces_on_cpu(scene, c, p.quality.cube.cube_size.min(64));
+    p.layered_depth = faces.iter().copied().max();
+    p.layered_faces = Some(faces);
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
         o.reference_note = Some(if p.quality.cube.ref_point.is_some() {
@@ -167,5 +181,22 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
         } else {
             "the layered map's: the centre of its objects' bounding box".into()
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The peel draws a face's layers up to its own depth complexity; the farthest surfaces'
+    /// layer, where the layers are fewer than the deepest face's, all six faces.
+    #[test]
+    fn a_face_peels_only_the_layers_it_reaches() {
+        let mut q = Quality::default();
+        assert_eq!(drawn_cubes(&q, Some([4, 1, 1, 2, 4, 1])), 13.0 / 6.0);
+        assert_eq!(drawn_cubes(&q, None), layers_for(&q, None) as f64);
+        q.layered.layers = Some(2);
+        assert_eq!(drawn_cubes(&q, Some([4, 1, 1, 2, 4, 1])), 9.0 / 6.0 + 1.0);
+        assert_eq!(drawn_cubes(&q, Some([0; 6])), 0.0);
     }
 }

@@ -10,7 +10,11 @@
 //! additive blending and the largest count is read back (on the library's own queue; a
 //! host's device without one is counted on the CPU along the same texel rays). A scene
 //! that needs 3 layers allocates 3; the count is taken again when objects move, and the
-//! layers are reallocated when it changes. Where the layers are fewer than the depth
+//! layers are reallocated when it changes. The count is kept per cube face: layer k of a
+//! face whose texels meet at most k surfaces would peel nothing, so it is cleared and not
+//! drawn (six-pass cubes; `layered.faces_peeled` counts the passes that draw) — the
+//! scene's deepest direction sets the layers allocated, each face peels only its own.
+//! Where the layers are fewer than the depth
 //! complexity (a `layers` knob under it, or more than `MAX_LAYERS` surfaces), the peel is
 //! cut: one more layer then holds the *farthest* surface along each texel's ray (depth test
 //! reversed over a depth cleared to the nearest), so that a ray that passes behind the
@@ -54,6 +58,11 @@ pub struct LayeredMaps {
     layers: u32,
     /// The depth complexity counted, and whether the GPU counted it.
     measured: Option<(u32, bool)>,
+    /// Per cube face the depth complexity counted there (the GPU's count, at the peel's own
+    /// size and views); `u32::MAX` for every face where the CPU counted (along fewer rays,
+    /// which could miss a face's deepest texels). Layer k of face f holds nothing where
+    /// k ≥ its count: the peel clears it and draws nothing there.
+    face_layers: [u32; 6],
     depth: Vec<Image>,
     peel: vk::Pipeline,
     /// The last layer's pipeline where the peel is cut: the farthest surface.
@@ -70,6 +79,7 @@ pub fn create(init: &StageInit, _objects: &[usize], maps: &mut Maps) -> Result<B
     let me = LayeredMaps {
         layers: 0,
         measured: None,
+        face_layers: [u32::MAX; 6],
         depth: Vec::new(),
         peel: vk::Pipeline::null(),
         far: vk::Pipeline::null(),
@@ -169,8 +179,10 @@ impl LayeredMaps {
         let q = &init.plan.quality;
         let centre = self.centre(init);
         let (count, gpu) = if init.ctx.queue.is_some() {
-            (count_on_gpu(init, centre)?, true)
+            self.face_layers = count_on_gpu(init, centre)?;
+            (self.face_layers.iter().copied().max().unwrap_or(0), true)
         } else {
+            self.face_layers = [u32::MAX; 6];
             (count_on_cpu(init.scene, centre, q.cube.cube_size.min(64)), false)
         };
         self.measured = Some((count, gpu));
@@ -228,8 +240,9 @@ fn normal_format(q: &Quality, materials: usize) -> vk::Format {
 }
 
 /// `layered.count`: every surface rendered into the six faces around `centre` with
-/// additive blending (one per surface along each texel's ray), read back, the maximum.
-fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
+/// additive blending (one per surface along each texel's ray), read back, the maximum of
+/// each face.
+fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<[u32; 6]> {
     let ctx = init.ctx;
     let size = init.plan.quality.cube.cube_size;
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -297,7 +310,12 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
             Ok(())
         })?;
         let counts = crate::vk::read_image(ctx, &target)?;
-        Ok(counts.data.iter().fold(0.0f32, |m, &c| m.max(c)).round() as u32)
+        let face = (size * size * counts.channels) as usize;
+        let mut most = [0u32; 6];
+        for (m, texels) in most.iter_mut().zip(counts.data.chunks(face)) {
+            *m = texels.iter().fold(0.0f32, |m, &c| m.max(c)).round() as u32;
+        }
+        Ok(most)
     })();
     destroy_pipelines(ctx, &mut [pipeline]);
     crate::vk::pipeline::destroy_pipeline_layout(ctx, layout);
@@ -308,10 +326,15 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<u32> {
 /// The depth complexity along the rays through the texel centres of six `size`² faces
 /// around `centre`, by the reference's BVH (every surface crossed counts).
 pub fn count_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> u32 {
+    count_faces_on_cpu(scene, centre, size).into_iter().max().unwrap_or(0)
+}
+
+/// [`count_on_cpu`] per cube face.
+pub fn count_faces_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> [u32; 6] {
     let bvh = crate::reference::bvh::Bvh::new(scene);
     let o = centre.as_dvec3();
-    let mut most = 0;
-    for face in 0..6 {
+    let mut faces = [0u32; 6];
+    for (face, most) in faces.iter_mut().enumerate() {
         for j in 0..size {
             for i in 0..size {
                 let (s, t) = ((i as f32 + 0.5) / size as f32, (j as f32 + 0.5) / size as f32);
@@ -325,11 +348,11 @@ pub fn count_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> u32
                         break;
                     }
                 }
-                most = most.max(n);
+                *most = (*most).max(n);
             }
         }
     }
-    most
+    faces
 }
 
 impl Stage for LayeredMaps {
@@ -365,6 +388,8 @@ impl Stage for LayeredMaps {
             rec.barrier(&mut self.depth[prev], Access::FragmentSampled);
             // A cut peel's extra layer: the farthest surface, peeling nothing.
             let far = cut && k == self.layers;
+            // A face whose texels meet fewer surfaces than this layer: cleared, not drawn.
+            let empty = |face: u32| six && !far && k >= self.face_layers[face as usize];
             let first = if k == 0 || far { LAYERED_FIRST } else { 0 };
             let faces: &[u32] = if six { &[0, 1, 2, 3, 4, 5] } else { &[0] };
             for &face in faces {
@@ -392,11 +417,10 @@ impl Stage for LayeredMaps {
                 let v = view + face;
                 let eye = eyes.get(v as usize).copied().unwrap_or_default();
                 let flags = f.flags | first | if six { face << LAYERED_FACE_SHIFT } else { 0 };
-                for d in f
-                    .scene
-                    .draws
-                    .iter()
-                    .filter(|d| d.index_count > 0 && (!six || crate::cube::face_sees_box(face as usize, eye, d.lo, d.hi)))
+                for d in
+                    f.scene.draws.iter().filter(|d| {
+                        d.index_count > 0 && !empty(face) && (!six || crate::cube::face_sees_box(face as usize, eye, d.lo, d.hi))
+                    })
                 {
                     f.push_flags(ctx, cmd, v, d.mesh, flags);
                     unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
@@ -417,6 +441,11 @@ impl Stage for LayeredMaps {
         }
         // 1 where the peel is cut and one more layer holds the farthest surfaces.
         s.push(("layered.far_layer".into(), if self.cut() { 1.0 } else { 0.0 }));
+        // The (layer, face) passes that draw the scene, of 6 per layer (in six passes).
+        if self.mode == CubeMode::SixPasses {
+            let drawn: u32 = self.face_layers.iter().map(|&f| f.min(self.layers)).sum::<u32>() + 6 * u32::from(self.cut());
+            s.push(("layered.faces_peeled".into(), drawn as f64));
+        }
         s
     }
 

@@ -143,13 +143,17 @@ pub struct MapWork {
 }
 
 impl MapWork {
-    /// `m`'s maps under `q` at a `size` camera, `layers` the layers a layered map peels
-    /// (`methods::layered::layers_for`; any for methods that peel none).
-    pub fn of(m: crate::plan::Method, q: &Quality, layers: u32, size: (u32, u32)) -> MapWork {
+    /// `m`'s maps under `q` at a `size` camera; `layers` the layers a layered map allocates
+    /// and its search reads (`methods::layered::layers_for`), `drawn` the cubes' worth of
+    /// faces its peel draws (`methods::layered::drawn_cubes`: a face peels only the layers
+    /// its texels reach); any for methods that peel none.
+    pub fn of(m: crate::plan::Method, q: &Quality, (layers, drawn): (u32, f64), size: (u32, u32)) -> MapWork {
         let maps = m.gpu.as_ref().map_or(&[][..], |g| g.maps);
         let sum = |shared: bool| maps.iter().filter(|i| i.shared == shared).map(|i| (i.texels)(q, layers, size)).sum::<f64>();
         let peels = maps.iter().any(|i| i.name == crate::methods::layered::LAYERED_CUBES.name);
-        MapWork { texels: sum(false), shared_texels: sum(true), layers: if peels { layers.max(1) as f64 } else { 1.0 } }
+        // The shared maps are the layered peel's: the texels its drawn faces rasterise.
+        let drawn_share = if peels && layers > 0 { (drawn / layers as f64).clamp(0.0, 1.0) } else { 1.0 };
+        MapWork { texels: sum(false), shared_texels: sum(true) * drawn_share, layers: if peels { layers.max(1) as f64 } else { 1.0 } }
     }
 }
 
@@ -360,7 +364,7 @@ mod tests {
         q.set("cube_size", "128").unwrap();
         q.set("relief_size", "64").unwrap();
         let cube = 6.0 * 128.0 * 128.0;
-        let of = |m| MapWork::of(m, &q, 3, (64, 64));
+        let of = |m| MapWork::of(m, &q, (3, 3.0), (64, 64));
         assert_eq!(of(ENVMAP), MapWork { texels: cube, shared_texels: 0.0, layers: 1.0 });
         assert_eq!(of(PROXY_RELIEF).texels, 6.0 * 64.0 * 64.0);
         assert_eq!(of(IMAGE_BASED).texels, cube * q.envmap.captures.pow(3) as f64);

@@ -135,7 +135,7 @@ fn models_measured(
     // The layered map's layers per (count size, reference point, layers knob): the variants
     // mostly share them, and each count builds a BVH of the scene.
     type Count = (u32, Option<[u32; 3]>, Option<u32>);
-    let mut counted: Vec<(Count, u32)> = Vec::new();
+    let mut counted: Vec<(Count, (u32, f64))> = Vec::new();
     for v in variants {
         let q = budget::variant_quality(quality, v)?;
         let (aa, aa_n, per_sample) = (q.get("aa"), features::aa_samples(&q).1, q.frame.msaa_per_sample);
@@ -211,15 +211,18 @@ pub fn is_candidate(m: Method) -> bool {
     !NOT_CANDIDATES.contains(&m.name)
 }
 
-/// The layers a layered map of every object it could serve would peel under `q` (its depth
-/// complexity counted from their boxes' centre, as the plan counts it).
-fn layered_layers(scene: &Scene, facts: &SceneFacts, q: &Quality) -> u32 {
+/// The layers a layered map of every object it could serve would allocate under `q`, and the
+/// cubes' worth of faces its peel would draw (its depth complexity counted per face from
+/// their boxes' centre, as the plan counts it).
+fn layered_layers(scene: &Scene, facts: &SceneFacts, q: &Quality) -> (u32, f64) {
     let meshes: Vec<usize> = facts.objects.iter().filter(|f| LAYERED.fits(f)).map(|f| f.mesh).collect();
     if meshes.is_empty() {
-        return 1;
+        return (1, 1.0);
     }
     let centre = crate::methods::layered::centre(scene, q, &meshes);
-    crate::methods::layered::layers_for(q, Some(crate::methods::layered::peel::count_on_cpu(scene, centre, q.cube.cube_size.min(64))))
+    let faces = crate::methods::layered::peel::count_faces_on_cpu(scene, centre, q.cube.cube_size.min(64));
+    let layers = crate::methods::layered::layers_for(q, faces.iter().copied().max());
+    (layers, crate::methods::layered::drawn_cubes(q, Some(faces)))
 }
 
 /// One object's candidates in one variant: none is predicted more accurate than the exact
