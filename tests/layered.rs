@@ -165,13 +165,16 @@ fn a_concave_mirror_reflects_itself_in_the_layers() {
         });
         prev = Some(l_img);
         assert_eq!(stat(&stats, "layered.layers"), 4.0, "ball front and back, bowl, floor");
-        // Each face peels only the layers its texels reach (measured 17 of the 24 passes);
-        // the plan's count (on the CPU, along the texel rays of at most 64² per face, every
-        // crossing counted) predicts them within one (measured 18).
-        let peeled = stat(&stats, "layered.faces_peeled");
+        // Each face peels only the layers its texels reach (measured 17 of the 24 passes),
+        // within the rectangle of its texels that meet that many surfaces; the plan's count
+        // (on the CPU, along the texel rays of at most 64² per face) predicts what it draws.
+        let (peeled, drawn) = (stat(&stats, "layered.faces_peeled"), stat(&stats, "layered.cubes_drawn"));
         let plan = specula::plan_with(&s, &specula::Choices::all(specula::methods::LAYERED), &quality(&knobs)).unwrap();
-        let predicted = 6.0 * specula::methods::layered::drawn_cubes(&plan.quality, plan.layered_faces);
-        assert!(peeled == 17.0 && (predicted - peeled).abs() <= 1.0, "faces peeled {peeled} (the plan's count: {predicted}) of 24");
+        let predicted = specula::methods::layered::drawn_cubes(&plan.quality, plan.layered_faces.as_ref());
+        eprintln!("faces peeled {peeled} of 24, cubes drawn {drawn:.3} (predicted {predicted:.3})");
+        // Measured: 17 passes, 1.972 cubes of texels of the 4 allocated, predicted 2.053.
+        assert!(peeled == 17.0 && (1.972 / 1.122..=1.972 * 1.122).contains(&drawn), "{peeled} passes, {drawn} cubes");
+        assert!((predicted / drawn - 1.0).abs() < 0.1, "drawn {drawn}, predicted {predicted}");
         rows.push((depth, l.psnr, dm.psnr, over_prev));
     }
     // Measured (depth 1, 2, 3, 4): layered 23.44, 23.48, 23.50, 23.83 dB; over distance

@@ -155,7 +155,7 @@ impl Plan {
         }
         self.layered_centre = fresh.layered_centre;
         self.layered_depth = fresh.layered_depth;
-        self.layered_faces = fresh.layered_faces;
+        self.layered_faces = fresh.layered_faces.clone();
         self.stages = fresh.stages;
         self.captures = fresh.captures;
         for f in FAMILIES {

@@ -241,9 +241,10 @@ pub struct Plan {
     /// plan budgets (the stage counts again on the GPU at the map's own size).
     #[serde(skip)]
     pub layered_depth: Option<u32>,
-    /// The same per cube face: the layers each face peels (`layered::drawn_cubes`).
+    /// The same texel by texel: where each layer of each face holds surfaces, which the peel
+    /// draws (`layered::drawn_cubes`).
     #[serde(skip)]
-    pub layered_faces: Option<[u32; 6]>,
+    pub layered_faces: Option<crate::methods::layered::peel::PeelExtent>,
     /// Image-based reflections' captures (§3.3): per object that takes the method, in the
     /// order of its layers in `envmap.captures`, the centres of its cube maps.
     pub captures: Vec<CaptureSet>,

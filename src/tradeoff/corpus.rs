@@ -139,8 +139,10 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                         let Some(f) = facts.objects.iter().find(|f| f.mesh == mesh) else { continue };
                         let pixels = object_pixels[mesh + 1];
                         let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
-                        let peel =
-                            (crate::methods::layered::planned_layers(&plan), crate::methods::layered::drawn_cubes(&q, plan.layered_faces));
+                        let peel = (
+                            crate::methods::layered::planned_layers(&plan),
+                            crate::methods::layered::drawn_cubes(&q, plan.layered_faces.as_ref()),
+                        );
                         let maps = MapWork::of(o.method, &q, peel, size);
                         let work = workload(f, &scene, &q, maps, size, pixels as f64, &frame);
                         any = Some(work);

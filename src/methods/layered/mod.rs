@@ -57,16 +57,16 @@ pub fn layers_for(q: &Quality, depth: Option<u32>) -> u32 {
     layers + u32::from(depth.is_some_and(|d| d > layers))
 }
 
-/// The cubes' worth of faces the peel draws under `q` where each face's depth complexity is
-/// `faces` (`peel`: a face peels only the layers its texels reach; the farthest surfaces'
-/// layer, where the peel is cut, draws all six); without counts, every layer's six.
-pub fn drawn_cubes(q: &Quality, faces: Option<[u32; 6]>) -> f64 {
-    let Some(faces) = faces else { return layers_for(q, None) as f64 };
-    let depth = faces.iter().copied().max().unwrap_or(0);
+/// The cubes' worth of texels the peel draws under `q` where its layers hold surfaces as
+/// `extent` says (`peel`: each layer of each face drawn only where its texels meet that many
+/// surfaces; the farthest surfaces' layer, where the peel is cut, whole); without a count,
+/// every layer whole.
+pub fn drawn_cubes(q: &Quality, extent: Option<&peel::PeelExtent>) -> f64 {
+    let Some(extent) = extent else { return layers_for(q, None) as f64 };
+    let depth = extent.depth();
     // As layers_for: the knob or the depth complexity, and one more where it is cut.
     let peeled = q.layered.layers.unwrap_or_else(|| depth.clamp(1, MAX_LAYERS));
-    let cut = depth > peeled;
-    faces.iter().map(|&f| f.min(peeled)).sum::<u32>() as f64 / 6.0 + f64::from(u32::from(cut))
+    extent.drawn_cubes(peeled) + f64::from(u32::from(depth > peeled))
 }
 
 const fn one(_: &Quality) -> u32 {
@@ -171,9 +171,9 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
     }
     let c = centre(scene, &p.quality, &meshes);
     p.layered_centre = Some(c);
-    let faces = peel::count_faces_on_cpu(scene, c, p.quality.cube.cube_size.min(64));
-    p.layered_depth = faces.iter().copied().max();
-    p.layered_faces = Some(faces);
+    let extent = peel::extent_on_cpu(scene, c, p.quality.cube.cube_size.min(64));
+    p.layered_depth = Some(extent.depth());
+    p.layered_faces = Some(extent);
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
         o.reference_note = Some(if p.quality.cube.ref_point.is_some() {
@@ -188,15 +188,27 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
 mod tests {
     use super::*;
 
-    /// The peel draws a face's layers up to its own depth complexity; the farthest surfaces'
-    /// layer, where the layers are fewer than the deepest face's, all six faces.
+    /// The peel draws a face's layer k where its texels meet more than k surfaces (the
+    /// rectangle around them); the farthest surfaces' layer, where the layers are fewer than
+    /// the deepest texel's, whole.
     #[test]
     fn a_face_peels_only_the_layers_it_reaches() {
+        // 4² faces: face 0 meets 3 surfaces at texel (1, 2), 1 elsewhere; face 1 none; the
+        // others 1 everywhere.
+        let e = peel::PeelExtent::from_counts(4, |face, x, y| match face {
+            0 if (x, y) == (1, 2) => 3,
+            1 => 0,
+            _ => 1,
+        });
+        assert_eq!(e.depth(), 3);
+        assert_eq!(e.faces[0], vec![[0, 0, 4, 4], [1, 2, 2, 3], [1, 2, 2, 3]]);
+        assert!(e.faces[1].is_empty());
         let mut q = Quality::default();
-        assert_eq!(drawn_cubes(&q, Some([4, 1, 1, 2, 4, 1])), 13.0 / 6.0);
+        // Layer 0 of five faces whole, layers 1 and 2 one texel each of face 0.
+        assert_eq!(drawn_cubes(&q, Some(&e)), (5.0 + 2.0 / 16.0) / 6.0);
         assert_eq!(drawn_cubes(&q, None), layers_for(&q, None) as f64);
+        // Two layers: the farthest surfaces' layer whole.
         q.layered.layers = Some(2);
-        assert_eq!(drawn_cubes(&q, Some([4, 1, 1, 2, 4, 1])), 9.0 / 6.0 + 1.0);
-        assert_eq!(drawn_cubes(&q, Some([0; 6])), 0.0);
+        assert_eq!(drawn_cubes(&q, Some(&e)), (5.0 + 1.0 / 16.0) / 6.0 + 1.0);
     }
 }

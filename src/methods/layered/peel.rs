@@ -51,6 +51,60 @@ pub fn describe_layer(q: &Quality) -> String {
     )
 }
 
+/// Where the peel draws: per cube face, per layer k, the texel rectangle whose rays meet more
+/// than k surfaces (none past the face's depth complexity). Layer k holds nothing outside
+/// it, so the peel clears each layer whole and draws the scene only there (scissor). From
+/// the GPU's count at the map's own size (`layered.count`), or the CPU's along fewer rays
+/// (the plan's prediction; `size` the texels per side it counted).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PeelExtent {
+    pub size: u32,
+    /// `[x0, y0, x1, y1)` per face, per layer.
+    pub faces: [Vec<[u32; 4]>; 6],
+}
+
+impl PeelExtent {
+    /// From each face's texel counts (`count(face, x, y)`: the surfaces along its ray).
+    pub fn from_counts(size: u32, count: impl Fn(usize, u32, u32) -> u32) -> PeelExtent {
+        let mut e = PeelExtent { size, faces: Default::default() };
+        for (face, rects) in e.faces.iter_mut().enumerate() {
+            for y in 0..size {
+                for x in 0..size {
+                    let n = count(face, x, y) as usize;
+                    if rects.len() < n {
+                        rects.resize(n, [u32::MAX, u32::MAX, 0, 0]);
+                    }
+                    for r in &mut rects[..n] {
+                        *r = [r[0].min(x), r[1].min(y), r[2].max(x + 1), r[3].max(y + 1)];
+                    }
+                }
+            }
+        }
+        e
+    }
+
+    /// The most surfaces along any texel's ray.
+    pub fn depth(&self) -> u32 {
+        self.faces.iter().map(|f| f.len() as u32).max().unwrap_or(0)
+    }
+
+    /// The cubes' worth of texels the first `layers` layers' passes draw.
+    pub fn drawn_cubes(&self, layers: u32) -> f64 {
+        let face = (self.size as f64).powi(2).max(1.0);
+        let area = |r: &[u32; 4]| (r[2].saturating_sub(r[0]) as f64) * (r[3].saturating_sub(r[1]) as f64);
+        self.faces.iter().flat_map(|f| f.iter().take(layers as usize)).map(area).sum::<f64>() / face / 6.0
+    }
+
+    /// Face `face`'s rectangle in layer `k`, `None` where the layer holds nothing there.
+    fn rect(&self, face: usize, k: u32) -> Option<vk::Rect2D> {
+        let r = self.faces[face].get(k as usize)?;
+        Some(vk::Rect2D {
+            offset: vk::Offset2D { x: r[0] as i32, y: r[1] as i32 },
+            extent: vk::Extent2D { width: r[2] - r[0], height: r[3] - r[1] },
+        })
+    }
+}
+
 /// Half-precision normals hold material indices exactly up to 2048.
 const HALF_MATERIALS: usize = 2048;
 
@@ -58,11 +112,10 @@ pub struct LayeredMaps {
     layers: u32,
     /// The depth complexity counted, and whether the GPU counted it.
     measured: Option<(u32, bool)>,
-    /// Per cube face the depth complexity counted there (the GPU's count, at the peel's own
-    /// size and views); `u32::MAX` for every face where the CPU counted (along fewer rays,
-    /// which could miss a face's deepest texels). Layer k of face f holds nothing where
-    /// k ≥ its count: the peel clears it and draws nothing there.
-    face_layers: [u32; 6],
+    /// Where each layer of each face holds surfaces (the GPU's count, at the peel's own size
+    /// and views); `None` where the CPU counted (along fewer rays, which could miss a face's
+    /// deepest texels): every layer drawn whole.
+    extent: Option<PeelExtent>,
     depth: Vec<Image>,
     peel: vk::Pipeline,
     /// The last layer's pipeline where the peel is cut: the farthest surface.
@@ -79,7 +132,7 @@ pub fn create(init: &StageInit, _objects: &[usize], maps: &mut Maps) -> Result<B
     let me = LayeredMaps {
         layers: 0,
         measured: None,
-        face_layers: [u32::MAX; 6],
+        extent: None,
         depth: Vec::new(),
         peel: vk::Pipeline::null(),
         far: vk::Pipeline::null(),
@@ -179,10 +232,12 @@ impl LayeredMaps {
         let q = &init.plan.quality;
         let centre = self.centre(init);
         let (count, gpu) = if init.ctx.queue.is_some() {
-            self.face_layers = count_on_gpu(init, centre)?;
-            (self.face_layers.iter().copied().max().unwrap_or(0), true)
+            let extent = count_on_gpu(init, centre)?;
+            let depth = extent.depth();
+            self.extent = Some(extent);
+            (depth, true)
         } else {
-            self.face_layers = [u32::MAX; 6];
+            self.extent = None;
             (count_on_cpu(init.scene, centre, q.cube.cube_size.min(64)), false)
         };
         self.measured = Some((count, gpu));
@@ -240,9 +295,9 @@ fn normal_format(q: &Quality, materials: usize) -> vk::Format {
 }
 
 /// `layered.count`: every surface rendered into the six faces around `centre` with
-/// additive blending (one per surface along each texel's ray), read back, the maximum of
-/// each face.
-fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<[u32; 6]> {
+/// additive blending (one per surface along each texel's ray), read back: where each layer
+/// of each face holds surfaces.
+fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<PeelExtent> {
     let ctx = init.ctx;
     let size = init.plan.quality.cube.cube_size;
     let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -310,12 +365,7 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<[u32; 6]> {
             Ok(())
         })?;
         let counts = crate::vk::read_image(ctx, &target)?;
-        let face = (size * size * counts.channels) as usize;
-        let mut most = [0u32; 6];
-        for (m, texels) in most.iter_mut().zip(counts.data.chunks(face)) {
-            *m = texels.iter().fold(0.0f32, |m, &c| m.max(c)).round() as u32;
-        }
-        Ok(most)
+        Ok(PeelExtent::from_counts(size, |face, x, y| counts.texel(face as u32, x, y)[0].round().max(0.0) as u32))
     })();
     destroy_pipelines(ctx, &mut [pipeline]);
     crate::vk::pipeline::destroy_pipeline_layout(ctx, layout);
@@ -326,15 +376,15 @@ fn count_on_gpu(init: &StageInit, centre: Vec3) -> Result<[u32; 6]> {
 /// The depth complexity along the rays through the texel centres of six `size`² faces
 /// around `centre`, by the reference's BVH (every surface crossed counts).
 pub fn count_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> u32 {
-    count_faces_on_cpu(scene, centre, size).into_iter().max().unwrap_or(0)
+    extent_on_cpu(scene, centre, size).depth()
 }
 
-/// [`count_on_cpu`] per cube face.
-pub fn count_faces_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> [u32; 6] {
+/// [`count_on_cpu`] texel by texel: where each layer of each face holds surfaces.
+pub fn extent_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) -> PeelExtent {
     let bvh = crate::reference::bvh::Bvh::new(scene);
     let o = centre.as_dvec3();
-    let mut faces = [0u32; 6];
-    for (face, most) in faces.iter_mut().enumerate() {
+    let mut counts = vec![0u32; 6 * (size * size) as usize];
+    for face in 0..6 {
         for j in 0..size {
             for i in 0..size {
                 let (s, t) = ((i as f32 + 0.5) / size as f32, (j as f32 + 0.5) / size as f32);
@@ -348,11 +398,11 @@ pub fn count_faces_on_cpu(scene: &crate::scene::Scene, centre: Vec3, size: u32) 
                         break;
                     }
                 }
-                *most = (*most).max(n);
+                counts[(face * size as usize + j as usize) * size as usize + i as usize] = n;
             }
         }
     }
-    faces
+    PeelExtent::from_counts(size, |face, x, y| counts[(face * size as usize + y as usize) * size as usize + x as usize])
 }
 
 impl Stage for LayeredMaps {
@@ -388,8 +438,14 @@ impl Stage for LayeredMaps {
             rec.barrier(&mut self.depth[prev], Access::FragmentSampled);
             // A cut peel's extra layer: the farthest surface, peeling nothing.
             let far = cut && k == self.layers;
-            // A face whose texels meet fewer surfaces than this layer: cleared, not drawn.
-            let empty = |face: u32| six && !far && k >= self.face_layers[face as usize];
+            // Where this layer of a face holds surfaces: the scissor of its draws (none: the
+            // layer is cleared there, not drawn); the whole face without a GPU count, in one
+            // multiview pass, and in the farthest surfaces' layer.
+            let whole = vk::Rect2D { offset: vk::Offset2D::default(), extent: vk::Extent2D { width: size, height: size } };
+            let area = |face: u32| match &self.extent {
+                Some(e) if six && !far => e.rect(face as usize, k),
+                _ => Some(whole),
+            };
             let first = if k == 0 || far { LAYERED_FIRST } else { 0 };
             let faces: &[u32] = if six { &[0, 1, 2, 3, 4, 5] } else { &[0] };
             for &face in faces {
@@ -417,11 +473,13 @@ impl Stage for LayeredMaps {
                 let v = view + face;
                 let eye = eyes.get(v as usize).copied().unwrap_or_default();
                 let flags = f.flags | first | if six { face << LAYERED_FACE_SHIFT } else { 0 };
-                for d in
-                    f.scene.draws.iter().filter(|d| {
-                        d.index_count > 0 && !empty(face) && (!six || crate::cube::face_sees_box(face as usize, eye, d.lo, d.hi))
-                    })
-                {
+                let drawn = area(face);
+                if let Some(r) = drawn.filter(|r| *r != whole) {
+                    unsafe { ctx.device.cmd_set_scissor(cmd, 0, &[r]) };
+                }
+                for d in f.scene.draws.iter().filter(|d| {
+                    d.index_count > 0 && drawn.is_some() && (!six || crate::cube::face_sees_box(face as usize, eye, d.lo, d.hi))
+                }) {
                     f.push_flags(ctx, cmd, v, d.mesh, flags);
                     unsafe { ctx.device.cmd_draw_indexed(cmd, d.index_count, 1, d.first_index, d.vertex_offset, 0) };
                 }
@@ -441,10 +499,12 @@ impl Stage for LayeredMaps {
         }
         // 1 where the peel is cut and one more layer holds the farthest surfaces.
         s.push(("layered.far_layer".into(), if self.cut() { 1.0 } else { 0.0 }));
-        // The (layer, face) passes that draw the scene, of 6 per layer (in six passes).
-        if self.mode == CubeMode::SixPasses {
-            let drawn: u32 = self.face_layers.iter().map(|&f| f.min(self.layers)).sum::<u32>() + 6 * u32::from(self.cut());
+        // The (layer, face) passes that draw the scene, of 6 per layer, and the texels
+        // they draw, in cubes (six-pass cubes counted on the GPU).
+        if let (Some(e), CubeMode::SixPasses) = (&self.extent, self.mode) {
+            let drawn: usize = e.faces.iter().map(|f| f.len().min(self.layers as usize)).sum::<usize>() + 6 * usize::from(self.cut());
             s.push(("layered.faces_peeled".into(), drawn as f64));
+            s.push(("layered.cubes_drawn".into(), e.drawn_cubes(self.layers) + f64::from(u32::from(self.cut()))));
         }
         s
     }

@@ -220,9 +220,9 @@ fn layered_layers(scene: &Scene, facts: &SceneFacts, q: &Quality) -> (u32, f64) 
         return (1, 1.0);
     }
     let centre = crate::methods::layered::centre(scene, q, &meshes);
-    let faces = crate::methods::layered::peel::count_faces_on_cpu(scene, centre, q.cube.cube_size.min(64));
-    let layers = crate::methods::layered::layers_for(q, faces.iter().copied().max());
-    (layers, crate::methods::layered::drawn_cubes(q, Some(faces)))
+    let extent = crate::methods::layered::peel::extent_on_cpu(scene, centre, q.cube.cube_size.min(64));
+    let layers = crate::methods::layered::layers_for(q, Some(extent.depth()));
+    (layers, crate::methods::layered::drawn_cubes(q, Some(&extent)))
 }
 
 /// One object's candidates in one variant: none is predicted more accurate than the exact
