@@ -156,6 +156,13 @@ impl Shape {
         }
     }
 
+    /// Whether object `f` misses the shape only as seen from where the camera is now (several
+    /// reflection points of a curved reflector, which a camera move changes), not by its
+    /// form (a saddle, a curved face where flat ones are needed).
+    pub fn misses_from_this_view(self, f: &ObjectFacts) -> bool {
+        matches!(self, Shape::ConvexOrConcave) && f.curvature != crate::plan::facts::Curvature::Saddle && !self.fits(f)
+    }
+
     /// [`Shape::misfit`] for object `f`.
     pub fn misfit_of(self, f: &ObjectFacts) -> &'static str {
         match self {

@@ -213,6 +213,34 @@ static CACHE: Mutex<Option<HashMap<u64, Arc<MeshFacts>>>> = Mutex::new(None);
 /// Visible fractions by (mesh hash, reference point bits).
 type VisibleCache = HashMap<(u64, [u32; 3]), f32>;
 static VISIBLE: Mutex<Option<VisibleCache>> = Mutex::new(None);
+/// Reflection-point counts by (the reflector's hash, the other visible meshes' hashes
+/// combined, the eye's bits): the check scores up to 2²¹ vertex pairs, and every plan of a
+/// scene with a curved mirror asks for it (each re-plan of a frame that moved nothing else).
+type SeveralCache = HashMap<(u64, u64, [u32; 3]), (u32, u32)>;
+static SEVERAL: Mutex<Option<SeveralCache>> = Mutex::new(None);
+
+/// `reflection_points::several`, remembered for the same geometry and eye.
+fn several_cached(scene: &Scene, index: usize, eye: Vec3) -> (u32, u32) {
+    let others = scene
+        .meshes
+        .iter()
+        .enumerate()
+        .filter(|(i, m)| *i != index && !m.hidden)
+        .fold(0xcbf2_9ce4_8422_2325u64, |h, (i, m)| (h ^ mesh_hash(m) ^ i as u64).wrapping_mul(0x0100_0000_01b3));
+    let key = (mesh_hash(&scene.meshes[index]), others, [eye.x.to_bits(), eye.y.to_bits(), eye.z.to_bits()]);
+    if let Some(f) = SEVERAL.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).copied())) {
+        return f;
+    }
+    let f = super::reflection_points::several(scene, index, eye);
+    if let Ok(mut c) = SEVERAL.lock() {
+        let map = c.get_or_insert_with(HashMap::new);
+        if map.len() > 1024 {
+            map.clear();
+        }
+        map.insert(key, f);
+    }
+    f
+}
 
 fn mesh_hash(m: &Mesh) -> u64 {
     let mut h = 0xcbf2_9ce4_8422_2325u64;
@@ -632,7 +660,7 @@ impl SceneFacts {
                     curvature: mf.curvature,
                     reflection_points: match (class, mf.planar, mf.curvature) {
                         (ObjectClass::Mirror, false, Curvature::Convex | Curvature::Concave) => {
-                            super::reflection_points::several(scene, i, scene.camera_or_default().position)
+                            several_cached(scene, i, scene.camera_or_default().position)
                         }
                         _ => (0, 0),
                     },

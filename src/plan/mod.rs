@@ -325,6 +325,12 @@ fn choose(
                 format!("object '{}'", mesh.name),
                 format!("method '{}' cannot serve a graded-index medium, whose rays curve (survey §6.5): {}", m.name, curved()),
             ))
+        } else if let Some(f) = m.fallback.filter(|f| m.can_serve(class) && m.shape.misses_from_this_view(facts) && f.fits(facts)) {
+            // A chosen method that cannot serve the object from where the camera is now (a
+            // curved reflector with several reflection points from this eye) takes its
+            // fallback, with the refusal as the reason, rather than failing the plan: the
+            // camera (or the object) moves, and an engine moves them every frame.
+            Ok((f, format!("{source}: {}, refused from this view — it serves {}: its fallback {}", m.name, m.shape.refusal(facts), f.name)))
         } else if m.can_serve(class) && !m.shape.fits(facts) {
             Err(Error::invalid(format!("object '{}'", mesh.name), format!("method '{}' serves {}", m.name, m.shape.refusal(facts))))
         } else if m.can_serve(class) {

@@ -142,10 +142,12 @@ fn tessellate(m: &Mesh, t: u32, vertices: &mut Vec<GpuCurvedVertex>, indices: &m
 /// A reflector's parameterisation into [0,1]², per triangle corner (`m.indices`' order; half
 /// a texel of margin at `size`): its own UVs, rescaled to fill the square, when they are
 /// present, span an area and do not overlap (the triangles' UV areas add up to no more than
-/// their bounding box); else the projection onto the plane across its area-weighted normal;
-/// where that normal vanishes (a closed surface, which a plane would fold onto itself), a
-/// cube atlas around its centre ([`cube_atlas`]). Returns the coordinates and whether they are
-/// the mesh's own.
+/// their bounding box); else the projection onto the plane across its area-weighted normal
+/// where that plane holds the surface one-to-one (no triangle faces away from the normal: a
+/// height field over it); else — a closed surface, whose normals cancel, or one that curls
+/// past the plane, as a sphere with a hole does, which a plane would fold onto itself — a cube
+/// atlas around its centre ([`cube_atlas`]). Returns the coordinates and whether they are the
+/// mesh's own.
 pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
     let tri_area = |a: Vec2, b: Vec2, c: Vec2| 0.5 * ((b - a).perp_dot(c - a)).abs();
     let bbox = |uvs: &[Vec2]| uvs.iter().fold((Vec2::splat(f32::MAX), Vec2::splat(f32::MIN)), |(lo, hi), u| (lo.min(*u), hi.max(*u)));
@@ -166,7 +168,18 @@ pub fn parameterisation(m: &Mesh, size: u32) -> (Vec<Vec2>, bool) {
         }
         let b = m.bounds();
         let extent = b.max - b.min;
-        if n.length() > 1e-3 * extent.length_squared() {
+        // The triangles' area that faces away from the plane's normal, where the plane's
+        // projection folds onto the rest (edge-on rim triangles of a hemisphere do not count).
+        let folded = |axis: Vec3| -> f32 {
+            m.indices
+                .chunks_exact(3)
+                .map(|t| (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])))
+                .filter(|c| c.dot(axis) < -1e-3 * c.length())
+                .map(|c| 0.5 * c.length())
+                .sum()
+        };
+        let total: f32 = m.indices.chunks_exact(3).map(|t| 0.5 * (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).length()).sum();
+        if n.length() > 1e-3 * extent.length_squared() && folded(n.normalize()) <= 1e-3 * total {
             let axis = n.normalize();
             let u = axis.any_orthonormal_vector();
             let v = axis.cross(u);
@@ -757,16 +770,9 @@ mod tests {
         assert_eq!(curvature(&cap), Curvature::Concave);
     }
 
-    /// A closed sphere without UVs: the cube atlas gives every triangle its own place — no
-    /// two triangles' charts overlap (sampled at the triangles' centroids and corners pulled
-    /// towards them), where a plane's projection folds the back onto the front.
-    #[test]
-    fn a_closed_uvless_sphere_gets_a_chart_without_overlaps() {
-        let mut s = shapes::uv_sphere("s", Vec3::new(0.3, -0.2, 0.1), 0.7, 24, 12, 0);
-        s.uvs.clear();
-        let (uv, own) = parameterisation(&s, 128);
-        assert!(!own && uv.len() == s.indices.len());
-        assert!(uv.iter().all(|u| u.x > 0.0 && u.x < 1.0 && u.y > 0.0 && u.y < 1.0));
+    /// Whether no two triangles' charts in `uv` (per corner) overlap, sampled at each
+    /// triangle's centroid and its corners pulled towards it; the first overlap found else.
+    fn first_overlap(uv: &[Vec2]) -> Option<(usize, Vec2, usize)> {
         let tris: Vec<[Vec2; 3]> =
             uv.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).filter(|t| (t[1] - t[0]).perp_dot(t[2] - t[0]).abs() > 1e-9).collect();
         let inside = |t: &[Vec2; 3], q: Vec2| {
@@ -777,10 +783,42 @@ mod tests {
         for (i, t) in tris.iter().enumerate() {
             let c = (t[0] + t[1] + t[2]) / 3.0;
             for q in [c, c.lerp(t[0], 0.8), c.lerp(t[1], 0.8), c.lerp(t[2], 0.8)] {
-                let hits = tris.iter().enumerate().filter(|(j, o)| *j != i && inside(o, q)).count();
-                assert_eq!(hits, 0, "triangle {i}'s point {q} lies in {hits} other triangles' charts");
+                if let Some(j) = tris.iter().enumerate().position(|(j, o)| j != i && inside(o, q)) {
+                    return Some((i, q, j));
+                }
             }
         }
+        None
+    }
+
+    /// A closed sphere without UVs: the cube atlas gives every triangle its own place — no
+    /// two triangles' charts overlap, where a plane's projection folds the back onto the
+    /// front. So does a nearly closed one (a hole at its pole: its normals do not cancel,
+    /// but a plane would still fold it), and a hemisphere keeps the plane's projection,
+    /// which holds it one-to-one.
+    #[test]
+    fn a_closed_uvless_sphere_gets_a_chart_without_overlaps() {
+        let mut s = shapes::uv_sphere("s", Vec3::new(0.3, -0.2, 0.1), 0.7, 24, 12, 0);
+        s.uvs.clear();
+        let (uv, own) = parameterisation(&s, 128);
+        assert!(!own && uv.len() == s.indices.len());
+        assert!(uv.iter().all(|u| u.x > 0.0 && u.x < 1.0 && u.y > 0.0 && u.y < 1.0));
+        assert_eq!(first_overlap(&uv), None);
+        // The pole's ring of triangles cut out: a hole of 0.26 of the radius.
+        let top = s.positions.iter().map(|p| p.y).fold(f32::MIN, f32::max);
+        let cut = |m: &Mesh, above: f32| -> Mesh {
+            let keep: Vec<u32> =
+                m.indices.chunks_exact(3).filter(|t| t.iter().all(|&i| m.positions[i as usize].y < above)).flatten().copied().collect();
+            Mesh { indices: keep, ..m.clone() }
+        };
+        let holed = cut(&s, top - 1e-3);
+        assert!(holed.indices.len() < s.indices.len());
+        let (uv, _) = parameterisation(&holed, 128);
+        assert_eq!(first_overlap(&uv), None, "the sphere with a hole folds");
+        let mut cap = bowl(1.0, 1.5, 12);
+        cap.uvs.clear();
+        let (uv, _) = parameterisation(&cap, 128);
+        assert_eq!(first_overlap(&uv), None, "a cap short of a hemisphere");
     }
 
     /// A spherical cap of radius r and half-angle a around −y, normals towards its centre.
