@@ -63,7 +63,7 @@ pub const CURVED_REFLECTOR_INFO: &MethodInfo = &MethodInfo {
     abi: 15,
     section: "§5",
     family: "geometry",
-    summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors, and those with several reflection points for the environment seen from the camera, are refused",
+    summary: "convex or concave mirrors by geometry transformation: the reflector's geometry image (positions and normals over its parameterisation), a coarse-to-fine search per environment vertex for the sample that meets the reflection law, the environment drawn at those virtual positions per reflector and laid onto it with its Fresnel weight; single reflections; saddle-shaped reflectors are refused, and those with several reflection points for the environment seen from the camera take the fallback (distance) with the refusal as the reason",
     serves: &[ObjectClass::Mirror],
     knobs: &[GeometryKnobs::geometry_image, GeometryKnobs::curved_search, GeometryKnobs::tessellation, FrameKnobs::fresnel],
     gpu: Some(GpuSpec { maps: &[], camera: CURVED_PASS, map_shading: MapShading::Sky, leaves_out: LeavesOut::Itself, cycles: one, views: |_| 0, shades_every_pixel: false }),
