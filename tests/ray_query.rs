@@ -384,10 +384,11 @@ fn hybrid_self_refraction_in_a_non_convex_glass_object() {
         "torus: refractor-map {p:.2} dB, hybrid=rays {h:.2} dB tracing {:.2} % of {rays} searches, hybrid=confirm {c:.2} dB, ray-query {e:.2} dB",
         100.0 * traced
     );
-    // Measured at 64²: refractor-map 8.26 dB, hybrid=rays 44.69 dB tracing 72.77 % of 32310
-    // searches and ray queries (inside and out; the torus is saddle-shaped, so every ray that
-    // leaves it, the camera's reflection included, is traced against it first, and where it
-    // meets it again it is followed back in), hybrid=confirm 64.86 dB, ray-query 64.87 dB.
+    // Measured at 64²: refractor-map 8.26 dB, hybrid=rays 44.69 dB tracing 74.74 % of 34821
+    // searches and ray queries (inside and out, and one per pixel for the camera's triangle;
+    // the torus is saddle-shaped, so every ray that leaves it, the camera's reflection
+    // included, is traced against it first, and where it meets it again it is followed back
+    // in), hybrid=confirm 64.86 dB, ray-query 64.87 dB.
     // Before paths that came back in spent the budget of interfaces that `depth` gives the
     // exact tracers, interfaces were taken as entering or leaving by the interpolated normal
     // as the exact tracers take them, and the triangle a ray leaves was skipped: 34.81 and
@@ -396,7 +397,7 @@ fn hybrid_self_refraction_in_a_non_convex_glass_object() {
     // most 1.122 × measured.
     assert!(h >= 43.69 && h < e, "hybrid=rays {h:.2} dB (refractor-map {p:.2}, ray-query {e:.2})");
     assert!(c >= 63.86 && c >= e - 1.0, "hybrid=confirm {c:.2} dB (rays {h:.2}, ray-query {e:.2})");
-    assert!((0.05..=0.816).contains(&traced), "traced share {traced}");
+    assert!((0.05..=0.839).contains(&traced), "traced share {traced}");
     common::assert_clean(&ctx);
 }
 

@@ -143,8 +143,8 @@ vec3 hybrid_geometric_normal(vec3 p, vec3 eye) {
 }
 
 // A solid refractor that is not convex (FLAG_HYBRID_REENTERS): a ray that leaves it may meet
-// it again, which neither map holds (the distance map leaves the object out). Such rays are
-// traced against the object first; where they meet it, the refracted path is queued here,
+// it again, which neither map holds (the distance map leaves the object out). Such rays ask
+// one ray query of every object: where the nearest is the refractor itself, the refracted path is queued here,
 // followed inside after the path that found it (a work list instead of recursion; a path
 // that finds the list full is dropped), and the reflected ray goes on the same way.
 //
@@ -190,7 +190,11 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
     uint skip = hybrid_from;
     if ((push.flags & FLAG_HYBRID_REENTERS) != 0u) {
         for (uint k = 0u; k < HYBRID_MAX_MEETINGS; ++k) {
-            float t_min = max(1e-5 * length(from - o.reference_point.xyz), 1e-6 * length(from)) + 1e-30;
+            float r = length(from - o.reference_point.xyz);
+            float t_min = max(1e-5 * r, 1e-6 * length(from)) + 1e-30;
+            // A point the refractor map answered (no triangle known) may lie off the surface
+            // by the search's tolerance: start past it, or the ray meets the surface it left.
+            if (skip == RAY_NO_TRIANGLE) t_min = max(t_min, 2.0 * HYBRID_TOLERANCE * r);
             RQ_COUNT(2u * push.object);
             RQ_COUNT(2u * push.object + 1u);
             // The nearest triangle of any object: the refractor's own, or the ray goes on to
@@ -207,6 +211,8 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
             vec3 n = rq_surface(own, along).n;
             bool entering = dot(n, along) <= 0.0;
             if (!entering) n = -n;  // against the ray
+            // Taken as leaving, the segment ran inside as the exact tracers see it: absorbed.
+            if (!entering) times *= volume_transmittance(materials[o.material], own.t);
             float eta_t_i = entering ? hybrid_ior : 1.0 / hybrid_ior;
             vec3 f = material_fresnel(materials[o.material], -dot(along, n), eta_t_i);
             vec3 t;
@@ -224,7 +230,7 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
 
 // refractor_exit (distance/refractor/trace.glsl) where its refractor-map search cannot
 // answer: the exit surface found by a ray query against the refractor's own triangles, with
-// its shading normal turned along the ray.
+// its interpolated normal as it is (refractor_inside_ior decides leaving or entering by it).
 bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     vec3 ref = o.reference_point.xyz;
     search_map = 1;

@@ -55,29 +55,35 @@ vec3 hybrid_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3
 // inside it, as through the exact tracers; on a refractor that is not convex the reflection
 // is traced against it (hybrid_outside), which finds that case as the exact tracers do,
 // without the screen-space normal that a silhouette's pixel quad gets wrong. Every channel
-// (one, without dispersion) inside through one call site.
+// (one, without dispersion) inside through one call site; under dispersion the reflection too
+// is followed per channel, so that the paths it queues refract with that channel's index.
 vec3 hybrid_refractor_radiance(Object o, Material m, vec3 p, vec3 n, vec3 eye) {
     SpecularSplit s = specular_split(m, p, n, eye);
     vec3 c = vec3(0.0);
-    hybrid_queued = 0u;
-    hybrid_ior = material_ior(m);
     // The triangle the camera sees at p (the pass rasterises without triangle ids): the
     // refractor's nearest along the eye's ray to just past p.
     float seen = length(p - eye);
+    RQ_COUNT(2u * push.object);
+    RQ_COUNT(2u * push.object + 1u);
     hybrid_camera_triangle = rq_trace_mesh(eye, (p - eye) / seen, 0.0, seen * (1.0 + 1e-3), push.object, true, RAY_NO_TRIANGLE).triangle;
-    if (dot(s.r, hybrid_ng) < 0.0 && (push.flags & FLAG_HYBRID_REENTERS) == 0u) {
-        hybrid_paths[0] = HybridPath(p, s.r, s.fr, 1u, hybrid_camera_triangle);
-        hybrid_queued = 1u;
-    } else {
-        // Off a refractor that is not convex, the reflection may meet it again.
-        hybrid_from = hybrid_camera_triangle;
-        c = hybrid_outside(o, p, s.r, s.fr, 1u);
-    }
+    bool into = dot(s.r, hybrid_ng) < 0.0 && (push.flags & FLAG_HYBRID_REENTERS) == 0u;
     bool disperses = material_disperses(m);
     for (int k = 0; k < (disperses ? 3 : 1); ++k) {
-        vec3 w = disperses ? s.ft * channel_mask(k) : s.ft;
+        vec3 mask = disperses ? channel_mask(k) : vec3(1.0);
+        float ior = disperses ? m.nu[k] : material_ior(m);
+        hybrid_ior = ior;
+        hybrid_queued = 0u;
+        if (into) {
+            hybrid_paths[0] = HybridPath(p, s.r, s.fr * mask, 1u, hybrid_camera_triangle);
+            hybrid_queued = 1u;
+        } else {
+            // Off a refractor that is not convex, the reflection may meet it again.
+            hybrid_from = hybrid_camera_triangle;
+            c += hybrid_outside(o, p, s.r, s.fr * mask, 1u);
+        }
+        vec3 w = s.ft * mask;
         vec3 dir = disperses ? s.tc[k] : s.t;
-        if (any(greaterThan(w, vec3(0.0))) || hybrid_queued > 0u) c = hybrid_inside_ior(o, m, p, dir, w, c, disperses ? m.nu[k] : material_ior(m));
+        if (any(greaterThan(w, vec3(0.0))) || hybrid_queued > 0u) c = hybrid_inside_ior(o, m, p, dir, w, c, ior);
     }
     return c;
 }

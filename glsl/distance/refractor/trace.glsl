@@ -1,6 +1,7 @@
 // Self refraction with a refractor map (survey §4.4): the refracted ray is searched inside
 // the object's own refractor map, refracted out with Snell's law, or reflected internally
-// on total internal reflection, up to `internal_bounces` times; each ray that leaves
+// on total internal reflection, up to `internal_bounces` times (the hybrid search: within
+// its budget of interfaces, distance/hybrid.glsl); each ray that leaves
 // searches the environment's distance map. Fresnel weights every interface, absorption
 // (KHR_materials_volume) every segment inside. Used by the
 // camera pass (refractor.search) and, for inter-object cycles, by distance-map generation.
@@ -49,7 +50,8 @@ bool refractor_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
 
 // c plus the radiance arriving at point p of solid refractor o (material m) along dir, a
 // ray that runs inside it, times weight: searched in its refractor map to the surface it
-// meets, refracted out there (Fresnel) or reflected on inside, up to internal_bounces times.
+// meets, refracted out there (Fresnel) or reflected on inside, up to internal_bounces times
+// (REFRACTOR_LAST_BOUNCE).
 // `ior`: the index the ray refracts out with (a channel's under dispersion).
 vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, vec3 c, float ior) {
     vec3 pos = p;
@@ -61,13 +63,15 @@ vec3 refractor_inside_ior(Object o, Material m, vec3 p, vec3 dir, vec3 weight, v
             weight = vec3(0.0);
             break;
         }
-        weight *= volume_transmittance(m, length(hit - pos));  // absorbed on the way there
         // Leaving the object where the normal faces along the ray (the map's always does):
         // ν_i/ν_t = ior, the normal turned to the inside. A triangle's interpolated normal
         // (the hybrid's exits) may face the ray near a silhouette; the exact tracers then take
         // the ray as entering (specular_split), and so does this.
         float cos_i = dot(dir, n2);
         bool leaving = cos_i > 0.0;
+        // Absorbed on the way there: a segment that meets the surface from within, as the
+        // exact tracers absorb (segment_transmittance).
+        if (leaving) weight *= volume_transmittance(m, length(hit - pos));
         vec3 against = leaving ? -n2 : n2;
         float eta_i_t = leaving ? ior : 1.0 / ior;
         vec3 out_dir;

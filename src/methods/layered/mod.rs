@@ -59,10 +59,13 @@ pub fn layers_for(q: &Quality, depth: Option<u32>) -> u32 {
 
 /// The cubes' worth of texels the peel draws under `q` where its layers hold surfaces as
 /// `extent` says (`peel`: each layer of each face drawn only where its texels meet that many
-/// surfaces; the farthest surfaces' layer, where the peel is cut, whole); without a count,
-/// every layer whole.
+/// surfaces; the farthest surfaces' layer, where the peel is cut, whole); without a count, or
+/// in one multiview pass per layer (which draws every face), every layer whole.
 pub fn drawn_cubes(q: &Quality, extent: Option<&peel::PeelExtent>) -> f64 {
     let Some(extent) = extent else { return layers_for(q, None) as f64 };
+    if q.cube.cube_mode != crate::quality::CubeMode::SixPasses {
+        return layers_for(q, Some(extent.depth())) as f64;
+    }
     let depth = extent.depth();
     // As layers_for: the knob or the depth complexity, and one more where it is cut.
     let peeled = q.layered.layers.unwrap_or_else(|| depth.clamp(1, MAX_LAYERS));

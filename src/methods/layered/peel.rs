@@ -95,13 +95,14 @@ impl PeelExtent {
         self.faces.iter().flat_map(|f| f.iter().take(layers as usize)).map(area).sum::<f64>() / face / 6.0
     }
 
-    /// Face `face`'s rectangle in layer `k`, `None` where the layer holds nothing there.
+    /// Face `face`'s rectangle in layer `k`, one texel wider on each side (within the
+    /// face: the count and the peel are different pipelines, whose coverage of a triangle's
+    /// edge could differ by a rounding), `None` where the layer holds nothing there.
     fn rect(&self, face: usize, k: u32) -> Option<vk::Rect2D> {
         let r = self.faces[face].get(k as usize)?;
-        Some(vk::Rect2D {
-            offset: vk::Offset2D { x: r[0] as i32, y: r[1] as i32 },
-            extent: vk::Extent2D { width: r[2] - r[0], height: r[3] - r[1] },
-        })
+        let (x0, y0) = (r[0].saturating_sub(1), r[1].saturating_sub(1));
+        let (x1, y1) = ((r[2] + 1).min(self.size), (r[3] + 1).min(self.size));
+        Some(vk::Rect2D { offset: vk::Offset2D { x: x0 as i32, y: y0 as i32 }, extent: vk::Extent2D { width: x1 - x0, height: y1 - y0 } })
     }
 }
 
