@@ -498,3 +498,54 @@ fn glass_ball_refractions_on_the_front() {
     assert!(map_ms >= 1.12 * image_ms, "image-space {image_ms:.1} ms, refractor-map {map_ms:.1} ms");
     common::assert_clean(&ctx);
 }
+
+/// Issue 35's niche for distance-multi (§4.3): three mirror balls in mutual view, each
+/// reflecting the others' reflections. Inter-object distance maps are on the front of error
+/// against time among the methods that serve them, the exact tracers included: none is
+/// faster beyond the noise (1.12×) and more accurate by over 0.5 dB (the README's
+/// "dominated"), and the exact tracers are slower — while nothing moves: frames timed as
+/// above, the maps made in the warm-up frame and searched by the timed ones (a static scene
+/// seen from a moving camera reuses them). Measured: distance-multi 25.28 dB in 3.7–3.9 ms,
+/// distance 18.85 in 3.6–3.7, envmap 17.09 in 1.5–1.7, proxy-sphere 18.61 in 1.7–2.1, bvh
+/// 26.84 in 9.1–14.4, ray-query 26.84 in 8.9–11.8; with its maps made again every frame
+/// (`map_updates=always`) distance-multi takes 267 ms, dominated by the exact tracers. A run
+/// whose ratios miss is measured once more.
+#[test]
+fn mirror_balls_in_mutual_view_on_the_front() {
+    use glam::Vec3;
+    use specula::methods::{BVH, DISTANCE, DISTANCE_MULTI, ENVMAP, PROXY_SPHERE, RAY_QUERY};
+    const SIZE: (u32, u32) = (128, 128);
+    let ctx = common::gpu();
+    let mut scene = Scene::new();
+    common::emissive_room(&mut scene, Vec3::new(0.0, 2.0, 0.0), 2.0);
+    let m = scene.add_material(common::mirror(0.9)).unwrap();
+    for (i, c) in [Vec3::new(-0.6, 1.5, 0.0), Vec3::new(0.6, 1.5, 0.0), Vec3::new(0.0, 1.5, -0.9)].into_iter().enumerate() {
+        scene.add_mesh(specula::scene::shapes::uv_sphere(&format!("ball{i}"), c, 0.45, 24, 12, m)).unwrap();
+    }
+    scene.camera = Some(specula::scene::Camera::look_at(Vec3::new(0.0, 2.2, 2.0), Vec3::new(0.0, 1.5, -0.3), 60f32.to_radians()));
+    let mut base = Quality::default();
+    base.reference.spp = 16;
+    base.set("depth", "4").unwrap();
+    let reference = specula::reference::render_reference(&scene, &base, SIZE).unwrap();
+    let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
+    let run = |m: specula::Method| {
+        let f = specula::render(&ctx, &scene, m, &base, SIZE, (1, 3)).unwrap();
+        let ms = f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>();
+        (psnr(&split(&scene, &f.image, &reference, &ids), "specular"), ms)
+    };
+    let methods = [DISTANCE_MULTI, DISTANCE, ENVMAP, PROXY_SPHERE, BVH, RAY_QUERY];
+    let dominated = |r: &[(f64, f64)]| r[1..].iter().any(|&(db, ms)| ms * 1.12 < r[0].1 && db > r[0].0 + 0.5);
+    let exact_faster = |r: &[(f64, f64)]| r[4].1.min(r[5].1) < 1.12 * r[0].1;
+    let mut r: Vec<(f64, f64)> = methods.iter().map(|&m| run(m)).collect();
+    if dominated(&r) || exact_faster(&r) {
+        let again: Vec<(f64, f64)> = methods.iter().map(|&m| run(m)).collect();
+        for (a, b) in r.iter_mut().zip(again) {
+            a.1 = a.1.min(b.1);
+        }
+    }
+    for (m, (db, ms)) in methods.iter().zip(&r) {
+        println!("three mirror balls at 128²: {m} {db:.2} dB in {ms:.2} ms");
+    }
+    assert!(!dominated(&r) && !exact_faster(&r), "distance-multi off the front: {r:.2?}");
+    common::assert_clean(&ctx);
+}
