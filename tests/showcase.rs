@@ -451,6 +451,23 @@ fn flat_glass_view_budget_moves_the_faces_error() {
     common::assert_clean(&s.ctx);
 }
 
+/// For the niche tests: a method's specular PSNR against `base`'s reference (its `spp`) and
+/// its GPU ms (the median of 3 frames after one warm-up, readback left out), at `size`.
+fn front_runner<'a>(
+    ctx: &'a specula::vk::Context,
+    scene: &'a Scene,
+    base: &'a Quality,
+    size: (u32, u32),
+) -> impl Fn(specula::Method) -> (f64, f64) + 'a {
+    let reference = specula::reference::render_reference(scene, base, size).unwrap();
+    let ids = specula::reference::object_ids(scene, size).unwrap();
+    move |m| {
+        let f = specula::render(ctx, scene, m, base, size, (1, 3)).unwrap();
+        let ms = f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>();
+        (psnr(&split(scene, &f.image, &reference, &ids), "specular"), ms)
+    }
+}
+
 /// Issue 35's niches on `glass-1.5` at 128²: refractor-map (§4.4) is on the Pareto front of
 /// error against time among every method, the exact tracers included — as accurate as they
 /// are on the ball, in less time — and image-space refraction (§4.4, Wyman) with two Newton
@@ -465,16 +482,10 @@ fn glass_ball_refractions_on_the_front() {
     let mut base = Quality::default();
     base.reference.spp = 16;
     base.set("image_space_iterations", "2").unwrap();
-    let reference = specula::reference::render_reference(&scene, &base, SIZE).unwrap();
-    let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
-    let run = |m: specula::Method| {
-        let f = specula::render(&ctx, &scene, m, &base, SIZE, (1, 3)).unwrap();
-        let ms = f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>();
-        (psnr(&split(&scene, &f.image, &reference, &ids), "specular"), ms)
-    };
+    let run = front_runner(&ctx, &scene, &base, SIZE);
     let methods =
         [specula::methods::IMAGE_SPACE_REFRACTION, specula::methods::REFRACTOR_MAP, specula::methods::BVH, specula::methods::RAY_QUERY];
-    let measure = || methods.map(run);
+    let measure = || methods.map(&run);
     let mut r = measure();
     let ok = |r: &[(f64, f64); 4]| {
         let exact_ms = r[2].1.min(r[3].1);
@@ -526,13 +537,7 @@ fn mirror_balls_in_mutual_view_on_the_front() {
     let mut base = Quality::default();
     base.reference.spp = 16;
     base.set("depth", "4").unwrap();
-    let reference = specula::reference::render_reference(&scene, &base, SIZE).unwrap();
-    let ids = specula::reference::object_ids(&scene, SIZE).unwrap();
-    let run = |m: specula::Method| {
-        let f = specula::render(&ctx, &scene, m, &base, SIZE, (1, 3)).unwrap();
-        let ms = f.passes.iter().filter(|p| p.name != "frame.readback").map(|p| p.gpu_ms).sum::<f64>();
-        (psnr(&split(&scene, &f.image, &reference, &ids), "specular"), ms)
-    };
+    let run = front_runner(&ctx, &scene, &base, SIZE);
     let methods = [DISTANCE_MULTI, DISTANCE, ENVMAP, PROXY_SPHERE, BVH, RAY_QUERY];
     let dominated = |r: &[(f64, f64)]| r[1..].iter().any(|&(db, ms)| ms * 1.12 < r[0].1 && db > r[0].0 + 0.5);
     let exact_faster = |r: &[(f64, f64)]| r[4].1.min(r[5].1) < 1.12 * r[0].1;
