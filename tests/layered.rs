@@ -170,7 +170,7 @@ fn a_concave_mirror_reflects_itself_in_the_layers() {
         // (on the CPU, along the texel rays of at most 64² per face) predicts what it draws.
         let (peeled, drawn) = (stat(&stats, "layered.faces_peeled"), stat(&stats, "layered.cubes_drawn"));
         let plan = specula::plan_with(&s, &specula::Choices::all(specula::methods::LAYERED), &quality(&knobs)).unwrap();
-        let predicted = specula::methods::layered::drawn_cubes(&plan.quality, plan.layered_faces.as_ref());
+        let predicted = specula::methods::layered::drawn_cubes(&plan.quality, plan.layered_extent.as_ref());
         eprintln!("faces peeled {peeled} of 24, cubes drawn {drawn:.3} (predicted {predicted:.3})");
         // Measured: 17 passes, 1.972 cubes of texels of the 4 allocated, predicted 2.053.
         assert!(peeled == 17.0 && (1.972 / 1.122..=1.972 * 1.122).contains(&drawn), "{peeled} passes, {drawn} cubes");

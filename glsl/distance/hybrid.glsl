@@ -37,6 +37,12 @@ const float HYBRID_WINDOW = 0.01;
 // refractor through (the budget of interfaces ends it first: 16 internal bounces + 2).
 const uint HYBRID_MAX_MEETINGS = 18u;
 
+// Where a ray query from surface point p starts: off the surface by 10⁻⁵ of p's distance from
+// the reference point `ref`, and by more than the f32 rounding of p far from the origin.
+float hybrid_t_min(vec3 p, vec3 ref) {
+    return max(1e-5 * length(p - ref), 1e-6 * length(p)) + 1e-30;
+}
+
 bool hybrid_confirms() {
     return (push.flags & FLAG_HYBRID_CONFIRM) != 0u;
 }
@@ -96,9 +102,7 @@ vec3 hybrid_radiance(Object o, vec3 p, vec3 dir) {
     vec4 texel = textureLod(distance_maps, vec4(s.dir, search_layer), 0.0);
     bool resolved = hybrid_resolved(s, x, dir, texel.a, textureGather(distance_maps, vec4(s.dir, search_layer), 3));
     RQ_COUNT(2u * push.object);
-    // Off the surface by 10⁻⁵ of its distance from the reference point, and by more than
-    // the f32 rounding of p far from the origin.
-    float t_min = max(1e-5 * length(x), 1e-6 * length(p)) + 1e-30;
+    float t_min = hybrid_t_min(p, o.reference_point.xyz);
     RayHit h = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (resolved) {
         if (!hybrid_confirms()) return texel.rgb;
@@ -191,7 +195,7 @@ vec3 hybrid_outside(Object o, vec3 p, vec3 d, vec3 w, uint used) {
     if ((push.flags & FLAG_HYBRID_REENTERS) != 0u) {
         for (uint k = 0u; k < HYBRID_MAX_MEETINGS; ++k) {
             float r = length(from - o.reference_point.xyz);
-            float t_min = max(1e-5 * r, 1e-6 * length(from)) + 1e-30;
+            float t_min = hybrid_t_min(from, o.reference_point.xyz);
             // A point the refractor map answered (no triangle known) may lie off the surface
             // by the search's tolerance: start past it, or the ray meets the surface it left.
             if (skip == RAY_NO_TRIANGLE) t_min = max(t_min, 2.0 * HYBRID_TOLERANCE * r);
@@ -241,7 +245,7 @@ bool hybrid_exit(Object o, vec3 pos, vec3 dir, out vec3 hit, out vec3 n2) {
     vec4 texel = textureLod(refractor_maps, vec4(h.dir, search_layer), 0.0);
     vec4 around = textureGather(refractor_maps, vec4(h.dir, search_layer), 3);
     RQ_COUNT(2u * push.object);
-    float t_min = max(1e-5 * length(pos - ref), 1e-6 * length(pos)) + 1e-30;
+    float t_min = hybrid_t_min(pos, ref);
     RayHit r = RayHit(RQ_T_MAX, 0.0, 0.0, RAY_NO_TRIANGLE);
     if (hybrid_resolved(h, x, dir, texel.w, around)) {
         if (!hybrid_confirms()) {

@@ -228,18 +228,7 @@ fn several_cached(scene: &Scene, index: usize, eye: Vec3) -> (u32, u32) {
         .filter(|(i, m)| *i != index && !m.hidden)
         .fold(0xcbf2_9ce4_8422_2325u64, |h, (i, m)| (h ^ mesh_hash(m) ^ i as u64).wrapping_mul(0x0100_0000_01b3));
     let key = (mesh_hash(&scene.meshes[index]), others, [eye.x.to_bits(), eye.y.to_bits(), eye.z.to_bits()]);
-    if let Some(f) = SEVERAL.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).copied())) {
-        return f;
-    }
-    let f = super::reflection_points::several(scene, index, eye);
-    if let Ok(mut c) = SEVERAL.lock() {
-        let map = c.get_or_insert_with(HashMap::new);
-        if map.len() > 1024 {
-            map.clear();
-        }
-        map.insert(key, f);
-    }
-    f
+    memo(&SEVERAL, key, || super::reflection_points::several(scene, index, eye))
 }
 
 fn mesh_hash(m: &Mesh) -> u64 {
@@ -457,19 +446,24 @@ pub fn may_meet_itself(m: &Mesh, x: Vec3) -> bool {
 
 /// `visible_fraction`, cached per mesh and reference point.
 fn visible_fraction_cached(m: &Mesh, x: Vec3) -> f32 {
-    let key = (mesh_hash(m), [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]);
-    if let Some(f) = VISIBLE.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).copied())) {
-        return f;
+    memo(&VISIBLE, (mesh_hash(m), [x.x.to_bits(), x.y.to_bits(), x.z.to_bits()]), || visible_fraction(m, x))
+}
+
+/// `cache`'s value for `key`, else `f()` remembered there (at most 1024 entries: a full
+/// cache starts over).
+fn memo<K: std::hash::Hash + Eq, V: Copy>(cache: &Mutex<Option<HashMap<K, V>>>, key: K, f: impl FnOnce() -> V) -> V {
+    if let Some(v) = cache.lock().ok().and_then(|c| c.as_ref().and_then(|c| c.get(&key).copied())) {
+        return v;
     }
-    let f = visible_fraction(m, x);
-    if let Ok(mut c) = VISIBLE.lock() {
+    let v = f();
+    if let Ok(mut c) = cache.lock() {
         let map = c.get_or_insert_with(HashMap::new);
         if map.len() > 1024 {
             map.clear();
         }
-        map.insert(key, f);
+        map.insert(key, v);
     }
-    f
+    v
 }
 
 /// Area fraction of mesh `m`'s triangles whose centroid is the first surface of the mesh

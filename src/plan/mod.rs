@@ -154,8 +154,7 @@ impl Plan {
             e.reference_point = f.reference_point;
         }
         self.layered_centre = fresh.layered_centre;
-        self.layered_depth = fresh.layered_depth;
-        self.layered_faces = fresh.layered_faces.clone();
+        self.layered_extent = fresh.layered_extent.clone();
         self.stages = fresh.stages;
         self.captures = fresh.captures;
         for f in FAMILIES {
@@ -289,8 +288,7 @@ fn empty_plan(quality: &Quality) -> Plan {
         objects: Vec::new(),
         envmaps: Vec::new(),
         layered_centre: None,
-        layered_depth: None,
-        layered_faces: None,
+        layered_extent: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: vec![REFERENCE_PASS],
@@ -531,8 +529,7 @@ fn plan_inner(scene: &Scene, choices: &Choices, quality: &Quality, hints: bool, 
         objects,
         envmaps: Vec::new(),
         layered_centre: None,
-        layered_depth: None,
-        layered_faces: None,
+        layered_extent: None,
         captures: Vec::new(),
         stages: Vec::new(),
         passes: Vec::new(),

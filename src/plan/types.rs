@@ -237,14 +237,12 @@ pub struct Plan {
     /// views are the peel's, apart from the objects' own (their refractor maps for caustics).
     pub layered_centre: Option<Vec3>,
     /// The scene's depth complexity around `layered_centre`, counted on the CPU along the
-    /// texel rays of six faces of at most 64² (`layered::peel::count_on_cpu`): the layers the
-    /// plan budgets (the stage counts again on the GPU at the map's own size).
+    /// texel rays of six faces of at most 64² (`layered::peel::extent_on_cpu`), texel by
+    /// texel: its depth is the layers the plan budgets, where each layer of each face holds
+    /// surfaces what the peel draws (`layered::drawn_cubes`); the stage counts again on the
+    /// GPU at the map's own size.
     #[serde(skip)]
-    pub layered_depth: Option<u32>,
-    /// The same texel by texel: where each layer of each face holds surfaces, which the peel
-    /// draws (`layered::drawn_cubes`).
-    #[serde(skip)]
-    pub layered_faces: Option<crate::methods::layered::peel::PeelExtent>,
+    pub layered_extent: Option<crate::methods::layered::peel::PeelExtent>,
     /// Image-based reflections' captures (§3.3): per object that takes the method, in the
     /// order of its layers in `envmap.captures`, the centres of its cube maps.
     pub captures: Vec<CaptureSet>,

@@ -141,7 +141,7 @@ pub fn measure(ctx: &Context, cfg: &Measure, progress: &mut dyn FnMut(&str)) -> 
                         let psnr = regions.iter().find(|r| r.name == o.name).map_or(PSNR_CAP, |r| r.psnr);
                         let peel = (
                             crate::methods::layered::planned_layers(&plan),
-                            crate::methods::layered::drawn_cubes(&q, plan.layered_faces.as_ref()),
+                            crate::methods::layered::drawn_cubes(&q, plan.layered_extent.as_ref()),
                         );
                         let maps = MapWork::of(o.method, &q, peel, size);
                         let work = workload(f, &scene, &q, maps, size, pixels as f64, &frame);

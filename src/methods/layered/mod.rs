@@ -48,13 +48,21 @@ pub const LAYERED_CUBES: MapInfo = MapInfo {
 /// farthest surfaces where they are fewer than the complexity (`peel`). The stage allocates
 /// what it counts on the GPU (`layered.layers` in the frame's stats).
 pub fn planned_layers(p: &Plan) -> u32 {
-    layers_for(&p.quality, p.layered_depth)
+    layers_for(&p.quality, p.layered_extent.as_ref().map(peel::PeelExtent::depth))
 }
 
 /// [`planned_layers`] under `q` where the depth complexity counted is `depth`.
 pub fn layers_for(q: &Quality, depth: Option<u32>) -> u32 {
+    let (peeled, cut) = peeled(q, depth);
+    peeled + u32::from(cut)
+}
+
+/// The layers peeled under `q` where the depth complexity counted is `depth` (the knob, else
+/// the complexity, at most `MAX_LAYERS`; that most without a count), and whether the peel is
+/// cut (one more layer then holds the farthest surfaces).
+pub(super) fn peeled(q: &Quality, depth: Option<u32>) -> (u32, bool) {
     let layers = q.layered.layers.unwrap_or_else(|| depth.map_or(MAX_LAYERS, |d| d.clamp(1, MAX_LAYERS)));
-    layers + u32::from(depth.is_some_and(|d| d > layers))
+    (layers, depth.is_some_and(|d| d > layers))
 }
 
 /// The cubes' worth of texels the peel draws under `q` where its layers hold surfaces as
@@ -66,10 +74,8 @@ pub fn drawn_cubes(q: &Quality, extent: Option<&peel::PeelExtent>) -> f64 {
     if q.cube.cube_mode != crate::quality::CubeMode::SixPasses {
         return layers_for(q, Some(extent.depth())) as f64;
     }
-    let depth = extent.depth();
-    // As layers_for: the knob or the depth complexity, and one more where it is cut.
-    let peeled = q.layered.layers.unwrap_or_else(|| depth.clamp(1, MAX_LAYERS));
-    extent.drawn_cubes(peeled) + f64::from(u32::from(depth > peeled))
+    let (layers, cut) = peeled(q, Some(extent.depth()));
+    extent.drawn_cubes(layers) + f64::from(u32::from(cut))
 }
 
 const fn one(_: &Quality) -> u32 {
@@ -174,9 +180,7 @@ pub fn share_centre(scene: &crate::scene::Scene, p: &mut Plan) {
     }
     let c = centre(scene, &p.quality, &meshes);
     p.layered_centre = Some(c);
-    let extent = peel::extent_on_cpu(scene, c, p.quality.cube.cube_size.min(64));
-    p.layered_depth = Some(extent.depth());
-    p.layered_faces = Some(extent);
+    p.layered_extent = Some(peel::extent_on_cpu(scene, c, p.quality.cube.cube_size.min(64)));
     for o in p.objects.iter_mut().filter(|o| o.method == LAYERED) {
         o.reference_point = c;
         o.reference_note = Some(if p.quality.cube.ref_point.is_some() {

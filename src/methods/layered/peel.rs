@@ -30,7 +30,7 @@ use crate::frame::layout::{LAYERED_FACE_SHIFT, LAYERED_FIRST};
 use crate::frame::stage::{cube_texel_bytes, describe_cube, FrameIo, Maps, Stage, StageInit};
 use crate::frame::{destroy_pipelines, FrameInputs};
 use crate::methods::cube_maps::radiance_format;
-use crate::quality::{CubeMode, Precision, Quality, MAX_LAYERS};
+use crate::quality::{CubeMode, Precision, Quality};
 use crate::vk::pipeline::{allocate_set, graphics_pipeline, sampler, write_image, Blend, DepthOp, GraphicsDesc, Multisample, VertexInput};
 use crate::vk::{begin_rendering, build, Access, Buffer, Context, Image, ImageDesc, ImageKind, MemoryLocation, Owner, Recorder, Target};
 use crate::Result;
@@ -242,7 +242,7 @@ impl LayeredMaps {
             (count_on_cpu(init.scene, centre, q.cube.cube_size.min(64)), false)
         };
         self.measured = Some((count, gpu));
-        Ok(q.layered.layers.unwrap_or(count.clamp(1, MAX_LAYERS)))
+        Ok(super::peeled(q, Some(count)).0)
     }
 
     /// The layers' two images, `layers` cubes each, into the frame's maps.
