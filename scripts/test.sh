@@ -34,7 +34,7 @@ fi
 # The binaries that compare measured frame times between methods run alone, afterwards.
 cargo test --locked --all-targets --no-run --message-format=json-render-diagnostics >target/test-binaries.json
 mapfile -t binaries < <(grep -E '"profile":\{[^}]*"test":true\}' target/test-binaries.json | grep -o '"executable":"[^"]*"' | sed 's/"executable":"//; s/"$//')
-alone=(planner per_object curved budget)
+alone=(planner per_object curved budget niches)
 # The longest first, so that the two lanes end together.
 first=(c_abi c_abi_leaks caustics aa frames tradeoff_cli golden geometry raytrace_conformance showcase distance)
 name() { basename "$1" | sed 's/-[0-9a-f]*$//'; }

@@ -240,3 +240,19 @@ pub fn scaled(base: &Scene, k: f32) -> Scene {
     s.camera = Some(cam);
     s
 }
+
+/// Per-object errors of `frame` against `reference` (the reference's first hits).
+pub fn split(
+    scene: &Scene,
+    image: &specula::image::ImageData,
+    reference: &specula::image::ImageData,
+    ids: &[u32],
+) -> Vec<specula::metrics::MaskedError> {
+    let specular: Vec<bool> = scene.meshes.iter().map(|m| scene.materials[m.material].kind.is_specular()).collect();
+    let names: Vec<String> = scene.meshes.iter().map(|m| m.name.clone()).collect();
+    specula::metrics::errors_by_object(image, reference, ids, &specular, &names).unwrap()
+}
+
+pub fn psnr(e: &[specula::metrics::MaskedError], name: &str) -> f64 {
+    e.iter().find(|x| x.name == name).unwrap_or_else(|| panic!("{name}: {e:?}")).psnr
+}
