@@ -479,8 +479,8 @@ fn localised_and_image_based_reflections_against_one_map() {
 }
 
 /// Displacement-mapped proxies (§3.2): the height map of the floor face holds, seen from
-/// the ceiling, a box standing on the floor at its top's depth and the floor elsewhere,
-/// and its radiance; the object itself is left out. Sampled from the object's distance map
+/// the ball's top down, a box standing on the floor at its top's depth and the floor
+/// elsewhere, and its radiance; the object itself and what is above it are left out. Sampled from the object's distance map
 /// (`relief_source=distance`), the same where the ball's centre sees the floor and the box's
 /// top, and not behind the box, which the distance map does not hold.
 #[test]
@@ -497,6 +497,9 @@ fn relief_height_maps_hold_what_stands_before_each_face() {
         })
         .unwrap();
     scene.add_mesh(shapes::cuboid("block", Vec3::new(1.0, -1.5, 1.0), Vec3::splat(0.5), grey)).unwrap();
+    // Above the ball: from the ceiling it hides the floor under the ball, which the ball's
+    // downward rays reach; the ball's floor map starts at the ball's top and clips it.
+    scene.add_mesh(shapes::cuboid("shelf", Vec3::new(-0.5, 1.2, -0.5), Vec3::splat(0.3), grey)).unwrap();
     let m = scene.add_material(common::mirror(0.9)).unwrap();
     scene.add_mesh(shapes::uv_sphere("ball", Vec3::new(-0.5, -0.5, -0.5), 0.4, 32, 16, m)).unwrap();
     scene.camera = Some(Camera::look_at(Vec3::new(0.0, 0.0, 1.9), Vec3::new(-0.5, -0.5, -0.5), 1.0));
@@ -530,9 +533,11 @@ fn relief_height_maps_hold_what_stands_before_each_face() {
     assert!((floor[3] - (hi.y - lo.y - margin)).abs() < 1e-3, "the floor at the room's height: {floor:?}");
     assert!((block[3] - (hi.y - margin - (-1.0))).abs() < 1e-3, "the block's top 1 m below the ceiling: {block:?}");
     assert!((block[0] - 0.2).abs() < 1e-3 && (block[2] - 0.6).abs() < 1e-3, "the block's radiance: {block:?}");
-    // The ball is not in its own maps: the floor under it.
+    // The ball is not in its own maps, nor the shelf above it (behind where the floor map
+    // starts, the ball's top): the floor under it. Drawn from the ceiling, the shelf's top
+    // hid the floor from every downward ray of the ball, which then saw the sky.
     let under = texel(-0.5, -0.5);
-    assert!((under[3] - floor[3]).abs() < 1e-3, "the ball left out: {under:?}");
+    assert!((under[3] - floor[3]).abs() < 1e-3, "the ball and the shelf left out: {under:?}");
 
     // Sampled from the distance map: the floor and the box's top where the ball's centre sees
     // them; behind the box (from the ball's centre) the search meets the box instead.

@@ -84,6 +84,9 @@ pub struct CubeMaps {
     faces_drawn: u32,
     /// The family's view block its layers' views are in (`with_views`), six per layer.
     view_block: Option<&'static str>,
+    /// Height maps: per layer where each face starts along its axis, as last drawn
+    /// (`relief::starts`).
+    relief_from: Vec<[f32; 6]>,
 }
 
 /// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
@@ -135,6 +138,11 @@ impl CubeMaps {
             always: q.frame.map_updates_always,
             faces_drawn: 0,
             view_block: None,
+            relief_from: if kind == MapKind::Relief {
+                objects.iter().map(|&m| crate::methods::envmap::relief::starts(init.scene, m)).collect()
+            } else {
+                Vec::new()
+            },
         };
         build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
@@ -319,13 +327,25 @@ impl Stage for CubeMaps {
         } else if self.kind == MapKind::Relief {
             // Height maps: orthographic views over the whole box, every face of a layer that
             // sees the change: a light or material, another object's move, or its own
-            // object's where its shadows or caustics fall on what the layer draws.
+            // object's where its shadows or caustics fall on what the layer draws. Its own
+            // move also moves where its faces start (`relief::starts`): a face changes where
+            // something lies between where it was drawn from and where it starts now.
             let lighting = crate::frame::cube_deps::Lighting::of(init.scene, init.plan, maps);
             let casts = !lighting.shadows.is_empty() || lighting.caustics != crate::frame::cube_deps::CausticReach::Unchanged;
             let global = !changes.lights.is_empty() || !changes.materials.is_empty();
             for (k, &own) in self.objects.iter().enumerate() {
                 if global || changes.moved.iter().any(|&m| m != own || casts) {
                     self.deps.faces[k] = crate::frame::ALL_FACES;
+                }
+                let now = crate::methods::envmap::relief::starts(init.scene, own);
+                for (f, from) in self.relief_from[k].iter_mut().enumerate() {
+                    let moved = *from != now[f];
+                    if moved && crate::methods::envmap::relief::holds_between(init.scene, own, f, *from, now[f]) {
+                        self.deps.faces[k] |= 1 << f;
+                    }
+                    if self.deps.faces[k] & (1 << f) != 0 {
+                        *from = now[f];
+                    }
                 }
             }
         } else {

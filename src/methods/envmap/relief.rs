@@ -5,7 +5,12 @@
 //! camera pass (`glsl/envmap/relief.frag`) marches each reflected or refracted ray through
 //! the height maps of the (at most three) faces it moves towards, and the nearest hit that
 //! is not a cliff of its height map (the side of something, which a height map stretches
-//! over a texel) gives the radiance. The object is left out of its own maps.
+//! over a texel) gives the radiance. The object is left out of its own maps, and each of
+//! its maps starts at the object's own side away from the face (PMDS06's impostors are the
+//! scene seen from the reflector): a ray from the object towards face f never meets what
+//! lies behind that plane, and a height map that held it (a ball between the object and
+//! the opposite wall) would hide from the object's rays everything in front of face f
+//! behind it — they would start "behind the map's surface" and see the sky.
 //!
 //! What a box proxy (`proxy-box`, what engines call a parallax-corrected probe) becomes with
 //! depth: a room's contents in front of its walls, seen from every side, so that parts
@@ -73,25 +78,64 @@ pub fn objects(p: &Plan) -> Vec<usize> {
 /// face f's lies inside the depth range.
 const MARGIN: f32 = 1e-3;
 
-/// Face f's view over box (lo, hi): looking along the cube face's major axis c from just
-/// inside the opposite face, the screen axes the cube face's (s, t), reversed depth (1 at
-/// the eye's plane, 0 a margin beyond face f). Returns (world → clip, eye, direction).
-pub fn face_view(f: usize, (lo, hi): (Vec3, Vec3)) -> (Mat4, Vec3, Vec3) {
+/// Face f's view over box (lo, hi): looking along the cube face's major axis c, the screen
+/// axes the cube face's (s, t). Its eye (from which the maps' depths are measured) lies just
+/// inside the opposite face; its near plane (reversed depth 1) at `start` along c (the
+/// object's side away from face f, [`starts`]; `None` or anything before the eye: the eye's
+/// plane), depth 0 a margin beyond face f. Returns (world → clip, eye, direction).
+pub fn face_view(f: usize, (lo, hi): (Vec3, Vec3), start: Option<f32>) -> (Mat4, Vec3, Vec3) {
     let [a, b, c] = crate::cube::FACE_AXES[f];
     let (centre, half) = ((lo + hi) * 0.5, ((hi - lo) * 0.5).max(Vec3::splat(1e-6)));
     let margin = MARGIN * (hi - lo).length().max(1e-6);
     let extent = |axis: Vec3| axis.abs().dot(half);
-    // Inside the opposite face by the margin: that face's own wall is clipped away.
+    // Just inside the opposite face: that face's own wall clipped away.
     let eye = centre - c * (extent(c) - margin);
-    let far = 2.0 * extent(c);
+    let (first, end) = (c.dot(eye), c.dot(centre) + extent(c) + margin);
+    let near = start.unwrap_or(first).clamp(first, end - 2.0 * margin);
+    let depth = end - near;
     let (hw, hh) = (extent(a), extent(b));
     let rows = [
         (a / hw).extend(-a.dot(eye) / hw),
         (b / hh).extend(-b.dot(eye) / hh),
-        (-c / far).extend(1.0 + c.dot(eye) / far),
+        (-c / depth).extend(end / depth),
         Vec4::new(0.0, 0.0, 0.0, 1.0),
     ];
     (Mat4::from_cols(rows[0], rows[1], rows[2], rows[3]).transpose(), eye, c)
+}
+
+/// Per face f, where object `mesh`'s height maps start along f's axis c (c·x of its box's
+/// side away from face f): a ray from the object towards face f never meets what lies
+/// behind that plane, and a map that held it (a ball between the object and the opposite
+/// wall) would hide from the object's rays what stands before face f behind it.
+pub fn starts(scene: &crate::scene::Scene, mesh: usize) -> [f32; 6] {
+    let b = scene.meshes.get(mesh).map(|m| m.bounds());
+    std::array::from_fn(|f| {
+        let c = crate::cube::FACE_AXES[f][2];
+        b.map_or(f32::NEG_INFINITY, |b| c.dot(b.min).min(c.dot(b.max)))
+    })
+}
+
+/// Whether a mesh other than `own` (drawn in its maps) has a triangle that face f's view
+/// sees (not edge-on along its axis c) reaching between the planes c·x = `s0` and `s1`:
+/// moving the start of that face's map between them changes what it holds.
+pub fn holds_between(scene: &crate::scene::Scene, own: usize, f: usize, s0: f32, s1: f32) -> bool {
+    let c = crate::cube::FACE_AXES[f][2];
+    let (lo, hi) = (s0.min(s1), s0.max(s1));
+    if hi - lo <= 0.0 {
+        return false;
+    }
+    scene.meshes.iter().enumerate().filter(|(m, mesh)| *m != own && !mesh.hidden).any(|(_, mesh)| {
+        let b = mesh.bounds();
+        let (a, z) = (c.dot(b.min).min(c.dot(b.max)), c.dot(b.min).max(c.dot(b.max)));
+        a < hi
+            && z > lo
+            && mesh.indices.chunks_exact(3).any(|t| {
+                let [p, q, r] = [0, 1, 2].map(|i| mesh.positions[t[i] as usize]);
+                let (ta, tz) = (c.dot(p).min(c.dot(q)).min(c.dot(r)), c.dot(p).max(c.dot(q)).max(c.dot(r)));
+                let area = (q - p).cross(r - p);
+                ta < hi && tz > lo && area.dot(c).abs() > 1e-6 * area.length()
+            })
+    })
 }
 
 /// The view block's size: six views per relief object.
@@ -104,14 +148,16 @@ pub fn view_blocks(p: &Plan) -> Vec<(&'static str, u32)> {
     }
 }
 
-/// Writes the relief objects' views: eye.w 1 (planar depth along dir.xyz); dir.w the object's
-/// layer in the distance maps (`relief_source=distance`), else 0.
+/// Writes the relief objects' views (each from the object's own box, as it is this frame):
+/// eye.w 1 (planar depth along dir.xyz); dir.w the object's layer in the distance maps
+/// (`relief_source=distance`), else 0.
 pub fn write_views(fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
     let Some(mut v) = fr.layout.first(VIEWS) else { return };
     for mesh in objects(fr.plan) {
         let layer = distance_layer(fr.plan, mesh).unwrap_or(0);
+        let from = starts(fr.scene, mesh);
         for f in 0..6 {
-            let (vp, eye, dir) = face_view(f, fr.plan.proxy_box);
+            let (vp, eye, dir) = face_view(f, fr.plan.proxy_box, Some(from[f]));
             table[v as usize] = crate::frame::views::view(vp, eye.extend(1.0), dir.extend(layer as f32));
             v += 1;
         }
@@ -283,7 +329,7 @@ mod tests {
             Vec3::new(if v.x > 0.0 { hi.x } else { lo.x }, if v.y > 0.0 { hi.y } else { lo.y }, if v.z > 0.0 { hi.z } else { lo.z })
         };
         for f in 0..6 {
-            let (vp, eye, c) = face_view(f, (lo, hi));
+            let (vp, eye, c) = face_view(f, (lo, hi), None);
             let [a, b, _] = crate::cube::FACE_AXES[f];
             // The box corner where a·p and b·p are largest: clip (1, 1); smallest: (−1, −1).
             let (top, bottom) = (vp * pick(a + b).extend(1.0), vp * pick(-(a + b)).extend(1.0));
@@ -296,5 +342,49 @@ mod tests {
             assert!(z > 0.0 && z < 0.01, "face {f}: {z}");
             assert!(c.dot(on_f - eye) > 0.0);
         }
+    }
+
+    /// A view from an object's box starts at the object's side away from face f (what lies
+    /// behind it is clipped), its eye where the box's views' eye is (the maps' depths keep
+    /// their meaning), face f still at depth just above 0; a start outside the box is
+    /// clamped into it.
+    #[test]
+    fn face_views_start_at_the_objects_back() {
+        let (lo, hi) = (Vec3::new(-2.0, 0.0, -2.0), Vec3::new(2.0, 3.0, 2.0));
+        let mut scene = crate::scene::Scene::new();
+        let m = scene.add_material(crate::scene::Material::default()).unwrap();
+        let ball = scene.add_mesh(crate::scene::shapes::uv_sphere("ball", Vec3::new(1.0, 1.0, 0.0), 0.5, 8, 4, m)).unwrap();
+        let from = starts(&scene, ball);
+        for f in 0..6 {
+            let (vp, eye, c) = face_view(f, (lo, hi), Some(from[f]));
+            let (_, box_eye, _) = face_view(f, (lo, hi), None);
+            assert!((eye - box_eye).length() < 1e-6, "face {f}");
+            let back = Vec3::new(1.0, 1.0, 0.0) - c * 0.5;
+            assert!(((vp * back.extend(1.0)).z - 1.0).abs() < 1e-3, "face {f}: the ball's back at depth 1");
+            let on_f = (lo + hi) * 0.5 + c * (c.abs().dot(hi - lo) * 0.5);
+            let z = (vp * on_f.extend(1.0)).z;
+            assert!(z > 0.0 && z < 0.01, "face {f}: {z}");
+            assert!((vp * (back - c * 0.1).extend(1.0)).z > 1.0, "face {f}: behind the ball clipped");
+        }
+        for (f, s) in [(0, 100.0), (1, -100.0)] {
+            let (vp, eye, c) = face_view(f, (lo, hi), Some(s));
+            let z = |x: f32| (vp * (eye + c * x).extend(1.0)).z;
+            assert!(z(0.0) >= 1.0 - 1e-5 && z(3.99) > 0.0 && z(4.01) < 0.0 + 1e-2, "face {f}: {} {} {}", z(0.0), z(3.99), z(4.01));
+        }
+        // Moving the ball's start across the room's empty middle changes no map; across
+        // another ball it does, but not along an axis that sees that ball edge-on.
+        assert!(!holds_between(&scene, ball, 0, -1.0, 0.0));
+        let other = scene.add_mesh(crate::scene::shapes::uv_sphere("other", Vec3::new(-0.5, 1.0, 0.0), 0.2, 8, 4, m)).unwrap();
+        assert!(holds_between(&scene, ball, 0, -1.0, 0.0) && holds_between(&scene, ball, 1, 1.0, 0.0));
+        assert!(!holds_between(&scene, other, 0, -1.0, 0.0) && !holds_between(&scene, ball, 1, -1.0, 0.0));
+        // A floor-like quad at y 0.5 over x −1…0: edge-on along x, seen along y.
+        let quad = crate::scene::Mesh {
+            indices: vec![0, 1, 2],
+            positions: vec![Vec3::new(-1.0, 0.5, -1.0), Vec3::new(0.0, 0.5, -1.0), Vec3::new(-0.5, 0.5, 1.0)],
+            ..Default::default()
+        };
+        let mut flat = crate::scene::Scene::new();
+        flat.meshes.push(quad);
+        assert!(!holds_between(&flat, 9, 0, -1.0, 0.0) && holds_between(&flat, 9, 2, 0.0, 1.0));
     }
 }
