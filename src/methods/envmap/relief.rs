@@ -156,8 +156,8 @@ pub fn write_views(fr: &ViewFrame, table: &mut [crate::gpu_scene::GpuView]) {
     for mesh in objects(fr.plan) {
         let layer = distance_layer(fr.plan, mesh).unwrap_or(0);
         let from = starts(fr.scene, mesh);
-        for f in 0..6 {
-            let (vp, eye, dir) = face_view(f, fr.plan.proxy_box, Some(from[f]));
+        for (f, &start) in from.iter().enumerate() {
+            let (vp, eye, dir) = face_view(f, fr.plan.proxy_box, Some(start));
             table[v as usize] = crate::frame::views::view(vp, eye.extend(1.0), dir.extend(layer as f32));
             v += 1;
         }
@@ -355,8 +355,8 @@ mod tests {
         let m = scene.add_material(crate::scene::Material::default()).unwrap();
         let ball = scene.add_mesh(crate::scene::shapes::uv_sphere("ball", Vec3::new(1.0, 1.0, 0.0), 0.5, 8, 4, m)).unwrap();
         let from = starts(&scene, ball);
-        for f in 0..6 {
-            let (vp, eye, c) = face_view(f, (lo, hi), Some(from[f]));
+        for (f, &start) in from.iter().enumerate() {
+            let (vp, eye, c) = face_view(f, (lo, hi), Some(start));
             let (_, box_eye, _) = face_view(f, (lo, hi), None);
             assert!((eye - box_eye).length() < 1e-6, "face {f}");
             let back = Vec3::new(1.0, 1.0, 0.0) - c * 0.5;
