@@ -29,7 +29,12 @@ float relief_depth(vec2 uv, float layer) {
 }
 
 // The march through layer `layer` up to t_end: the hit's t (negative: none), radiance, and
-// whether it lies on a cliff.
+// whether it lies on a cliff. Past a cliff the ray is in the space the map hides behind a
+// step (a ball in front of the wall stretched into a column to it), which the march takes
+// for free space: it goes on until the ray is in front of the map again and takes the next
+// hit that is not a cliff (the wall behind the ball); the first cliff only where there is
+// none. A ray that truly meets the side of something is held nearer by the map of a face
+// that sees that side.
 float relief_march(uint layer, vec3 p, vec3 dir, float t_end, out vec3 L, out bool cliff) {
     View v = views[push_relief_view_base() + layer];
     vec3 c = v.dir.xyz;
@@ -40,13 +45,20 @@ float relief_march(uint layer, vec3 p, vec3 dir, float t_end, out vec3 L, out bo
     vec4 c1 = v.view_proj * vec4(p + dir * t_end, 1.0);
     vec2 uv0 = c0.xy * 0.5 + 0.5, uv1 = c1.xy * 0.5 + 0.5;
     float d0 = dot(p - v.eye.xyz, c), d1 = d0 + along * t_end;
-    // Behind this map's surface (hidden from the opposite face): not this map's ray.
+    // Behind this map's surface (hidden from where the map starts): not this map's ray.
     if (d0 >= relief_depth(uv0, l)) return -1.0;
     int n = int(max(push_relief_steps(), 1u));
-    float prev = 0.0;
+    // A texel's width in world units: the view's x row is a / (half width).
+    float half_width = 1.0 / length(vec3(v.view_proj[0][0], v.view_proj[1][0], v.view_proj[2][0]));
+    float texel = 2.0 * half_width / float(textureSize(relief_maps, 0).x);
+    float prev = 0.0, cliff_t = -1.0;
+    vec3 cliff_L = vec3(0.0);
+    bool hidden = false;
     for (int i = 1; i <= n; i++) {
         float s = float(i) / float(n);
-        if (mix(d0, d1, s) < relief_depth(mix(uv0, uv1, s), l)) {
+        bool behind = mix(d0, d1, s) >= relief_depth(mix(uv0, uv1, s), l);
+        if (!behind || hidden) {
+            hidden = hidden && behind;
             prev = s;
             continue;
         }
@@ -56,16 +68,27 @@ float relief_march(uint layer, vec3 p, vec3 dir, float t_end, out vec3 L, out bo
             if (mix(d0, d1, m) >= relief_depth(mix(uv0, uv1, m), l)) hi = m; else lo = m;
         }
         vec2 uv = mix(uv0, uv1, hi);
-        L = textureLod(relief_maps, vec3(uv, l), 0.0).rgb;
+        vec3 radiance = textureLod(relief_maps, vec3(uv, l), 0.0).rgb;
         vec4 around = textureGather(relief_maps, vec3(uv, l), 3);
-        // A texel's width in world units: the view's x row is a / (half width).
-        float half_width = 1.0 / length(vec3(v.view_proj[0][0], v.view_proj[1][0], v.view_proj[2][0]));
-        float texel = 2.0 * half_width / float(textureSize(relief_maps, 0).x);
         float spread = max(max(around.x, around.y), max(around.z, around.w)) - min(min(around.x, around.y), min(around.z, around.w));
-        cliff = spread > RELIEF_CLIFF * texel;
-        return hi * t_end;
+        // Where the ray stepped into the hidden space at a silhouette (not onto a surface),
+        // it is far behind the map's depth there even after the halvings.
+        float past = mix(d0, d1, hi) - relief_depth(uv, l);
+        if (spread <= RELIEF_CLIFF * texel && past <= RELIEF_CLIFF * texel) {
+            L = radiance;
+            cliff = false;
+            return hi * t_end;
+        }
+        if (cliff_t < 0.0) {
+            cliff_t = hi * t_end;
+            cliff_L = radiance;
+        }
+        hidden = true;
+        prev = s;
     }
-    return -1.0;
+    L = cliff_L;
+    cliff = cliff_t >= 0.0;
+    return cliff_t;
 }
 
 vec3 relief_radiance(Object o, vec3 p, vec3 dir) {
