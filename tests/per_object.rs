@@ -293,10 +293,11 @@ fn auto_is_as_good_as_the_best_single_method() {
         // cost; curved reflectors (§5) on the mirror sphere in its box room (43.45 vs
         // proxy-box 42.26 dB). Image-based reflections (§3.3: 45.00 dB with its 8 captures)
         // and displacement-mapped proxies (§3.2: 51.82 dB, the box room's walls as height
-        // maps) are measured by the planner's corpus and calibration but not its candidates
-        // (`predict::NOT_CANDIDATES`): their error models predict the mirror here at 24.8 and
-        // 20.5 dB where proxy-box's is 26.6, and image-based on the thin pane at the exact
-        // tracer's 50.7 dB, where it measures 38.56 against proxy-box's 40.83.
+        // maps) are left out of the singles here; proxy-relief is one of auto's candidates,
+        // image-based is measured by the planner's corpus and calibration but not a
+        // candidate (`predict::NOT_CANDIDATES`): its error model predicts it on the thin
+        // pane at the exact tracer's 50.7 dB, where it measures 38.56 against proxy-box's
+        // 40.83 (auto, taking it, measured 38.56: this test fails).
         let singles: Vec<(&str, f64)> = Method::ALL
             .iter()
             .filter(|m| {

@@ -184,7 +184,7 @@ pub const PROXY_RELIEF_INFO: &MethodInfo = &MethodInfo {
     abi: 20,
     section: "§3.2",
     family: "envmap",
-    summary: "displacement-mapped proxies (PMDS06): the scene's box as six rectangles displaced by height maps (what stands in front of each face, rasterised from the opposite face: radiance and depth); the ray is marched through the height maps of the faces it moves towards (relief_steps, then halvings) and the nearest hit that is not a height map's cliff is shaded",
+    summary: "displacement-mapped proxies (PMDS06): the scene's box as six rectangles displaced by height maps (what stands in front of each face, rasterised from the object's far side: radiance and depth); the ray is marched through the height maps of the faces it moves towards (relief_steps, then halvings), on past a silhouette's hidden space, and the nearest hit that is not a height map's cliff is shaded",
     serves: EVERY_CLASS,
     knobs: &[
         EnvmapKnobs::relief_size, EnvmapKnobs::relief_steps, EnvmapKnobs::relief_source, CubeKnobs::cube_precision, FrameKnobs::fresnel, CubeKnobs::cube_size, CubeKnobs::ref_point, SearchKnobs::linear_steps, SearchKnobs::secant_steps, SearchKnobs::binary_steps, SearchKnobs::parallax_iterations, SearchKnobs::search_tolerance,

@@ -197,14 +197,17 @@ fn models_measured(
 /// GPU methods that the corpus and the calibration measure (error and cost models exist,
 /// `specula corpus --evaluate` reports them) but that the predicted models leave out, so
 /// that `auto` and the budgets over them do not choose them (a scene's own models file,
-/// `specula tradeoff --calibrate`, still may):
-/// their error models, fitted on corpus rooms, mispredict the scenes that make or break them
-/// by more than any tolerance can absorb — image-based reflections predicted at the exact
-/// tracer's 50.7 dB on a thin pane in a box room (capped there, and taken for speed) where
-/// they measure 38.6 (proxy-box 40.8), and displacement-mapped proxies predicted at 20.5 dB
-/// on a mirror ball in a box room where they measure 51.8 (proxy-box 42.3; 72×48 against a
-/// one-sample reference, `tests/per_object.rs`). Chosen by name they render as any method.
-pub const NOT_CANDIDATES: [&str; 2] = ["image-based", "proxy-relief"];
+/// `specula tradeoff --calibrate`, still may): image-based reflections, whose error model,
+/// fitted on corpus rooms where their filtered captures measured up to 5 dB above the
+/// exact tracer's aliased frame on thin panes, predicts them at the exact tracer's 50.7 dB
+/// on a thin pane in a box room (capped there, and taken for speed) where they measure
+/// 38.6 (proxy-box 40.8; 72×48 against a one-sample reference, `tests/per_object.rs`).
+/// Displacement-mapped proxies were here too, predicted at 20.5 dB on a mirror ball in a box
+/// room where they measured 51.8: with their height maps drawn from the object's side and
+/// their march going on past silhouettes (BENCHMARKS.md) the corpus measures them as it does
+/// proxy-box wherever nothing stands between an object and the walls, and they are
+/// candidates. Chosen by name they render as any method.
+pub const NOT_CANDIDATES: [&str; 1] = ["image-based"];
 
 /// Whether `auto` and the budgets consider method `m` ([`NOT_CANDIDATES`]).
 pub fn is_candidate(m: Method) -> bool {
