@@ -550,6 +550,26 @@ fn relief_height_maps_hold_what_stands_before_each_face() {
     assert!(near(&s_floor, &floor, 0.01), "sampled floor {s_floor:?} vs {floor:?}");
     assert!(near(&s_block, &block, 0.08), "sampled box top {s_block:?} vs {block:?}");
     assert!(s_behind[3] < behind[3] - 0.5, "the distance map does not hold the floor behind the box: {s_behind:?} vs {behind:?}");
+    // The ball's own move redraws the faces whose start it carries past something: 1 m down,
+    // its top passes the block's (the floor map, −y) and its bottom enters the block's height
+    // (the ceiling map, +y); its sides stay where they were (±x, ±z: not redrawn). 5 cm
+    // further down nothing lies between (the block's sides are edge-on to ±y): none.
+    let mut q = Quality::default();
+    q.set("relief_size", "16").unwrap();
+    let mut moved = scene.clone();
+    let ball = moved.meshes.iter().position(|m| m.name == "ball").unwrap();
+    let mut r = Renderer::new(&ctx, &moved, plan(&moved, specula::methods::PROXY_RELIEF, &q), 16, 16).unwrap();
+    r.render(&ctx).unwrap();
+    let drawn = |f: &specula::Frame| f.stats.iter().find(|(n, _)| n == "envmap.relief.faces_drawn").map(|(_, v)| *v);
+    for (k, (dy, faces)) in [(-1.0, 2.0), (-1.05, 0.0)].into_iter().enumerate() {
+        moved.set_object_transform(ball, glam::Mat4::from_translation(Vec3::new(0.0, dy, 0.0))).unwrap();
+        r.update(&moved).unwrap();
+        let f = r.render(&ctx).unwrap();
+        // A frame that draws no face of the stage does not run it (its stats are its last run's).
+        let ran = f.map_updates.iter().any(|u| u.stage == "envmap.relief");
+        assert_eq!((ran, if ran { drawn(&f) } else { Some(0.0) }), (faces > 0.0, Some(faces)), "move {k}: {:?}", f.stats);
+    }
+    r.destroy(&ctx);
     // Height maps are drawn face by face whatever cube_mode says: with multiview cubes their
     // pipelines once carried the multiview mask (a validation error per draw).
     let mut q = Quality::default();

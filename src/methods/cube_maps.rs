@@ -362,7 +362,10 @@ impl Stage for CubeMaps {
     }
 
     fn record(&mut self, rec: &mut Recorder, f: &FrameInputs, io: &mut FrameIo) {
-        let cycles = if self.frame_latency { 1 } else { self.cycles };
+        // Only inter-object distance maps read their own previous cycle; every other kind
+        // (radiance cubes, captures and height maps, which read the distance maps' last
+        // cycle) would draw the same image again each cycle: once.
+        let cycles = if self.frame_latency || !self.inter_object { 1 } else { self.cycles };
         // The images are taken out of the frame's maps while this pass writes them.
         let mut images = self.images(io.maps);
         let count = images.len();
