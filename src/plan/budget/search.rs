@@ -24,6 +24,11 @@ pub(super) struct Timing<'a> {
 struct Composition {
     /// Per pick: maps of its own in another family's maps.
     composed: Vec<bool>,
+    /// Per pick: its own maps are drawn once per inter-object cycle (distance cubes: its
+    /// method's, or its radiance cube drawn as one, `distance::cubes_converted`); other maps
+    /// are drawn once a frame (`cube_maps::CubeMaps::record`). The maps composition gives a
+    /// pick are distance cubes, drawn each cycle.
+    cycled: Vec<bool>,
     /// The inter-object cycles the frame runs.
     cycles: u32,
 }
@@ -40,7 +45,8 @@ impl Timing<'_> {
     /// keeps its own behaviour), and the inter-object cycles the frame runs.
     fn composition(&self, picks: &[&Candidate]) -> Composition {
         if Self::uniform(picks) {
-            return Composition { composed: vec![false; picks.len()], cycles: picks.first().map_or(1, |c| c.cycles) };
+            let n = picks.len();
+            return Composition { composed: vec![false; n], cycled: vec![true; n], cycles: picks.first().map_or(1, |c| c.cycles) };
         }
         let methods: Vec<Method> = picks.iter().map(|c| c.method).collect();
         let mut composed = vec![false; picks.len()];
@@ -55,8 +61,10 @@ impl Timing<'_> {
             .iter()
             .zip(&self.facts.objects)
             .any(|(c, f)| gpu(c.method).map_shading == MapShading::Refractor && self.facts.objects.iter().any(|g| g.sees(f.mesh)));
-        let converts = || crate::methods::distance::cubes_converted(&methods, &self.sight).contains(&true);
-        let composes = self.quality.frame.compose && (sees_refractor || composed.contains(&true) || converts());
+        let converted = crate::methods::distance::cubes_converted(&methods, &self.sight);
+        let composes = self.quality.frame.compose && (sees_refractor || composed.contains(&true) || converted.contains(&true));
+        let distance = |m: Method| gpu(m).maps.iter().any(|i| i.name == crate::methods::distance::DISTANCE_CUBES.name);
+        let cycled = picks.iter().enumerate().map(|(i, c)| distance(c.method) || converted[i]).collect();
         let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
         let cycles = if latency {
             1
@@ -65,17 +73,20 @@ impl Timing<'_> {
         } else {
             own
         };
-        Composition { composed, cycles }
+        Composition { composed, cycled, cycles }
     }
 
-    /// The scale of each object's map share: the frame's cycles over its calibration's (1 for
-    /// a whole-scene row, which runs as measured).
-    fn scale(c: &Candidate, whole: bool, how: &Composition) -> f64 {
+    /// Pick `i`'s maps: its own map share and, composed, the maps composition gives it, each
+    /// scaled by the frame's cycles over its calibration's where drawn each cycle (a
+    /// whole-scene row runs as measured).
+    fn maps_ms(c: &Candidate, i: usize, whole: bool, how: &Composition) -> f64 {
         if whole {
-            1.0
-        } else {
-            how.cycles as f64 / c.cycles as f64
+            return c.fixed;
         }
+        let per_cycle = how.cycles as f64 / c.cycles as f64;
+        let own = if how.cycled[i] { per_cycle } else { 1.0 };
+        let compose = if how.composed[i] { c.compose_fixed * per_cycle } else { 0.0 };
+        c.fixed * own + compose
     }
 
     /// Views of the whole scene the picks render (`GpuSpec::views`), `i`'s own left out:
@@ -100,8 +111,7 @@ impl Timing<'_> {
     /// Object `i`'s maps and camera work, its camera work repeated in the others' views.
     fn own_ms(&self, picks: &[&Candidate], i: usize, whole: bool, how: &Composition) -> f64 {
         let c = picks[i];
-        let compose = if !whole && how.composed[i] { c.compose_fixed } else { 0.0 };
-        (c.fixed + compose) * Self::scale(c, whole, how) + c.screen * (1.0 + self.views(picks, Some(i), whole))
+        Self::maps_ms(c, i, whole, how) + c.screen * (1.0 + self.views(picks, Some(i), whole))
     }
 
     /// Per method its whole-screen kernels, once, repeated in the views of objects of other
@@ -129,7 +139,7 @@ impl Timing<'_> {
         let users = picks.iter().filter(|d| d.method == c.method).count().max(1) as f64;
         let shared = self.kernels(picks, whole).into_iter().find(|(m, _)| *m == c.method).map_or(0.0, |(_, s)| s);
         let how = self.composition(picks);
-        let maps = c.fixed * Self::scale(c, whole, &how);
+        let maps = Self::maps_ms(c, i, whole, &how);
         (maps, self.own_ms(picks, i, whole, &how) - maps + shared / users)
     }
 }
@@ -311,6 +321,39 @@ mod tests {
         assert_eq!(search(Budget::Within(6.5), &time, &per), [0]);
         // 8 ms: both fit with the margin; the more accurate.
         assert_eq!(search(Budget::MaxMs(8.0), &time, &per), [0]);
+    }
+
+    /// A mirror on proxy-relief beside a glass ball on refractor-map that sees it: the frame
+    /// composes (two cycles); the relief's height maps are drawn once, the distance map
+    /// composition gives the mirror once per cycle, as are the maps of methods that have
+    /// distance cubes of their own (refractor-map's, distance's); one method everywhere,
+    /// asked for by nobody: the whole-scene method, as measured.
+    #[test]
+    fn maps_drawn_once_a_frame_are_not_counted_per_cycle() {
+        use crate::methods::{DISTANCE, PROXY_RELIEF, REFRACTOR_MAP};
+        use crate::scene::{shapes, Material, Scene, SurfaceKind};
+        use glam::Vec3;
+        let mut scene = Scene::new();
+        let wall = scene.add_material(Material { emissive: Vec3::ONE, ..Default::default() }).unwrap();
+        scene.add_mesh(shapes::cuboid("room", Vec3::ZERO, Vec3::splat(3.0), wall)).unwrap();
+        let glass = scene.add_material(Material { kind: SurfaceKind::Dielectric { ior: 1.5, thin: false }, ..Default::default() }).unwrap();
+        let mirror = scene
+            .add_material(Material { kind: SurfaceKind::Mirror { nu: Vec3::splat(37.0), kappa: Vec3::ZERO }, ..Default::default() })
+            .unwrap();
+        scene.add_mesh(shapes::uv_sphere("glass", Vec3::new(-0.8, 0.0, 0.0), 0.5, 16, 8, glass)).unwrap();
+        scene.add_mesh(shapes::uv_sphere("mirror", Vec3::new(0.8, 0.0, 0.0), 0.5, 16, 8, mirror)).unwrap();
+        let q = crate::quality::Quality::default();
+        let facts = crate::plan::facts::SceneFacts::new(&scene, &q, true);
+        let timing = Timing { base: 0.0, quality: q, facts: &facts, sight: facts.sight() };
+        let on = |m, fixed| Candidate { method: m, fixed, compose_fixed: 4.0, ..cand(0.0, 30.0) };
+        let (glass_map, relief, distance) = (on(REFRACTOR_MAP, 10.0), on(PROXY_RELIEF, 10.0), on(DISTANCE, 10.0));
+        let how = timing.composition(&[&glass_map, &relief]);
+        assert_eq!((how.cycles, how.composed.clone(), how.cycled.clone()), (2, vec![false, true], vec![true, false]));
+        assert_eq!(timing.object_parts(&[&glass_map, &relief], 1, false).0, 10.0 + 2.0 * 4.0);
+        let how = timing.composition(&[&glass_map, &distance]);
+        assert_eq!((how.cycles, how.cycled[1]), (2, true));
+        assert_eq!(timing.object_parts(&[&glass_map, &distance], 1, false).0, 2.0 * 10.0 + if how.composed[1] { 8.0 } else { 0.0 });
+        assert_eq!(timing.frame_ms(&[&relief, &relief], false), 20.0);
     }
 
     #[test]
