@@ -3,16 +3,18 @@
 // variants: PER_SAMPLE
 // proxy-relief.shade: displacement-mapped proxies (survey §3.2, PMDS06; src/methods/envmap/
 // relief.rs). The scene's box is six rectangles displaced by height maps: layer 6·o + f of
-// `relief_maps` holds what stands in front of face f, seen orthographically from the
-// opposite face along f's direction c (rgb radiance, alpha its depth from there). A ray
+// `relief_maps` holds what stands in front of face f between the object o's side away from
+// it and face f, seen orthographically along f's direction c (rgb radiance, alpha its depth
+// from the view's eye, just inside the opposite face). A ray
 // p + t·dir that moves towards face f (dir·c > 0) and starts in front of that height map is
 // marched through it (relief_steps linear steps up to where it leaves the box, then eight
 // halvings): the first step whose depth reaches the map's is the hit. A height map takes
 // everything behind its surface for solid, so a ray that crosses into the space hidden
 // behind a step of it (a cliff: the four texels around the hit more than RELIEF_CLIFF texel
-// widths apart) has met either the side of something or free space the map cannot see: the
-// nearest hit off a cliff, in any face's map, wins; the nearest cliff only where no map
-// holds one. A ray no map holds sees the environment.
+// widths apart, or the ray far behind the map's depth there) has met either the side of
+// something or free space the map cannot see: the march goes on past it, the nearest hit
+// off a cliff, in any face's map, wins; the nearest cliff only where no map holds one. A
+// ray no map holds sees the environment.
 #include "common/specular.glsl"
 #include "envmap/proxy.glsl"
 

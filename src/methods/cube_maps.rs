@@ -85,8 +85,9 @@ pub struct CubeMaps {
     /// The family's view block its layers' views are in (`with_views`), six per layer.
     view_block: Option<&'static str>,
     /// Height maps: per layer where each face starts along its axis, as last drawn
-    /// (`relief::starts`).
+    /// (`relief::starts`), and the box their views span (`Plan::proxy_box`).
     relief_from: Vec<[f32; 6]>,
+    relief_box: (glam::Vec3, glam::Vec3),
 }
 
 /// `envmap.generate`'s constructor (`RADIANCE_CUBES`).
@@ -138,6 +139,7 @@ impl CubeMaps {
             always: q.frame.map_updates_always,
             faces_drawn: 0,
             view_block: None,
+            relief_box: plan.proxy_box,
             relief_from: if kind == MapKind::Relief {
                 objects.iter().map(|&m| crate::methods::envmap::relief::starts(init.scene, m)).collect()
             } else {
@@ -320,11 +322,21 @@ impl Stage for CubeMaps {
         if self.frame_latency && seen {
             self.frames = 0;
         }
+        let relief = self.kind == MapKind::Relief;
+        if relief && init.plan.proxy_box != self.relief_box {
+            // The box the height maps' views span moved (a scene without a room, whose bounds
+            // follow its objects): every view changed.
+            self.relief_box = init.plan.proxy_box;
+            self.deps.all();
+        }
         if self.every_face() || (self.shows_by_maps && seen) {
             // Maps that show the others by the distance maps: whatever changed may have
             // changed those.
             self.deps.all();
-        } else if self.kind == MapKind::Relief {
+            if relief {
+                self.relief_from = self.objects.iter().map(|&m| crate::methods::envmap::relief::starts(init.scene, m)).collect();
+            }
+        } else if relief {
             // Height maps: orthographic views over the whole box, every face of a layer that
             // sees the change: a light or material, another object's move, or its own
             // object's where its shadows or caustics fall on what the layer draws. Its own

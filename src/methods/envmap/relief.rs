@@ -73,16 +73,17 @@ pub fn objects(p: &Plan) -> Vec<usize> {
     layered.into_iter().map(|(_, m)| m).collect()
 }
 
-/// Margin inside the box where the orthographic views start (a fraction of its diagonal):
-/// the opposite face's wall, on the box's side, lies before the near plane and is clipped;
-/// face f's lies inside the depth range.
+/// A margin, as a fraction of the box's diagonal: the views' eye lies this far inside the
+/// opposite face (whose own wall is clipped), their near plane this far past the object's
+/// side (a surface it rests on is clipped, not left to rounding), and depth 0 this far
+/// beyond face f (whose wall lies inside the depth range).
 const MARGIN: f32 = 1e-3;
 
 /// Face f's view over box (lo, hi): looking along the cube face's major axis c, the screen
 /// axes the cube face's (s, t). Its eye (from which the maps' depths are measured) lies just
-/// inside the opposite face; its near plane (reversed depth 1) at `start` along c (the
-/// object's side away from face f, [`starts`]; `None` or anything before the eye: the eye's
-/// plane), depth 0 a margin beyond face f. Returns (world → clip, eye, direction).
+/// inside the opposite face; its near plane (reversed depth 1) a margin past `start` along c
+/// (the object's side away from face f, [`starts`]; `None` or anything before the eye: the
+/// eye's plane), depth 0 a margin beyond face f. Returns (world → clip, eye, direction).
 pub fn face_view(f: usize, (lo, hi): (Vec3, Vec3), start: Option<f32>) -> (Mat4, Vec3, Vec3) {
     let [a, b, c] = crate::cube::FACE_AXES[f];
     let (centre, half) = ((lo + hi) * 0.5, ((hi - lo) * 0.5).max(Vec3::splat(1e-6)));
@@ -91,7 +92,7 @@ pub fn face_view(f: usize, (lo, hi): (Vec3, Vec3), start: Option<f32>) -> (Mat4,
     // Just inside the opposite face: that face's own wall clipped away.
     let eye = centre - c * (extent(c) - margin);
     let (first, end) = (c.dot(eye), c.dot(centre) + extent(c) + margin);
-    let near = start.unwrap_or(first).clamp(first, end - 2.0 * margin);
+    let near = start.map_or(first, |s| s + margin).clamp(first, end - 2.0 * margin);
     let depth = end - near;
     let (hw, hh) = (extent(a), extent(b));
     let rows = [
@@ -360,7 +361,8 @@ mod tests {
             let (_, box_eye, _) = face_view(f, (lo, hi), None);
             assert!((eye - box_eye).length() < 1e-6, "face {f}");
             let back = Vec3::new(1.0, 1.0, 0.0) - c * 0.5;
-            assert!(((vp * back.extend(1.0)).z - 1.0).abs() < 1e-3, "face {f}: the ball's back at depth 1");
+            let z = (vp * back.extend(1.0)).z;
+            assert!(z > 1.0 && z < 1.01, "face {f}: the ball's back just before the near plane (clipped): {z}");
             let on_f = (lo + hi) * 0.5 + c * (c.abs().dot(hi - lo) * 0.5);
             let z = (vp * on_f.extend(1.0)).z;
             assert!(z > 0.0 && z < 0.01, "face {f}: {z}");

@@ -64,7 +64,7 @@ impl Timing<'_> {
         let converted = crate::methods::distance::cubes_converted(&methods, &self.sight);
         let composes = self.quality.frame.compose && (sees_refractor || composed.contains(&true) || converted.contains(&true));
         let distance = |m: Method| gpu(m).maps.iter().any(|i| i.name == crate::methods::distance::DISTANCE_CUBES.name);
-        let cycled = picks.iter().enumerate().map(|(i, c)| distance(c.method) || converted[i]).collect();
+        let cycled = picks.iter().enumerate().map(|(i, c)| distance(c.method) || (converted[i] && self.quality.frame.compose)).collect();
         let latency = picks.iter().any(|c| gpu(c.method).map_shading == MapShading::Traced) && self.quality.distance.frame_latency;
         let cycles = if latency {
             1
