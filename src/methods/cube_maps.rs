@@ -103,6 +103,11 @@ pub fn with_views(init: &StageInit, layers: &[usize], maps: &mut Maps, kind: Map
     Ok(Box::new(me))
 }
 
+/// Per height-map layer (its object) where each face starts (`relief::starts`).
+fn relief_starts(scene: &crate::scene::Scene, objects: &[usize]) -> Vec<[f32; 6]> {
+    objects.iter().map(|&m| crate::methods::envmap::relief::starts(scene, m)).collect()
+}
+
 pub fn radiance_format(p: Precision) -> vk::Format {
     match p {
         Precision::Half => vk::Format::R16G16B16A16_SFLOAT,
@@ -140,11 +145,7 @@ impl CubeMaps {
             faces_drawn: 0,
             view_block: None,
             relief_box: plan.proxy_box,
-            relief_from: if kind == MapKind::Relief {
-                objects.iter().map(|&m| crate::methods::envmap::relief::starts(init.scene, m)).collect()
-            } else {
-                Vec::new()
-            },
+            relief_from: if kind == MapKind::Relief { relief_starts(init.scene, objects) } else { Vec::new() },
         };
         build(ctx, me, |me| me.init(ctx, plan, init.layout, format, images, maps))
     }
@@ -334,7 +335,7 @@ impl Stage for CubeMaps {
             // changed those.
             self.deps.all();
             if relief {
-                self.relief_from = self.objects.iter().map(|&m| crate::methods::envmap::relief::starts(init.scene, m)).collect();
+                self.relief_from = relief_starts(init.scene, &self.objects);
             }
         } else if relief {
             // Height maps: orthographic views over the whole box, every face of a layer that
